@@ -1,0 +1,187 @@
+"""Newton with analytic Jacobian and predictor-corrector pseudo-arclength continuation.
+
+Both work on a residual ``fun(x, omega) -> (R, dR/dx, dR/domega)`` (see
+:class:`bladedamp.hbm.system.HarmonicBalanceSystem`). Unknowns are scaled (``x / x_scale``,
+``omega / omega_scale``) so that tolerances mean the same for every problem. A solver
+that does not converge says so and keeps what it has: the returned :class:`Branch` carries
+every converged point, ``success`` and a ``message`` naming the frequency where it stopped.
+"""
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import _validate
+
+
+class ConvergenceWarning(UserWarning):
+    """A Newton or continuation run stopped without converging."""
+
+
+@dataclass
+class NewtonResult:
+    x: np.ndarray
+    converged: bool
+    iterations: int
+    residual_norm: float
+
+
+def newton(fun, x0, omega, x_scale, residual_scale, tol=1e-10, max_iter=30):
+    """Solve R(x, omega) = 0 at fixed omega. Convergence: scaled step and residual below ``tol``."""
+    x = np.array(x0, dtype=float)
+    rnorm = np.inf
+    for it in range(1, max_iter + 1):
+        R, J, _ = fun(x, omega)
+        rnorm = np.linalg.norm(R) / residual_scale
+        if not np.all(np.isfinite(R)):
+            return NewtonResult(x, False, it, rnorm)
+        dx = -np.linalg.solve(J, R)
+        x = x + dx
+        if np.linalg.norm(dx / x_scale) < tol and rnorm < np.sqrt(tol):
+            R, _, _ = fun(x, omega)
+            rnorm = np.linalg.norm(R) / residual_scale
+            if rnorm < tol * 10:
+                return NewtonResult(x, True, it, rnorm)
+    return NewtonResult(x, False, max_iter, rnorm)
+
+
+@dataclass
+class Branch:
+    """A solution branch x(omega) from continuation.
+
+    Attributes
+    ----------
+    omega : (n,) angular frequencies of the converged points [rad/s]
+    x : (n, N) unknowns at each point
+    iterations : (n,) Newton iterations of each corrector
+    success : bool, whether the branch reached the end of the requested range
+    message : str, why it stopped
+    """
+
+    omega: np.ndarray
+    x: np.ndarray
+    iterations: np.ndarray
+    success: bool
+    message: str
+    turning_points: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+
+
+def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=None,
+                 step=None, max_step=None, min_step=None, max_points=5000, tol=1e-10,
+                 max_corrector=12, target_iterations=4):
+    """Pseudo-arclength continuation of R(x, omega) = 0 from ``omega_start`` to ``omega_end``.
+
+    Parameters
+    ----------
+    fun : callable (x, omega) -> (R, dR/dx, dR/domega)
+    x0 : initial guess at ``omega_start``
+    omega_start, omega_end : range [rad/s] (either direction)
+    x_scale : scale of the unknowns (scalar or array); default max |x0|
+    residual_scale : scale of the residual norm; default |R(0, omega_start)| (the excitation)
+    step, max_step, min_step : arc-length steps in scaled units (the scaled omega range is 1)
+    max_points : stop after this many points
+    tol : Newton tolerance on the scaled step and residual
+    target_iterations : corrector iterations for which the step is kept; fewer -> grow, more -> shrink
+    """
+    _validate.finite("omega_start", omega_start)
+    _validate.finite("omega_end", omega_end)
+    if omega_start == omega_end:
+        raise ValueError("omega_end must differ from omega_start")
+    x0 = np.asarray(x0, dtype=float)
+    if not np.all(np.isfinite(x0)):
+        raise ValueError("x0 (initial guess) must be finite")
+    direction = np.sign(omega_end - omega_start)
+    w_scale = abs(omega_end - omega_start)
+    if x_scale is None:
+        x_scale = max(np.abs(x0).max(), 1e-300)
+    x_scale = np.broadcast_to(np.asarray(x_scale, dtype=float), x0.shape).copy()
+    if residual_scale is None:
+        residual_scale = max(np.linalg.norm(fun(np.zeros_like(x0), omega_start)[0]), 1e-300)
+    step = 0.01 if step is None else step
+    max_step = 0.02 if max_step is None else max_step
+    min_step = 1e-7 if min_step is None else min_step
+    n = x0.size
+
+    first = newton(fun, x0, omega_start, x_scale, residual_scale, tol=tol)
+    if not first.converged:
+        msg = f"Newton did not converge at the start, omega = {omega_start:.6g} rad/s " \
+              f"(scaled residual {first.residual_norm:.3g})"
+        warnings.warn(msg, ConvergenceWarning, stacklevel=2)
+        return Branch(np.zeros(0), np.zeros((0, n)), np.zeros(0, dtype=int), False, msg)
+
+    scale = np.append(x_scale, w_scale)
+    ys = [np.append(first.x, omega_start) / scale]
+    its = [first.iterations]
+    tangent_prev = None
+
+    def scaled_system(y):
+        x, w = y[:n] * x_scale, y[n] * w_scale
+        R, J, Rw = fun(x, w)
+        return R / residual_scale, np.hstack([J * x_scale[None, :], (Rw * w_scale)[:, None]]) / residual_scale
+
+    def tangent_at(y, prev):
+        _, Jy = scaled_system(y)
+        if prev is None:
+            prev = np.zeros(n + 1)
+            prev[n] = direction
+        t = np.linalg.solve(np.vstack([Jy, prev[None, :]]), np.append(np.zeros(n), 1.0))
+        t /= np.linalg.norm(t)
+        return t if t @ prev > 0 else -t
+
+    message, success = "", False
+    turning = []
+    h = step
+    while len(ys) < max_points:
+        y = ys[-1]
+        tangent = tangent_at(y, tangent_prev)
+        if tangent_prev is not None and np.sign(tangent[n]) != np.sign(tangent_prev[n]) and len(ys) > 1:
+            turning.append(len(ys) - 1)
+        accepted = False
+        while h >= min_step:
+            yp = y + h * tangent
+            yc = yp.copy()
+            ok = False
+            for it in range(1, max_corrector + 1):
+                R, Jy = scaled_system(yc)
+                if not np.all(np.isfinite(R)):
+                    break
+                G = np.append(R, tangent @ (yc - yp))
+                dy = -np.linalg.solve(np.vstack([Jy, tangent[None, :]]), G)
+                yc = yc + dy
+                if np.linalg.norm(dy) < tol:
+                    R, _ = scaled_system(yc)
+                    ok = np.linalg.norm(R) < tol * 10
+                    break
+            # reject corrector results that jump back along the branch
+            if ok and (yc - y) @ tangent > 0:
+                accepted = True
+                break
+            h /= 2
+        if not accepted:
+            w_stop = ys[-1][n] * w_scale
+            message = f"continuation did not converge after omega = {w_stop:.6g} rad/s " \
+                      f"({w_stop / (2 * np.pi):.6g} Hz), step fell below {min_step:g}; branch kept up to there"
+            warnings.warn(message, ConvergenceWarning, stacklevel=2)
+            break
+        ys.append(yc)
+        its.append(it)
+        tangent_prev = tangent
+        if it <= target_iterations - 1:
+            h = min(h * 1.5, max_step)
+        elif it > target_iterations + 1:
+            h = max(h / 1.5, min_step)
+        if direction * (yc[n] * w_scale - omega_end) >= 0:
+            # land exactly on omega_end
+            end = newton(fun, yc[:n] * x_scale, omega_end, x_scale, residual_scale, tol=tol)
+            if end.converged:
+                ys[-1] = np.append(end.x, omega_end) / scale
+            success, message = True, "reached the end of the frequency range"
+            break
+    else:
+        message = f"stopped after max_points = {max_points} points at omega = {ys[-1][n] * w_scale:.6g} rad/s"
+        warnings.warn(message, ConvergenceWarning, stacklevel=2)
+
+    Y = np.array(ys) * scale
+    return Branch(Y[:, n], Y[:, :n], np.array(its), success, message, np.array(turning, dtype=int))

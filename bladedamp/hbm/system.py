@@ -1,0 +1,115 @@
+"""Harmonic balance residual of a linear structure with nonlinear elements (AFT).
+
+    R(x, Omega) = A(Omega) x + sum_e T_e^T f_e(T_e x, Omega) - f_ext(Omega) = 0
+
+``x`` holds the harmonic coefficients of all degrees of freedom (harmonic-major, see
+:mod:`bladedamp.hbm.fourier`), ``A`` the real-form dynamic stiffness built from M, D, K,
+``T_e`` the (real-form, possibly harmonic-dependent, e.g. cyclic) map from the structure to
+the local coordinates of element ``e`` and ``f_e`` its AFT forces with their analytic
+Jacobian. Because the same ``T_e`` maps displacements out and forces back, the Jacobian
+``T^T (df/dw) T`` and the energy balance are exact by construction.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Protocol
+
+import numpy as np
+
+from .fourier import HarmonicBasis
+
+
+class NonlinearElement(Protocol):
+    """What an element provides to the harmonic balance."""
+
+    n_local: int
+
+    def harmonic_forces(self, local: np.ndarray, basis: HarmonicBasis, omega: float, jacobian: bool = True):
+        """Return ``(force (C, n_local), d force / d local (C*n_local, C*n_local) or None,
+        d force / d omega (C*n_local,) or None)``; force conjugate to ``local`` (restoring)."""
+        ...
+
+
+@dataclass
+class Coupling:
+    """An element and the real-form map ``matrix`` (C*n_local, C*n_dof) from the structure to it."""
+
+    element: NonlinearElement
+    matrix: np.ndarray
+    name: str = ""
+
+
+@dataclass
+class HarmonicBalanceSystem:
+    """Residual, analytic Jacobian and omega-derivative of a harmonic balance problem.
+
+    Parameters
+    ----------
+    basis : HarmonicBasis
+    mass, damping, stiffness : (n, n) arrays [kg, N s/m, N/m] (or modal equivalents)
+    excitation : callable omega -> (f (C*n,), df/domega (C*n,)), harmonic-major
+    couplings : nonlinear elements with their maps
+    """
+
+    basis: HarmonicBasis
+    mass: np.ndarray
+    damping: np.ndarray
+    stiffness: np.ndarray
+    excitation: Callable[[float], tuple[np.ndarray, np.ndarray]]
+    couplings: list[Coupling] = field(default_factory=list)
+
+    @property
+    def n_dof(self) -> int:
+        return np.atleast_2d(self.mass).shape[0]
+
+    @property
+    def n_unknowns(self) -> int:
+        return self.n_dof * self.basis.n_coeffs
+
+    def linear_solution(self, omega: float) -> np.ndarray:
+        """Solution without the nonlinear elements (initial guess, scaling)."""
+        A, _ = self.basis.dynamic_stiffness(omega, self.mass, self.damping, self.stiffness)
+        f, _ = self.excitation(omega)
+        return np.linalg.lstsq(A, f, rcond=None)[0]
+
+    def residual(self, x: np.ndarray, omega: float, jacobian: bool = True):
+        """``(R, dR/dx, dR/domega)``; the last two are None when ``jacobian`` is False."""
+        basis = self.basis
+        C = basis.n_coeffs
+        A, dA = basis.dynamic_stiffness(omega, self.mass, self.damping, self.stiffness)
+        f, df = self.excitation(omega)
+        R = A @ x - f
+        J = A.copy() if jacobian else None
+        Rw = dA @ x - df if jacobian else None
+        for c in self.couplings:
+            local = (c.matrix @ x).reshape(C, c.element.n_local)
+            force, jac, domega = c.element.harmonic_forces(local, basis, omega, jacobian)
+            R += c.matrix.T @ force.ravel()
+            if jacobian:
+                J += c.matrix.T @ jac @ c.matrix
+                if domega is not None:
+                    Rw += c.matrix.T @ domega
+        return R, J, Rw
+
+    def excitation_work(self, x: np.ndarray, omega: float) -> float:
+        """Work of the excitation on the structure per period [J]."""
+        C = self.basis.n_coeffs
+        f, _ = self.excitation(omega)
+        return float(np.sum(self.basis.work_per_cycle(f.reshape(C, -1), x.reshape(C, -1))))
+
+    def viscous_dissipation(self, x: np.ndarray, omega: float) -> float:
+        """Energy dissipated by the viscous damping per period [J] (oint v^T D dx)."""
+        C = self.basis.n_coeffs
+        X = x.reshape(C, -1)
+        velocity = omega * (self.basis.derivative @ X)
+        return float(np.sum(self.basis.work_per_cycle(velocity @ np.atleast_2d(self.damping).T, X)))
+
+    def element_dissipation(self, x: np.ndarray, omega: float) -> list[float]:
+        """Energy absorbed by each nonlinear element per period [J] (oint f . dw)."""
+        C = self.basis.n_coeffs
+        out = []
+        for c in self.couplings:
+            local = (c.matrix @ x).reshape(C, c.element.n_local)
+            force, _, _ = c.element.harmonic_forces(local, self.basis, omega, False)
+            out.append(float(np.sum(self.basis.work_per_cycle(force, local))))
+        return out

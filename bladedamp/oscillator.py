@@ -1,0 +1,153 @@
+"""The friction oscillator: one mass on a spring with one elastic Coulomb contact.
+
+The teaching model of friction damping and the test bench of the HBM engine::
+
+    m x'' + c x' + k x + k3 x^3 + f_C(x) = F cos(Omega t)
+
+The contact is a point contact (stiffness k_T in series with a Coulomb slider, normal load
+N) whose plane is inclined by ``contact_angle`` to the motion: the tangential displacement
+is x cos(alpha) and the approach grows by x sin(alpha), so the normal load varies with the
+displacement (N = N0 + k_N x sin(alpha), lifting off when it reaches zero).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import _validate
+from .contact.laws import LinearNormalLaw
+from .contact.point import PointContactElement
+from .hbm.continuation import continuation
+from .hbm.elements import CubicSpring
+from .hbm.fourier import HarmonicBasis
+from .hbm.system import Coupling, HarmonicBalanceSystem
+from .response import FrequencyResponse
+from .timedomain import TimeResponse, _oscillator_steady_state
+
+
+@dataclass
+class FrictionOscillator:
+    """Single-DOF friction oscillator.
+
+    Parameters
+    ----------
+    mass : m [kg]
+    stiffness : k [N/m]
+    damping : c [N s/m]
+    contact_stiffness : tangential contact stiffness k_T [N/m]
+    friction_coefficient : mu [-]
+    normal_load : static normal load N0 [N]
+    forcing : excitation amplitude F [N]
+    contact_angle : inclination alpha of the contact plane to the motion [rad], in [0, pi/2)
+    normal_stiffness : k_N [N/m], needed when contact_angle > 0 (default: k_T)
+    cubic_stiffness : k3 [N/m^3] (hardening spring, gives folds)
+    """
+
+    mass: float = 1.0
+    stiffness: float = 1.0e4
+    damping: float = 1.0
+    contact_stiffness: float = 1.0e4
+    friction_coefficient: float = 0.3
+    normal_load: float = 1.0
+    forcing: float = 1.0
+    contact_angle: float = 0.0
+    normal_stiffness: float | None = None
+    cubic_stiffness: float = 0.0
+
+    def __post_init__(self):
+        _validate.positive("mass", self.mass)
+        _validate.positive("stiffness", self.stiffness)
+        _validate.nonnegative("damping", self.damping)
+        _validate.positive("contact_stiffness (k_T)", self.contact_stiffness)
+        _validate.nonnegative("friction_coefficient (mu)", self.friction_coefficient)
+        _validate.nonnegative("normal_load", self.normal_load)
+        _validate.finite("forcing", self.forcing)
+        _validate.in_range("contact_angle", self.contact_angle, 0.0, np.pi / 2, closed="left")
+        if self.normal_stiffness is None:
+            self.normal_stiffness = self.contact_stiffness
+        _validate.positive("normal_stiffness (k_N)", self.normal_stiffness)
+        _validate.finite("cubic_stiffness", self.cubic_stiffness)
+
+    # ----- closed forms ---------------------------------------------------------------
+    @property
+    def slip_force(self) -> float:
+        """mu N0 [N]."""
+        return self.friction_coefficient * self.normal_load
+
+    def linear_amplitude(self, omega, stuck: bool) -> np.ndarray:
+        """Amplitude of the linear system with the contact stuck (k + k_T) or absent (k) [m]."""
+        omega = np.asarray(omega, dtype=float)
+        k = self.stiffness + (self.contact_stiffness * np.cos(self.contact_angle) ** 2 if stuck else 0.0)
+        return np.abs(self.forcing / (k - self.mass * omega ** 2 + 1j * self.damping * omega))
+
+    # ----- harmonic balance -----------------------------------------------------------
+    def hbm_system(self, harmonics=(1,), n_samples=None) -> HarmonicBalanceSystem:
+        """The harmonic balance residual of this oscillator."""
+        basis = HarmonicBasis(tuple(harmonics), n_samples)
+        C = basis.n_coeffs
+        alpha = self.contact_angle
+        contact = PointContactElement(self.contact_stiffness, self.friction_coefficient,
+                                      LinearNormalLaw(self.normal_stiffness), 1.0,
+                                      self.normal_load / self.normal_stiffness)
+        direction = np.array([[np.cos(alpha)], [0.0], [-np.sin(alpha)]])  # x -> (u_xi, u_eta, u_zeta)
+        couplings = [Coupling(contact, basis.real_form(lambda h: direction), "contact")]
+        if self.cubic_stiffness != 0.0:
+            couplings.append(Coupling(CubicSpring(self.cubic_stiffness), np.eye(C), "cubic spring"))
+        f = np.zeros(C)
+        f[basis.cos_index(1)] = self.forcing
+        return HarmonicBalanceSystem(basis, [[self.mass]], [[self.damping]], [[self.stiffness]],
+                                     lambda omega: (f, np.zeros(C)), couplings)
+
+    def frequency_response(self, omega_start: float, omega_end: float, harmonics=(1,), n_samples=None,
+                           **continuation_options) -> FrequencyResponse:
+        """FRF by harmonic balance and pseudo-arclength continuation from ``omega_start`` to ``omega_end`` [rad/s].
+
+        ``continuation_options`` go to :func:`bladedamp.hbm.continuation.continuation`
+        (``max_step`` sets the point density).
+        """
+        _validate.positive("omega_start", omega_start)
+        _validate.positive("omega_end", omega_end)
+        system = self.hbm_system(harmonics, n_samples)
+        x0 = system.linear_solution(omega_start)
+        scale = max(self.linear_amplitude([omega_start, omega_end], stuck=False).max(),
+                    abs(self.forcing) / self.stiffness, 1e-300)
+        branch = continuation(system.residual, x0, omega_start, omega_end, x_scale=scale,
+                              **continuation_options)
+        C = system.basis.n_coeffs
+        return FrequencyResponse(branch.omega, branch.x.reshape(-1, C, 1), system.basis, ("x",),
+                                 branch.success, branch.message, branch.iterations, branch.turning_points)
+
+    def energy_balance(self, response: FrequencyResponse):
+        """Per point: (excitation work, viscous dissipation, contact dissipation) per cycle [J]."""
+        system = self.hbm_system(response.basis.harmonics, response.basis.n_samples)
+        rows = []
+        for omega, X in zip(response.omega, response.coefficients):
+            x = X.ravel()
+            rows.append((system.excitation_work(x, omega), system.viscous_dissipation(x, omega),
+                         sum(system.element_dissipation(x, omega))))
+        return np.array(rows)
+
+    # ----- time integration -----------------------------------------------------------
+    def time_response(self, omega, steps_per_period: int = 2048, max_periods: int = 5000,
+                      min_periods: int = 20, tol: float = 1e-9) -> TimeResponse:
+        """Steady state by central-difference integration from rest at each ``omega`` [rad/s]."""
+        omega = np.atleast_1d(np.asarray(omega, dtype=float))
+        _validate.positive("omega", omega)
+        _validate.integer("steps_per_period", steps_per_period, minimum=16)
+        dt_max = 2.0 / np.sqrt((self.stiffness + self.contact_stiffness + self.normal_stiffness) / self.mass)
+        if np.any(2 * np.pi / omega / steps_per_period > 0.5 * dt_max):
+            raise ValueError("steps_per_period too small for the explicit scheme at the lowest omega")
+        if self.cubic_stiffness != 0:
+            raise ValueError("time_response does not integrate the cubic spring (cubic_stiffness must be 0)")
+        samples = np.zeros((omega.size, steps_per_period))
+        periods = np.zeros(omega.size, dtype=int)
+        converged = np.zeros(omega.size, dtype=bool)
+        sin_a, cos_a = np.sin(self.contact_angle), np.cos(self.contact_angle)
+        for i, w in enumerate(omega):
+            periods[i], converged[i] = _oscillator_steady_state(
+                w, self.mass, self.damping, self.stiffness, self.cubic_stiffness, self.contact_stiffness,
+                self.friction_coefficient, self.normal_load, self.normal_stiffness, sin_a, cos_a,
+                self.forcing, steps_per_period, max_periods, min_periods, tol, samples[i])
+        spec = np.fft.rfft(samples, axis=1) / steps_per_period
+        return TimeResponse(omega, 2 * np.abs(spec[:, 1]), np.abs(samples).max(axis=1), samples, periods, converged)
