@@ -80,7 +80,8 @@ class RoughnessNormalLaw:
         a_ref, p = self.reference_approach, self.exponent
         ratio = np.maximum(approach, 0.0) / a_ref
         n_ref = self.reference_load * weight
-        return n_ref * ratio ** p, n_ref * p / a_ref * ratio ** (p - 1)
+        # lift-off (a <= 0): no force and no stiffness (for p = 1, 0**0 would give 1)
+        return n_ref * ratio ** p, np.where(approach > 0, n_ref * p / a_ref * ratio ** (p - 1), 0.0)
 
     def approach_for_load(self, load: np.ndarray, weight: np.ndarray) -> np.ndarray:
         ratio = np.maximum(np.asarray(load, dtype=float), 0.0) / (self.reference_load * weight)

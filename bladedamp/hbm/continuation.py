@@ -65,7 +65,7 @@ class Branch:
     iterations: np.ndarray
     success: bool
     message: str
-    turning_points: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    turning_points: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))  # indices of folds
 
 
 def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=None,
@@ -111,10 +111,14 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         warnings.warn(msg, ConvergenceWarning, stacklevel=2)
         return Branch(np.zeros(0), np.zeros((0, n)), np.zeros(0, dtype=int), False, msg)
 
-    scale = np.append(x_scale, w_scale)
-    ys = [np.append(first.x, omega_start) / scale]
+    # unknowns are scaled by x_scale, which grows to the largest |x| met on the branch, so
+    # the arc length weighs every unknown by its own size (a step is a fraction of it)
+    points = [np.append(first.x, omega_start)]
     its = [first.iterations]
-    tangent_prev = None
+    tangent_prev = None  # in unscaled units
+
+    def scale():
+        return np.append(x_scale, w_scale)
 
     def scaled_system(y):
         x, w = y[:n] * x_scale, y[n] * w_scale
@@ -126,18 +130,18 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         if prev is None:
             prev = np.zeros(n + 1)
             prev[n] = direction
+        else:
+            prev = prev / scale()
+            prev /= np.linalg.norm(prev)
         t = np.linalg.solve(np.vstack([Jy, prev[None, :]]), np.append(np.zeros(n), 1.0))
         t /= np.linalg.norm(t)
         return t if t @ prev > 0 else -t
 
     message, success = "", False
-    turning = []
     h = step
-    while len(ys) < max_points:
-        y = ys[-1]
+    while len(points) < max_points:
+        y = points[-1] / scale()
         tangent = tangent_at(y, tangent_prev)
-        if tangent_prev is not None and np.sign(tangent[n]) != np.sign(tangent_prev[n]) and len(ys) > 1:
-            turning.append(len(ys) - 1)
         accepted = False
         while h >= min_step:
             yp = y + h * tangent
@@ -160,28 +164,32 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
                 break
             h /= 2
         if not accepted:
-            w_stop = ys[-1][n] * w_scale
+            w_stop = points[-1][n]
             message = f"continuation did not converge after omega = {w_stop:.6g} rad/s " \
                       f"({w_stop / (2 * np.pi):.6g} Hz), step fell below {min_step:g}; branch kept up to there"
             warnings.warn(message, ConvergenceWarning, stacklevel=2)
             break
-        ys.append(yc)
+        tangent_prev = tangent * scale()
+        points.append(yc * scale())
         its.append(it)
-        tangent_prev = tangent
+        x_scale = np.maximum(x_scale, np.abs(points[-1][:n]))
         if it <= target_iterations - 1:
             h = min(h * 1.5, max_step)
         elif it > target_iterations + 1:
             h = max(h / 1.5, min_step)
-        if direction * (yc[n] * w_scale - omega_end) >= 0:
+        if direction * (points[-1][n] - omega_end) >= 0:
             # land exactly on omega_end
-            end = newton(fun, yc[:n] * x_scale, omega_end, x_scale, residual_scale, tol=tol)
+            end = newton(fun, points[-1][:n], omega_end, x_scale, residual_scale, tol=tol)
             if end.converged:
-                ys[-1] = np.append(end.x, omega_end) / scale
+                points[-1] = np.append(end.x, omega_end)
             success, message = True, "reached the end of the frequency range"
             break
     else:
-        message = f"stopped after max_points = {max_points} points at omega = {ys[-1][n] * w_scale:.6g} rad/s"
+        message = f"stopped after max_points = {max_points} points at omega = {points[-1][n]:.6g} rad/s"
         warnings.warn(message, ConvergenceWarning, stacklevel=2)
 
-    Y = np.array(ys) * scale
-    return Branch(Y[:, n], Y[:, :n], np.array(its), success, message, np.array(turning, dtype=int))
+    Y = np.array(points)
+    # turning points: where omega stops growing along the branch and turns back
+    d = np.sign(np.diff(Y[:, n]))
+    turning = np.flatnonzero(d[1:] * d[:-1] < 0) + 1
+    return Branch(Y[:, n], Y[:, :n], np.array(its), success, message, turning)

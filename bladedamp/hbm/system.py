@@ -49,6 +49,8 @@ class HarmonicBalanceSystem:
     mass, damping, stiffness : (n, n) arrays [kg, N s/m, N/m] (or modal equivalents)
     excitation : callable omega -> (f (C*n,), df/domega (C*n,)), harmonic-major
     couplings : nonlinear elements with their maps
+    static_stiffness : optional (n, n) stiffness acting on the static harmonic only (e.g. to fix
+        a position that nothing else fixes statically) [N/m]
     """
 
     basis: HarmonicBasis
@@ -57,6 +59,7 @@ class HarmonicBalanceSystem:
     stiffness: np.ndarray
     excitation: Callable[[float], tuple[np.ndarray, np.ndarray]]
     couplings: list[Coupling] = field(default_factory=list)
+    static_stiffness: np.ndarray | None = None
 
     @property
     def n_dof(self) -> int:
@@ -66,9 +69,17 @@ class HarmonicBalanceSystem:
     def n_unknowns(self) -> int:
         return self.n_dof * self.basis.n_coeffs
 
+    def _dynamic_stiffness(self, omega: float):
+        A, dA = self.basis.dynamic_stiffness(omega, self.mass, self.damping, self.stiffness)
+        if self.static_stiffness is not None and self.basis.has_static:
+            n = self.n_dof
+            j = self.basis.cos_index(0)
+            A[j * n:(j + 1) * n, j * n:(j + 1) * n] += self.static_stiffness
+        return A, dA
+
     def linear_solution(self, omega: float) -> np.ndarray:
         """Solution without the nonlinear elements (initial guess, scaling)."""
-        A, _ = self.basis.dynamic_stiffness(omega, self.mass, self.damping, self.stiffness)
+        A, _ = self._dynamic_stiffness(omega)
         f, _ = self.excitation(omega)
         return np.linalg.lstsq(A, f, rcond=None)[0]
 
@@ -76,7 +87,7 @@ class HarmonicBalanceSystem:
         """``(R, dR/dx, dR/domega)``; the last two are None when ``jacobian`` is False."""
         basis = self.basis
         C = basis.n_coeffs
-        A, dA = basis.dynamic_stiffness(omega, self.mass, self.damping, self.stiffness)
+        A, dA = self._dynamic_stiffness(omega)
         f, df = self.excitation(omega)
         R = A @ x - f
         J = A.copy() if jacobian else None

@@ -1,0 +1,263 @@
+"""Damper geometry: contact frames, control points, contact patches and the maps G_D, G_P (Eq. 6-9).
+
+Frames. Blade frame: x circumferential, y axial, z radial (outwards). A damper sits under
+the platforms of two neighbouring blades, between blade i (its platform point "OL", on the
+blade's -x side) and blade i+1 (point "OR", on its +x side; blade i+1 lies at -x). Seen from
+the damper, the OL platform is at +x, the OR platform at -x; both lean over the damper,
+their undersides inclined by the platform angles gamma_L, gamma_R to the circumferential
+direction, so centrifugal force presses the damper up into the groove.
+
+Contact frame of each contact (Fig. 2, 3): zeta = unit normal from the platform into the
+damper, eta = y (damper axis, contact length l_C), xi = eta x zeta (across the contact
+height h_C). Rows of the rotation matrix R_c are (xi, eta, zeta) in blade coordinates.
+
+Kinematics (Eq. 6): relative motion damper - platform at the contact centre c,
+    w_u   = R_c (u_D + phi_D x r_c - u_P,c - phi_P,c x dr_c)
+    w_phi = R_c (phi_D - phi_P,c)
+with r_c the contact centre seen from the damper's centre of gravity and dr_c the contact
+centre seen from the blade model's platform point, i.e. w = G_D u_D - G_P u_P with
+G_D (12 x 6) and G_P (12 x 12) block matrices. A rigid motion of damper and platforms
+together gives w = 0 (tested).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import _validate
+from ..contact.laws import LinearNormalLaw, RoughnessNormalLaw
+from ..contact.patch import ContactPatch
+
+CONTACTS = ("OL", "OR")
+
+
+def skew(r: np.ndarray) -> np.ndarray:
+    """[r]x with [r]x v = r x v."""
+    return np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
+
+
+def rigid_map(rotation: np.ndarray, offset: np.ndarray) -> np.ndarray:
+    """6x6 map of a body's (u, phi) at its reference point to (u, phi) of a point at ``offset``,
+    expressed in the frame ``rotation``: [[R, -R [r]x], [0, R]] (u + phi x r = u - r x phi)."""
+    G = np.zeros((6, 6))
+    G[:3, :3] = rotation
+    G[:3, 3:] = -rotation @ skew(offset)
+    G[3:, 3:] = rotation
+    return G
+
+
+def contact_normal(side: str, gamma: float) -> np.ndarray:
+    """Unit normal from the platform into the damper (blade frame) for platform angle gamma [rad]."""
+    s, c = np.sin(gamma), np.cos(gamma)
+    return np.array([-s, 0.0, -c]) if side == "OL" else np.array([s, 0.0, -c])
+
+
+def contact_frame(normal: np.ndarray) -> np.ndarray:
+    """Rotation matrix with rows (xi, eta, zeta): eta = y, zeta = normal, xi = eta x zeta."""
+    eta = np.array([0.0, 1.0, 0.0])
+    xi = np.cross(eta, normal)
+    return np.array([xi, eta, normal])
+
+
+@dataclass(frozen=True)
+class ContactProperties:
+    """Contact parameters shared by both contacts of a damper.
+
+    Parameters
+    ----------
+    friction_coefficient : mu [-]
+    tangential_stiffness_per_length : tangential contact stiffness per unit contact length
+        along the damper axis [N/m per m]; a patch gets k_T = this * l_C
+    normal_to_tangential_stiffness : k_N / k_T [-]
+    roughness_exponent : 1 for a linear normal law, > 1 for the rough-surface power law
+    roughness_reference_load : total load per contact [N] at which k_N holds (power law only)
+    points_along_length : point contacts along l_C (eta)
+    points_across_height : point contacts across h_C (xi) for flat faces (the wedge)
+    """
+
+    friction_coefficient: float = 0.3
+    tangential_stiffness_per_length: float = 1.0e9
+    normal_to_tangential_stiffness: float = 1.25
+    roughness_exponent: float = 1.0
+    roughness_reference_load: float = 10.0
+    points_along_length: int = 5
+    points_across_height: int = 5
+
+    def __post_init__(self):
+        _validate.nonnegative("friction_coefficient (mu)", self.friction_coefficient)
+        _validate.positive("tangential_stiffness_per_length", self.tangential_stiffness_per_length)
+        _validate.positive("normal_to_tangential_stiffness", self.normal_to_tangential_stiffness)
+        _validate.in_range("roughness_exponent", self.roughness_exponent, 1.0, 5.0)
+        _validate.positive("roughness_reference_load", self.roughness_reference_load)
+        _validate.integer("points_along_length", self.points_along_length, minimum=1)
+        _validate.integer("points_across_height", self.points_across_height, minimum=1)
+
+    def patch(self, height: float, length: float, n_xi: int) -> ContactPatch:
+        k_t = self.tangential_stiffness_per_length * length
+        k_n = self.normal_to_tangential_stiffness * k_t
+        if self.roughness_exponent == 1.0:
+            law = LinearNormalLaw(k_n)
+        else:
+            law = RoughnessNormalLaw(k_n, self.roughness_reference_load, self.roughness_exponent)
+        return ContactPatch(height, length, k_t, self.friction_coefficient, law, n_xi, self.points_along_length)
+
+
+@dataclass
+class DamperGeometry:
+    """Everything the kinematics needs of a damper between two platforms.
+
+    frames : (2, 3, 3) rows (xi, eta, zeta) of the OL and OR contacts
+    centres : (2, 3) contact centres seen from the damper's centre of gravity [m]
+    patches : (ContactPatch, ContactPatch) for OL, OR
+    inertia : (6, 6) generalised mass matrix I_D about the centre of gravity [kg, kg m^2]
+    section : (k, 2) cross-section polygon in (x, z) relative to the centre of gravity [m]
+    """
+
+    frames: np.ndarray
+    centres: np.ndarray
+    patches: tuple[ContactPatch, ContactPatch]
+    inertia: np.ndarray
+    section: np.ndarray
+    gamma_left: float
+    gamma_right: float
+
+    @property
+    def G_D(self) -> np.ndarray:
+        """(12, 6): damper CG motion -> relative motion at OL', OR' (Eq. 6, 9)."""
+        return np.vstack([rigid_map(R, r) for R, r in zip(self.frames, self.centres)])
+
+    def G_P(self, platform_offsets) -> np.ndarray:
+        """(12, 12): platform point motions (OL, OR; 6 each) -> relative motion (Eq. 6, 8).
+
+        ``platform_offsets`` (2, 3): contact centres seen from the blade model's OL / OR points.
+        """
+        G = np.zeros((12, 12))
+        for c, (R, dr) in enumerate(zip(self.frames, platform_offsets)):
+            G[6 * c:6 * c + 6, 6 * c:6 * c + 6] = rigid_map(R, np.asarray(dr, dtype=float))
+        return G
+
+    def frictionless_normal_loads(self, radial_force: float) -> np.ndarray:
+        """Normal loads (N_OL, N_OR) [N] balancing a radial force on the damper, rigid platforms.
+
+        N_L n_L + N_R n_R + F e_z = 0 in the x-z plane:
+        N_L = F sin(gamma_R) / sin(gamma_L + gamma_R), N_R = F sin(gamma_L) / sin(gamma_L + gamma_R).
+        """
+        gl, gr = self.gamma_left, self.gamma_right
+        return radial_force * np.array([np.sin(gr), np.sin(gl)]) / np.sin(gl + gr)
+
+
+def _check_angles(gamma_left, gamma_right):
+    _validate.in_range("gamma_left (platform angle, rad)", gamma_left, 0.0, np.pi / 2, closed="neither")
+    _validate.in_range("gamma_right (platform angle, rad)", gamma_right, 0.0, np.pi / 2, closed="neither")
+
+
+def _polygon_inertia(poly: np.ndarray, mass: float, length: float) -> tuple[np.ndarray, np.ndarray]:
+    """Centroid (x, z) and 6x6 mass matrix of a uniform prism with cross-section ``poly`` (x, z) along y."""
+    x, z = poly[:, 0], poly[:, 1]
+    x1, z1 = np.roll(x, -1), np.roll(z, -1)
+    cross = x * z1 - x1 * z
+    area = cross.sum() / 2
+    cx = ((x + x1) * cross).sum() / (6 * area)
+    cz = ((z + z1) * cross).sum() / (6 * area)
+    # second moments about the origin, then shifted to the centroid (per unit area)
+    ixx_a = ((z ** 2 + z * z1 + z1 ** 2) * cross).sum() / 12  # int z^2 dA
+    izz_a = ((x ** 2 + x * x1 + x1 ** 2) * cross).sum() / 12  # int x^2 dA
+    ixz_a = ((x * z1 + 2 * x * z + 2 * x1 * z1 + x1 * z) * cross).sum() / 24
+    zz = ixx_a / area - cz ** 2   # mean z'^2
+    xx = izz_a / area - cx ** 2   # mean x'^2
+    xz = ixz_a / area - cx * cz
+    yy = length ** 2 / 12
+    inertia = mass * np.array([[yy + zz, 0.0, -xz], [0.0, xx + zz, 0.0], [-xz, 0.0, xx + yy]])
+    M = np.zeros((6, 6))
+    M[:3, :3] = mass * np.eye(3)
+    M[3:, 3:] = inertia
+    return np.array([cx, cz]), M
+
+
+@dataclass
+class CylinderDamper:
+    """Cylindrical damper (Fig. 1): curved surfaces, Hertzian line contacts, free to roll.
+
+    Parameters
+    ----------
+    mass : m [kg] (0 means no damper)
+    radius : cylinder radius [m]
+    length : contact length l_C along the axis [m]
+    contact : ContactProperties (line contact: one row of points along the length)
+    """
+
+    mass: float
+    radius: float = 2.0e-3
+    length: float = 20.0e-3
+    contact: ContactProperties = field(default_factory=ContactProperties)
+
+    def __post_init__(self):
+        _validate.nonnegative("damper mass", self.mass)
+        _validate.positive("cylinder radius", self.radius)
+        _validate.positive("damper length l_C", self.length)
+
+    kind = "cylinder"
+
+    def geometry(self, gamma_left: float, gamma_right: float) -> DamperGeometry:
+        """Contact frames, centres, patches and inertia for platform angles [rad]."""
+        _check_angles(gamma_left, gamma_right)
+        normals = [contact_normal("OL", gamma_left), contact_normal("OR", gamma_right)]
+        frames = np.array([contact_frame(n) for n in normals])
+        centres = np.array([-self.radius * n for n in normals])  # surface point facing each platform
+        patches = tuple(self.contact.patch(0.0, self.length, 1) for _ in CONTACTS)
+        M = np.zeros((6, 6))
+        M[:3, :3] = self.mass * np.eye(3)
+        transverse = self.mass * (3 * self.radius ** 2 + self.length ** 2) / 12
+        M[3:, 3:] = np.diag([transverse, self.mass * self.radius ** 2 / 2, transverse])
+        angle = np.linspace(0, 2 * np.pi, 49)[:-1]
+        section = self.radius * np.column_stack([np.cos(angle), np.sin(angle)])
+        return DamperGeometry(frames, centres, patches, M, section, gamma_left, gamma_right)
+
+
+@dataclass
+class WedgeDamper:
+    """Wedge-shaped damper (Fig. 1): flat contact faces of height h_C and length l_C.
+
+    The cross-section is the triangle whose two upper sides are the contact faces (each of
+    height h_C, inclined like the platforms) meeting at the apex, closed by the base.
+
+    Parameters
+    ----------
+    mass : m [kg] (0 means no damper)
+    contact_height : h_C [m]
+    length : l_C [m]
+    contact : ContactProperties (``points_across_height`` x ``points_along_length`` points)
+    """
+
+    mass: float
+    contact_height: float | None = 2.0e-3
+    length: float = 20.0e-3
+    contact: ContactProperties = field(default_factory=ContactProperties)
+
+    kind = "wedge"
+
+    def __post_init__(self):
+        _validate.nonnegative("damper mass", self.mass)
+        if self.contact_height is None:
+            raise ValueError("contact_height h_C of a wedge damper must be given, in (0, inf) m")
+        _validate.positive("contact_height h_C", self.contact_height)
+        _validate.positive("damper length l_C", self.length)
+
+    def geometry(self, gamma_left: float, gamma_right: float) -> DamperGeometry:
+        _check_angles(gamma_left, gamma_right)
+        normals = [contact_normal("OL", gamma_left), contact_normal("OR", gamma_right)]
+        frames = np.array([contact_frame(n) for n in normals])
+        h = self.contact_height
+        # faces run from the apex (origin) downwards along -xi_OL ... check: xi points down the face
+        ends = [h * frames[c, 0] for c in range(2)]
+        for c in range(2):
+            if ends[c][2] > 0:  # make the face run downwards from the apex
+                ends[c] = -ends[c]
+        poly = np.array([[0.0, 0.0], [ends[1][0], ends[1][2]], [ends[0][0], ends[0][2]]])
+        if (poly[1, 0] - poly[0, 0]) * (poly[2, 1] - poly[0, 1]) - (poly[2, 0] - poly[0, 0]) * (poly[1, 1] - poly[0, 1]) < 0:
+            poly = poly[[0, 2, 1]]
+        cg, M = _polygon_inertia(poly, self.mass, self.length)
+        centres = np.array([np.array([e[0] / 2 - cg[0], 0.0, e[2] / 2 - cg[1]]) for e in ends])
+        patches = tuple(self.contact.patch(h, self.length, self.contact.points_across_height) for _ in CONTACTS)
+        return DamperGeometry(frames, centres, patches, M, poly - cg, gamma_left, gamma_right)

@@ -1,0 +1,75 @@
+"""Damper kinetics: centrifugal preload (Eq. 26) and the static seating of the damper.
+
+The dynamic equilibrium of the damper (Eq. 12) is not condensed here: the damper's six
+rigid-body coordinates stay unknowns of the harmonic balance (see :mod:`bladedamp.disk`),
+which keeps the Jacobian exact and lets the damper inertia be switched on or off.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .. import _validate
+from .geometry import DamperGeometry
+
+
+def centrifugal_force(mass: float, radius: float, omega_excitation: float, engine_order: int,
+                      rotor_speed: float | None = None) -> tuple[float, float]:
+    """Centrifugal force on the damper and its derivative in the excitation frequency.
+
+    F_CG = m R Omega_R^2 with Omega_R = Omega_E / EO (Eq. 3, 26): F = m R Omega_E^2 / EO^2.
+    At EO = 0 the rotor speed cannot follow from the excitation frequency: give
+    ``rotor_speed`` [rad/s] explicitly (then dF/dOmega_E = 0).
+
+    Returns (F [N], dF/dOmega_E [N s/rad]).
+    """
+    _validate.nonnegative("damper mass", mass)
+    _validate.positive("damper radius R", radius)
+    if rotor_speed is not None:
+        _validate.positive("rotor_speed", rotor_speed)
+        return mass * radius * rotor_speed ** 2, 0.0
+    if engine_order == 0:
+        raise ValueError("engine_order = 0 needs an explicit rotor_speed (rad/s, > 0): "
+                         "Omega_R = Omega_E / EO is undefined")
+    return mass * radius * omega_excitation ** 2 / engine_order ** 2, 2 * mass * radius * omega_excitation / engine_order ** 2
+
+
+def seat(geometry: DamperGeometry, radial_force: float, tol: float = 1e-12, max_iter: int = 50):
+    """Static seating of the damper under a radial force, frictionless, rigid platforms.
+
+    Solves sum_c G_D,c^T f_c(G_D,c u_D) = (0, 0, F, 0, 0, 0) for the damper displacement
+    u_D with the normal laws of both patches (lift-off included). Directions that no normal
+    force fixes (the axial position, the cylinder's roll) are left at zero (least squares).
+
+    Returns (u_D (6,), approach (2, P) per-point static approach [m], loads (2,) [N]).
+    """
+    _validate.nonnegative("radial_force", radial_force)
+    G = geometry.G_D.reshape(2, 6, 6)
+    P = geometry.patches[0].n_points
+    if radial_force == 0:
+        return np.zeros(6), np.zeros((2, P)), np.zeros(2)
+    # start: uniform approach carrying the frictionless loads
+    loads = geometry.frictionless_normal_loads(radial_force)
+    approach = [geometry.patches[c].approach_for_load(loads[c]).mean() for c in range(2)]
+    normals = geometry.frames[:, 2, :]
+    A = np.array([[-normals[c, 0], -normals[c, 2]] for c in range(2)])
+    dx, dz = np.linalg.solve(A, approach)
+    u = np.array([dx, 0.0, dz, 0.0, 0.0, 0.0])
+    load = np.array([0.0, 0.0, radial_force, 0.0, 0.0, 0.0])
+    for _ in range(max_iter):
+        R = -load.copy()
+        K = np.zeros((6, 6))
+        for c, patch in enumerate(geometry.patches):
+            Bz = patch.point_map[:, 2, :]                    # (P, 6): u_zeta of each point
+            a = -(Bz @ (G[c] @ u))
+            N, dN = patch.normal_law.force(a, patch.weights)
+            R += G[c].T @ (Bz.T @ (-N))
+            K += G[c].T @ (Bz.T * dN) @ Bz @ G[c]
+        du = -np.linalg.lstsq(K, R, rcond=None)[0]
+        u = u + du
+        if np.linalg.norm(du) <= tol * (np.linalg.norm(u) + 1e-30):
+            break
+    else:
+        raise RuntimeError(f"static seating of the damper did not converge (radial force {radial_force} N)")
+    approach = np.array([-(p.point_map[:, 2, :] @ (G[c] @ u)) for c, p in enumerate(geometry.patches)])
+    loads = np.array([p.normal_law.force(approach[c], p.weights)[0].sum() for c, p in enumerate(geometry.patches)])
+    return u, approach, loads

@@ -1,0 +1,375 @@
+"""Bladed disk with underplatform dampers: the tuned disk by cyclic symmetry (Eq. 21-25).
+
+Unknowns of one sector: the blade's modal coordinates q (Eq. 2) and the six rigid-body
+coordinates u_D of its damper (the damper between this blade, at its OL platform, and the
+next blade, at that blade's OR platform). Harmonic h of the next blade is this blade's
+times e^{i h dphi}, dphi = 2 pi EO / n (Eq. 25), so the relative motion at the contacts is
+
+    w_h = G_D u_D,h - G_P [Phi_OL ; e^{i h dphi} Phi_OR] q_h          (Eq. 6, 24)
+
+and the contact forces go back to the sector through the transpose of the same (complex)
+map. The damper's equilibrium (Eq. 12, with or without inertia) is part of the residual
+instead of being condensed (Eq. 13-15): same solution, exact sparse Jacobian.
+
+Static preload: with the paper's one-harmonic setting ``harmonics=(1,)`` the damper is first
+seated frictionlessly under the centrifugal force F_CG = m R Omega_E^2 / EO^2 (Eq. 26) and the
+points keep that static approach; with a static harmonic (``0 in harmonics``) the centrifugal
+force is a static load on the damper and the seating is part of the harmonic balance.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import _validate
+from .blade import ModalBlade
+from .damper.geometry import CONTACTS, CylinderDamper, DamperGeometry, WedgeDamper
+from .damper.kinetics import centrifugal_force, seat
+from .hbm.continuation import continuation
+from .hbm.fourier import HarmonicBasis
+from .hbm.system import Coupling, HarmonicBalanceSystem
+from .response import FrequencyResponse
+
+DAMPER_DOFS = ("uD_x", "uD_y", "uD_z", "phiD_x", "phiD_y", "phiD_z")
+
+
+@dataclass
+class DamperContacts:
+    """Both contacts of one damper as a harmonic-balance element (12 local coordinates:
+    the relative motions w of OL and OR, Eq. 7). Forces are those on the platforms (Eq. 11).
+
+    ``approach(omega)`` gives the per-point static approach (2, P) and its omega-derivative.
+    """
+
+    geometry: DamperGeometry
+    approach: callable
+    n_local: int = 12
+
+    def evaluate(self, local, basis, omega, jacobian=True):
+        """Patch evaluations (OL, OR) at ``local`` (C, 12)."""
+        offsets, _ = self.approach(omega)
+        return [patch.evaluate(local[:, 6 * c:6 * c + 6], basis, offsets[c], jacobian)
+                for c, patch in enumerate(self.geometry.patches)]
+
+    def harmonic_forces(self, local, basis, omega, jacobian=True):
+        C = basis.n_coeffs
+        evs = self.evaluate(local, basis, omega, jacobian)
+        force = np.hstack([ev.force for ev in evs])
+        if not jacobian:
+            return force, None, None
+        jac = np.zeros((C, 12, C, 12))
+        for c, ev in enumerate(evs):
+            jac[:, 6 * c:6 * c + 6, :, 6 * c:6 * c + 6] = ev.jacobian.reshape(C, 6, C, 6)
+        domega = None
+        offsets, doffsets = self.approach(omega)
+        if np.any(doffsets != 0):
+            # the preload follows the rotor speed: forward difference in omega (one extra AFT pass)
+            h = 1e-7 * omega
+            off_h = offsets + h * doffsets
+            force_h = np.hstack([patch.evaluate(local[:, 6 * c:6 * c + 6], basis, off_h[c], False).force
+                                 for c, patch in enumerate(self.geometry.patches)])
+            domega = ((force_h - force) / h).ravel()
+        return force, jac.reshape(C * 12, C * 12), domega
+
+
+@dataclass
+class TunedDisk:
+    """Tuned bladed disk with one damper per blade pair (cyclic symmetry, Eq. 21-25).
+
+    Parameters
+    ----------
+    blade : ModalBlade (points OL, OR, tip, excitation)
+    damper : CylinderDamper, WedgeDamper or None (mass 0 or None: no damper)
+    n_blades : n >= 2
+    engine_order : EO in 0..n/2
+    gamma_left, gamma_right : platform angles at OL and OR [rad], in (0, pi/2)
+    damper_radius : R, distance of the damper's centre of gravity to the rotor axis [m]
+    excitation : (6,) harmonic tip load (F_x, F_y, F_z, M_x, M_y, M_z) at the blade's
+        "excitation" point [N, N m] (cosine amplitude)
+    rotor_speed : [rad/s], required when EO = 0; otherwise Omega_R = Omega_E / EO
+    damper_inertia : include the damper's mass and rotary inertia in Eq. 12
+    """
+
+    blade: ModalBlade
+    damper: CylinderDamper | WedgeDamper | None
+    n_blades: int = 16
+    engine_order: int = 1
+    gamma_left: float = np.radians(35.0)
+    gamma_right: float = np.radians(35.0)
+    damper_radius: float = 0.1
+    excitation: np.ndarray = field(default_factory=lambda: np.array([0.1, 0, 0, 0, 0, 0]))
+    rotor_speed: float | None = None
+    damper_inertia: bool = True
+
+    def __post_init__(self):
+        _validate.integer("n_blades", self.n_blades, minimum=2)
+        _validate.integer("engine_order (EO)", self.engine_order, minimum=0, maximum=self.n_blades // 2)
+        _validate.in_range("gamma_left (platform angle, rad)", self.gamma_left, 0.0, np.pi / 2, closed="neither")
+        _validate.in_range("gamma_right (platform angle, rad)", self.gamma_right, 0.0, np.pi / 2, closed="neither")
+        _validate.positive("damper_radius R", self.damper_radius)
+        self.excitation = np.asarray(_validate.finite("excitation", self.excitation), dtype=float)
+        if self.excitation.shape != (6,):
+            raise ValueError("excitation must be a 6-vector (F_x, F_y, F_z, M_x, M_y, M_z) in N and N m")
+        if self.engine_order == 0 and self.has_damper and self.rotor_speed is None:
+            raise ValueError("engine_order = 0 needs an explicit rotor_speed (rad/s, > 0)")
+        if self.rotor_speed is not None:
+            _validate.positive("rotor_speed", self.rotor_speed)
+
+    # ----- geometry --------------------------------------------------------------------
+    @property
+    def has_damper(self) -> bool:
+        return self.damper is not None and self.damper.mass > 0
+
+    @property
+    def interblade_phase(self) -> float:
+        """dphi = 2 pi EO / n [rad] (Eq. 25)."""
+        return 2 * np.pi * self.engine_order / self.n_blades
+
+    @property
+    def dof_names(self) -> tuple[str, ...]:
+        modes = self.blade.mode_names or tuple(f"q{j + 1}" for j in range(self.blade.n_modes))
+        return tuple(f"q_{m}" for m in modes) + (DAMPER_DOFS if self.has_damper else ())
+
+    def damper_geometry(self) -> DamperGeometry:
+        return self.damper.geometry(self.gamma_left, self.gamma_right)
+
+    def platform_offsets(self, geometry: DamperGeometry) -> np.ndarray:
+        """(2, 3) contact centres seen from the blade's OL / OR points (in each blade's frame).
+
+        The damper's OL contact centre is put on the blade's OL point; the blade pitch at the
+        platform (unrolled, neighbouring blade frames parallel) is chosen so that the OR contact
+        centre lies above or below the neighbour's OR point; the remaining radial offset (non-zero
+        for asymmetric platforms) is carried by the rigid platform.
+        """
+        p_ol, p_or = self.blade.points["OL"], self.blade.points["OR"]
+        cg = p_ol - geometry.centres[0]                      # damper CG in blade i's frame
+        or_centre = cg + geometry.centres[1]                 # in blade i's frame
+        pitch = p_or[0] - or_centre[0]                       # blade i+1 frame = blade i frame - pitch x
+        return np.array([np.zeros(3), or_centre + np.array([pitch, 0.0, 0.0]) - p_or])
+
+    def centrifugal_force(self, omega: float):
+        """(F_CG [N], dF_CG / dOmega_E) (Eq. 26)."""
+        return centrifugal_force(self.damper.mass, self.damper_radius, omega, self.engine_order, self.rotor_speed)
+
+    # ----- harmonic balance --------------------------------------------------------------
+    def hbm_system(self, harmonics=(1,), n_samples=None, static_retention: float = 1e-6) -> HarmonicBalanceSystem:
+        """The harmonic balance of one sector.
+
+        ``static_retention``: with a static harmonic, frictionless seating leaves the damper's
+        axial position (and the cylinder's roll angle) free; a spring of this fraction of the
+        normal contact stiffness on the static harmonic of the damper fixes them.
+        """
+        basis = HarmonicBasis(tuple(harmonics), n_samples)
+        C, nm = basis.n_coeffs, self.blade.n_modes
+        n = nm + (6 if self.has_damper else 0)
+        omega0 = self.blade.natural_angular_frequencies
+        M, D, K = np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n))
+        M[:nm, :nm] = np.eye(nm)
+        K[:nm, :nm] = np.diag(omega0 ** 2)
+        D[:nm, :nm] = np.diag(2 * self.blade.damping_ratios * omega0)  # Eq. 5
+        modal_force = self.blade.shape("excitation").T @ self.excitation
+        j1 = basis.cos_index(1)
+        couplings, static_stiffness = [], None
+        if self.has_damper:
+            geometry = self.damper_geometry()
+            if self.damper_inertia:
+                M[nm:, nm:] = geometry.inertia
+            G_D, G_P = geometry.G_D, geometry.G_P(self.platform_offsets(geometry))
+            phi = np.vstack([self.blade.shape("OL"), self.blade.shape("OR")])  # (12, nm)
+            dphi = self.interblade_phase
+
+            def sector_map(h):
+                phase = np.ones(12, dtype=complex)
+                phase[6:] = np.exp(1j * h * dphi)          # Eq. 24: the OR platform is the next blade's
+                out = np.zeros((12, n), dtype=complex)
+                out[:, :nm] = -G_P @ (phase[:, None] * phi)
+                out[:, nm:] = G_D
+                return out
+
+            couplings.append(Coupling(DamperContacts(geometry, self._approach_function(geometry, basis)),
+                                      basis.real_form(sector_map), "damper contacts"))
+            if basis.has_static:
+                k_n = sum(p.normal_law.stiffness for p in geometry.patches)
+                static_stiffness = np.zeros((n, n))
+                static_stiffness[nm:, nm:] = static_retention * k_n * np.diag([1, 1, 1, 1e-4, 1e-4, 1e-4])
+
+        def excitation(omega):
+            f, df = np.zeros((C, n)), np.zeros((C, n))
+            f[j1, :nm] = modal_force
+            if self.has_damper and basis.has_static:
+                F, dF = self.centrifugal_force(omega)
+                f[basis.cos_index(0), nm + 2] = F       # radially outwards on the damper
+                df[basis.cos_index(0), nm + 2] = dF
+            return f.ravel(), df.ravel()
+
+        return HarmonicBalanceSystem(basis, M, D, K, excitation, couplings, static_stiffness)
+
+    def _approach_function(self, geometry: DamperGeometry, basis: HarmonicBasis):
+        P = geometry.patches[0].n_points
+        if basis.has_static:
+            zero = np.zeros((2, P))
+            return lambda omega: (zero, zero)
+        # seat once at a reference load; the laws are homogeneous, so the static approach
+        # scales as F_CG^(1/p) (p = 1 for the linear law)
+        exponent = getattr(geometry.patches[0].normal_law, "exponent", 1.0)
+        F_ref = 1.0
+        _, approach_ref, _ = seat(geometry, F_ref)
+
+        def approach(omega):
+            F, dF = self.centrifugal_force(omega)
+            if F <= 0:
+                return np.zeros_like(approach_ref), np.zeros_like(approach_ref)
+            scale = (F / F_ref) ** (1 / exponent)
+            return approach_ref * scale, approach_ref * scale / (exponent * F) * dF
+
+        return approach
+
+    def static_normal_loads(self, omega: float) -> np.ndarray:
+        """Static normal loads (N_OL, N_OR) [N] from frictionless seating at Omega_E = omega."""
+        if not self.has_damper:
+            return np.zeros(2)
+        return seat(self.damper_geometry(), self.centrifugal_force(omega)[0])[2]
+
+    def frequency_response(self, f_start_hz: float, f_end_hz: float, harmonics=(1,), n_samples=None,
+                           max_step: float = 0.02, **continuation_options) -> "DiskResponse":
+        """Forced response from ``f_start_hz`` to ``f_end_hz`` [Hz] by continuation.
+
+        ``max_step`` is the largest arc-length step in scaled units (smaller: more points).
+        """
+        _validate.positive("f_start_hz", f_start_hz)
+        _validate.positive("f_end_hz", f_end_hz)
+        if f_start_hz == f_end_hz:
+            raise ValueError("f_end_hz must differ from f_start_hz")
+        system = self.hbm_system(harmonics, n_samples)
+        w0, w1 = 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz
+        x0 = self._initial_guess(system, w0)
+        branch = continuation(system.residual, x0, w0, w1, x_scale=self._scales(system, w0, w1),
+                              max_step=max_step, **continuation_options)
+        return DiskResponse.from_branch(self, system, branch)
+
+    def _initial_guess(self, system, omega):
+        """Stuck linear solution: one Newton step from rest, where every contact point sticks."""
+        R, J, _ = system.residual(np.zeros(system.n_unknowns), omega)
+        return -np.linalg.solve(J, R)
+
+    def _scales(self, system, w0, w1):
+        """Scale of each unknown: its largest value in the stuck linear responses across the
+        range (harmonic coefficients pooled per DOF), floored at 1e-3 of the largest scale of
+        its kind (modal / damper translation / damper rotation)."""
+        C, n = system.basis.n_coeffs, system.n_dof
+        nm = self.blade.n_modes
+        omegas = np.linspace(w0, w1, 7)
+        X = np.array([np.abs(self._initial_guess(system, w)).reshape(C, n).max(axis=0) for w in omegas]).max(axis=0)
+        groups = [slice(0, nm)] + ([slice(nm, nm + 3), slice(nm + 3, nm + 6)] if self.has_damper else [])
+        for g in groups:
+            X[g] = np.maximum(X[g], 1e-3 * X[g].max() + 1e-300)
+        return np.tile(X, C)
+
+
+@dataclass
+class DiskResponse(FrequencyResponse):
+    """Frequency response of a tuned disk (reference sector).
+
+    Extra attributes (n points along the branch, C coefficients, P points per patch):
+
+    tip_amplitude : (n, 3) first-harmonic tip amplitude in x, y, z [m]
+    modal_amplitude : (n, n_m) first-harmonic modal amplitudes [sqrt(kg) m]
+    contact_force : (n, C, 12) generalised contact forces on the platforms, OL then OR (Eq. 11)
+    relative_motion : (n, C, 12) generalised relative motions w, OL then OR (Eq. 7)
+    point_displacement : (n, C, 2, P, 3) relative displacement coefficients of every patch point
+    point_state : (n, 2, P, 3) fraction of the period each point sticks, slips, is separated
+    point_dissipation : (n, 2, P) energy dissipated per period at each point [J]
+    dissipated_energy : (n,) friction dissipation per period, all contacts of one sector [J]
+    excitation_work : (n,) work of the excitation per period [J]
+    viscous_dissipation : (n,) blade modal damping dissipation per period [J]
+    normal_load : (n, 2) mean normal load of OL, OR [N]
+    """
+
+    tip_amplitude: np.ndarray = None
+    modal_amplitude: np.ndarray = None
+    contact_force: np.ndarray = None
+    relative_motion: np.ndarray = None
+    point_displacement: np.ndarray = None
+    point_state: np.ndarray = None
+    point_dissipation: np.ndarray = None
+    dissipated_energy: np.ndarray = None
+    excitation_work: np.ndarray = None
+    viscous_dissipation: np.ndarray = None
+    normal_load: np.ndarray = None
+    disk: TunedDisk = None
+
+    @classmethod
+    def from_branch(cls, disk: TunedDisk, system: HarmonicBalanceSystem, branch) -> "DiskResponse":
+        basis = system.basis
+        C, n_dof, nm = basis.n_coeffs, system.n_dof, disk.blade.n_modes
+        X = branch.x.reshape(-1, C, n_dof)
+        npts = len(branch.omega)
+        j1 = basis.cos_index(1)
+        tip_shape = disk.blade.shape("tip")[:3]
+        q1 = X[:, j1, :nm] - 1j * X[:, j1 + 1, :nm]
+        tip = np.abs(q1 @ tip_shape.T)
+        out = dict(tip_amplitude=tip, modal_amplitude=np.abs(q1),
+                   excitation_work=np.array([system.excitation_work(x.ravel(), w) for x, w in zip(X, branch.omega)]),
+                   viscous_dissipation=np.array([system.viscous_dissipation(x.ravel(), w)
+                                                 for x, w in zip(X, branch.omega)]))
+        if disk.has_damper and npts:
+            coupling = system.couplings[0]
+            P = coupling.element.geometry.patches[0].n_points
+            cf = np.zeros((npts, C, 12))
+            rm = np.zeros((npts, C, 12))
+            pdisp = np.zeros((npts, C, 2, P, 3))
+            pstate = np.zeros((npts, 2, P, 3))
+            pdiss = np.zeros((npts, 2, P))
+            load = np.zeros((npts, 2))
+            for i, (x, w) in enumerate(zip(X, branch.omega)):
+                local = (coupling.matrix @ x.ravel()).reshape(C, 12)
+                evs = coupling.element.evaluate(local, basis, w, jacobian=False)
+                rm[i] = local
+                for c, ev in enumerate(evs):
+                    cf[i, :, 6 * c:6 * c + 6] = ev.force
+                    pts = ev.points
+                    pdisp[i, :, c] = basis.to_coeffs(np.moveaxis(pts.displacement, 1, 0))
+                    for s in range(3):
+                        pstate[i, c, :, s] = (pts.state == s).mean(axis=1)
+                    fcoef = basis.to_coeffs(np.moveaxis(pts.force, 1, 0))
+                    pdiss[i, c] = basis.work_per_cycle(fcoef, pdisp[i, :, c]).sum(axis=-1)
+                    load[i, c] = pts.normal_load.sum(axis=0).mean()
+            out.update(contact_force=cf, relative_motion=rm, point_displacement=pdisp, point_state=pstate,
+                       point_dissipation=pdiss, dissipated_energy=pdiss.sum(axis=(1, 2)), normal_load=load)
+        else:
+            out.update(dissipated_energy=np.zeros(npts))
+        return cls(branch.omega, X, basis, disk.dof_names, branch.success, branch.message, branch.iterations,
+                   branch.turning_points, disk=disk, **out)
+
+    @property
+    def peak_tip_amplitude(self) -> float:
+        """Largest first-harmonic tip amplitude |u_x| on the branch [m]."""
+        return float(self.tip_amplitude[:, 0].max()) if len(self.omega) else float("nan")
+
+    @property
+    def resonance_frequency_hz(self) -> float:
+        """Frequency of the largest |u_x,tip| [Hz]."""
+        return float(self.frequency_hz[np.argmax(self.tip_amplitude[:, 0])])
+
+    def energy_balance_error(self) -> np.ndarray:
+        """|W_exc - W_visc - W_friction| / W_exc at every point."""
+        return np.abs(self.excitation_work - self.viscous_dissipation - self.dissipated_energy) / np.abs(self.excitation_work)
+
+    def plot(self, ax=None, direction: int = 0, label: str | None = None, **kwargs):
+        """Tip amplitude [mm] over frequency [Hz] (the paper's Fig. 4-6 style)."""
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            _, ax = plt.subplots(figsize=(6, 4))
+        if label is None:
+            d = self.disk
+            label = f"{d.damper.kind} {1e3 * d.damper.mass:g} g" if d is not None and d.has_damper else "no damper"
+        ax.plot(self.frequency_hz, 1e3 * self.tip_amplitude[:, direction], label=label, **kwargs)
+        ax.set_xlabel("excitation frequency [Hz]")
+        ax.set_ylabel(f"tip amplitude u_{'xyz'[direction]} [mm]")
+        ax.grid(True, alpha=0.3)
+        ax.legend()
+        if not self.success:
+            ax.set_title(f"incomplete: {self.message}", fontsize=8)
+        return ax

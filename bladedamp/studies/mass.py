@@ -1,0 +1,130 @@
+"""Damper mass: the peak tip amplitude as a function of the mass, and its minimum (Fig. 5, 6)."""
+from __future__ import annotations
+
+import dataclasses
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from .. import _validate
+from ..disk import TunedDisk
+
+
+def with_mass(disk: TunedDisk, mass: float) -> TunedDisk:
+    """The same disk with another damper mass [kg]."""
+    return dataclasses.replace(disk, damper=dataclasses.replace(disk.damper, mass=mass))
+
+
+def peak_response(disk: TunedDisk, f_range_hz=(90.0, 105.0), harmonics=(1,), max_step=0.05):
+    """(peak |u_x,tip| [m], frequency [Hz], response) over ``f_range_hz``.
+
+    The peak is refined by a parabola through the largest point and its neighbours.
+    Raises RuntimeError if the continuation does not cover the range (never a silent number).
+    """
+    r = disk.frequency_response(*f_range_hz, harmonics=harmonics, max_step=max_step)
+    if not r.success:
+        raise RuntimeError(f"frequency response incomplete: {r.message}")
+    a = r.tip_amplitude[:, 0]
+    i = int(np.argmax(a))
+    peak, f = a[i], r.frequency_hz[i]
+    if 0 < i < len(a) - 1:
+        x, y = r.frequency_hz[i - 1:i + 2], a[i - 1:i + 2]
+        if np.all(np.diff(x) > 0):
+            c = np.polyfit(x, y, 2)
+            if c[0] < 0:
+                f_v = -c[1] / (2 * c[0])
+                if x[0] <= f_v <= x[2]:
+                    peak, f = max(peak, np.polyval(c, f_v)), f_v
+    return float(peak), float(f), r
+
+
+@dataclass
+class MassSweep:
+    """Peak tip amplitude over damper mass.
+
+    mass : (k,) [kg]; peak_tip : (k,) [m]; resonance_hz : (k,) [Hz]; kind : damper type
+    """
+
+    mass: np.ndarray
+    peak_tip: np.ndarray
+    resonance_hz: np.ndarray
+    kind: str
+    undamped_peak_tip: float
+
+    @property
+    def reduction(self) -> np.ndarray:
+        """1 - peak / undamped peak."""
+        return 1 - self.peak_tip / self.undamped_peak_tip
+
+    def plot(self, ax=None, **kwargs):
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            _, ax = plt.subplots(figsize=(6, 4))
+        kwargs.setdefault("label", self.kind)
+        ax.semilogx(1e3 * self.mass, 1e3 * self.peak_tip, marker="o", **kwargs)
+        ax.axhline(1e3 * self.undamped_peak_tip, color="gray", ls="--", lw=1)
+        ax.set_xlabel("damper mass [g]")
+        ax.set_ylabel("resonance tip amplitude u_x [mm]")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend()
+        return ax
+
+
+def mass_sweep(disk: TunedDisk, masses, f_range_hz=(90.0, 105.0), harmonics=(1,), progress=None) -> MassSweep:
+    """Peak tip amplitude for each damper mass in ``masses`` [kg] (each > 0)."""
+    masses = np.atleast_1d(np.asarray(masses, dtype=float))
+    if masses.size == 0:
+        raise ValueError("masses must be a non-empty array of damper masses in (0, inf) kg")
+    _validate.positive("masses", masses)
+    peaks, freqs = [], []
+    for k, m in enumerate(masses):
+        p, f, _ = peak_response(with_mass(disk, m), f_range_hz, harmonics)
+        peaks.append(p)
+        freqs.append(f)
+        if progress:
+            progress(k + 1, masses.size)
+    undamped, _, _ = peak_response(dataclasses.replace(disk, damper=None), f_range_hz, harmonics)
+    return MassSweep(masses, np.array(peaks), np.array(freqs), disk.damper.kind, undamped)
+
+
+@dataclass
+class MassOptimum:
+    """Optimal damper mass [kg], its peak tip amplitude [m], the undamped peak [m]."""
+
+    mass: float
+    peak_tip: float
+    undamped_peak_tip: float
+    evaluations: int
+
+    @property
+    def reduction(self) -> float:
+        return 1 - self.peak_tip / self.undamped_peak_tip
+
+
+def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0), harmonics=(1,),
+                 xatol: float = 0.02) -> MassOptimum:
+    """Mass minimising the peak tip amplitude: bounded scalar optimisation in log(mass).
+
+    ``bounds`` [kg], 0 < low < high; ``xatol`` tolerance in log(mass).
+    """
+    lo, hi = (float(b) for b in bounds)
+    _validate.positive("mass bounds", [lo, hi])
+    if not lo < hi:
+        raise ValueError(f"mass bounds must satisfy 0 < low < high (got {bounds})")
+    cache = {}
+
+    def objective(logm):
+        m = float(np.exp(logm))
+        if m not in cache:
+            cache[m] = peak_response(with_mass(disk, m), f_range_hz, harmonics)[0]
+        return cache[m]
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = minimize_scalar(objective, bounds=(np.log(lo), np.log(hi)), method="bounded",
+                              options={"xatol": xatol})
+    undamped, _, _ = peak_response(dataclasses.replace(disk, damper=None), f_range_hz, harmonics)
+    return MassOptimum(float(np.exp(res.x)), float(res.fun), undamped, len(cache))
