@@ -76,9 +76,14 @@ class FrictionOscillator:
         return self.friction_coefficient * self.normal_load
 
     def linear_amplitude(self, omega, stuck: bool) -> np.ndarray:
-        """Amplitude of the linear system with the contact stuck (k + k_T) or absent (k) [m]."""
+        """Amplitude of the linear system with the contact stuck or absent (k) [m].
+
+        Stuck (and never lifting off): k + k_T cos^2(alpha) + k_N sin^2(alpha).
+        """
         omega = np.asarray(omega, dtype=float)
-        k = self.stiffness + (self.contact_stiffness * np.cos(self.contact_angle) ** 2 if stuck else 0.0)
+        stuck_k = self.contact_stiffness * np.cos(self.contact_angle) ** 2 \
+            + self.normal_stiffness * np.sin(self.contact_angle) ** 2
+        k = self.stiffness + (stuck_k if stuck else 0.0)
         return np.abs(self.forcing / (k - self.mass * omega ** 2 + 1j * self.damping * omega))
 
     # ----- harmonic balance -----------------------------------------------------------

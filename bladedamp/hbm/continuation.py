@@ -29,21 +29,21 @@ class NewtonResult:
 
 
 def newton(fun, x0, omega, x_scale, residual_scale, tol=1e-10, max_iter=30):
-    """Solve R(x, omega) = 0 at fixed omega. Convergence: scaled step and residual below ``tol``."""
+    """Solve R(x, omega) = 0 at fixed omega. Converged when the scaled residual is below ``tol``
+    and the last scaled update below sqrt(tol)."""
     x = np.array(x0, dtype=float)
     rnorm = np.inf
+    step_norm = np.inf
     for it in range(1, max_iter + 1):
         R, J, _ = fun(x, omega)
         rnorm = np.linalg.norm(R) / residual_scale
         if not np.all(np.isfinite(R)):
             return NewtonResult(x, False, it, rnorm)
+        if rnorm < tol and step_norm < np.sqrt(tol):
+            return NewtonResult(x, True, it, rnorm)
         dx = -np.linalg.solve(J, R)
         x = x + dx
-        if np.linalg.norm(dx / x_scale) < tol and rnorm < np.sqrt(tol):
-            R, _, _ = fun(x, omega)
-            rnorm = np.linalg.norm(R) / residual_scale
-            if rnorm < tol * 10:
-                return NewtonResult(x, True, it, rnorm)
+        step_norm = np.linalg.norm(dx / x_scale)
     return NewtonResult(x, False, max_iter, rnorm)
 
 
@@ -70,7 +70,7 @@ class Branch:
 
 def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=None,
                  step=None, max_step=None, min_step=None, max_points=5000, tol=1e-10,
-                 max_corrector=12, target_iterations=4):
+                 max_corrector=12, target_iterations=5):
     """Pseudo-arclength continuation of R(x, omega) = 0 from ``omega_start`` to ``omega_end``.
 
     Parameters
@@ -147,17 +147,19 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
             yp = y + h * tangent
             yc = yp.copy()
             ok = False
+            step_norm = np.inf
             for it in range(1, max_corrector + 1):
                 R, Jy = scaled_system(yc)
                 if not np.all(np.isfinite(R)):
                     break
+                # converged: residual at the noise level and the last update small
+                if np.linalg.norm(R) < tol and step_norm < np.sqrt(tol):
+                    ok = True
+                    break
                 G = np.append(R, tangent @ (yc - yp))
                 dy = -np.linalg.solve(np.vstack([Jy, tangent[None, :]]), G)
                 yc = yc + dy
-                if np.linalg.norm(dy) < tol:
-                    R, _ = scaled_system(yc)
-                    ok = np.linalg.norm(R) < tol * 10
-                    break
+                step_norm = np.linalg.norm(dy)
             # reject corrector results that jump back along the branch
             if ok and (yc - y) @ tangent > 0:
                 accepted = True

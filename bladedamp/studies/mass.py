@@ -17,26 +17,39 @@ def with_mass(disk: TunedDisk, mass: float) -> TunedDisk:
     return dataclasses.replace(disk, damper=dataclasses.replace(disk.damper, mass=mass))
 
 
-def peak_response(disk: TunedDisk, f_range_hz=(90.0, 105.0), harmonics=(1,), max_step=0.05):
-    """(peak |u_x,tip| [m], frequency [Hz], response) over ``f_range_hz``.
+def peak_response(disk: TunedDisk, f_range_hz=(90.0, 105.0), harmonics=(1,), max_step=0.05, direction: int = 0,
+                  max_widenings: int = 4):
+    """(peak first-harmonic tip amplitude [m], frequency [Hz], response) over ``f_range_hz``.
 
+    ``direction`` is the tip DOF (0..2: u_x, u_y, u_z). If the largest amplitude sits at an end
+    of the range, the range is widened by its own width on that side (at most
+    ``max_widenings`` times) so that a reported peak is always a true interior maximum.
     The peak is refined by a parabola through the largest point and its neighbours.
     Raises RuntimeError if the continuation does not cover the range (never a silent number).
     """
-    r = disk.frequency_response(*f_range_hz, harmonics=harmonics, max_step=max_step)
-    if not r.success:
-        raise RuntimeError(f"frequency response incomplete: {r.message}")
-    a = r.tip_amplitude[:, 0]
-    i = int(np.argmax(a))
+    lo, hi = (float(f) for f in f_range_hz)
+    if not 0 < lo < hi:
+        raise ValueError(f"f_range_hz must satisfy 0 < low < high Hz (got {f_range_hz})")
+    for _ in range(max_widenings + 1):
+        r = disk.frequency_response(lo, hi, harmonics=harmonics, max_step=max_step)
+        if not r.success:
+            raise RuntimeError(f"frequency response incomplete: {r.message}")
+        a = r.tip_amplitude[:, direction]
+        i = int(np.argmax(a))
+        if 0 < i < len(a) - 1:
+            break
+        width = hi - lo
+        lo, hi = (max(lo - width, 0.5 * lo), hi) if i == 0 else (lo, hi + width)
+    else:
+        raise RuntimeError(f"no interior resonance peak found up to the range {lo:.4g}-{hi:.4g} Hz")
     peak, f = a[i], r.frequency_hz[i]
-    if 0 < i < len(a) - 1:
-        x, y = r.frequency_hz[i - 1:i + 2], a[i - 1:i + 2]
-        if np.all(np.diff(x) > 0):
-            c = np.polyfit(x, y, 2)
-            if c[0] < 0:
-                f_v = -c[1] / (2 * c[0])
-                if x[0] <= f_v <= x[2]:
-                    peak, f = max(peak, np.polyval(c, f_v)), f_v
+    x, y = r.frequency_hz[i - 1:i + 2], a[i - 1:i + 2]
+    if np.all(np.diff(x) > 0):
+        c = np.polyfit(x, y, 2)
+        if c[0] < 0:
+            f_v = -c[1] / (2 * c[0])
+            if x[0] <= f_v <= x[2]:
+                peak, f = max(peak, np.polyval(c, f_v)), f_v
     return float(peak), float(f), r
 
 
