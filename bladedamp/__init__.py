@@ -3,11 +3,23 @@
 Data flows one way: geometry and parameters -> model -> harmonic balance residual ->
 continuation solver -> result objects -> plots, reports and 3D views.
 """
+from .blade import BeamBladeGeometry, ModalBlade, reference_blade
 from .contact import ContactPatch, LinearNormalLaw, RoughnessNormalLaw
+from .damper import ContactProperties, CylinderDamper, WedgeDamper
+from .disk import DiskResponse, TunedDisk
 from .hbm import HarmonicBasis
 from .oscillator import FrictionOscillator
+from .reference import reference_disk
 from .response import FrequencyResponse
 
 __version__ = "0.1.0"
-__all__ = ["ContactPatch", "LinearNormalLaw", "RoughnessNormalLaw", "HarmonicBasis", "FrictionOscillator",
-           "FrequencyResponse"]
+__all__ = ["BeamBladeGeometry", "ModalBlade", "reference_blade", "ContactPatch", "LinearNormalLaw",
+           "RoughnessNormalLaw", "ContactProperties", "CylinderDamper", "WedgeDamper", "TunedDisk", "DiskResponse",
+           "HarmonicBasis", "FrictionOscillator", "FrequencyResponse", "reference_disk", "frequency_response"]
+
+
+def frequency_response(model, f_range_hz, harmonics=(1,), **options):
+    """Forced response of ``model`` (a TunedDisk) over ``f_range_hz = (start, end)`` [Hz] by
+    harmonic balance and arc-length continuation; returns a :class:`DiskResponse`."""
+    start, end = f_range_hz
+    return model.frequency_response(start, end, harmonics=harmonics, **options)

@@ -249,9 +249,19 @@ class TunedDisk:
         return DiskResponse.from_branch(self, system, branch)
 
     def _initial_guess(self, system, omega):
-        """Stuck linear solution: one Newton step from rest, where every contact point sticks."""
-        R, J, _ = system.residual(np.zeros(system.n_unknowns), omega)
-        return -np.linalg.solve(J, R)
+        """Stuck linear solution: one Newton step from the static state, where every contact point sticks.
+
+        With a static harmonic the contacts have no preload at x = 0 (zero approach: every
+        point is open and the Jacobian there has no contact stiffness at all), so the step
+        starts from the damper seated frictionlessly under F_CG (``seat``) instead of from rest.
+        """
+        x = np.zeros(system.n_unknowns)
+        if self.has_damper and system.basis.has_static:
+            u_seat, _, _ = seat(self.damper_geometry(), self.centrifugal_force(omega)[0])
+            nm = self.blade.n_modes
+            x.reshape(system.basis.n_coeffs, system.n_dof)[system.basis.cos_index(0), nm:] = u_seat
+        R, J, _ = system.residual(x, omega)
+        return x - np.linalg.solve(J, R)
 
     def _scales(self, system, w0, w1):
         """Scale of each unknown: its largest value in the stuck linear responses across the
