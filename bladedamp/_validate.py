@@ -46,10 +46,14 @@ def finite(name: str, value):
 
 def integer(name: str, value, minimum: int = 0, maximum: int | None = None) -> int:
     """Check an integer in [minimum, maximum]."""
-    if isinstance(value, bool) or int(value) != value:
-        raise ValueError(f"{name} must be an integer (got {value!r})")
+    hi = "inf)" if maximum is None else f"{maximum}]"
+    try:
+        ok = not isinstance(value, bool) and float(value) == int(value)
+    except (TypeError, ValueError, OverflowError):
+        ok = False
+    if not ok:
+        raise ValueError(f"{name} must be an integer in [{minimum}, {hi} (got {value!r})")
     value = int(value)
     if value < minimum or (maximum is not None and value > maximum):
-        hi = "inf)" if maximum is None else f"{maximum}]"
         raise ValueError(f"{name} must be an integer in [{minimum}, {hi} (got {value!r})")
     return value

@@ -24,6 +24,8 @@ import numpy as np
 
 from . import _validate
 from .blade import ModalBlade
+from .contact.laws import LinearNormalLaw
+from .contact.point import point_contact_forces
 from .damper.geometry import CONTACTS, CylinderDamper, DamperGeometry, WedgeDamper
 from .damper.kinetics import centrifugal_force, seat
 from .hbm.continuation import continuation
@@ -40,11 +42,19 @@ class DamperContacts:
     the relative motions w of OL and OR, Eq. 7). Forces are those on the platforms (Eq. 11).
 
     ``approach(omega)`` gives the per-point static approach (2, P) and its omega-derivative.
+
+    ``harmonic_forces`` evaluates the points of both patches in one call of the point-contact
+    kernel when the patches share their normal law and friction coefficient (always, for the
+    dampers of :mod:`bladedamp.damper.geometry`): the same arithmetic as two
+    ``ContactPatch.evaluate`` calls, half the per-call overhead (tested against ``evaluate``).
+    With the one-harmonic preload and a linear normal law, d force / d omega comes from Euler's
+    identity instead of a second AFT pass (see ``harmonic_forces``).
     """
 
     geometry: DamperGeometry
     approach: callable
     n_local: int = 12
+    _stacked: tuple | None = field(default=None, init=False, repr=False)
 
     def evaluate(self, local, basis, omega, jacobian=True):
         """Patch evaluations (OL, OR) at ``local`` (C, 12)."""
@@ -52,25 +62,72 @@ class DamperContacts:
         return [patch.evaluate(local[:, 6 * c:6 * c + 6], basis, offsets[c], jacobian)
                 for c, patch in enumerate(self.geometry.patches)]
 
-    def harmonic_forces(self, local, basis, omega, jacobian=True):
+    def _stack(self):
+        """(point maps (2, P, 3, 6), k_T, mu, weights (2P,), normal law) or None if the patches differ."""
+        if self._stacked is None:
+            pa, pb = self.geometry.patches
+            same = (pa.normal_law == pb.normal_law and pa.friction_coefficient == pb.friction_coefficient
+                    and pa.n_points == pb.n_points)
+            if not same:
+                self._stacked = (False,)
+            else:
+                ps = (pa, pb)
+                self._stacked = (True, np.stack([p.point_map for p in ps]),
+                                 np.concatenate([p.tangential_stiffness * p.weights for p in ps]),
+                                 np.concatenate([np.full(p.n_points, p.friction_coefficient) for p in ps]),
+                                 np.concatenate([p.weights for p in ps]), pa.normal_law)
+        return self._stacked if self._stacked[0] else None
+
+    def _forces(self, local, basis, offsets, jacobian):
+        """Forces (C, 12) and Jacobian (C*12, C*12) or None of both patches."""
         C = basis.n_coeffs
-        evs = self.evaluate(local, basis, omega, jacobian)
-        force = np.hstack([ev.force for ev in evs])
+        stack = self._stack()
+        if stack is None:
+            evs = [patch.evaluate(local[:, 6 * c:6 * c + 6], basis, offsets[c], jacobian)
+                   for c, patch in enumerate(self.geometry.patches)]
+            force = np.hstack([ev.force for ev in evs])
+            blocks = [ev.jacobian.reshape(C, 6, C, 6) for ev in evs] if jacobian else None
+        else:
+            _, B, k_t, mu, weights, law = stack
+            P = B.shape[1]
+            coeffs = np.einsum("qpij,cqj->cqpi", B, local.reshape(C, 2, 6)).reshape(C, 2 * P, 3)
+            pts = point_contact_forces(coeffs, basis, k_t, mu, law, weights, np.ravel(offsets), jacobian=jacobian)
+            f_points = basis.to_coeffs(np.moveaxis(pts.force, 1, 0)).reshape(C, 2, P, 3)
+            force = np.einsum("cqpi,qpij->cqj", f_points, B).reshape(C, 12)
+            blocks = None
+            if jacobian:
+                # d f_coef[a, p, i] / d c_p[b, k] (point coefficient blocks direction-major), as ContactPatch
+                T = basis.n_samples
+                jp = np.matmul(basis.analysis, pts.jacobian.reshape(2 * P, T, 9 * C)).reshape(2, P, C, 3, 3, C)
+                blocks = np.einsum("qpamkb,qpkn->qambn", np.einsum("qpim,qpaikb->qpamkb", B, jp), B)
+        if not jacobian:
+            return force, None
+        jac = np.zeros((C, 12, C, 12))
+        for c in range(2):
+            jac[:, 6 * c:6 * c + 6, :, 6 * c:6 * c + 6] = blocks[c]
+        return force, jac.reshape(C * 12, C * 12)
+
+    def harmonic_forces(self, local, basis, omega, jacobian=True):
+        offsets, doffsets = self.approach(omega)
+        force, jac = self._forces(local, basis, offsets, jacobian)
         if not jacobian:
             return force, None, None
-        jac = np.zeros((C, 12, C, 12))
-        for c, ev in enumerate(evs):
-            jac[:, 6 * c:6 * c + 6, :, 6 * c:6 * c + 6] = ev.jacobian.reshape(C, 6, C, 6)
         domega = None
-        offsets, doffsets = self.approach(omega)
         if np.any(doffsets != 0):
-            # the preload follows the rotor speed: forward difference in omega (one extra AFT pass)
-            h = 1e-7 * omega
-            off_h = offsets + h * doffsets
-            force_h = np.hstack([patch.evaluate(local[:, 6 * c:6 * c + 6], basis, off_h[c], False).force
-                                 for c, patch in enumerate(self.geometry.patches)])
-            domega = ((force_h - force) / h).ravel()
-        return force, jac.reshape(C * 12, C * 12), domega
+            # the preload follows the rotor speed (one harmonic: the static approach scales with F_CG)
+            kappa = float(np.sum(doffsets * offsets) / np.sum(offsets * offsets))
+            linear = all(isinstance(p.normal_law, LinearNormalLaw) for p in self.geometry.patches)
+            if linear and np.abs(doffsets - kappa * offsets).max() <= 1e-12 * np.abs(doffsets).max():
+                # linear normal law: the forces are homogeneous of degree 1 in (w, approach) (springs
+                # and the Coulomb limit scale alike), so Euler's identity J w + (dF/da) a = F gives
+                # dF/dOmega = (F - J w) (da/dOmega) / a without another AFT pass
+                domega = (force.ravel() - jac @ local.ravel()) * kappa
+            else:
+                # forward difference in omega (one extra AFT pass)
+                h = 1e-7 * omega
+                force_h, _ = self._forces(local, basis, offsets + h * doffsets, False)
+                domega = ((force_h - force) / h).ravel()
+        return force, jac, domega
 
 
 @dataclass
@@ -137,28 +194,42 @@ class TunedDisk:
     def platform_offsets(self, geometry: DamperGeometry) -> np.ndarray:
         """(2, 3) contact centres seen from the blade's OL / OR points (in each blade's frame).
 
-        The damper's OL contact centre is put on the blade's OL point; the blade pitch at the
-        platform (unrolled, neighbouring blade frames parallel) is chosen so that the OR contact
-        centre lies above or below the neighbour's OR point; the remaining radial offset (non-zero
-        for asymmetric platforms) is carried by the rigid platform.
+        The blade pitch at the platform (unrolled, neighbouring blade frames parallel) is chosen
+        so that the OL and OR contact centres lie above or below the OL point of blade i and
+        the OR point of blade i+1. For asymmetric platforms the two contact centres are at
+        different heights (radial mismatch dz); the damper is placed half-way, so each rigid
+        platform carries half of it (OL offset -dz/2, OR offset +dz/2, radially). This keeps
+        the model mirror-symmetric: exchanging gamma_L and gamma_R gives the mirror image of
+        the assembly (the paper: "the same results are obtained if the left and right platform
+        angle are exchanged"); carrying all of dz on one side breaks that (measured: 1.8 %
+        on the 1 g cylinder's EO = 1 peak for 35 / 55 deg).
         """
         p_ol, p_or = self.blade.points["OL"], self.blade.points["OR"]
-        cg = p_ol - geometry.centres[0]                      # damper CG in blade i's frame
+        cg = p_ol - geometry.centres[0]                      # damper CG in blade i's frame (OL centre on OL)
         or_centre = cg + geometry.centres[1]                 # in blade i's frame
         pitch = p_or[0] - or_centre[0]                       # blade i+1 frame = blade i frame - pitch x
-        return np.array([np.zeros(3), or_centre + np.array([pitch, 0.0, 0.0]) - p_or])
+        mismatch = or_centre + np.array([pitch, 0.0, 0.0]) - p_or   # (0, dy, dz) with OL centre on OL
+        half = np.array([0.0, 0.0, mismatch[2] / 2])
+        return np.array([-half, mismatch - half])
 
     def centrifugal_force(self, omega: float):
         """(F_CG [N], dF_CG / dOmega_E) (Eq. 26)."""
         return centrifugal_force(self.damper.mass, self.damper_radius, omega, self.engine_order, self.rotor_speed)
 
     # ----- harmonic balance --------------------------------------------------------------
-    def hbm_system(self, harmonics=(1,), n_samples=None, static_retention: float = 1e-6) -> HarmonicBalanceSystem:
+    def hbm_system(self, harmonics=(1,), n_samples=None, static_retention: float = 1e-4) -> HarmonicBalanceSystem:
         """The harmonic balance of one sector.
 
         ``static_retention``: with a static harmonic, frictionless seating leaves the damper's
         axial position (and the cylinder's roll angle) free; a spring of this fraction of the
-        normal contact stiffness on the static harmonic of the damper fixes them.
+        normal contact stiffness on the static harmonic of the damper fixes them. It must not
+        be too weak: the mean tangential force left by slip onset (frictional shakedown) is
+        independent of the mean position, so only this spring balances it; at 1e-6 the
+        reference cylinder's (0, 1, 2, 3) continuation stalls at slip onset (~95.0 Hz, Newton
+        2-cycles in the static axial position). Measured on the reference FRFs (92-104 Hz,
+        harmonics (0, 1, 2, 3)): wedge 0.28 g peak 0.32178 / 0.32182 / 0.32201 / 0.32477 mm at
+        1e-6 / 1e-4 / 1e-3 / 1e-2, cylinder 1 g 0.48973 / 0.48997 / 0.49064 mm at 1e-4 / 1e-3 /
+        1e-2 (1e-6 does not converge): 1e-4 is within ~0.01 % of the weak-spring limit.
         """
         basis = HarmonicBasis(tuple(harmonics), n_samples)
         C, nm = basis.n_coeffs, self.blade.n_modes
@@ -266,14 +337,21 @@ class TunedDisk:
     def _scales(self, system, w0, w1):
         """Scale of each unknown: its largest value in the stuck linear responses across the
         range (harmonic coefficients pooled per DOF), floored at 1e-3 of the largest scale of
-        its kind (modal / damper translation / damper rotation)."""
+        its kind (modal / damper translation / damper rotation). A damper group that the stuck
+        response leaves at exactly zero (e.g. no damper rotation in the symmetric EO = n/2
+        standing wave) is floored at 1e-3 of the platform motion of the same kind instead
+        (a 1e-300 floor turned round-off in the Newton step into an overflow)."""
         C, n = system.basis.n_coeffs, system.n_dof
         nm = self.blade.n_modes
         omegas = np.linspace(w0, w1, 7)
         X = np.array([np.abs(self._initial_guess(system, w)).reshape(C, n).max(axis=0) for w in omegas]).max(axis=0)
-        groups = [slice(0, nm)] + ([slice(nm, nm + 3), slice(nm + 3, nm + 6)] if self.has_damper else [])
-        for g in groups:
-            X[g] = np.maximum(X[g], 1e-3 * X[g].max() + 1e-300)
+        groups = [(slice(0, nm), 0.0)]
+        if self.has_damper:
+            phi = np.abs(np.stack([self.blade.shape("OL"), self.blade.shape("OR")]))   # (2, 6, nm)
+            q = X[:nm].max()
+            groups += [(slice(nm, nm + 3), 1e-3 * q * phi[:, :3].max()), (slice(nm + 3, nm + 6), 1e-3 * q * phi[:, 3:].max())]
+        for g, platform_floor in groups:
+            X[g] = np.maximum(X[g], max(1e-3 * X[g].max(), platform_floor) + 1e-300)
         return np.tile(X, C)
 
 

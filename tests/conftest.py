@@ -1,0 +1,108 @@
+"""Shared closed forms and independent numerical helpers of the engine tests.
+
+Nothing here calls the code under test to produce a reference value: the closed forms are
+written from the physics (Jenkins element, unilateral spring, Duffing + Jenkins describing
+function), and the finite differences only call the function whose derivative is checked.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+# ---------------------------------------------------------------------------------------
+# closed forms
+# ---------------------------------------------------------------------------------------
+def jenkins_first_harmonic(k, slip_force, amplitude):
+    """First-harmonic force (a1, b1) of a 1D Jenkins element (spring k, Coulomb limit
+    ``slip_force``) driven by u = A cos(tau), in steady state: f ~ a1 cos + b1 sin.
+
+    stick (k A <= mu N): a1 = k A, b1 = 0.
+    gross slip: beta = arccos(1 - 2 mu N / (k A)),
+        a1 = k A / pi (beta - sin(2 beta) / 2),  b1 = -(4 mu N / pi)(1 - mu N / (k A)).
+    """
+    k, slip_force, A = (np.asarray(v, dtype=float) for v in (k, slip_force, amplitude))
+    k, slip_force, A = np.broadcast_arrays(k, slip_force, A)
+    stick = k * A <= slip_force
+    with np.errstate(divide="ignore", invalid="ignore"):
+        beta = np.arccos(np.clip(1.0 - 2.0 * slip_force / (k * A), -1.0, 1.0))
+        a1 = np.where(stick, k * A, k * A / np.pi * (beta - np.sin(2 * beta) / 2))
+        b1 = np.where(stick, 0.0, -(4 * slip_force / np.pi) * (1 - slip_force / (k * A)))
+    return a1, b1
+
+
+def jenkins_dissipation(k, slip_force, amplitude):
+    """Energy dissipated per cycle by a Jenkins element, 4 mu N (A - mu N / k) in slip, 0 in stick."""
+    return np.where(k * amplitude <= slip_force, 0.0, 4 * slip_force * (amplitude - slip_force / k))
+
+
+def unilateral_spring_harmonics(k, approach, amplitude):
+    """Static and first-harmonic normal force f_zeta = -k max(a - Z cos tau, 0) (Z >= a > 0).
+
+    Contact while cos tau < a / Z, i.e. tau in (theta0, 2 pi - theta0), theta0 = arccos(a / Z):
+        c0 = -(k / 2 pi) [2 a (pi - theta0) + 2 Z sin theta0]
+        a1 = (k Z / pi) [pi - theta0 + sin theta0 cos theta0],  b1 = 0.
+    """
+    theta0 = np.arccos(np.clip(approach / amplitude, -1.0, 1.0))
+    c0 = -(k / (2 * np.pi)) * (2 * approach * (np.pi - theta0) + 2 * amplitude * np.sin(theta0))
+    a1 = (k * amplitude / np.pi) * (np.pi - theta0 + np.sin(theta0) * np.cos(theta0))
+    return c0, a1
+
+
+def duffing_jenkins_residual(A, omega, osc):
+    """G(A, Omega) = |Z(A, Omega)|^2 - (F/A)^2 for the single-harmonic describing-function model
+    of the FrictionOscillator with contact_angle = 0:
+        Z = k + 3/4 k3 A^2 + a1(A)/A - m Omega^2 + i (c Omega - b1(A)/A).
+    G = 0 is the single-harmonic frequency response, independent of the AFT and continuation.
+    """
+    a1, b1 = jenkins_first_harmonic(osc.contact_stiffness, osc.slip_force, A)
+    kr = osc.stiffness + 0.75 * osc.cubic_stiffness * A ** 2 + a1 / A - osc.mass * omega ** 2
+    ki = osc.damping * omega - b1 / A
+    return kr ** 2 + ki ** 2 - (osc.forcing / A) ** 2
+
+
+# ---------------------------------------------------------------------------------------
+# numerical helpers
+# ---------------------------------------------------------------------------------------
+def central_difference(fun, x, step):
+    """Jacobian of a vector function by central differences, column by column.
+
+    ``step`` is a scalar or an array of per-entry steps.
+    """
+    x = np.asarray(x, dtype=float)
+    steps = np.broadcast_to(np.asarray(step, dtype=float), x.shape)
+    f0 = np.asarray(fun(x)).ravel()
+    J = np.zeros((f0.size, x.size))
+    for i in range(x.size):
+        e = np.zeros_like(x)
+        e.flat[i] = steps.flat[i]
+        J[:, i] = (np.asarray(fun(x + e)).ravel() - np.asarray(fun(x - e)).ravel()) / (2 * steps.flat[i])
+    return J
+
+
+def relative_matrix_error(J, J_ref):
+    """max |J - J_ref| / max |J_ref| (the Jacobians compared have entries of very different sizes)."""
+    return float(np.abs(J - J_ref).max() / np.abs(J_ref).max())
+
+
+def hbm_amplitudes(osc, omegas, harmonics, n_samples=None, return_solutions=False):
+    """First-harmonic amplitude of the HBM solution of ``osc`` at exactly the given frequencies.
+
+    Continuation over a range slightly wider than ``omegas`` (no folds here), then Newton at
+    each requested frequency from the nearest branch point.
+    """
+    from bladedamp.hbm.continuation import newton
+
+    system = osc.hbm_system(harmonics, n_samples)
+    frf = osc.frequency_response(0.98 * min(omegas), 1.02 * max(omegas), harmonics, n_samples)
+    assert frf.success, frf.message
+    j = system.basis.cos_index(1)
+    amps, sols = [], []
+    for w in omegas:
+        x0 = frf.coefficients[np.argmin(np.abs(frf.omega - w))].ravel()
+        res = newton(system.residual, x0, w, x_scale=np.abs(x0).max(), residual_scale=abs(osc.forcing))
+        assert res.converged, f"Newton did not converge at omega = {w}"
+        amps.append(np.hypot(res.x[j], res.x[j + 1]))
+        sols.append(res.x)
+    if return_solutions:
+        return np.array(amps), np.array(sols), system
+    return np.array(amps)

@@ -1,0 +1,230 @@
+"""Point contact (2D elastic Coulomb slider + normal law with lift-off) against closed forms.
+
+u is the relative displacement damper - platform, the force is the force on the platform
+(restoring: f = +k_T u while stuck). Loops of a 1D Jenkins element are sampled exactly by
+the return map when the displacement extremes fall on samples (u = A cos tau, T even), so
+the only AFT error is the quadrature of the kinked force: O(1/T^2).
+"""
+import numpy as np
+import pytest
+from conftest import jenkins_dissipation, jenkins_first_harmonic, unilateral_spring_harmonics
+
+from bladedamp.contact import SEPARATED, SLIP, STICK, LinearNormalLaw, point_contact_forces
+from bladedamp.hbm import HarmonicBasis
+
+K_T = 1.0e4      # N/m
+MU = 0.3
+K_N = 2.0e4      # N/m
+N0 = 1.0         # N
+SLIP_FORCE = MU * N0
+LAW = LinearNormalLaw(K_N)
+BIG_T = 2 ** 20
+
+
+def drive(coeffs, basis, k_t=K_T, mu=MU, normal_load=N0, jacobian=False):
+    """Point forces for (C, P, 3) displacement coefficients, every point preloaded by ``normal_load``."""
+    P = coeffs.shape[1]
+    load = np.broadcast_to(np.asarray(normal_load, dtype=float), (P,))
+    return point_contact_forces(coeffs, basis, np.full(P, k_t), np.full(P, mu), LAW, np.ones(P),
+                                load / K_N, jacobian=jacobian)
+
+
+def translation(basis, amplitudes, direction=(1.0, 0.0, 0.0)):
+    """Coefficients of u_p = A_p cos(tau) * direction for every amplitude A_p."""
+    amplitudes = np.atleast_1d(amplitudes)
+    c = np.zeros((basis.n_coeffs, amplitudes.size, 3))
+    c[basis.cos_index(1)] = amplitudes[:, None] * np.asarray(direction)[None, :]
+    return c
+
+
+def first_harmonic(basis, pts, axis=0):
+    """(a1, b1) of the force component ``axis`` of every point."""
+    F = basis.to_coeffs(np.moveaxis(pts.force, 1, 0))  # (C, P, 3)
+    j = basis.cos_index(1)
+    return F[j, :, axis], F[j + 1, :, axis]
+
+
+# ---------------------------------------------------------------------------------------
+# 1D Jenkins describing function
+# ---------------------------------------------------------------------------------------
+def test_jenkins_stick_is_exactly_linear():
+    """k A <= mu N: the slider never moves, the force is k_T u at every sample, k_eq = k_T."""
+    A_stick = SLIP_FORCE / K_T
+    amplitudes = np.array([1e-9, 0.3, 0.9, 1.0]) * A_stick   # 1.0: exactly at the stick limit
+    for T in (64, 1000):
+        basis = HarmonicBasis((1,), T)
+        pts = drive(translation(basis, amplitudes), basis)
+        a1, b1 = first_harmonic(basis, pts)
+        err = np.max(np.abs(a1 / (K_T * amplitudes) - 1))
+        print(f"T={T}: k_eq/k_T - 1 = {err:.2e}")
+        assert err < 1e-12, f"T={T}: k_eq/k_T - 1 = {err:.2e}"
+        assert np.all(np.abs(b1) < 1e-12 * K_T * amplitudes), f"stuck contact dissipates: b1 = {b1}"
+        assert np.all(pts.state == STICK)
+
+
+def test_jenkins_gross_slip_closed_form():
+    """Gross slip at T = 2**20: a1, b1 equal the closed form to 1e-10 relative."""
+    A_stick = SLIP_FORCE / K_T
+    amplitudes = A_stick * np.array([1.001, 1.05, 1.37, 2.0, 5.0, 31.4, 1000.0])
+    basis = HarmonicBasis((1,), BIG_T)
+    pts = drive(translation(basis, amplitudes), basis)
+    a1, b1 = first_harmonic(basis, pts)
+    a1_ref, b1_ref = jenkins_first_harmonic(K_T, SLIP_FORCE, amplitudes)
+    err = np.hypot(a1 - a1_ref, b1 - b1_ref) / np.hypot(a1_ref, b1_ref)
+    print(f"relative errors {np.array2string(err, precision=2)}")
+    assert err.max() < 1e-10, f"relative errors {np.array2string(err, precision=2)}"
+    # the loop really is a stick-slip loop: both states appear at every amplitude
+    for p in range(amplitudes.size):
+        assert {STICK, SLIP} <= set(np.unique(pts.state[p]))
+    # and the dissipation 4 mu N (A - mu N / k) is the quadrature of the same loop
+    W = -np.pi * amplitudes * b1
+    W_ref = jenkins_dissipation(K_T, SLIP_FORCE, amplitudes)
+    assert np.max(np.abs(W / W_ref - 1)) < 1e-10
+
+
+def test_aft_error_is_second_order_in_samples():
+    """The AFT error of the kinked Jenkins force decreases 4x when T doubles (order 2).
+
+    (a) kinks on samples (beta = 2 pi m / 64, on the grid of every T = 64 * 2^j): the
+    ratio is 4 to three digits; (b) amplitudes at random kink positions: the RMS error
+    over 200 amplitudes falls ~4x per doubling as well.
+    """
+    betas = 2 * np.pi * np.array([3, 5, 9, 13]) / 64
+    on_grid = 2 * SLIP_FORCE / K_T / (1 - np.cos(betas))
+    spread = np.geomspace(1.2, 30.0, 200) * SLIP_FORCE / K_T
+    err_grid, err_rms = [], []
+    Ts = [64, 128, 256, 512, 1024]
+    for T in Ts:
+        basis = HarmonicBasis((1,), T)
+        for amps, out in ((on_grid, err_grid), (spread, err_rms)):
+            a1, b1 = first_harmonic(basis, drive(translation(basis, amps), basis))
+            a1_ref, b1_ref = jenkins_first_harmonic(K_T, SLIP_FORCE, amps)
+            e = np.hypot(a1 - a1_ref, b1 - b1_ref) / np.hypot(a1_ref, b1_ref)
+            out.append(e if out is err_grid else np.sqrt(np.mean(e ** 2)))
+    ratio_grid = np.array(err_grid[:-1]) / np.array(err_grid[1:])
+    ratio_rms = np.array(err_rms[:-1]) / np.array(err_rms[1:])
+    print(f"on-grid error ratios per doubling {ratio_grid.round(4)}")
+    assert np.all(np.abs(ratio_grid - 4) < 0.05), f"on-grid error ratios per doubling {ratio_grid.round(4)}"
+    print(f"RMS error ratios per doubling {ratio_rms.round(3)}")
+    assert np.all(np.abs(ratio_rms - 4) < 0.5), f"RMS error ratios per doubling {ratio_rms.round(3)}"
+    print(f"RMS error at the default T = 64: {err_rms[0]:.2e}")
+    assert err_rms[0] < 3e-3, f"RMS error at the default T = 64: {err_rms[0]:.2e}"
+
+
+def test_jacobian_false_and_true_give_the_same_forces():
+    basis = HarmonicBasis((0, 1, 2, 3), 256)
+    rng = np.random.default_rng(1)
+    c = rng.normal(scale=SLIP_FORCE / K_T, size=(basis.n_coeffs, 5, 3))
+    c[:, :, 2] *= 0.2 * N0 / K_N / (SLIP_FORCE / K_T)
+    a = drive(c, basis, jacobian=False)
+    b = drive(c, basis, jacobian=True)
+    assert np.array_equal(a.force, b.force) and np.array_equal(a.state, b.state)
+    assert np.allclose(a.slip_work, b.slip_work, rtol=1e-14, atol=0)
+
+
+# ---------------------------------------------------------------------------------------
+# normal law and lift-off
+# ---------------------------------------------------------------------------------------
+def test_unilateral_normal_force_closed_form():
+    """u_zeta = Z cos tau with Z > a: the point lifts off for cos tau > a/Z; the static and
+    first-harmonic normal force equal the clipped-cosine closed form (T = 2**20)."""
+    a = N0 / K_N
+    Z = a * np.array([1.0, 1.3, 2.0, 7.0])
+    basis = HarmonicBasis((0, 1), BIG_T)
+    pts = drive(translation(basis, Z, direction=(0.0, 0.0, 1.0)), basis)
+    F = basis.to_coeffs(np.moveaxis(pts.force, 1, 0))
+    c0_ref, a1_ref = unilateral_spring_harmonics(K_N, a, Z)
+    j = basis.cos_index(1)
+    e0 = np.abs(F[basis.cos_index(0), :, 2] / c0_ref - 1)
+    e1 = np.abs(F[j, :, 2] / a1_ref - 1)
+    print(f"static {e0.max():.2e}, first harmonic {e1.max():.2e}")
+    assert e0.max() < 1e-10 and e1.max() < 1e-10, f"static {e0.max():.2e}, first harmonic {e1.max():.2e}"
+    assert np.all(np.abs(F[j + 1, :, 2]) < 1e-12 * K_N * Z), "an elastic normal contact must not dissipate"
+    # lift-off where and only where the approach a - u_zeta is <= 0, with zero force there
+    approach = a - pts.displacement[:, :, 2]
+    assert np.array_equal(pts.state == SEPARATED, approach <= 0)
+    assert np.all(pts.force[pts.state == SEPARATED] == 0.0)
+    # no tangential motion: no tangential force
+    assert np.all(pts.force[:, :, :2] == 0.0)
+
+
+def test_friction_limit_follows_the_normal_load():
+    """In slip the tangential force magnitude is mu N(t) with N(t) the instantaneous normal load."""
+    basis = HarmonicBasis((0, 1, 2), 4096)
+    c = np.zeros((basis.n_coeffs, 1, 3))
+    j = basis.cos_index(1)
+    c[j, 0, 0] = 10 * SLIP_FORCE / K_T            # large tangential stroke: slips
+    c[j + 1, 0, 2] = 0.5 * N0 / K_N               # normal load oscillates in [0.5, 1.5] N0
+    pts = drive(c, basis)
+    slip = pts.state[0] == SLIP
+    assert slip.sum() > basis.n_samples // 4
+    mag = np.hypot(pts.force[0, slip, 0], pts.force[0, slip, 1])
+    err = np.abs(mag / (MU * pts.normal_load[0, slip]) - 1).max()
+    print(f"|f_t| / (mu N) - 1 = {err:.2e}")
+    assert err < 1e-13, f"|f_t| / (mu N) - 1 = {err:.2e}"
+    stick = pts.state[0] == STICK
+    assert np.all(np.hypot(pts.force[0, stick, 0], pts.force[0, stick, 1])
+                  <= MU * pts.normal_load[0, stick] * (1 + 1e-12))
+    assert np.allclose(pts.normal_load[0], K_N * (N0 / K_N - pts.displacement[0, :, 2]), rtol=1e-12)
+
+
+# ---------------------------------------------------------------------------------------
+# 2D slider
+# ---------------------------------------------------------------------------------------
+@pytest.mark.parametrize("ratio", [1.5, 4.0, 40.0])
+def test_circular_orbit_full_slip(ratio):
+    """u_t = A (cos tau, sin tau), constant N, A > mu N / k_T: full slip with |f| = mu N at
+    every sample; steady slider circle r_s = sqrt(A^2 - (mu N / k_T)^2); dissipation per cycle
+    2 pi mu N r_s. The 2D radial return is a backward-Euler step along a curved path, so the
+    slider radius and the dissipation converge at first order in 1/T: check the error
+    falls ~16x for 16x more samples and is < 1e-5 at T = 2**20.
+    """
+    A = ratio * SLIP_FORCE / K_T
+    r_s = np.sqrt(A ** 2 - (SLIP_FORCE / K_T) ** 2)
+    W_ref = 2 * np.pi * SLIP_FORCE * r_s
+    errors = []
+    for T in (4096, 65536, BIG_T):
+        basis = HarmonicBasis((1,), T)
+        c = np.zeros((2, 1, 3))
+        c[0, 0, 0] = A
+        c[1, 0, 1] = A
+        pts = drive(c, basis)
+        f = pts.force[0]
+        assert np.all(pts.state == SLIP), f"T={T}: not all samples slip"
+        mag_err = np.abs(np.hypot(f[:, 0], f[:, 1]) / SLIP_FORCE - 1).max()
+        print(f"|f| / (mu N) - 1 = {mag_err:.2e}")
+        assert mag_err < 1e-13, f"|f| / (mu N) - 1 = {mag_err:.2e}"
+        slider = pts.displacement[0, :, :2] - f[:, :2] / K_T
+        r_err = np.abs(np.hypot(slider[:, 0], slider[:, 1]) / r_s - 1).max()
+        F = basis.to_coeffs(f)
+        W = float(np.sum(basis.work_per_cycle(F, c[:, 0, :])))
+        w_err = abs(W / W_ref - 1)
+        slip_err = abs(pts.slip_work[0] / W_ref - 1)
+        errors.append((T, r_err, w_err, slip_err))
+    msg = "; ".join(f"T={T}: slider radius {r:.2e}, work_per_cycle {w:.2e}, slip_work {s:.2e}"
+                    for T, r, w, s in errors)
+    ratios = [errors[i][2] / errors[i + 1][2] for i in range(2)]
+    print(f"error ratios per 16x samples {np.round(ratios, 3)}: {msg}")
+    assert all(10 < q < 25 for q in ratios), f"order-1 convergence expected, ratios {ratios}: {msg}"
+    assert errors[-1][1] < 1e-5 and errors[-1][2] < 1e-5 and errors[-1][3] < 1e-5, msg
+
+
+@pytest.mark.parametrize("angle_deg", [0.0, 30.0, 117.0])
+def test_straight_orbit_is_the_1d_jenkins_loop(angle_deg):
+    """A straight tangential orbit along any direction of the plane gives the 1D loop along
+    that direction and no force across it."""
+    th = np.radians(angle_deg)
+    direction = (np.cos(th), np.sin(th), 0.0)
+    amplitudes = SLIP_FORCE / K_T * np.array([0.7, 1.37, 5.0, 31.4])
+    basis = HarmonicBasis((1,), BIG_T)
+    pts = drive(translation(basis, amplitudes, direction), basis)
+    F = basis.to_coeffs(np.moveaxis(pts.force, 1, 0))           # (C, P, 3)
+    along = F[:, :, 0] * direction[0] + F[:, :, 1] * direction[1]
+    across = -F[:, :, 0] * direction[1] + F[:, :, 1] * direction[0]
+    a1_ref, b1_ref = jenkins_first_harmonic(K_T, SLIP_FORCE, amplitudes)
+    err = np.hypot(along[0] - a1_ref, along[1] - b1_ref) / np.hypot(a1_ref, b1_ref)
+    print(f"angle {angle_deg} deg: relative errors {np.array2string(err, precision=2)}")
+    assert err.max() < 1e-10, f"angle {angle_deg} deg: relative errors {np.array2string(err, precision=2)}"
+    print(f"force across the orbit {np.abs(across).max():.2e} N")
+    assert np.abs(across).max() < 1e-12 * SLIP_FORCE, f"force across the orbit {np.abs(across).max():.2e} N"
+    assert np.abs(pts.force[:, :, 1] * direction[0] - pts.force[:, :, 0] * direction[1]).max() < 1e-12 * SLIP_FORCE

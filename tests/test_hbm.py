@@ -1,0 +1,325 @@
+"""Harmonic balance engine: Fourier basis, residual Jacobian, continuation through folds, failures."""
+import warnings
+
+import numpy as np
+import pytest
+import scipy.optimize
+from conftest import central_difference, duffing_jenkins_residual, relative_matrix_error
+
+from bladedamp import FrictionOscillator
+from bladedamp.contact import SEPARATED, SLIP, STICK
+from bladedamp.hbm import HarmonicBasis
+from bladedamp.hbm.continuation import ConvergenceWarning, continuation, newton
+from bladedamp.hbm.system import Coupling
+
+
+# ---------------------------------------------------------------------------------------
+# Fourier basis against analytic signals
+# ---------------------------------------------------------------------------------------
+@pytest.mark.parametrize("harmonics", [(1,), (0, 1, 2, 3), (1, 3, 5, 7)], ids=str)
+def test_basis_synthesis_derivative_and_work(harmonics):
+    """Synthesis, analysis, d/dtau and work_per_cycle against the analytic signals
+    x = c0 + sum a_h cos(h tau) + b_h sin(h tau)."""
+    basis = HarmonicBasis(harmonics)
+    rng = np.random.default_rng(3)
+    c = rng.normal(size=(basis.n_coeffs, 2))
+    g = rng.normal(size=(basis.n_coeffs, 2))
+    tau = basis.tau
+
+    def signal(coeffs, tau, derivative=False):
+        out = np.zeros((tau.size, coeffs.shape[1]))
+        for h in basis.harmonics:
+            j = basis.cos_index(h)
+            if h == 0:
+                out += 0.0 if derivative else coeffs[j]
+            elif derivative:
+                out += h * (-np.outer(np.sin(h * tau), coeffs[j]) + np.outer(np.cos(h * tau), coeffs[j + 1]))
+            else:
+                out += np.outer(np.cos(h * tau), coeffs[j]) + np.outer(np.sin(h * tau), coeffs[j + 1])
+        return out
+
+    assert np.allclose(basis.to_time(c), signal(c, tau), atol=1e-13)
+    assert np.allclose(basis.to_coeffs(basis.to_time(c)), c, atol=1e-13)
+    assert np.allclose(basis.to_time(basis.derivative @ c), signal(c, tau, derivative=True), atol=1e-12)
+    # oint f dx over a period by a fine independent quadrature (trapezoid on 10007 points)
+    fine = 2 * np.pi * np.arange(10007) / 10007
+    W_ref = np.sum(signal(g, fine) * signal(c, fine, derivative=True), axis=0) * 2 * np.pi / fine.size
+    W = basis.work_per_cycle(g, c)
+    assert np.allclose(W, W_ref, rtol=1e-10, atol=1e-12), f"{W} vs {W_ref}"
+    # complex amplitudes X_h = a_h - i b_h: x(tau) = sum_h Re(X_h e^{i h tau})
+    X = basis.to_complex(c)
+    x_c = sum(np.real(np.outer(np.exp(1j * h * tau), X[h])) for h in basis.harmonics)
+    assert np.allclose(x_c, signal(c, tau), atol=1e-13)
+    assert np.allclose(basis.from_complex(X), c)
+
+
+def test_dynamic_stiffness_is_the_equation_of_motion():
+    """A(Omega) x = coefficients of M x'' + D x' + K x (x'' w.r.t. t = Omega^2 d2/dtau2), 2 DOF."""
+    basis = HarmonicBasis((0, 1, 2, 5))
+    M = np.array([[2.0, 0.3], [0.3, 1.0]])
+    D = np.array([[0.5, -0.1], [-0.1, 0.2]])
+    K = np.array([[3e4, -1e4], [-1e4, 2e4]])
+    omega = 123.4
+    rng = np.random.default_rng(5)
+    X = rng.normal(size=(basis.n_coeffs, 2))
+    A, dA = basis.dynamic_stiffness(omega, M, D, K)
+    d = basis.derivative
+    ref = (X @ K.T) + omega * (d @ X) @ D.T + omega ** 2 * (d @ d @ X) @ M.T
+    assert np.allclose((A @ X.ravel()).reshape(X.shape), ref, rtol=1e-12, atol=1e-9)
+    dA_fd = (basis.dynamic_stiffness(omega + 1e-4, M, D, K)[0]
+             - basis.dynamic_stiffness(omega - 1e-4, M, D, K)[0]) / 2e-4
+    assert relative_matrix_error(dA, dA_fd) < 1e-9
+    # and the complex form of paper Eq. 5 per harmonic: K - (h Omega)^2 M + i h Omega D
+    A_c = basis.real_form(lambda h: K - (h * omega) ** 2 * M + 1j * h * omega * D)
+    assert relative_matrix_error(A, A_c) < 1e-14
+
+
+def test_real_form_is_complex_multiplication():
+    """real_form(G_h) acting on coefficients = G_h X_h on complex amplitudes."""
+    basis = HarmonicBasis((0, 1, 3))
+    rng = np.random.default_rng(7)
+    G = {h: rng.normal(size=(2, 3)) + (1j * rng.normal(size=(2, 3)) if h else 0) for h in basis.harmonics}
+    X = rng.normal(size=(basis.n_coeffs, 3))
+    Y = (basis.real_form(lambda h: G[h]) @ X.ravel()).reshape(basis.n_coeffs, 2)
+    Xc, Yc = basis.to_complex(X), basis.to_complex(Y)
+    for h in basis.harmonics:
+        assert np.allclose(Yc[h], G[h] @ Xc[h], atol=1e-13)
+
+
+# ---------------------------------------------------------------------------------------
+# residual Jacobian against finite differences
+# ---------------------------------------------------------------------------------------
+@pytest.mark.parametrize("harmonics", [(1,), (0, 1, 2, 3), (1, 3, 5)], ids=str)
+def test_residual_jacobian_matches_finite_differences(harmonics):
+    """dR/dx and dR/dOmega of the FrictionOscillator (inclined contact with lift-off, cubic
+    spring) equal central differences, at a state with stick, slip and lift-off."""
+    osc = FrictionOscillator(damping=2.0, normal_load=3.0, forcing=2.0, contact_angle=0.3,
+                             normal_stiffness=1.5e4, cubic_stiffness=1e9)
+    system = osc.hbm_system(harmonics)
+    basis = system.basis
+    C = basis.n_coeffs
+    rng = np.random.default_rng(11)
+    x = rng.normal(scale=3e-4, size=C)
+    x[basis.cos_index(1)] = 2.5e-3        # x sin(alpha) reaches -N0/k_N: lift-off
+    omega = 117.0
+    contact = system.couplings[0]
+    pts = contact.element.samples(contact.matrix @ x, basis)
+    counts = np.bincount(pts.state.ravel(), minlength=3)
+    assert counts[STICK] > 0 and counts[SLIP] > 0 and counts[SEPARATED] > 0, f"state mix {counts}"
+    R, J, Rw = system.residual(x, omega)
+    step = 1e-6 * np.abs(x).max()
+    J_fd = central_difference(lambda y: system.residual(y, omega, jacobian=False)[0], x, step)
+    Rw_fd = (system.residual(x, omega + 1e-4, False)[0] - system.residual(x, omega - 1e-4, False)[0]) / 2e-4
+    err_x = relative_matrix_error(J, J_fd)
+    err_w = np.abs(Rw - Rw_fd).max() / np.abs(Rw).max()
+    print(f"states {counts.tolist()}: dR/dx rel err {err_x:.2e}, dR/dOmega rel err {err_w:.2e}")
+    assert err_x < 1e-6 and err_w < 1e-6, \
+        f"states {counts.tolist()}: dR/dx rel err {err_x:.2e}, dR/dOmega rel err {err_w:.2e}"
+
+
+# ---------------------------------------------------------------------------------------
+# continuation through folds: hardening Duffing + friction
+# ---------------------------------------------------------------------------------------
+DUFFING = dict(damping=2.0, normal_load=3.0, forcing=2.0, cubic_stiffness=1e9)
+FOLD_SAMPLES = 4096          # AFT samples: describing-function error ~1e-7 at the kinks
+
+
+@pytest.fixture(scope="module")
+def duffing_frf():
+    osc = FrictionOscillator(**DUFFING)
+    return osc, osc.frequency_response(100.0, 160.0, harmonics=(1,), n_samples=FOLD_SAMPLES)
+
+
+def _closed_form_fold(osc, A0, w0):
+    """Fold of the single-harmonic describing-function FRF: G = 0 and dG/dA = 0."""
+    def eqs(z):
+        A, w = z
+        h = 1e-6 * A
+        G = lambda a: duffing_jenkins_residual(a, w, osc) * a ** 2 / osc.forcing ** 2
+        return [G(A), (G(A + h) - G(A - h)) / (2 * h) * A]
+    sol = scipy.optimize.root(eqs, [A0, w0], tol=1e-14)
+    assert np.max(np.abs(eqs(sol.x))) < 1e-9, sol.message
+    return sol.x
+
+
+def _refined_hbm_fold(system, frf, tp, kind):
+    """Extremum of omega along the HBM branch between points tp-1 and tp+1.
+
+    Points y = (x / s, omega / 100) on the hyperplane n . (y - y_tp) = sigma, n the secant
+    from tp-1 to tp+1, solved by Newton with the analytic Jacobian; then a bounded scalar
+    search for the extremum of omega(sigma).
+    """
+    s = np.abs(frf.coefficients[tp]).max()
+    Y = np.hstack([frf.coefficients[:, :, 0] / s, frf.omega[:, None] / 100])
+    n = Y[tp + 1] - Y[tp - 1]
+    n /= np.linalg.norm(n)
+
+    def solve(sigma):
+        y = Y[tp] + sigma * n
+        for _ in range(50):
+            R, J, Rw = system.residual(y[:-1] * s, y[-1] * 100)
+            G = np.append(R / system.excitation(0)[0].max(), n @ (y - Y[tp]) - sigma)
+            M = np.vstack([np.hstack([J * s, Rw[:, None] * 100]) / system.excitation(0)[0].max(), n])
+            dy = np.linalg.solve(M, -G)
+            y = y + dy
+            if np.linalg.norm(dy) < 1e-13:
+                return y
+        raise AssertionError(f"fold refinement: Newton did not converge at sigma = {sigma}")
+
+    lo, hi = n @ (Y[tp - 1] - Y[tp]), n @ (Y[tp + 1] - Y[tp])
+    best = scipy.optimize.minimize_scalar(lambda sg: -kind * solve(sg)[-1], bounds=(lo, hi), method="bounded",
+                                          options={"xatol": 1e-12})
+    y = solve(best.x)
+    return np.hypot(*y[:-1]) * s, y[-1] * 100
+
+
+def test_continuation_passes_two_folds(duffing_frf):
+    """Two turning points; the closed-form folds (describing function of Duffing + Jenkins)
+    lie on the branch segments around the turning points; the refined HBM fold matches them:
+    frequency to 1e-6, amplitude to 1e-3 (the fold amplitude is where d omega / dA = 0; the ~1e-7 AFT error of the kinked force oscillates in A with a period
+    ~1/T, so its A-derivative, which moves the fold, is ~T times larger)."""
+    osc, frf = duffing_frf
+    assert frf.success, frf.message
+    tps = frf.turning_points
+    assert len(tps) == 2, f"turning points at {frf.omega[tps]} rad/s"
+    a, w = frf.harmonic_amplitude(), frf.omega
+    system = osc.hbm_system((1,), FOLD_SAMPLES)
+    kinds = []
+    for tp in tps:
+        A_f, w_f = _closed_form_fold(osc, a[tp], w[tp])
+        # the fold lies between the neighbours of the turning point (tp-1 and tp+1)
+        lo, hi = a[tp - 1:tp + 2].min(), a[tp - 1:tp + 2].max()
+        print(f"closed-form fold amplitude {A_f:.6e}, turning segment [{lo:.6e}, {hi:.6e}]")
+        assert lo <= A_f <= hi, f"closed-form fold amplitude {A_f:.6e} not in the turning segment [{lo:.6e}, {hi:.6e}]"
+        kind = np.sign(w[tp - 1] - w[tp - 2])     # +1: omega was increasing -> maximum
+        kinds.append(kind)
+        near = w[max(tp - 5, 0):tp + 5]
+        extreme = near.max() if kind > 0 else near.min()
+        print(f"closed-form fold frequency {w_f:.6f}, extreme branch frequency {extreme:.6f}")
+        assert kind * (extreme - w_f) <= 1e-6 * w_f, f"branch goes beyond the fold frequency {w_f:.6f}: {extreme:.6f}"
+        # HBM fold, refined: solutions on hyperplanes across the branch near the turning
+        # segment, omega(sigma) maximised/minimised by a bounded scalar search
+        A_h, w_h = _refined_hbm_fold(system, frf, tp, kind)
+        print(f"HBM fold ({A_h:.6e} m, {w_h:.6f} rad/s) vs closed form ({A_f:.6e} m, {w_f:.6f} rad/s): "
+              f"rel {A_h / A_f - 1:.1e}, {w_h / w_f - 1:.1e}")
+        assert abs(w_h / w_f - 1) < 1e-6 and abs(A_h / A_f - 1) < 1e-3, \
+            f"HBM fold ({A_h:.6e} m, {w_h:.6f} rad/s) vs closed form ({A_f:.6e} m, {w_f:.6f} rad/s): " \
+            f"rel {A_h / A_f - 1:.1e}, {w_h / w_f - 1:.1e}"
+    assert kinds == [1, -1], "expected the jump-down fold (omega max) first, then the jump-up fold (omega min)"
+
+
+def test_three_solutions_between_the_folds(duffing_frf):
+    """Between the fold frequencies the branch crosses the frequency three times; Newton from
+    each crossing converges to the three closed-form amplitudes (1e-5)."""
+    osc, frf = duffing_frf
+    a, w = frf.harmonic_amplitude(), frf.omega
+    w_mid = w[frf.turning_points].mean()
+    d = w - w_mid
+    crossings = np.flatnonzero(np.sign(d[:-1]) != np.sign(d[1:]))
+    assert crossings.size == 3, f"{crossings.size} crossings of {w_mid:.3f} rad/s"
+    system = osc.hbm_system((1,), FOLD_SAMPLES)
+    amps = []
+    for i in crossings:
+        res = newton(system.residual, frf.coefficients[i].ravel(), w_mid, np.abs(frf.coefficients[i]).max(),
+                     osc.forcing)
+        assert res.converged
+        amps.append(np.hypot(*res.x))
+    grid = np.geomspace(1e-5, 1e-2, 20001)
+    g = duffing_jenkins_residual(grid, w_mid, osc)
+    roots = [scipy.optimize.brentq(duffing_jenkins_residual, grid[i], grid[i + 1], args=(w_mid, osc), xtol=1e-16)
+             for i in np.flatnonzero(np.sign(g[:-1]) != np.sign(g[1:]))]
+    assert len(roots) == 3, f"closed form has {len(roots)} solutions"
+    err = np.abs(np.sort(amps) / np.sort(roots) - 1)
+    print(f"amplitudes {np.sort(amps)} vs closed form {np.sort(roots)}: rel err {err}")
+    assert err.max() < 1e-5, f"amplitudes {np.sort(amps)} vs closed form {np.sort(roots)}: rel err {err}"
+    assert len(set(np.round(np.sort(amps) / max(amps), 3))) == 3, "the three solutions must be distinct"
+
+
+def test_every_branch_point_solves_the_residual(duffing_frf):
+    osc, frf = duffing_frf
+    system = osc.hbm_system((1,), FOLD_SAMPLES)
+    worst = max(np.linalg.norm(system.residual(X.ravel(), om, jacobian=False)[0]) / osc.forcing
+                for om, X in zip(frf.omega, frf.coefficients))
+    print(f"max scaled residual on the branch {worst:.2e}")
+    assert worst < 1e-8, f"max scaled residual on the branch {worst:.2e}"
+    # and the closed-form describing-function equation, relative to |F/A|^2
+    a = frf.harmonic_amplitude()
+    g = duffing_jenkins_residual(a, frf.omega, osc) * a ** 2 / osc.forcing ** 2
+    print(f"max |G| A^2/F^2 on the branch {np.abs(g).max():.2e}")
+    assert np.abs(g).max() < 1e-5, f"max |G| A^2/F^2 on the branch {np.abs(g).max():.2e}"
+
+
+@pytest.mark.parametrize("harmonics", [(1, 3), (1, 3, 5, 7)], ids=str)
+def test_continuation_passes_corners_of_the_branch(harmonics):
+    """Below the resonance the multi-harmonic response has local displacement extrema; when
+    one of them reaches the friction limit a new slip phase is born and the AFT residual has
+    a kink (the force is C0, not C1, there): the branch has a corner at ~25 and ~39.5 rad/s.
+    The pseudo-arclength corrector cycles between the two pieces at any step size; the
+    continuation must still reach the end (it used to stop at 25.3 / 39.55 rad/s)."""
+    osc = FrictionOscillator(damping=2.0, normal_load=3.0, forcing=2.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ConvergenceWarning)
+        frf = osc.frequency_response(20.0, 200.0, harmonics=harmonics)
+    assert frf.success, frf.message
+    assert frf.omega[-1] == 200.0 and np.all(np.diff(frf.omega) > 0)
+    system = osc.hbm_system(harmonics)
+    worst = max(np.linalg.norm(system.residual(X.ravel(), om, jacobian=False)[0]) / osc.forcing
+                for om, X in zip(frf.omega, frf.coefficients))
+    print(f"max scaled residual on the branch {worst:.2e}")
+    assert worst < 1e-8, f"max scaled residual on the branch {worst:.2e}"
+
+
+# ---------------------------------------------------------------------------------------
+# failures are reported, not hidden
+# ---------------------------------------------------------------------------------------
+class NaNAbove:
+    """A broken element: NaN forces above ``omega_bad``."""
+
+    n_local = 1
+
+    def __init__(self, omega_bad):
+        self.omega_bad = omega_bad
+
+    def harmonic_forces(self, local, basis, omega, jacobian=True):
+        C = basis.n_coeffs
+        force = np.zeros((C, 1)) + (np.nan if omega > self.omega_bad else 0.0)
+        return force, (np.zeros((C, C)) if jacobian else None), None
+
+
+def _broken_system(omega_bad):
+    osc = FrictionOscillator(damping=2.0, normal_load=3.0, forcing=2.0)
+    system = osc.hbm_system((1, 3))
+    system.couplings.append(Coupling(NaNAbove(omega_bad), np.eye(system.basis.n_coeffs), "broken"))
+    return system
+
+
+def test_nan_element_stops_with_message_and_keeps_branch():
+    system = _broken_system(115.0)
+    with pytest.warns(ConvergenceWarning, match="115"):
+        branch = continuation(system.residual, system.linear_solution(90.0), 90.0, 140.0, x_scale=1e-3)
+    assert not branch.success
+    assert branch.omega.size > 10 and branch.x.shape == (branch.omega.size, system.n_unknowns)
+    assert branch.omega.max() <= 115.0 and branch.omega[-1] > 115.0 - 1e-3, f"stopped at {branch.omega[-1]}"
+    assert f"{branch.omega[-1]:.6g}" in branch.message, branch.message
+    worst = max(np.linalg.norm(system.residual(x, om, False)[0]) for om, x in zip(branch.omega, branch.x))
+    assert worst < 1e-8, "the kept points must be converged solutions"
+
+
+def test_newton_failure_at_the_start_is_reported():
+    system = _broken_system(100.0)
+    with pytest.warns(ConvergenceWarning, match=r"start, omega = 120"):
+        branch = continuation(system.residual, system.linear_solution(120.0), 120.0, 140.0, x_scale=1e-3)
+    assert not branch.success and branch.omega.size == 0 and "120" in branch.message
+
+
+def test_absurd_settings_fail_gracefully():
+    osc = FrictionOscillator(damping=2.0, normal_load=3.0, forcing=2.0)
+    # a minimum step above the first step: no step can be tried
+    with pytest.warns(ConvergenceWarning, match="90"):
+        frf = osc.frequency_response(90.0, 140.0, step=0.01, min_step=0.5)
+    assert not frf.success and frf.omega.size == 1 and "90" in frf.message
+    # too few points for the range
+    with pytest.warns(ConvergenceWarning, match="max_points"):
+        frf = osc.frequency_response(90.0, 140.0, max_points=10)
+    assert not frf.success and frf.omega.size == 10 and f"{frf.omega[-1]:.6g}" in frf.message
+    assert np.all(np.diff(frf.omega) > 0)

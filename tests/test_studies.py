@@ -1,0 +1,233 @@
+"""Damper design studies (bladedamp.studies.design): engine orders, asymmetric platforms,
+contact state (Eq. 27, Fig. 11) and wedge lift-off (Fig. 9).
+
+Each test checks a physical statement of the paper (Panning, Sextro, Popp) or a symmetry
+of the model, not a stored number of the code under test.
+"""
+from __future__ import annotations
+
+import dataclasses
+import warnings
+
+import numpy as np
+import pytest
+
+from bladedamp.reference import reference_disk
+from bladedamp.studies.design import (contact_state, engine_order_sweep, platform_angle_study,
+                                      wedge_liftoff_map)
+from bladedamp.studies.mass import peak_response, with_mass
+
+ROTOR_SPEED_EO0 = 2 * np.pi * 95
+
+
+def _angles(disk, left_deg, right_deg):
+    return dataclasses.replace(disk, gamma_left=np.radians(left_deg), gamma_right=np.radians(right_deg))
+
+
+@pytest.fixture(autouse=True)
+def _quiet():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        yield
+
+
+# ---------------------------------------------------------------------------------------
+# bad input
+# ---------------------------------------------------------------------------------------
+@pytest.mark.parametrize("call, match", [
+    (lambda: engine_order_sweep("cylinder", []), "engine_orders"),
+    (lambda: engine_order_sweep("cylinder", [9]), "engine_orders"),
+    (lambda: engine_order_sweep("cylinder", [1], mass_bounds=(0.0, 1e-2)), "mass_bounds"),
+    (lambda: engine_order_sweep("cylinder", [1], mass_bounds=(1e-2, 1e-3)), "mass_bounds"),
+    (lambda: engine_order_sweep("cylinder", [1], mass_bounds=(-1e-3, 1e-2)), "mass_bounds"),
+    (lambda: engine_order_sweep("cone", [1]), "kind"),
+    (lambda: engine_order_sweep("cylinder", [0], rotor_speed_eo0=0.0), "rotor_speed_eo0"),
+    (lambda: engine_order_sweep("cylinder", [1], f_range_hz=(105.0, 90.0)), "f_range_hz"),
+    (lambda: platform_angle_study([]), "gamma_right_deg"),
+    (lambda: platform_angle_study([90.0]), "gamma_right_deg"),
+    (lambda: platform_angle_study([35.0], gamma_left_deg=0.0), "gamma_left_deg"),
+    (lambda: platform_angle_study([35.0], fixed_mass=0.0), "fixed_mass"),
+    (lambda: platform_angle_study([35.0], mass_bounds=(1e-3, 1e-3)), "mass_bounds"),
+    (lambda: contact_state(reference_disk(None)), "damper"),
+    (lambda: contact_state(reference_disk("cylinder"), f_range_hz=(0.0, 90.0)), "f_range_hz"),
+    (lambda: wedge_liftoff_map(reference_disk("wedge"), f_range_hz=()), "f_range_hz"),
+])
+def test_bad_input_raises_value_error_naming_the_parameter(call, match):
+    with pytest.raises(ValueError, match=match):
+        call()
+
+
+# ---------------------------------------------------------------------------------------
+# engine orders (Fig. 7, 8)
+# ---------------------------------------------------------------------------------------
+def test_eo0_cylinder_rolls_optimum_is_the_undamped_amplitude():
+    """EO = 0: the cylinder rolls, no mass reduces the resonance by more than 1 %."""
+    s = engine_order_sweep("cylinder", [0], mass_bounds=(1e-4, 1e-2), xatol=0.1)
+    assert not s.failures
+    assert abs(s.optimal_peak_tip[0] / s.undamped_peak_tip[0] - 1) < 0.01
+    assert np.isnan(s.optimal_mass[0])
+    # and the rolling is real: already at a single mass the peak is the undamped one within 1 %
+    p, _, _ = peak_response(reference_disk("cylinder", 3e-3, engine_order=0, rotor_speed=ROTOR_SPEED_EO0))
+    assert abs(p / s.undamped_peak_tip[0] - 1) < 0.01
+
+
+def test_eo0_wedge_damps_where_the_cylinder_rolls():
+    """EO = 0: the wedge cannot roll (contact height), one mass already damps clearly."""
+    wedge = reference_disk("wedge", 1e-3, engine_order=0, rotor_speed=ROTOR_SPEED_EO0)
+    p, _, _ = peak_response(wedge)
+    undamped, _, _ = peak_response(reference_disk(None))
+    assert p < 0.6 * undamped
+
+
+@pytest.mark.slow
+def test_eo0_wedge_optimum_clearly_below_undamped():
+    s = engine_order_sweep("wedge", [0], mass_bounds=(1e-4, 1e-2), xatol=0.1)
+    assert not s.failures
+    assert s.reduction[0] > 0.4
+    assert np.isfinite(s.optimal_mass[0])
+
+
+@pytest.mark.slow
+def test_optimal_mass_is_a_true_minimum():
+    """The optimiser's mass gives a lower peak than 0.8 and 1.25 times that mass (EO = 1)."""
+    s = engine_order_sweep("cylinder", [1], mass_bounds=(5e-5, 5e-3), xatol=0.03)
+    m, p = s.optimal_mass[0], s.optimal_peak_tip[0]
+    assert np.isfinite(m) and s.reduction[0] > 0.3
+    disk = reference_disk("cylinder", m, engine_order=1)
+    for factor in (0.8, 1.25):
+        assert peak_response(with_mass(disk, factor * m))[0] > p
+
+
+# ---------------------------------------------------------------------------------------
+# asymmetric platforms (Fig. 10)
+# ---------------------------------------------------------------------------------------
+def test_mirror_symmetry_standing_wave():
+    """(gamma_L, gamma_R) = (35, 60) and (60, 35) are mirror images: same peak. Exact for a
+    standing wave (EO = 0; the wedge, since the cylinder rolls there)."""
+    d = reference_disk("wedge", 1e-3, engine_order=0, rotor_speed=ROTOR_SPEED_EO0)
+    pa = peak_response(_angles(d, 35, 60), max_step=0.02)[0]
+    pb = peak_response(_angles(d, 60, 35), max_step=0.02)[0]
+    assert abs(pa - pb) / pa < 1e-4            # measured 1.9e-5 (peak interpolation)
+
+
+def _mirror_difference_eo1():
+    d = reference_disk("cylinder", 1e-3)
+    pa = peak_response(_angles(d, 35, 60), (94.0, 97.0), max_step=0.02)[0]
+    pb = peak_response(_angles(d, 60, 35), (94.0, 97.0), max_step=0.02)[0]
+    return abs(pa - pb) / pa
+
+
+def test_mirror_symmetry_eo1_within_peak_resolution():
+    """EO = 1, 1 g cylinder: exchanging gamma_L and gamma_R changes the peak by < 1e-3
+    (measured 2.2e-4; 2.1e-2 before the radial platform mismatch was split half/half)."""
+    assert _mirror_difference_eo1() < 1e-3
+
+
+@pytest.mark.xfail(strict=False, reason=(
+    "paper: exchanging gamma_L and gamma_R gives the same results. Measured at EO = 1 (1 g "
+    "cylinder, 35/60 vs 60/35 deg): peaks 0.416942 / 0.417035 mm, relative difference 2.2e-4 "
+    "(1.9e-4 at max_step 0.005, so not the peak interpolation); at EO = 0 (standing wave) the "
+    "difference is 2e-5. A travelling wave (EO != 0, n/2) is mapped to EO -> -EO by the mirror, "
+    "so exact equality is not guaranteed with friction and damper inertia."))
+def test_mirror_symmetry_eo1_exact_as_in_the_paper():
+    assert _mirror_difference_eo1() < 1e-5
+
+
+def test_platform_angle_study_fixed_mass_symmetric_matches_peak_response():
+    s = platform_angle_study([35.0], optimise=False)
+    p, _, _ = peak_response(reference_disk("cylinder", 1e-3))
+    assert s.peak_tip_at_fixed_mass[0] == pytest.approx(p, rel=1e-9)
+    assert s.peak_tip_at_fixed_mass[0] < s.undamped_peak_tip
+    assert np.isnan(s.optimal_mass[0])
+
+
+# ---------------------------------------------------------------------------------------
+# contact state (Eq. 27, Fig. 11)
+# ---------------------------------------------------------------------------------------
+def test_gamma_r_85_left_sticks_right_slides():
+    """Paper: at gamma_R = 85 deg |w*_OL| < 1 (stick, F* ~ w*), |w*_OR| > 1 (slide, |F*| ~ 1).
+    Measured: w*_OL = -0.226 - 0.666j (|.| 0.704), w*_OR = 3.031 + 1.335j (|.| 3.31),
+    F_N = 10.95 N (OL), 6.31 N (OR)."""
+    d = _angles(reference_disk("cylinder", 1e-3), 35, 85)
+    cs = contact_state(d)
+    assert abs(cs.w_star[0]) < 1
+    assert abs(cs.w_star[1]) > 1
+    assert abs(cs.F_star[0] - cs.w_star[0]) < 1e-6 * abs(cs.w_star[0])   # whole contact sticks
+    assert abs(cs.F_star[1]) < abs(cs.w_star[1])                        # friction-limited
+    assert cs.normal_load[1] < cs.normal_load[0]                        # less normal force at OR
+    # normalisation (Eq. 27)
+    assert cs.normal_load == pytest.approx(d.static_normal_loads(2 * np.pi * cs.resonance_hz), rel=1e-9)
+    assert cs.w_star == pytest.approx(cs.w_xi * cs.tangential_stiffness / (cs.friction_coefficient * cs.normal_load))
+
+
+def test_symmetric_platforms_equal_contact_states_standing_wave():
+    """Symmetric platforms, EO = 0: both contacts see exactly the same normalised motion."""
+    cs = contact_state(reference_disk("wedge", 1e-3, engine_order=0, rotor_speed=ROTOR_SPEED_EO0))
+    assert abs(abs(cs.w_star[0]) - abs(cs.w_star[1])) < 1e-6 * abs(cs.w_star[0])
+    assert cs.normal_load[0] == pytest.approx(cs.normal_load[1], rel=1e-12)
+
+
+def test_symmetric_platforms_eo1_equal_magnitude_opposite_phase():
+    """Paper: equal conditions at OL and OR, 180 deg phase shift. In the model (travelling
+    wave, EO = 1) the magnitudes agree to 3.2 % (2.620 vs 2.538), the phases differ by ~180 deg."""
+    cs = contact_state(reference_disk("cylinder", 1e-3))
+    a, b = np.abs(cs.w_star)
+    assert abs(a - b) / max(a, b) < 0.05
+    assert a > 1 and b > 1                     # both slide at the reference optimum
+    dphase = np.degrees(np.angle(cs.w_star[1] / cs.w_star[0]))
+    assert abs(abs(dphase) - 180) < 10
+
+
+def test_contact_state_plot():
+    import matplotlib
+    matplotlib.use("Agg")
+    cs = contact_state(reference_disk("cylinder", 1e-3))
+    assert cs.plot() is not None
+
+
+# ---------------------------------------------------------------------------------------
+# lift-off (Fig. 9)
+# ---------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def liftoff_maps():
+    """Wedge of 1 g: below (F_x = 0.04 N) and just above (0.07 N) the lift-off threshold."""
+    out = {}
+    for F in (0.04, 0.07):
+        disk = reference_disk("wedge", 1e-3, excitation=np.array([F, 0, 0, 0, 0, 0]))
+        out[F] = (disk, wedge_liftoff_map(disk))
+    return out
+
+
+def test_liftoff_ratio_two_ways_agree(liftoff_maps):
+    """r from the first-harmonic amplitude and from the AFT time samples of the approach."""
+    for disk, lm in liftoff_maps.values():
+        T = lm.n_samples
+        # max over T samples of cos lies within cos(pi / T) of the true maximum
+        assert np.all(lm.ratio_time <= lm.ratio * (1 + 1e-12))
+        assert np.all(lm.ratio_time >= lm.ratio * np.cos(np.pi / T) - 1e-12)
+        clear = np.abs(lm.ratio - 1) > 1 - np.cos(np.pi / T)
+        assert np.array_equal((lm.min_approach < 0)[clear], (lm.ratio > 1)[clear])
+        # the static approach is the disk's own preload (TunedDisk._approach_function)
+        approach = disk._approach_function(disk.damper_geometry(), disk.hbm_system().basis)
+        assert lm.static_approach == pytest.approx(approach(2 * np.pi * lm.resonance_hz)[0], rel=1e-8)
+
+
+def test_liftoff_first_at_the_edges(liftoff_maps):
+    """Increasing the excitation, the first points to lift off (r > 1) are in the outermost
+    rows across the contact height (|xi*| = 0.4, the cells at the edges xi* = +-0.5)."""
+    _, below = liftoff_maps[0.04]
+    _, above = liftoff_maps[0.07]
+    assert below.ratio.max() < 1
+    assert above.ratio.max() > 1
+    edge = np.isclose(np.abs(above.xi_star), np.abs(above.xi_star).max())
+    lifted = above.ratio > 1
+    assert lifted.any()
+    assert np.all(edge[None, :] | ~lifted)
+    for c in range(2):                         # the largest ratio of each contact is at an edge
+        assert edge[np.argmax(above.ratio[c])]
+
+
+def test_liftoff_plot(liftoff_maps):
+    import matplotlib
+    matplotlib.use("Agg")
+    assert liftoff_maps[0.07][1].plot() is not None

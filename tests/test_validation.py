@@ -1,0 +1,84 @@
+"""Bad input is refused with a ValueError that names the parameter."""
+import numpy as np
+import pytest
+
+from bladedamp import ContactPatch, FrictionOscillator, HarmonicBasis, LinearNormalLaw, RoughnessNormalLaw
+from bladedamp.contact.point import PointContactElement
+from bladedamp.hbm.continuation import continuation
+
+LAW = LinearNormalLaw(1e5)
+
+
+def _patch(**kw):
+    args = dict(height=0.004, length=0.02, tangential_stiffness=1e5, friction_coefficient=0.4, normal_law=LAW)
+    args.update(kw)
+    return ContactPatch(**args)
+
+
+def _dummy_residual(x, omega):
+    return x - 1.0, np.eye(x.size), np.zeros(x.size)
+
+
+CASES = {
+    # negative / zero stiffness
+    "negative stiffness": (lambda: FrictionOscillator(stiffness=-1.0), "stiffness"),
+    "zero contact stiffness": (lambda: FrictionOscillator(contact_stiffness=0.0), "contact_stiffness"),
+    "negative normal stiffness": (lambda: FrictionOscillator(normal_stiffness=-1.0), "normal_stiffness"),
+    "negative patch k_T": (lambda: _patch(tangential_stiffness=-1e5), "tangential stiffness"),
+    "negative law k_N": (lambda: LinearNormalLaw(-1.0), "normal stiffness"),
+    "negative point k_T": (lambda: PointContactElement(-1.0, 0.3, LAW, 1.0, 0.0), "tangential stiffness"),
+    # friction coefficient
+    "negative mu (oscillator)": (lambda: FrictionOscillator(friction_coefficient=-0.1), "friction_coefficient"),
+    "negative mu (patch)": (lambda: _patch(friction_coefficient=-0.4), "friction coefficient"),
+    "negative mu (point)": (lambda: PointContactElement(1e4, -0.3, LAW, 1.0, 0.0), "friction coefficient"),
+    # other physical parameters
+    "negative mass": (lambda: FrictionOscillator(mass=-1.0), "mass"),
+    "negative damping": (lambda: FrictionOscillator(damping=-1.0), "damping"),
+    "negative normal load": (lambda: FrictionOscillator(normal_load=-1.0), "normal_load"),
+    "contact angle 90 deg": (lambda: FrictionOscillator(contact_angle=np.pi / 2), "contact_angle"),
+    "roughness exponent < 1": (lambda: RoughnessNormalLaw(1e5, 10.0, 0.5), "exponent"),
+    "patch weights not summing to 1": (lambda: _patch(n_xi=1, n_eta=2, weights=[0.3, 0.3]), "weights"),
+    "patch n_xi = 0": (lambda: _patch(n_xi=0), "n_xi"),
+    # NaN / inf
+    "NaN forcing": (lambda: FrictionOscillator(forcing=np.nan), "forcing"),
+    "inf mass": (lambda: FrictionOscillator(mass=np.inf), "mass"),
+    "NaN normal load": (lambda: FrictionOscillator(normal_load=np.nan), "normal_load"),
+    "NaN cubic stiffness": (lambda: FrictionOscillator(cubic_stiffness=np.nan), "cubic_stiffness"),
+    "NaN law k_N": (lambda: LinearNormalLaw(np.nan), "normal stiffness"),
+    "NaN patch height": (lambda: _patch(height=np.nan), "contact height"),
+    "NaN omega_start": (lambda: FrictionOscillator().frequency_response(np.nan, 100.0), "omega_start"),
+    "NaN initial guess": (lambda: continuation(_dummy_residual, np.array([np.nan]), 1.0, 2.0), "x0"),
+    "NaN harmonic": (lambda: HarmonicBasis((1, np.nan)), "harmonics"),
+    "NaN n_samples": (lambda: HarmonicBasis((1, 3), np.nan), "n_samples"),
+    "inf n_samples": (lambda: HarmonicBasis((1, 3), np.inf), "n_samples"),
+    "NaN patch n_eta": (lambda: _patch(n_eta=np.nan), "n_eta"),
+    # harmonics
+    "empty harmonics": (lambda: HarmonicBasis(()), "harmonics"),
+    "empty harmonics (FRF)": (lambda: FrictionOscillator().frequency_response(90.0, 100.0, harmonics=()), "harmonics"),
+    "negative harmonic": (lambda: HarmonicBasis((-1, 1)), "harmonics"),
+    "fractional harmonic": (lambda: HarmonicBasis((1.5,)), "harmonics"),
+    "only the static term": (lambda: HarmonicBasis((0,)), "harmonic"),
+    # samples
+    "n_samples too small": (lambda: HarmonicBasis((1, 3), 6), "n_samples"),
+    "n_samples too small (FRF)": (lambda: FrictionOscillator().frequency_response(90.0, 100.0, harmonics=(1, 3),
+                                                                                   n_samples=5), "n_samples"),
+    "steps_per_period too small": (lambda: FrictionOscillator().time_response([100.0], steps_per_period=8),
+                                   "steps_per_period"),
+    "steps_per_period unstable": (lambda: FrictionOscillator().time_response([1.0], steps_per_period=16),
+                                  "steps_per_period"),
+    # frequency ranges
+    "omega_start == omega_end (FRF)": (lambda: FrictionOscillator().frequency_response(100.0, 100.0), "omega_end"),
+    "omega_start == omega_end (continuation)": (lambda: continuation(_dummy_residual, np.zeros(1), 5.0, 5.0),
+                                                "omega_end"),
+    "negative omega_start": (lambda: FrictionOscillator().frequency_response(-100.0, 100.0), "omega_start"),
+    "negative omega (time response)": (lambda: FrictionOscillator().time_response([-100.0]), "omega"),
+    "time response with a cubic spring": (lambda: FrictionOscillator(cubic_stiffness=1e9).time_response([100.0]),
+                                          "cubic_stiffness"),
+}
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_bad_input_raises_value_error_naming_the_parameter(case):
+    make, name = CASES[case]
+    with pytest.raises(ValueError, match=name):
+        make()
