@@ -123,10 +123,12 @@ class DamperContacts:
                 # dF/dOmega = (F - J w) (da/dOmega) / a without another AFT pass
                 domega = (force.ravel() - jac @ local.ravel()) * kappa
             else:
-                # forward difference in omega (one extra AFT pass)
-                h = 1e-7 * omega
-                force_h, _ = self._forces(local, basis, offsets + h * doffsets, False)
-                domega = ((force_h - force) / h).ravel()
+                # central difference in omega, both ends without the Jacobian so that both take
+                # the same return-map passes (two extra AFT passes)
+                h = 1e-6 * omega
+                force_p, _ = self._forces(local, basis, offsets + h * doffsets, False)
+                force_m, _ = self._forces(local, basis, offsets - h * doffsets, False)
+                domega = ((force_p - force_m) / (2 * h)).ravel()
         return force, jac, domega
 
 

@@ -118,8 +118,14 @@ def test_jacobian_false_and_true_give_the_same_forces():
     c[:, :, 2] *= 0.2 * N0 / K_N / (SLIP_FORCE / K_T)
     a = drive(c, basis, jacobian=False)
     b = drive(c, basis, jacobian=True)
-    assert np.array_equal(a.force, b.force) and np.array_equal(a.state, b.state)
-    assert np.allclose(a.slip_work, b.slip_work, rtol=1e-14, atol=0)
+    # with the Jacobian the return map also waits for the slider's derivative to become
+    # periodic, which may take extra passes; the forces then differ only at the periodicity
+    # tolerance (1e-10 of the slip displacement mu N / k_T)
+    diff = np.abs(a.force - b.force).max() / SLIP_FORCE
+    print(f"max force difference / mu N: {diff:.1e}")
+    assert diff < 1e-9, f"forces with and without the Jacobian differ by {diff:.1e} of mu N"
+    assert np.array_equal(a.state, b.state)
+    assert np.allclose(a.slip_work, b.slip_work, rtol=1e-9, atol=0)
 
 
 # ---------------------------------------------------------------------------------------

@@ -551,7 +551,11 @@ def test_merged_patch_evaluation_equals_separate_patches(kind, harmonics):
         h = 1e-7 * w
         f_h = np.hstack([p.evaluate(local[:, 6 * c:6 * c + 6], system.basis, offsets[c] + h * doffsets[c], False).force
                          for c, p in enumerate(coupling.element.geometry.patches)])
-        ref_dw = ((f_h - ref_force) / h).ravel()
+        # both ends of the difference without the Jacobian (with it the return map may take
+        # extra passes, which moves the forces at the 1e-11 level)
+        f_0 = np.hstack([p.evaluate(local[:, 6 * c:6 * c + 6], system.basis, offsets[c], False).force
+                         for c, p in enumerate(coupling.element.geometry.patches)])
+        ref_dw = ((f_h - f_0) / h).ravel()
         assert np.abs(domega - ref_dw).max() <= 1e-6 * np.abs(ref_dw).max()
     else:
         assert domega is None
