@@ -316,10 +316,50 @@ class TunedDisk:
             raise ValueError("f_end_hz must differ from f_start_hz")
         system = self.hbm_system(harmonics, n_samples)
         w0, w1 = 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz
-        x0 = self._initial_guess(system, w0)
-        branch = continuation(system.residual, x0, w0, w1, x_scale=self._scales(system, w0, w1),
+        scales = self._scales(system, w0, w1)
+        x0 = self._start_solution(system, w0, scales)
+        branch = continuation(system.residual, x0, w0, w1, x_scale=scales,
                               max_step=max_step, **continuation_options)
         return DiskResponse.from_branch(self, system, branch)
+
+    def _start_solution(self, system, omega, scales, tol=1e-10):
+        """Solution at the first frequency, robust in gross slip.
+
+        Newton with a backtracking line search from the stuck linear solution; if that fails
+        (a light damper sliding far from its stuck state), the excitation is ramped up from 10 %
+        (homotopy), each level started from the previous solution. Returns the best iterate
+        (the continuation then reports honestly if it is not a solution)."""
+        f_full = system.excitation
+
+        def solve(x, level):
+            system.excitation = lambda w: tuple(level * v for v in f_full(w))
+            try:
+                for _ in range(60):
+                    R, J, _ = system.residual(x, omega)
+                    r0 = np.linalg.norm(R)
+                    if r0 <= tol * max(np.linalg.norm(f_full(omega)[0]), 1e-300):
+                        return x, True
+                    dx = -np.linalg.solve(J, R)
+                    t = 1.0
+                    while t > 1e-4:
+                        x_new = x + t * dx
+                        if np.linalg.norm(system.residual(x_new, omega, False)[0]) < (1 - 1e-4 * t) * r0:
+                            break
+                        t /= 2
+                    x = x_new
+                    if np.linalg.norm(t * dx / scales) < 1e-14:
+                        break
+                return x, False
+            finally:
+                system.excitation = f_full
+
+        x, ok = solve(self._initial_guess(system, omega), 1.0)
+        if ok:
+            return x
+        x = self._initial_guess(system, omega)
+        for level in np.linspace(0.1, 1.0, 10):
+            x, ok = solve(x, level)
+        return x
 
     def _initial_guess(self, system, omega):
         """Stuck linear solution: one Newton step from the static state, where every contact point sticks.

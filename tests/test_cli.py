@@ -25,9 +25,21 @@ def test_reproduce_writes_summary_report_and_figures(tmp_path):
         peaks = np.array(sweep["peak_tip_mm"])
         assert 0 < np.argmin(peaks) < len(peaks) - 1, (kind, peaks)
         assert summary["optimum"][kind]["1"]["peak_tip_mm"] <= peaks.min() * (1 + 1e-3), kind
+    # issue 5: engine orders 0..8 for both dampers, platform angles, contact state, lift-off
+    for kind in ("cylinder", "wedge"):
+        assert set(summary["optimum"][kind]) == {str(eo) for eo in range(9)}, summary["optimum"][kind].keys()
+    pa = summary["platform_angle"]
+    assert len(pa["gamma_r_deg"]) == len(pa["opt_peak_tip_mm"]) == len(pa["peak_tip_mm_at_1g"])
+    for c in ("OL", "OR"):
+        assert len(summary["contact_state_85deg"][c]["w_star"]) == 2
+    lift = summary["wedge_liftoff"]
+    assert np.array(lift["r"]).shape == (2, len(lift["xi_star"]))
     report = (tmp_path / "report.md").read_text()
+    assert "## Design studies" in report
     assert "| 1F |" in report and "verdict" in report
-    for name in ("fig4_frf_four_modes.png", "fig5_mass_variation.png", "fig6_mass_optimisation.png"):
+    for name in ("fig4_frf_four_modes.png", "fig5_mass_variation.png", "fig6_mass_optimisation.png",
+                 "fig7_8_engine_orders.png", "fig9_wedge_liftoff.png", "fig10_platform_angles.png",
+                 "fig11_contact_state.png", "design_map.png"):
         assert (tmp_path / name).stat().st_size > 10_000, name
 
 

@@ -23,6 +23,7 @@ import numpy as np
 from .. import _validate
 from ..damper.kinetics import seat
 from ..disk import TunedDisk
+from .parallel import parallel_map
 from .mass import optimal_mass, peak_response
 
 ROLLING_TOLERANCE = 0.01   # an optimum less than 1 % below the undamped peak counts as "no damping"
@@ -103,9 +104,24 @@ class EngineOrderSweep:
         return ax
 
 
+def _engine_order_case(case):
+    """Optimal mass of one (kind, EO); the RuntimeError text if the response fails."""
+    from ..reference import reference_disk
+
+    kind, eo, bounds, f_range, xatol, rotor_speed_eo0, disk_kwargs = case
+    kw = dict(disk_kwargs)
+    if eo == 0:
+        kw["rotor_speed"] = rotor_speed_eo0
+    disk = reference_disk(kind, np.sqrt(bounds[0] * bounds[1]), engine_order=eo, **kw)
+    try:
+        return optimal_mass(disk, bounds, f_range, xatol=xatol)
+    except RuntimeError as exc:
+        return str(exc)
+
+
 def engine_order_sweep(kind: str, engine_orders=range(0, 9), mass_bounds=(1e-5, 2e-2),
                        rotor_speed_eo0: float = 2 * np.pi * 95, f_range_hz=(90.0, 105.0), xatol: float = 0.02,
-                       progress=None, **disk_kwargs) -> EngineOrderSweep:
+                       progress=None, processes: int | None = 1, **disk_kwargs) -> EngineOrderSweep:
     """Re-optimise the damper mass of the reference disk for each engine order (Fig. 7, 8).
 
     Parameters
@@ -118,9 +134,10 @@ def engine_order_sweep(kind: str, engine_orders=range(0, 9), mass_bounds=(1e-5, 
         the peak sits at an end
     xatol : tolerance of the optimiser in log(mass)
     progress : optional callable(done, total)
+    processes : worker processes over the engine orders (None: every core)
     disk_kwargs : passed to :func:`bladedamp.reference.reference_disk`
     """
-    from ..reference import N_BLADES, reference_disk
+    from ..reference import N_BLADES
 
     if kind not in ("cylinder", "wedge"):
         raise ValueError(f"kind must be 'cylinder' or 'wedge' (got {kind!r})")
@@ -137,24 +154,17 @@ def engine_order_sweep(kind: str, engine_orders=range(0, 9), mass_bounds=(1e-5, 
     k = eos.size
     m_opt, p_opt, p_und = np.full(k, np.nan), np.full(k, np.nan), np.full(k, np.nan)
     failures = {}
-    for j, eo in enumerate(eos):
-        kw = dict(disk_kwargs)
-        if eo == 0:
-            kw["rotor_speed"] = rotor_speed_eo0
-        disk = reference_disk(kind, np.sqrt(bounds[0] * bounds[1]), engine_order=int(eo), **kw)
-        try:
-            opt = optimal_mass(disk, bounds, f_range, xatol=xatol)
-        except RuntimeError as exc:
-            failures[int(eo)] = str(exc)
-            warnings.warn(f"engine order {eo}: {exc}", RuntimeWarning, stacklevel=2)
+    cases = [(kind, int(eo), bounds, f_range, xatol, rotor_speed_eo0, disk_kwargs) for eo in eos]
+    for j, (eo, result) in enumerate(zip(eos, parallel_map(_engine_order_case, cases, processes, progress))):
+        if isinstance(result, str):
+            failures[int(eo)] = result
+            warnings.warn(f"engine order {eo}: {result}", RuntimeWarning, stacklevel=2)
             continue
-        p_und[j] = opt.undamped_peak_tip
-        if opt.peak_tip >= (1 - ROLLING_TOLERANCE) * opt.undamped_peak_tip:
-            p_opt[j] = opt.undamped_peak_tip          # no mass helps (the rolling cylinder)
+        p_und[j] = result.undamped_peak_tip
+        if result.peak_tip >= (1 - ROLLING_TOLERANCE) * result.undamped_peak_tip:
+            p_opt[j] = result.undamped_peak_tip          # no mass helps (the rolling cylinder)
         else:
-            m_opt[j], p_opt[j] = opt.mass, opt.peak_tip
-        if progress:
-            progress(j + 1, k)
+            m_opt[j], p_opt[j] = result.mass, result.peak_tip
     return EngineOrderSweep(kind, eos.astype(int), m_opt, p_opt, p_und, 1 - p_opt / p_und, failures)
 
 
@@ -199,9 +209,24 @@ class PlatformAngleStudy:
         return ax
 
 
+def _platform_angle_case(case):
+    """(peak at the fixed mass, optimal mass, optimal peak) of one gamma_R [m, kg, m]."""
+    from ..reference import reference_disk
+
+    kind, gamma_left_deg, g, fixed_mass, bounds, f_range, optimise, xatol, disk_kwargs = case
+    base = reference_disk(kind, fixed_mass, **disk_kwargs)
+    disk = dataclasses.replace(base, gamma_left=np.radians(gamma_left_deg), gamma_right=np.radians(g))
+    p_fix = peak_response(disk, f_range)[0]
+    if not optimise:
+        return p_fix, np.nan, np.nan
+    opt = optimal_mass(disk, bounds, f_range, xatol=xatol)
+    return p_fix, opt.mass, opt.peak_tip
+
+
 def platform_angle_study(gamma_right_deg, kind: str = "cylinder", gamma_left_deg: float = 35.0,
                          fixed_mass: float = 1e-3, mass_bounds=(1e-5, 2e-2), f_range_hz=(90.0, 105.0),
-                         optimise: bool = True, xatol: float = 0.02, **disk_kwargs) -> PlatformAngleStudy:
+                         optimise: bool = True, xatol: float = 0.02, progress=None, processes: int | None = 1,
+                         **disk_kwargs) -> PlatformAngleStudy:
     """Peak tip amplitude over the right platform angle gamma_R (Fig. 10), EO of the reference disk.
 
     Parameters
@@ -212,6 +237,7 @@ def platform_angle_study(gamma_right_deg, kind: str = "cylinder", gamma_left_deg
     fixed_mass : damper mass of the comparison at constant mass [kg] (> 0)
     mass_bounds : (low, high) [kg] of the mass optimisation, 0 < low < high
     optimise : False skips the mass optimisation (optimal_* are NaN)
+    progress : optional callable(done, total); processes : worker processes (None: every core)
     disk_kwargs : passed to :func:`bladedamp.reference.reference_disk`
     """
     from ..reference import reference_disk
@@ -227,16 +253,11 @@ def platform_angle_study(gamma_right_deg, kind: str = "cylinder", gamma_left_deg
     bounds = _check_mass_bounds(mass_bounds)
     f_range = _check_f_range(f_range_hz)
 
-    k = gr.size
-    m_opt, p_opt, p_fix = np.full(k, np.nan), np.full(k, np.nan), np.full(k, np.nan)
     undamped, _, _ = peak_response(reference_disk(None, **disk_kwargs), f_range)
-    for j, g in enumerate(gr):
-        base = reference_disk(kind, fixed_mass, **disk_kwargs)
-        disk = dataclasses.replace(base, gamma_left=np.radians(gamma_left_deg), gamma_right=np.radians(g))
-        p_fix[j] = peak_response(disk, f_range)[0]
-        if optimise:
-            opt = optimal_mass(disk, bounds, f_range, xatol=xatol)
-            m_opt[j], p_opt[j] = opt.mass, opt.peak_tip
+    cases = [(kind, float(gamma_left_deg), float(g), fixed_mass, bounds, f_range, optimise, xatol, disk_kwargs)
+             for g in gr]
+    results = np.array(parallel_map(_platform_angle_case, cases, processes, progress))
+    p_fix, m_opt, p_opt = results.T
     return PlatformAngleStudy(kind, float(gamma_left_deg), float(fixed_mass), gr, m_opt, p_opt, p_fix, undamped)
 
 
@@ -393,3 +414,125 @@ def wedge_liftoff_map(disk: TunedDisk, f_range_hz=(90.0, 105.0)) -> LiftoffMap:
     xi_s, eta_s = geometry.patches[0].normalised_coordinates
     return LiftoffMap(xi_s, eta_s, amplitude / a_static, (a_static - min_a) / a_static, min_a, a_static,
                       amplitude, float(r.frequency_hz[i]), float(r.tip_amplitude[i, 0]), basis.n_samples)
+
+
+# ---------------------------------------------------------------------------------------
+# 5. design search beyond the paper: damper mass x platform angle (x wedge contact height)
+# ---------------------------------------------------------------------------------------
+@dataclass
+class DesignMap:
+    """Peak tip amplitude over a grid of damper mass and right platform angle.
+
+    kind : damper type; contact_height : wedge h_C [m] (None for the cylinder)
+    mass : (m,) [kg]; gamma_right_deg : (g,) [deg]; peak_tip : (g, m) [m]
+    undamped_peak_tip : [m]
+    """
+
+    kind: str
+    contact_height: float | None
+    mass: np.ndarray
+    gamma_right_deg: np.ndarray
+    peak_tip: np.ndarray
+    undamped_peak_tip: float
+
+    @property
+    def optimum(self) -> dict:
+        """Best grid point: {'mass_g', 'gamma_right_deg', 'peak_tip_mm', 'reduction_pct'}."""
+        g, m = np.unravel_index(np.nanargmin(self.peak_tip), self.peak_tip.shape)
+        p = self.peak_tip[g, m]
+        return {"mass_g": 1e3 * float(self.mass[m]), "gamma_right_deg": float(self.gamma_right_deg[g]),
+                "peak_tip_mm": 1e3 * float(p), "reduction_pct": 100 * float(1 - p / self.undamped_peak_tip)}
+
+    def plot(self, ax=None, **kwargs):
+        """Contours of the peak amplitude [mm] over mass [g] (log) and gamma_R [deg], optimum marked."""
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            _, ax = plt.subplots(figsize=(6, 4.5))
+        M, G = np.meshgrid(1e3 * self.mass, self.gamma_right_deg)
+        cs = ax.contourf(M, G, 1e3 * self.peak_tip, levels=15, cmap="viridis_r", **kwargs)
+        plt.colorbar(cs, ax=ax, label="resonance tip amplitude u_x [mm]")
+        opt = self.optimum
+        ax.plot(opt["mass_g"], opt["gamma_right_deg"], "r*", ms=14, label=f"best {opt['peak_tip_mm']:.3f} mm")
+        ax.set_xscale("log")
+        ax.set_xlabel("damper mass [g]")
+        ax.set_ylabel("platform angle gamma_R [deg]")
+        extra = f", h_C = {1e3 * self.contact_height:g} mm" if self.contact_height else ""
+        ax.set_title(f"{self.kind}{extra}: design map")
+        ax.legend(loc="upper right", fontsize=8)
+        return ax
+
+
+def _design_case(case):
+    from ..reference import reference_disk
+
+    kind, mass, gamma_left_deg, g, contact_height, f_range, disk_kwargs = case
+    disk = reference_disk(kind, mass, **disk_kwargs)
+    damper = disk.damper if contact_height is None else dataclasses.replace(disk.damper, contact_height=contact_height)
+    disk = dataclasses.replace(disk, damper=damper, gamma_left=np.radians(gamma_left_deg), gamma_right=np.radians(g))
+    try:
+        return peak_response(disk, f_range)[0]
+    except RuntimeError:
+        return np.nan
+
+
+def design_map(kind: str, masses, gamma_right_deg, contact_height: float | None = None,
+               gamma_left_deg: float = 35.0, f_range_hz=(90.0, 105.0), progress=None,
+               processes: int | None = 1, **disk_kwargs) -> DesignMap:
+    """Peak tip amplitude over damper mass x right platform angle (and a wedge's contact height).
+
+    masses [kg] (> 0, non-empty), gamma_right_deg [deg] in (0, 90) (non-empty), contact_height [m]
+    (wedge only). Grid points whose response fails are NaN (never a number that was not solved).
+    """
+    from ..reference import reference_disk
+
+    if kind not in ("cylinder", "wedge"):
+        raise ValueError(f"kind must be 'cylinder' or 'wedge' (got {kind!r})")
+    masses = np.atleast_1d(np.asarray(masses, dtype=float))
+    gr = np.atleast_1d(np.asarray(gamma_right_deg, dtype=float))
+    if masses.size == 0 or gr.size == 0:
+        raise ValueError("masses and gamma_right_deg must be non-empty (masses in (0, inf) kg, angles in (0, 90) deg)")
+    _validate.positive("masses", masses)
+    _validate.in_range("gamma_right_deg", gr, 0.0, 90.0, closed="neither")
+    if contact_height is not None:
+        if kind != "wedge":
+            raise ValueError("contact_height applies to the wedge only (kind='wedge')")
+        _validate.positive("contact_height h_C", contact_height)
+    f_range = _check_f_range(f_range_hz)
+    cases = [(kind, float(m), float(gamma_left_deg), float(g), contact_height, f_range, disk_kwargs)
+             for g in gr for m in masses]
+    peaks = np.array(parallel_map(_design_case, cases, processes, progress)).reshape(gr.size, masses.size)
+    undamped, _, _ = peak_response(reference_disk(None, **disk_kwargs), f_range)
+    return DesignMap(kind, contact_height, masses, gr, peaks, undamped)
+
+
+def _liftoff_case(case):
+    from ..reference import reference_disk
+
+    mass, contact_height, force, f_range = case
+    disk = reference_disk("wedge", mass, excitation=np.array([force, 0, 0, 0, 0, 0]))
+    disk = dataclasses.replace(disk, damper=dataclasses.replace(disk.damper, contact_height=contact_height))
+    try:
+        return float(wedge_liftoff_map(disk, f_range).ratio.max())
+    except RuntimeError:
+        return np.nan
+
+
+def liftoff_onset(contact_heights, forces, mass: float = 1e-3, f_range_hz=(90.0, 105.0), progress=None,
+                  processes: int | None = 1) -> dict:
+    """Largest lift-off ratio r of the wedge over contact height x tip excitation F_x.
+
+    Returns {'contact_height_mm': [...], 'force_n': [...], 'max_ratio': [[...]] (heights x forces)};
+    r > 1 means some point separates during the cycle.
+    """
+    hs = np.atleast_1d(np.asarray(contact_heights, dtype=float))
+    fs = np.atleast_1d(np.asarray(forces, dtype=float))
+    if hs.size == 0 or fs.size == 0:
+        raise ValueError("contact_heights (m, > 0) and forces (N, > 0) must be non-empty")
+    _validate.positive("contact_heights", hs)
+    _validate.positive("forces", fs)
+    _validate.positive("mass", mass)
+    f_range = _check_f_range(f_range_hz)
+    cases = [(mass, float(h), float(f), f_range) for h in hs for f in fs]
+    r = np.array(parallel_map(_liftoff_case, cases, processes, progress)).reshape(hs.size, fs.size)
+    return {"contact_height_mm": list(1e3 * hs), "force_n": list(fs), "max_ratio": r.tolist(), "mass_g": 1e3 * mass}

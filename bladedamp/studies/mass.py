@@ -86,21 +86,27 @@ class MassSweep:
         return ax
 
 
-def mass_sweep(disk: TunedDisk, masses, f_range_hz=(90.0, 105.0), harmonics=(1,), progress=None) -> MassSweep:
-    """Peak tip amplitude for each damper mass in ``masses`` [kg] (each > 0)."""
+def _peak_of(case):
+    disk, f_range, harmonics = case
+    p, f, _ = peak_response(disk, f_range, harmonics)
+    return p, f
+
+
+def mass_sweep(disk: TunedDisk, masses, f_range_hz=(90.0, 105.0), harmonics=(1,), progress=None,
+               processes: int | None = 1) -> MassSweep:
+    """Peak tip amplitude for each damper mass in ``masses`` [kg] (each > 0).
+
+    ``processes``: worker processes over the masses (None: every core)."""
+    from .parallel import parallel_map
+
     masses = np.atleast_1d(np.asarray(masses, dtype=float))
     if masses.size == 0:
         raise ValueError("masses must be a non-empty array of damper masses in (0, inf) kg")
     _validate.positive("masses", masses)
-    peaks, freqs = [], []
-    for k, m in enumerate(masses):
-        p, f, _ = peak_response(with_mass(disk, m), f_range_hz, harmonics)
-        peaks.append(p)
-        freqs.append(f)
-        if progress:
-            progress(k + 1, masses.size)
+    cases = [(with_mass(disk, m), f_range_hz, harmonics) for m in masses]
+    peaks, freqs = np.array(parallel_map(_peak_of, cases, processes, progress)).T
     undamped, _, _ = peak_response(dataclasses.replace(disk, damper=None), f_range_hz, harmonics)
-    return MassSweep(masses, np.array(peaks), np.array(freqs), disk.damper.kind, undamped)
+    return MassSweep(masses, peaks, freqs, disk.damper.kind, undamped)
 
 
 @dataclass

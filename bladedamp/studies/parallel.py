@@ -1,0 +1,39 @@
+"""Process-level parallelism over independent study cases (each case its own continuation)."""
+from __future__ import annotations
+
+import multiprocessing
+import os
+import warnings
+from concurrent.futures import ProcessPoolExecutor, as_completed
+
+
+def _quiet(fn, item):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return fn(item)
+
+
+def parallel_map(fn, items, processes: int | None = None, progress=None) -> list:
+    """``[fn(item) for item in items]``, in order, on ``processes`` worker processes.
+
+    ``fn`` must be a module-level function (picklable). ``processes=None`` uses every core;
+    1 runs in this process. ``progress(done, total)`` is called as cases finish.
+    """
+    items = list(items)
+    n = len(items)
+    processes = min(processes or os.cpu_count() or 1, n) if n else 1
+    if processes <= 1:
+        out = []
+        for k, item in enumerate(items):
+            out.append(_quiet(fn, item))
+            if progress:
+                progress(k + 1, n)
+        return out
+    results = [None] * n
+    with ProcessPoolExecutor(processes, mp_context=multiprocessing.get_context("fork")) as pool:
+        futures = {pool.submit(_quiet, fn, item): k for k, item in enumerate(items)}
+        for done, future in enumerate(as_completed(futures), start=1):
+            results[futures[future]] = future.result()
+            if progress:
+                progress(done, n)
+    return results

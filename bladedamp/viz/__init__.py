@@ -1,0 +1,23 @@
+"""Views of bladed disks with underplatform dampers.
+
+* :mod:`bladedamp.viz.meshcat_view` (needs the "viz" extra: meshcat, trimesh): ``show(result)``
+  builds the operating deflection shape of a :class:`~bladedamp.disk.DiskResponse` at a frequency
+  of its FRF, with per-point contact maps (stick / slip / separated over the cycle, lift-off
+  ratio) and a colour legend; ``Scene.save_html`` writes a standalone HTML file that opens in a
+  browser without a server; ``Scene.serve`` starts a meshcat server bound to localhost (close it).
+* :mod:`bladedamp.viz.widgets`: slider callbacks of the notebooks (no meshcat needed).
+
+Nothing here imports meshcat until a 3D name is used, so ``bladedamp.viz.widgets`` works
+without the "viz" extra.
+"""
+_MESHCAT_NAMES = ("Scene", "LiveView", "show", "ods_scene", "contact_map_scene", "cycle_data",
+                  "blade_deflection", "screenshot")
+
+__all__ = list(_MESHCAT_NAMES)
+
+
+def __getattr__(name):
+    if name in _MESHCAT_NAMES:
+        from . import meshcat_view
+        return getattr(meshcat_view, name)
+    raise AttributeError(f"module 'bladedamp.viz' has no attribute {name!r}")
