@@ -18,6 +18,8 @@ force is a static load on the damper and the seating is part of the harmonic bal
 """
 from __future__ import annotations
 
+import dataclasses
+
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -148,6 +150,8 @@ class TunedDisk:
         "excitation" point [N, N m] (cosine amplitude)
     rotor_speed : [rad/s], required when EO = 0; otherwise Omega_R = Omega_E / EO
     damper_inertia : include the damper's mass and rotary inertia in Eq. 12
+    initial_gaps : (2, P) gaps of the OL and OR patch points before loading [m] (default: a
+        perfect fit), e.g. :func:`bladedamp.geometry.misfit_gaps` of a damper that does not fit
     """
 
     blade: ModalBlade
@@ -160,6 +164,7 @@ class TunedDisk:
     excitation: np.ndarray = field(default_factory=lambda: np.array([0.1, 0, 0, 0, 0, 0]))
     rotor_speed: float | None = None
     damper_inertia: bool = True
+    initial_gaps: np.ndarray | None = None
 
     def __post_init__(self):
         _validate.integer("n_blades", self.n_blades, minimum=2)
@@ -191,7 +196,14 @@ class TunedDisk:
         return tuple(f"q_{m}" for m in modes) + (DAMPER_DOFS if self.has_damper else ())
 
     def damper_geometry(self) -> DamperGeometry:
-        return self.damper.geometry(self.gamma_left, self.gamma_right)
+        geometry = self.damper.geometry(self.gamma_left, self.gamma_right)
+        if self.initial_gaps is not None:
+            gaps = np.asarray(_validate.finite("initial_gaps", self.initial_gaps), dtype=float)
+            P = geometry.patches[0].n_points
+            if gaps.shape != (2, P):
+                raise ValueError(f"initial_gaps must have shape (2, {P}) (OL, OR points) in m")
+            geometry.patches = tuple(dataclasses.replace(p, initial_gap=g) for p, g in zip(geometry.patches, gaps))
+        return geometry
 
     def platform_offsets(self, geometry: DamperGeometry) -> np.ndarray:
         """(2, 3) contact centres seen from the blade's OL / OR points (in each blade's frame).
@@ -279,12 +291,30 @@ class TunedDisk:
         return HarmonicBalanceSystem(basis, M, D, K, excitation, couplings, static_stiffness)
 
     def _approach_function(self, geometry: DamperGeometry, basis: HarmonicBasis):
-        P = geometry.patches[0].n_points
+        """omega -> (per-point static approach (2, P) [m], its omega-derivative)."""
+        gaps = np.array([p.initial_gap for p in geometry.patches])
         if basis.has_static:
-            zero = np.zeros((2, P))
-            return lambda omega: (zero, zero)
-        # seat once at a reference load; the laws are homogeneous, so the static approach
-        # scales as F_CG^(1/p) (p = 1 for the linear law)
+            rest = -gaps  # the seating is part of the harmonic balance
+            zero = np.zeros_like(rest)
+            return lambda omega: (rest, zero)
+        if np.any(gaps != 0):
+            # a misfit: the seating is not homogeneous in F_CG; seat at each load, d/dF by central
+            # differences of the (smooth away from touch-down) seating
+            cache = {}
+
+            def approach(omega):
+                if omega not in cache:
+                    F, dF = self.centrifugal_force(omega)
+                    a = seat(geometry, F)[1]
+                    h = 1e-6 * max(F, 1e-12)
+                    da = (seat(geometry, F + h)[1] - seat(geometry, max(F - h, 0.0))[1]) / (F + h - max(F - h, 0.0))
+                    cache.clear()
+                    cache[omega] = (a, da * dF)
+                return cache[omega]
+
+            return approach
+        # perfect fit: seat once at a reference load; the laws are homogeneous, so the static
+        # approach scales as F_CG^(1/p) (p = 1 for the linear law)
         exponent = getattr(geometry.patches[0].normal_law, "exponent", 1.0)
         F_ref = 1.0
         _, approach_ref, _ = seat(geometry, F_ref)

@@ -527,6 +527,32 @@ def derive_patches(disk=None, *, blade_geometry: BeamBladeGeometry | None = None
                  for c in range(2))
 
 
+def misfit_gaps(disk, damper_shape: trimesh.Trimesh, blade_geometry: BeamBladeGeometry | None = None) -> np.ndarray:
+    """Initial gaps (2, P) [m] of the contact model's points for a damper that does not fit.
+
+    The damper mesh ``damper_shape`` (about its CG, e.g. a wedge with a wrong face angle) is
+    dropped rigidly into the groove of ``disk`` (a TunedDisk), and the gap from each platform to
+    the damper is measured at the points of the disk's own contact patches (their xi, eta grid
+    on the nominal faces). Pass the result as ``TunedDisk(initial_gaps=...)``: the solver then
+    seats the damper on the touching part of its faces only.
+    """
+    geometry = disk.damper.geometry(disk.gamma_left, disk.gamma_right)
+    parts = sector_meshes(blade_geometry, disk.damper, disk.gamma_left, disk.gamma_right)
+    layout = parts["layout"]
+    mesh = damper_shape.copy()
+    mesh.apply_translation(layout.damper_cg)
+    mesh.apply_translation(seat_damper_mesh(mesh, layout.frames, layout.contact_centres))
+    platforms = (parts["platform_ol"], parts["platform_or"])
+    gaps = []
+    for c, patch in enumerate(geometry.patches):
+        gap, _ = surface_gaps(mesh, platforms[c], layout.frames[c], layout.contact_centres[c], patch.xi, patch.eta)
+        if not np.all(np.isfinite(gap)):
+            raise ValueError("damper_shape does not face the platform at every contact point "
+                             "(the misfit is too large for the nominal patch)")
+        gaps.append(gap)
+    return np.array(gaps)
+
+
 # --------------------------------------------------------------------------------------
 # whole disk (pictures)
 # --------------------------------------------------------------------------------------

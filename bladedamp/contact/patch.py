@@ -73,6 +73,10 @@ class ContactPatch:
     weights : array (n_xi*n_eta,), optional
         Share of each point in stiffness and load (default uniform); e.g. a Hertz pressure
         profile for a cylinder.
+    initial_gap : array (n_xi*n_eta,), optional
+        Gap of each point before loading [m] (default 0: a perfect fit; > 0 open, < 0
+        interference), e.g. from a damper whose shape does not fit the platform
+        (:func:`bladedamp.geometry.misfit_gaps`). The approach at rest is ``-initial_gap``.
     """
 
     height: float
@@ -83,6 +87,7 @@ class ContactPatch:
     n_xi: int = 3
     n_eta: int = 5
     weights: np.ndarray | None = None
+    initial_gap: np.ndarray | None = None
     xi: np.ndarray = field(init=False, repr=False)
     eta: np.ndarray = field(init=False, repr=False)
     point_map: np.ndarray = field(init=False, repr=False)
@@ -108,6 +113,13 @@ class ContactPatch:
                 raise ValueError(f"weights must be {self.n_points} non-negative values summing to 1")
             self.weights = w
         self.point_map = rigid_point_map(self.xi, self.eta)
+        if self.initial_gap is None:
+            self.initial_gap = np.zeros(self.n_points)
+        else:
+            gap = np.asarray(_validate.finite("initial_gap", self.initial_gap), dtype=float)
+            if gap.shape != (self.n_points,):
+                raise ValueError(f"initial_gap must have one value per point, shape ({self.n_points},) m")
+            self.initial_gap = gap
 
     @property
     def n_points(self) -> int:

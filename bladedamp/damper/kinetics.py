@@ -36,6 +36,9 @@ def centrifugal_force(mass: float, radius: float, omega_excitation: float, engin
 def seat(geometry: DamperGeometry, radial_force: float, tol: float = 1e-12, max_iter: int = 50):
     """Static seating of the damper under a radial force, frictionless, rigid platforms.
 
+    Points with an initial gap (``ContactPatch.initial_gap``) touch only once the damper has
+    moved by it: a damper that does not fit seats on part of its faces.
+
     Solves sum_c G_D,c^T f_c(G_D,c u_D) = (0, 0, F, 0, 0, 0) for the damper displacement
     u_D with the normal laws of both patches (lift-off included). Directions that no normal
     force fixes (the axial position, the cylinder's roll) are left at zero (least squares).
@@ -46,7 +49,7 @@ def seat(geometry: DamperGeometry, radial_force: float, tol: float = 1e-12, max_
     G = geometry.G_D.reshape(2, 6, 6)
     P = geometry.patches[0].n_points
     if radial_force == 0:
-        return np.zeros(6), np.zeros((2, P)), np.zeros(2)
+        return np.zeros(6), -np.array([p.initial_gap for p in geometry.patches]), np.zeros(2)
     # start: uniform approach carrying the frictionless loads
     loads = geometry.frictionless_normal_loads(radial_force)
     approach = [geometry.patches[c].approach_for_load(loads[c]).mean() for c in range(2)]
@@ -60,7 +63,7 @@ def seat(geometry: DamperGeometry, radial_force: float, tol: float = 1e-12, max_
         K = np.zeros((6, 6))
         for c, patch in enumerate(geometry.patches):
             Bz = patch.point_map[:, 2, :]                    # (P, 6): u_zeta of each point
-            a = -(Bz @ (G[c] @ u))
+            a = -patch.initial_gap - Bz @ (G[c] @ u)
             N, dN = patch.normal_law.force(a, patch.weights)
             R += G[c].T @ (Bz.T @ (-N))
             K += G[c].T @ (Bz.T * dN) @ Bz @ G[c]
@@ -70,6 +73,6 @@ def seat(geometry: DamperGeometry, radial_force: float, tol: float = 1e-12, max_
             break
     else:
         raise RuntimeError(f"static seating of the damper did not converge (radial force {radial_force} N)")
-    approach = np.array([-(p.point_map[:, 2, :] @ (G[c] @ u)) for c, p in enumerate(geometry.patches)])
+    approach = np.array([-p.initial_gap - p.point_map[:, 2, :] @ (G[c] @ u) for c, p in enumerate(geometry.patches)])
     loads = np.array([p.normal_law.force(approach[c], p.weights)[0].sum() for c, p in enumerate(geometry.patches)])
     return u, approach, loads
