@@ -38,6 +38,7 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 
+from _timing import best_of  # noqa: E402
 from bladedamp.reference import reference_disk  # noqa: E402
 
 F_RANGE = (92.0, 104.0)
@@ -64,14 +65,6 @@ def step_for(disk, min_points):
             return step, n
         step *= 0.8
 
-
-def best_of(fun, repeat):
-    best, out = np.inf, None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fun()
-        best = min(best, time.perf_counter() - t0)
-    return best, out
 
 
 def profile(disk, max_step, top):

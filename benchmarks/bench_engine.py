@@ -35,6 +35,7 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 
+from _timing import best_of  # noqa: E402
 from bladedamp import ContactPatch, FrictionOscillator, LinearNormalLaw  # noqa: E402
 from bladedamp.hbm import HarmonicBasis  # noqa: E402
 from bladedamp.hbm.continuation import newton  # noqa: E402
@@ -44,15 +45,6 @@ OMEGAS = np.linspace(90.0, 140.0, 11)
 HBM_HARMONICS = (1, 3, 5, 7)
 TI_SETTINGS = dict(steps_per_period=256, tol=1e-5, min_periods=5)
 
-
-def best_of(fun, repeat):
-    """(best wall time [s], result of the last call)."""
-    best, out = np.inf, None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fun()
-        best = min(best, time.perf_counter() - t0)
-    return best, out
 
 
 def hbm_newton_sweep(osc, omegas, harmonics):

@@ -121,9 +121,7 @@ def reproduce(out: Path, processes: int | None = None) -> dict:
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
     fig.suptitle("Fig. 4: tuned disk, EO = 1, F_x = 0.1 N, F_y = -0.1 N, M_z = 0.001 N m")
-    fig.tight_layout()
-    fig.savefig(out / "fig4_frf_four_modes.png", dpi=120)
-    plt.close(fig)
+    _save(fig, out / "fig4_frf_four_modes.png")
 
     fig, ax = plt.subplots(figsize=(7, 4.5))
     free_r = reference_disk(None).frequency_response(85.0, 115.0, max_step=0.05)
@@ -135,18 +133,14 @@ def reproduce(out: Path, processes: int | None = None) -> dict:
     ax.set_title("Fig. 5: variation of the cylinder's mass (EO = 1, F_x = 0.1 N)")
     ax.grid(True, alpha=0.3)
     ax.legend()
-    fig.tight_layout()
-    fig.savefig(out / "fig5_mass_variation.png", dpi=120)
-    plt.close(fig)
+    _save(fig, out / "fig5_mass_variation.png")
 
     fig, ax = plt.subplots(figsize=(7, 4.5))
     for kind, sw in sweeps.items():
         sw.plot(ax=ax)
         ax.plot(1e3 * optima[kind].mass, 1e3 * optima[kind].peak_tip, "k*", ms=12)
     ax.set_title("Fig. 6: resonance amplitude over damper mass, EO = 1 (stars: optima)")
-    fig.tight_layout()
-    fig.savefig(out / "fig6_mass_optimisation.png", dpi=120)
-    plt.close(fig)
+    _save(fig, out / "fig6_mass_optimisation.png")
     progress("figures of Fig. 4-6 written")
 
     design = _design_studies(out, progress, processes, timings)
@@ -169,6 +163,15 @@ def reproduce(out: Path, processes: int | None = None) -> dict:
     (out / "report.md").write_text(_report(summary, table1) + _design_report(summary))
     print(f"wrote {out / 'summary.json'}, {out / 'report.md'} and figures in {total:.1f} s", file=sys.stderr)
     return summary
+
+
+def _save(fig, path: Path, dpi: int = 120):
+    """Lay out, write and close a figure."""
+    import matplotlib.pyplot as plt
+
+    fig.tight_layout()
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
 
 
 def _finite(x):
@@ -205,9 +208,7 @@ def _design_studies(out: Path, progress, processes, timings) -> dict:
     for ax in axes:
         ax.grid(True, alpha=0.3)
         ax.legend()
-    fig.tight_layout()
-    fig.savefig(out / "fig7_8_engine_orders.png", dpi=120)
-    plt.close(fig)
+    _save(fig, out / "fig7_8_engine_orders.png")
 
     # -- asymmetric platforms (Fig. 10) --
     t0 = time.perf_counter()
@@ -220,9 +221,7 @@ def _design_studies(out: Path, progress, processes, timings) -> dict:
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
     pa.plot(ax=ax)
     ax.set_title("Fig. 10: cylinder, gamma_L = 35 deg, EO = 1")
-    fig.tight_layout()
-    fig.savefig(out / "fig10_platform_angles.png", dpi=120)
-    plt.close(fig)
+    _save(fig, out / "fig10_platform_angles.png")
 
     # -- contact state in the complex plane (Fig. 11, Eq. 27) --
     t0 = time.perf_counter()
@@ -240,9 +239,7 @@ def _design_studies(out: Path, progress, processes, timings) -> dict:
     for ax, g in zip(axes, (35.0, 85.0)):
         states[g].plot(ax=ax)
         ax.set_title(f"Fig. 11: gamma_R = {g:g} deg")
-    fig.tight_layout()
-    fig.savefig(out / "fig11_contact_state.png", dpi=120)
-    plt.close(fig)
+    _save(fig, out / "fig11_contact_state.png")
 
     # -- wedge lift-off (Fig. 9) and its onset over contact height and excitation --
     lift = wedge_liftoff_map(reference_disk("wedge", 1e-3))
@@ -254,9 +251,7 @@ def _design_studies(out: Path, progress, processes, timings) -> dict:
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
     lift.plot(ax=ax)
     ax.set_title("Fig. 9: wedge 1 g, F_x = 0.1 N, contact OL")
-    fig.tight_layout()
-    fig.savefig(out / "fig9_wedge_liftoff.png", dpi=120)
-    plt.close(fig)
+    _save(fig, out / "fig9_wedge_liftoff.png")
     timings["contact_state_liftoff_s"] = time.perf_counter() - t0
 
     # -- design map beyond the paper --
@@ -273,9 +268,7 @@ def _design_studies(out: Path, progress, processes, timings) -> dict:
     fig, axes = plt.subplots(1, len(maps), figsize=(5.2 * len(maps), 4.2))
     for ax, m in zip(axes, maps):
         m.plot(ax=ax)
-    fig.tight_layout()
-    fig.savefig(out / "design_map.png", dpi=110)
-    plt.close(fig)
+    _save(fig, out / "design_map.png", 110)
     timings["design_map_s"] = time.perf_counter() - t0
     return result
 
