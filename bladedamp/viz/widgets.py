@@ -1,0 +1,676 @@
+"""Slider callbacks of the teaching notebooks: plain functions, parameter values in, data or
+matplotlib figures out.
+
+The notebooks wire these to ipywidgets (``interact``); the tests call them directly with values
+and check the returned data, so nothing here needs a browser or a running kernel.
+
+Two kinds of callbacks:
+
+* the point contact and the friction oscillator (notebook 01): closed forms and cheap AFT
+  evaluations (tens of milliseconds), the oscillator's FRF with time integration at a few
+  frequencies (a few tenths of a second, memoised);
+* the reference bladed disk (notebooks 02, 03): a frequency response per slider move. A
+  continuation run over the 1F window takes 1-2 s; :class:`DiskFRFCache` answers in 0.1-0.5 s
+  (2-core machine) instead by Newton's method on a fixed frequency grid, each frequency started
+  from the cached solution of the nearest parameter value already computed (the *warm start*:
+  nearest mass, or nearest platform angle), or from the previous frequencies on a cold start
+  (about 1 s), with the peak refined on finer grids. Where Newton does not converge (a light
+  damper in gross slip) it falls back to the continuation solver (1-2 s). Results are
+  memoised, so moving a slider back is instant. Peaks agree with
+  :func:`bladedamp.studies.peak_response` to 0.1 % (tests).
+
+Units: SI inside; the arguments of the ``*_figure`` callbacks carry their slider units in their
+names (``mass_g``, ``amplitude_mm``, ``gamma_right_deg``).
+"""
+from __future__ import annotations
+
+import dataclasses
+import time
+import warnings
+from collections import OrderedDict
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..contact.laws import LinearNormalLaw
+from ..contact.patch import ContactPatch
+from ..contact.point import SEPARATED, SLIP, STICK, point_contact_forces
+from ..hbm.continuation import Branch, newton
+from ..hbm.fourier import HarmonicBasis
+from ..oscillator import FrictionOscillator
+
+__all__ = ["interactive_view", "hysteresis_loop", "hysteresis_figure", "describing_function", "describing_function_figure",
+           "oscillator_comparison", "oscillator_figure", "DiskFRF", "DiskFRFCache", "DEFAULT_CACHE", "disk_frf",
+           "undamped_frf", "disk_frf_figure", "mass_sweep_peaks", "mass_study_figure", "engine_order_figure",
+           "contact_state_at_peak", "platform_angle_figure", "closed_form_jenkins"]
+
+# the slider callbacks set the slip force mu N; this splits it into mu and N (only the lift-off
+# and normal-load plots see the split)
+FRICTION_COEFFICIENT = 0.3
+STATE_COLOURS = {STICK: "tab:blue", SLIP: "tab:red", SEPARATED: "tab:gray"}
+STATE_NAMES = {STICK: "stick", SLIP: "slip", SEPARATED: "lift-off"}
+
+
+def interactive_view(callback):
+    """Wrap a ``*_figure`` callback for ``ipywidgets.interact``: draw the figure, show it, return
+    None (interact would otherwise display the returned figure a second time). The wrapper keeps
+    the callback's signature, so ``interact`` finds its parameters and defaults."""
+    import functools
+
+    @functools.wraps(callback)
+    def view(*args, **kwargs):
+        import matplotlib.pyplot as plt
+
+        callback(*args, **kwargs)
+        plt.show()
+
+    return view
+
+
+def _figure(*args, **kwargs):
+    import matplotlib.pyplot as plt
+
+    return plt.subplots(*args, **kwargs)
+
+
+# ---------------------------------------------------------------------------------------
+# 1. the point contact: hysteresis loop, describing function
+# ---------------------------------------------------------------------------------------
+def closed_form_jenkins(k_t, slip_force, amplitude):
+    """Closed form of the 1D elastic Coulomb (Jenkins) element under u = A cos(tau), constant N.
+
+    Returns ``(k_eq, d_eq, energy)``: equivalent stiffness Re(F_1 / A) [N/m], equivalent damping
+    stiffness Im(F_1 / A) [N/m] (the imaginary part of the complex stiffness of Eq. 10) and the
+    energy dissipated per cycle [J]. Stick (k_T A <= mu N): k_T, 0, 0. Gross slip, with
+    beta = arccos(1 - 2 mu N / (k_T A)):
+    k_eq = k_T / pi (beta - sin(2 beta) / 2), d_eq = 4 mu N / (pi A) (1 - mu N / (k_T A)),
+    energy = 4 mu N (A - mu N / k_T) = pi A^2 d_eq.
+    """
+    k_t, slip_force, A = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (k_t, slip_force, amplitude)))
+    stick = k_t * A <= slip_force
+    with np.errstate(divide="ignore", invalid="ignore"):
+        beta = np.arccos(np.clip(1.0 - 2.0 * slip_force / (k_t * A), -1.0, 1.0))
+        k_eq = np.where(stick, k_t, k_t / np.pi * (beta - np.sin(2 * beta) / 2))
+        d_eq = np.where(stick, 0.0, 4 * slip_force / (np.pi * A) * (1 - slip_force / (k_t * A)))
+    energy = np.where(stick, 0.0, 4 * slip_force * (A - slip_force / k_t))
+    return k_eq, d_eq, energy
+
+
+def _normal_motion(normal_load, normal_variation, phase_deg, k_n):
+    """First-harmonic normal displacement giving N(tau) = N0 (1 + v cos(tau - phase))."""
+    z = normal_variation * normal_load / k_n
+    ph = np.radians(phase_deg)
+    return -z * np.cos(ph), -z * np.sin(ph)
+
+
+def hysteresis_loop(amplitude, k_t, slip_force, normal_variation=0.0, phase_deg=0.0,
+                    friction_coefficient=FRICTION_COEFFICIENT, n_samples=512) -> dict:
+    """Steady hysteresis loop of one point contact (elastic Coulomb slider, Fig. 3) under
+    u_xi = A cos(tau) and a normal load N(tau) = N0 (1 + v cos(tau - phase)) (lift-off when v > 1).
+
+    Parameters: amplitude A [m] (>= 0), k_t [N/m], slip_force mu N0 [N], normal_variation v [-],
+    phase_deg [deg] of the normal load against the tangential motion, friction_coefficient mu.
+
+    Returns a dict of samples over one period: ``tau``, ``u`` [m], ``force`` (tangential force on
+    the platform) [N], ``normal`` [N], ``state`` (0 stick, 1 slip, 2 separated), and
+    ``energy`` = oint f du [J] (the loop area, the energy dissipated per cycle), ``slip_work`` [J]
+    (the same from the slider's moves), ``energy_closed_form`` [J] (the Jenkins closed form for
+    v = 0), ``share`` {stick, slip, lift-off: fraction of the period}.
+    """
+    if amplitude < 0 or k_t <= 0 or slip_force < 0 or friction_coefficient <= 0 or normal_variation < 0:
+        raise ValueError("need amplitude >= 0, k_t > 0, slip_force >= 0, friction_coefficient > 0, "
+                         "normal_variation >= 0")
+    basis = HarmonicBasis((1,), n_samples)
+    N0 = slip_force / friction_coefficient
+    k_n = k_t
+    coeffs = np.zeros((basis.n_coeffs, 1, 3))
+    coeffs[0, 0, 0] = amplitude
+    coeffs[0, 0, 2], coeffs[1, 0, 2] = _normal_motion(N0, normal_variation, phase_deg, k_n)
+    pts = point_contact_forces(coeffs, basis, np.array([k_t]), np.array([friction_coefficient]),
+                               LinearNormalLaw(k_n), np.array([1.0]), np.array([N0 / k_n]), jacobian=False)
+    u, f = pts.displacement[0, :, 0], pts.force[0, :, 0]
+    # loop area, trapezoid over the closed loop
+    energy = float(np.sum(0.5 * (f + np.roll(f, -1)) * (np.roll(u, -1) - u)))
+    _, _, e_closed = closed_form_jenkins(k_t, slip_force, amplitude)
+    state = pts.state[0]
+    share = {STATE_NAMES[s]: float(np.mean(state == s)) for s in (STICK, SLIP, SEPARATED)}
+    return dict(tau=basis.tau, u=u, force=f, normal=pts.normal_load[0], state=state, energy=energy,
+                slip_work=float(pts.slip_work[0]), energy_closed_form=float(e_closed), share=share)
+
+
+def hysteresis_figure(amplitude_mm=0.1, k_t_kn_per_m=10.0, slip_force_n=0.3, normal_variation=0.0, phase_deg=0.0):
+    """Slider callback (notebook 01): the hysteresis loop f(u) coloured by stick / slip / lift-off,
+    beside the time signals. Returns the figure; ``fig.loop`` holds the :func:`hysteresis_loop` data."""
+    A, k_t = 1e-3 * amplitude_mm, 1e3 * k_t_kn_per_m
+    d = hysteresis_loop(A, k_t, slip_force_n, normal_variation, phase_deg)
+    fig, (ax, ax2) = _figure(1, 2, figsize=(10, 3.8))
+    u_mm = 1e3 * d["u"]
+    for s in (STICK, SLIP, SEPARATED):
+        sel = d["state"] == s
+        if sel.any():
+            ax.scatter(u_mm[sel], d["force"][sel], s=6, color=STATE_COLOURS[s], label=STATE_NAMES[s])
+    ax.plot(np.append(u_mm, u_mm[0]), np.append(d["force"], d["force"][0]), color="k", lw=0.6)
+    ax.axhline(slip_force_n, color="gray", ls=":", lw=1)
+    ax.axhline(-slip_force_n, color="gray", ls=":", lw=1)
+    ax.set_xlabel("tangential displacement u [mm]")
+    ax.set_ylabel("tangential contact force f_T [N]")
+    ax.set_title(f"loop area = dissipated energy: {1e3 * d['energy']:.3g} mJ per cycle"
+                 + ("" if normal_variation else f"\n(closed form {1e3 * d['energy_closed_form']:.3g} mJ)"), fontsize=9)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8, loc="upper left")
+    ax2.plot(np.degrees(d["tau"]), d["force"], label="f_T [N]")
+    ax2.plot(np.degrees(d["tau"]), FRICTION_COEFFICIENT * d["normal"], label="mu N(t) [N]", ls="--")
+    ax2.plot(np.degrees(d["tau"]), -FRICTION_COEFFICIENT * d["normal"], color="C1", ls="--")
+    ax2.set_xlabel("phase Omega t [deg]")
+    ax2.set_ylabel("force [N]")
+    ax2.set_xlim(0, 360)
+    ax2.grid(True, alpha=0.3)
+    ax2.legend(fontsize=8, loc="lower right")
+    fig.tight_layout()
+    fig.loop = d
+    return fig
+
+
+def describing_function(k_t, slip_force, amplitudes, normal_variation=0.0, phase_deg=0.0,
+                        friction_coefficient=FRICTION_COEFFICIENT, n_samples=256) -> dict:
+    """Complex equivalent stiffness k_hat = F_1 / W_1 (Eq. 10) of a one-point contact patch
+    (:meth:`bladedamp.contact.ContactPatch.equivalent_stiffness`) over tangential amplitudes [m],
+    with the Jenkins closed form beside it.
+
+    Returns a dict: ``amplitude`` [m], ``k_eq`` = Re k_hat, ``d_eq`` = Im k_hat [N/m],
+    ``energy`` = pi A^2 Im k_hat [J per cycle], and ``k_eq_closed``, ``d_eq_closed``,
+    ``energy_closed`` (constant normal load).
+    """
+    A = np.atleast_1d(np.asarray(amplitudes, dtype=float))
+    if np.any(A <= 0):
+        raise ValueError("amplitudes must be > 0 m")
+    N0 = slip_force / friction_coefficient
+    k_n = k_t
+    patch = ContactPatch(0.0, 1.0, k_t, friction_coefficient, LinearNormalLaw(k_n), n_xi=1, n_eta=1)
+    basis = HarmonicBasis((1,), n_samples)
+    offset = patch.approach_for_load(N0)
+    za, zb = _normal_motion(N0, normal_variation, phase_deg, k_n)
+    k_hat = np.empty(A.size, dtype=complex)
+    for i, a in enumerate(A):
+        w = np.zeros((basis.n_coeffs, 6))
+        w[0, 0] = a
+        w[0, 2], w[1, 2] = za, zb
+        k_hat[i] = patch.equivalent_stiffness(w, basis, offset)[1][0]
+    k_c, d_c, e_c = closed_form_jenkins(k_t, slip_force, A)
+    return dict(amplitude=A, k_eq=k_hat.real, d_eq=k_hat.imag, energy=np.pi * A ** 2 * k_hat.imag,
+                k_eq_closed=k_c, d_eq_closed=d_c, energy_closed=e_c)
+
+
+def describing_function_figure(k_t_kn_per_m=10.0, slip_force_n=0.3, normal_variation=0.0, amplitude_mm=None,
+                               n_points=60):
+    """Slider callback (notebook 01): equivalent stiffness and damping over the amplitude
+    (normalised by the slip amplitude mu N / k_T), AFT points on the closed form, and the energy
+    per cycle. ``fig.data`` holds the :func:`describing_function` result."""
+    k_t = 1e3 * k_t_kn_per_m
+    a_slip = slip_force_n / k_t
+    A = a_slip * np.logspace(-1, 2, n_points)
+    d = describing_function(k_t, slip_force_n, A, normal_variation)
+    x = A / a_slip
+    fig, (ax, ax2) = _figure(1, 2, figsize=(10, 3.8))
+    ax.semilogx(x, d["k_eq_closed"] / k_t, "C0-", label="k_eq / k_T, closed form")
+    ax.semilogx(x, d["d_eq_closed"] / k_t, "C3-", label="d_eq / k_T, closed form")
+    ax.semilogx(x, d["k_eq"] / k_t, "C0o", ms=3, label="k_eq / k_T, AFT (Eq. 10)")
+    ax.semilogx(x, d["d_eq"] / k_t, "C3o", ms=3, label="d_eq / k_T, AFT (Eq. 10)")
+    ax.set_xlabel("amplitude A / (mu N / k_T)")
+    ax.set_ylabel("complex contact stiffness / k_T")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    ax2.loglog(1e3 * A, 1e3 * np.maximum(d["energy_closed"], 1e-30), "k-", label="closed form 4 mu N (A - mu N / k_T)")
+    ax2.loglog(1e3 * A, 1e3 * np.maximum(d["energy"], 1e-30), "C2o", ms=3, label="AFT: pi A^2 Im k_hat")
+    ax2.set_ylim(1e3 * max(d["energy_closed"].max(), 1e-30) * 1e-5, None)
+    ax2.set_xlabel("amplitude A [mm]")
+    ax2.set_ylabel("energy dissipated per cycle [mJ]")
+    ax2.grid(True, which="both", alpha=0.3)
+    ax2.legend(fontsize=8)
+    if amplitude_mm is not None:
+        ax.axvline(1e-3 * amplitude_mm / a_slip, color="k", ls=":")
+        ax2.axvline(amplitude_mm, color="k", ls=":")
+    fig.tight_layout()
+    fig.data = d
+    return fig
+
+
+# ---------------------------------------------------------------------------------------
+# 2. the friction oscillator: HBM beside time integration
+# ---------------------------------------------------------------------------------------
+_OSC_CACHE: "OrderedDict[tuple, dict]" = OrderedDict()
+
+
+def oscillator_comparison(normal_load=3.0, forcing=2.0, damping=2.0, harmonics=(1, 3, 5), omega_range=(70.0, 200.0),
+                          time_omegas=(90.0, 110.0, 130.0, 160.0), steps_per_period=512, max_step=0.05) -> dict:
+    """FRF of the :class:`FrictionOscillator` (m = 1 kg, k = k_T = 1e4 N/m, mu = 0.3) by HBM
+    beside time integration at ``time_omegas`` [rad/s], and the linear limits.
+
+    Returns a dict: ``osc``, ``frf`` (FrequencyResponse), ``omega`` [rad/s], ``hbm`` (first-harmonic
+    amplitude on the branch) [m], ``time_omega``, ``time_amplitude`` (time integration),
+    ``hbm_at_time`` (HBM interpolated there), ``energy`` (excitation, viscous, contact work per
+    cycle on the branch), ``free``, ``stuck`` (linear amplitudes over ``omega``) and the same on a
+    dense grid ``omega_dense``: ``free_dense``, ``stuck_dense``. Memoised.
+    """
+    key = (float(normal_load), float(forcing), float(damping), tuple(harmonics), tuple(omega_range),
+           tuple(time_omegas), int(steps_per_period), float(max_step))
+    if key in _OSC_CACHE:
+        return _OSC_CACHE[key]
+    osc = FrictionOscillator(damping=damping, normal_load=normal_load, forcing=forcing)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        frf = osc.frequency_response(*omega_range, harmonics=harmonics, max_step=max_step)
+    amp = frf.harmonic_amplitude(0, 1)
+    tw = np.asarray(time_omegas, dtype=float)
+    tr = osc.time_response(tw, steps_per_period=steps_per_period) if tw.size else None
+    order = np.argsort(frf.omega)
+    out = dict(osc=osc, frf=frf, omega=frf.omega, hbm=amp, time_omega=tw,
+               time_amplitude=tr.amplitude if tr is not None else np.zeros(0),
+               time_converged=tr.converged if tr is not None else np.zeros(0, bool),
+               hbm_at_time=np.interp(tw, frf.omega[order], amp[order]),
+               energy=osc.energy_balance(frf), free=osc.linear_amplitude(frf.omega, stuck=False),
+               stuck=osc.linear_amplitude(frf.omega, stuck=True))
+    dense = np.linspace(*omega_range, 600)
+    out.update(omega_dense=dense, free_dense=osc.linear_amplitude(dense, stuck=False),
+               stuck_dense=osc.linear_amplitude(dense, stuck=True))
+    _OSC_CACHE[key] = out
+    while len(_OSC_CACHE) > 32:
+        _OSC_CACHE.popitem(last=False)
+    return out
+
+
+def oscillator_figure(normal_load=3.0, forcing=2.0, damping=2.0, **kwargs):
+    """Slider callback (notebook 01): HBM FRF, time-integration points, the free and stuck linear
+    limits. ``fig.data`` holds the :func:`oscillator_comparison` result."""
+    d = oscillator_comparison(normal_load, forcing, damping, **kwargs)
+    fig, ax = _figure(figsize=(7, 4))
+    ax.semilogy(d["omega_dense"], 1e3 * d["free_dense"], color="gray", ls="--", lw=1, label="linear, no contact (k)")
+    ax.semilogy(d["omega_dense"], 1e3 * d["stuck_dense"], color="gray", ls=":", lw=1,
+                label="linear, stuck (k + k_T)")
+    ax.semilogy(d["omega"], 1e3 * d["hbm"], "C0-", label=f"HBM, harmonics {tuple(d['frf'].basis.harmonics)}")
+    if d["time_omega"].size:
+        ax.semilogy(d["time_omega"], 1e3 * d["time_amplitude"], "C3o", label="time integration")
+    ax.set_xlabel("excitation frequency Omega [rad/s]")
+    ax.set_ylabel("first-harmonic amplitude |x_1| [mm]")
+    ax.set_title(f"friction oscillator: mu N = {d['osc'].slip_force:.3g} N, F = {forcing:.3g} N", fontsize=9)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.data = d
+    return fig
+
+
+# ---------------------------------------------------------------------------------------
+# 3. the reference disk: warm-started frequency responses
+# ---------------------------------------------------------------------------------------
+@dataclass
+class DiskFRF:
+    """A frequency response of the reference disk on a frequency grid.
+
+    frequency_hz : (n,) [Hz]; tip : (n, 3) first-harmonic tip amplitude u_x, u_y, u_z [m];
+    x : (n, N) harmonic balance unknowns; peak_tip [m] and resonance_hz [Hz] of u_x (refined);
+    peak_x : unknowns at the refined peak; method : "linear", "warm", "cold" or "continuation";
+    seconds : compute time [s]; disk : the TunedDisk; system : its HarmonicBalanceSystem.
+    """
+
+    frequency_hz: np.ndarray
+    tip: np.ndarray
+    x: np.ndarray
+    peak_tip: float
+    resonance_hz: float
+    peak_x: np.ndarray
+    method: str
+    seconds: float
+    disk: object
+    system: object
+
+    def reduction(self, undamped: "DiskFRF") -> float:
+        """1 - peak / undamped peak."""
+        return 1.0 - self.peak_tip / undamped.peak_tip
+
+
+def _tip(disk, system, X) -> np.ndarray:
+    basis = system.basis
+    C, n = basis.n_coeffs, system.n_dof
+    nm = disk.blade.n_modes
+    j = basis.cos_index(1)
+    X = np.asarray(X).reshape(-1, C, n)
+    q1 = X[:, j, :nm] - 1j * X[:, j + 1, :nm]
+    return np.abs(q1 @ disk.blade.shape("tip")[:3].T)
+
+
+class DiskFRFCache:
+    """Memoised, warm-started frequency responses of reference disks (see the module docstring).
+
+    Parameters
+    ----------
+    f_range_hz : frequency window [Hz]; widened (once per side, by its width) when the peak
+        sits at an end
+    n_points : frequencies of the grid
+    refine_points : frequencies of each finer grid around the largest point
+    refine_rounds : how many finer grids (each spans two steps of the previous one)
+    max_entries : memoised responses kept (least recently used dropped)
+    """
+
+    def __init__(self, f_range_hz=(92.0, 100.0), n_points=33, refine_points=7, refine_rounds=3, max_entries=256):
+        self.f_range_hz = tuple(float(f) for f in f_range_hz)
+        self.n_points = int(n_points)
+        self.refine_points = int(refine_points)
+        self.refine_rounds = int(refine_rounds)
+        self.max_entries = int(max_entries)
+        self._memo: "OrderedDict[tuple, DiskFRF]" = OrderedDict()
+        self._base_disks: dict = {}
+        self.stats = {"memo": 0, "linear": 0, "warm": 0, "cold": 0, "continuation": 0}
+
+    # -- keys -------------------------------------------------------------------------
+    @staticmethod
+    def family(kind, engine_order=1, gamma_right_deg=35.0, excitation=None, harmonics=(1,)):
+        """Everything but the mass: responses of one family warm-start each other."""
+        exc = None if excitation is None else tuple(float(v) for v in excitation)
+        return (kind, int(engine_order), round(float(gamma_right_deg), 6), exc, tuple(harmonics))
+
+    def _disk(self, family, mass):
+        """The family's reference disk with ``mass`` (the blade's beam modes are built once per family)."""
+        from ..reference import reference_disk
+
+        if family not in self._base_disks:
+            kind, eo, gamma_r, exc, _ = family
+            kw = {}
+            if exc is not None:
+                kw["excitation"] = np.array(exc)
+            if eo == 0:
+                kw["rotor_speed"] = 2 * np.pi * 95.0      # EO = 0 needs a rotor speed: the 1F frequency
+            disk = reference_disk(kind, 1e-3, engine_order=eo, **kw)
+            if gamma_r != 35.0:
+                disk = dataclasses.replace(disk, gamma_right=np.radians(gamma_r))
+            self._base_disks[family] = disk
+        base = self._base_disks[family]
+        if base.damper is None:
+            return base
+        return dataclasses.replace(base, damper=dataclasses.replace(base.damper, mass=mass))
+
+    # -- public -----------------------------------------------------------------------
+    def response(self, kind="cylinder", mass=1e-3, engine_order=1, gamma_right_deg=35.0, excitation=None,
+                 harmonics=(1,)) -> DiskFRF:
+        """Frequency response of the reference disk with a ``kind`` damper of ``mass`` [kg]
+        (``kind=None``: no damper), at ``engine_order``, right platform angle [deg]."""
+        if kind not in (None, "cylinder", "wedge"):
+            raise ValueError(f"kind must be None, 'cylinder' or 'wedge' (got {kind!r})")
+        if kind is not None and not mass > 0:
+            raise ValueError(f"mass must be > 0 kg (got {mass!r})")
+        fam = self.family(kind, engine_order, gamma_right_deg, excitation, harmonics)
+        mass = 0.0 if kind is None else float(mass)
+        key = fam + (float(f"{mass:.6g}"),)
+        if key in self._memo:
+            self._memo.move_to_end(key)
+            self.stats["memo"] += 1
+            return self._memo[key]
+        t0 = time.perf_counter()
+        disk = self._disk(fam, mass if kind is not None else 1e-3)
+        system = disk.hbm_system(harmonics)
+        result = self._solve(fam, mass, disk, system, t0)
+        self._memo[key] = result
+        while len(self._memo) > self.max_entries:
+            self._memo.popitem(last=False)
+        return result
+
+    def clear(self):
+        self._memo.clear()
+
+    # -- internals --------------------------------------------------------------------
+    def _neighbour(self, fam, mass):
+        """Cached damped response nearest in parameters, or None: same damper type, engine order,
+        excitation and harmonics; distance |log(m / m')| + |gamma_R - gamma_R'| / 20 deg."""
+        best, dist = None, np.inf
+        kind, eo, gamma_r, exc, harmonics = fam
+        for key, r in self._memo.items():
+            k_kind, k_eo, k_gamma, k_exc, k_harm, k_mass = key
+            if (k_kind, k_eo, k_exc, k_harm) == (kind, eo, exc, harmonics) and k_mass > 0 and r.method != "linear":
+                d = abs(np.log(k_mass / mass)) + abs(k_gamma - gamma_r) / 20.0
+                if d < dist:
+                    best, dist = r, d
+        return best
+
+    def _solve(self, fam, mass, disk, system, t0) -> DiskFRF:
+        lo, hi = self.f_range_hz
+        for _ in range(3):
+            r = self._solve_range(fam, mass, disk, system, lo, hi, t0)
+            i = int(np.argmax(r.tip[:, 0]))
+            width = hi - lo
+            if 0 < i < len(r.frequency_hz) - 1:
+                return r
+            lo, hi = (max(lo - width, 0.5 * lo), hi) if i == 0 else (lo, hi + width)
+        return r
+
+    def _solve_range(self, fam, mass, disk, system, lo, hi, t0) -> DiskFRF:
+        w0, w1 = 2 * np.pi * lo, 2 * np.pi * hi
+        if not disk.has_damper:
+            fs = np.linspace(lo, hi, 8 * self.n_points)   # linear and sharp: a dense grid is cheap
+            # linear: one solve per frequency
+            X = np.array([disk._initial_guess(system, 2 * np.pi * f) for f in fs])
+            return self._finish(disk, system, fs, X, "linear", t0, lambda f, x: (disk._initial_guess(system, 2 * np.pi * f), True))
+        fs = np.linspace(lo, hi, self.n_points)
+        scales = disk._scales(system, w0, w1)
+        rscale = max(np.linalg.norm(system.residual(np.zeros(system.n_unknowns), w0)[0]), 1e-300)
+
+        def solve(f, x0, max_iter=30):
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                res = newton(system.residual, x0, 2 * np.pi * f, scales, rscale, max_iter=max_iter)
+            return res.x, res.converged and np.all(np.isfinite(res.x))
+
+        nb = self._neighbour(fam, mass)
+        guesses = None
+        if nb is not None and nb.x.shape[1] == system.n_unknowns:
+            guesses = np.array([np.interp(fs, nb.frequency_hz, nb.x[:, k]) for k in range(nb.x.shape[1])]).T
+        X, ok_all = np.zeros((fs.size, system.n_unknowns)), True
+        x_prev = disk._initial_guess(system, w0)
+        for i, f in enumerate(fs):
+            x, ok = solve(f, guesses[i], 10) if guesses is not None else (None, False)
+            if not ok and i >= 2:
+                # secant predictor along the frequency
+                x, ok = solve(f, 2 * X[i - 1] - X[i - 2], 10)
+            if not ok:
+                x, ok = solve(f, x_prev)
+            if not ok and i >= 1:
+                # sub-steps from the previous frequency, each with a secant predictor
+                xa, xb, fa = X[i - 1] if i < 2 else X[i - 2], X[i - 1], fs[i - 1]
+                df = (f - fa) / 8
+                for k in range(1, 9):
+                    pred = xb + (xb - xa) * (df / (fa - fs[i - 2] if i >= 2 and k == 1 else df))
+                    x, ok = solve(fa + k * df, pred, 15)
+                    if not ok:
+                        x, ok = solve(fa + k * df, xb, 30)
+                    if not ok:
+                        break
+                    xa, xb = xb, x
+            if not ok:
+                ok_all = False
+                break
+            X[i] = x_prev = x
+        if ok_all:
+            return self._finish(disk, system, fs, X, "warm" if guesses is not None else "cold", t0, solve)
+        # fallback: arc-length continuation, then the grid by interpolation of the branch
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            resp = disk.frequency_response(lo, hi, max_step=0.05)
+        order = np.argsort(resp.omega)
+        fb, xb = resp.frequency_hz[order], resp.coefficients.reshape(len(resp.omega), -1)[order]
+        fb, idx = np.unique(fb, return_index=True)
+        xb = xb[idx]
+        X = np.array([np.interp(fs, fb, xb[:, k]) for k in range(xb.shape[1])]).T
+        tip_b = _tip(disk, system, xb)
+        i = int(np.argmax(tip_b[:, 0]))
+        out = self._finish(disk, system, fs, X, "continuation", t0, solve)
+        if tip_b[i, 0] > out.peak_tip:
+            out.peak_tip, out.resonance_hz, out.peak_x = float(tip_b[i, 0]), float(fb[i]), xb[i]
+        out.frequency_hz, out.tip, out.x = fb, tip_b, xb
+        return out
+
+    def _finish(self, disk, system, fs, X, method, t0, solve) -> DiskFRF:
+        tip = _tip(disk, system, X)
+        i = int(np.argmax(tip[:, 0]))
+        peak, f_peak, x_peak = float(tip[i, 0]), float(fs[i]), X[i]
+        extra_f, extra_x = [], []
+        # refine on finer and finer grids between the neighbours of the largest point
+        a, b, x = fs[max(i - 1, 0)], fs[min(i + 1, fs.size - 1)], X[max(i - 1, 0)]
+        for _ in range(self.refine_rounds):
+            grid = np.linspace(a, b, self.refine_points)
+            for f in grid:
+                x_new, ok = solve(f, x)
+                if not ok:
+                    continue
+                x = x_new
+                extra_f.append(float(f))
+                extra_x.append(x)
+                t = float(_tip(disk, system, x)[0, 0])
+                if t > peak:
+                    peak, f_peak, x_peak = t, float(f), x
+            step = grid[1] - grid[0]
+            a, b, x = f_peak - step, f_peak + step, x_peak
+        if extra_f:
+            # the refinement points sharpen the plotted peak too
+            fs = np.concatenate([fs, extra_f])
+            X = np.vstack([X, np.array(extra_x)])
+            fs, idx = np.unique(fs, return_index=True)
+            X = X[idx]
+            tip = _tip(disk, system, X)
+        self.stats[method] += 1
+        return DiskFRF(fs, tip, X, peak, f_peak, x_peak, method, time.perf_counter() - t0, disk, system)
+
+
+DEFAULT_CACHE = DiskFRFCache()
+
+
+def disk_frf(kind="cylinder", mass_g=1.0, engine_order=1, gamma_right_deg=35.0, excitation=None,
+             cache: DiskFRFCache | None = None) -> DiskFRF:
+    """Warm-started frequency response of the reference disk over the 1F window (mass in grams)."""
+    cache = DEFAULT_CACHE if cache is None else cache
+    return cache.response(kind, 1e-3 * mass_g, engine_order, gamma_right_deg, excitation)
+
+
+def undamped_frf(engine_order=1, excitation=None, cache: DiskFRFCache | None = None) -> DiskFRF:
+    """Frequency response of the reference disk without damper."""
+    cache = DEFAULT_CACHE if cache is None else cache
+    return cache.response(None, 0.0, engine_order, 35.0, excitation)
+
+
+def disk_frf_figure(mass_g=1.0, kind="cylinder", engine_order=1, gamma_right_deg=35.0, cache=None):
+    """Slider callback (notebooks 02, 03): tip amplitude over frequency with and without the
+    damper; the title gives the peak and the reduction. ``fig.data = (damped, undamped)``."""
+    damped = disk_frf(kind, mass_g, engine_order, gamma_right_deg, cache=cache)
+    free = undamped_frf(engine_order, cache=cache)
+    fig, ax = _figure(figsize=(7, 4))
+    ax.plot(free.frequency_hz, 1e3 * free.tip[:, 0], "k--", lw=1, label="no damper")
+    ax.plot(damped.frequency_hz, 1e3 * damped.tip[:, 0], "C0-", label=f"{kind} {mass_g:.3g} g")
+    ax.plot([damped.resonance_hz], [1e3 * damped.peak_tip], "C3o")
+    ax.set_xlabel("excitation frequency [Hz]")
+    ax.set_ylabel("tip amplitude u_x [mm]")
+    ax.set_xlim(damped.frequency_hz[0], damped.frequency_hz[-1])
+    ax.set_title(f"EO = {engine_order}, gamma_R = {gamma_right_deg:g} deg: peak {1e3 * damped.peak_tip:.3f} mm at "
+                 f"{damped.resonance_hz:.2f} Hz, reduction {100 * damped.reduction(free):.1f} % "
+                 f"({damped.method}, {damped.seconds:.2f} s)", fontsize=9)
+    ax.grid(True, alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.data = (damped, free)
+    return fig
+
+
+def mass_sweep_peaks(kind, masses_g, engine_order=1, gamma_right_deg=35.0, cache=None) -> dict:
+    """Peak tip amplitude [m] and reduction over damper masses [g], warm-started mass after mass.
+
+    Returns a dict ``mass_g``, ``peak_tip``, ``resonance_hz``, ``undamped_peak_tip``, ``reduction``,
+    and the best grid point ``best_mass_g``, ``best_reduction``."""
+    masses_g = np.atleast_1d(np.asarray(masses_g, dtype=float))
+    rs = [disk_frf(kind, m, engine_order, gamma_right_deg, cache=cache) for m in masses_g]
+    free = undamped_frf(engine_order, cache=cache)
+    peaks = np.array([r.peak_tip for r in rs])
+    red = 1 - peaks / free.peak_tip
+    j = int(np.argmax(red))
+    return dict(mass_g=masses_g, peak_tip=peaks, resonance_hz=np.array([r.resonance_hz for r in rs]),
+                undamped_peak_tip=free.peak_tip, reduction=red, best_mass_g=float(masses_g[j]),
+                best_reduction=float(red[j]))
+
+
+def mass_study_figure(mass_g=1.0, kind="cylinder", sweeps=None, engine_order=1, cache=None):
+    """Slider callback (notebook 03): left, the FRF at ``mass_g``; right, precomputed
+    ``sweeps`` {kind: :func:`mass_sweep_peaks` result} with the current mass marked."""
+    damped = disk_frf(kind, mass_g, engine_order, cache=cache)
+    free = undamped_frf(engine_order, cache=cache)
+    fig, (ax, ax2) = _figure(1, 2, figsize=(11, 4))
+    ax.plot(free.frequency_hz, 1e3 * free.tip[:, 0], "k--", lw=1, label="no damper")
+    ax.plot(damped.frequency_hz, 1e3 * damped.tip[:, 0], label=f"{kind} {mass_g:.3g} g")
+    ax.set_xlim(damped.frequency_hz[0], damped.frequency_hz[-1])
+    ax.set_xlabel("excitation frequency [Hz]")
+    ax.set_ylabel("tip amplitude u_x [mm]")
+    ax.set_title(f"peak {1e3 * damped.peak_tip:.3f} mm, reduction {100 * damped.reduction(free):.1f} %", fontsize=9)
+    ax.grid(True, alpha=0.3)
+    ax.legend()
+    for k, sw in (sweeps or {}).items():
+        ax2.semilogx(sw["mass_g"], 1e3 * sw["peak_tip"], "o-", label=k)
+    ax2.axhline(1e3 * free.peak_tip, color="gray", ls="--", lw=1, label="no damper")
+    ax2.plot([mass_g], [1e3 * damped.peak_tip], "k*", ms=14, label="this mass")
+    ax2.set_xlabel("damper mass [g]")
+    ax2.set_ylabel("resonance tip amplitude u_x [mm]")
+    ax2.grid(True, which="both", alpha=0.3)
+    ax2.legend(fontsize=8)
+    fig.tight_layout()
+    fig.data = (damped, free)
+    return fig
+
+
+def engine_order_figure(engine_order=1, kind="cylinder", mass_g=1.0, cache=None):
+    """Slider callback (notebook 03): FRF with and without the damper at one engine order."""
+    return disk_frf_figure(mass_g, kind, engine_order, 35.0, cache)
+
+
+def contact_state_at_peak(frf: DiskFRF):
+    """Eq. 27 at the refined resonance of ``frf``: a :class:`bladedamp.studies.ContactState`
+    (normalised first-harmonic xi motion and force of both contacts), from the cached solution,
+    the same definitions as :func:`bladedamp.studies.contact_state`."""
+    from ..disk import DiskResponse
+    from ..studies.design import ContactState
+
+    disk, system = frf.disk, frf.system
+    if not disk.has_damper:
+        raise ValueError("contact_state_at_peak needs a damped response")
+    omega = 2 * np.pi * frf.resonance_hz
+    branch = Branch(np.array([omega]), frf.peak_x[None, :], np.zeros(1, dtype=int), True, "peak")
+    r = DiskResponse.from_branch(disk, system, branch)
+    basis = r.basis
+    w1 = basis.to_complex(r.relative_motion[0])[1]
+    f1 = basis.to_complex(r.contact_force[0])[1]
+    w_xi, F_xi = w1[[0, 6]], f1[[0, 6]]
+    patches = disk.damper_geometry().patches
+    c_t = np.array([p.tangential_stiffness for p in patches])
+    mu = np.array([p.friction_coefficient for p in patches])
+    F_N = np.asarray(disk.static_normal_loads(omega), dtype=float)
+    state = ContactState(w_xi * c_t / (mu * F_N), F_xi / (mu * F_N), w_xi, F_xi, F_N, c_t, mu,
+                         float(frf.resonance_hz), float(frf.peak_tip))
+    state.point_state = r.point_state[0]     # (2, P, 3) stick / slip / separated share per point
+    return state
+
+
+def platform_angle_figure(gamma_right_deg=35.0, kind="cylinder", mass_g=1.0, cache=None):
+    """Slider callback (notebook 03): FRF at the right platform angle gamma_R (gamma_L = 35 deg)
+    and the complex-plane contact state at resonance (Eq. 27, Fig. 11).
+    ``fig.data = (damped FRF, undamped FRF, ContactState)``."""
+    damped = disk_frf(kind, mass_g, 1, gamma_right_deg, cache=cache)
+    free = undamped_frf(1, cache=cache)
+    state = contact_state_at_peak(damped)
+    fig, (ax, ax2) = _figure(1, 2, figsize=(11, 4.5), gridspec_kw={"width_ratios": [1.4, 1]})
+    ax.plot(free.frequency_hz, 1e3 * free.tip[:, 0], "k--", lw=1, label="no damper")
+    ax.plot(damped.frequency_hz, 1e3 * damped.tip[:, 0], label=f"{kind} {mass_g:.3g} g, gamma_R = {gamma_right_deg:g} deg")
+    ax.set_xlim(damped.frequency_hz[0], damped.frequency_hz[-1])
+    ax.set_xlabel("excitation frequency [Hz]")
+    ax.set_ylabel("tip amplitude u_x [mm]")
+    ax.set_title(f"peak {1e3 * damped.peak_tip:.3f} mm, reduction {100 * damped.reduction(free):.1f} %; "
+                 f"N_OL = {state.normal_load[0]:.3g} N, N_OR = {state.normal_load[1]:.3g} N", fontsize=9)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    state.plot(ax=ax2)
+    ax2.set_title("Eq. 27 at resonance: |w*| < 1 sticks", fontsize=9)
+    fig.tight_layout()
+    fig.data = (damped, free, state)
+    return fig

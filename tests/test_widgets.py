@@ -1,0 +1,208 @@
+"""Slider callbacks of the notebooks (bladedamp.viz.widgets), called with values, no browser.
+
+The reference values are closed forms (Jenkins element) or the library's own solvers
+(continuation, ``contact_state``), which the warm-started callbacks must reproduce.
+"""
+import inspect
+import warnings
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+import bladedamp as bd  # noqa: E402
+from bladedamp.studies import contact_state, peak_response  # noqa: E402
+from bladedamp.viz import widgets as W  # noqa: E402
+
+
+@pytest.fixture(autouse=True)
+def _close_figures():
+    yield
+    plt.close("all")
+
+
+# ----- point contact ---------------------------------------------------------------------
+def test_hysteresis_loop_area_is_the_closed_form_energy():
+    k_t, slip, A = 1e4, 0.3, 1e-4             # slip amplitude 30 um, A = 3.3 of it
+    d = W.hysteresis_loop(A, k_t, slip)
+    exact = 4 * slip * (A - slip / k_t)
+    assert d["energy_closed_form"] == pytest.approx(exact)
+    assert d["energy"] == pytest.approx(exact, rel=1e-3)
+    assert d["slip_work"] == pytest.approx(exact, rel=1e-3)
+    assert np.abs(d["force"]).max() == pytest.approx(slip, rel=1e-9)   # Coulomb limit
+    assert d["share"]["lift-off"] == 0 and 0 < d["share"]["slip"] < 1
+
+
+def test_hysteresis_loop_sticks_below_the_slip_amplitude():
+    d = W.hysteresis_loop(2e-5, 1e4, 0.3)     # k_T A = 0.2 N < mu N = 0.3 N
+    assert d["share"]["stick"] == 1.0
+    assert d["energy"] == pytest.approx(0.0, abs=1e-12)
+    np.testing.assert_allclose(d["force"], 1e4 * d["u"], atol=1e-12)
+
+
+def test_hysteresis_loop_with_normal_load_variation_lifts_off():
+    d = W.hysteresis_loop(1e-4, 1e4, 0.3, normal_variation=1.3)
+    assert d["share"]["lift-off"] > 0.1
+    assert np.all(d["force"][d["state"] == 2] == 0)
+    assert d["normal"].min() == 0.0
+    assert d["energy"] == pytest.approx(d["slip_work"], rel=1e-3)   # loop area = slider work
+    # the Coulomb limit follows the normal load
+    assert np.all(np.abs(d["force"]) <= 0.3 * d["normal"] + 1e-12)
+
+
+def test_hysteresis_figure_draws_the_loop():
+    fig = W.hysteresis_figure(amplitude_mm=0.1, k_t_kn_per_m=10.0, slip_force_n=0.3)
+    ax = fig.axes[0]
+    x = np.concatenate([line.get_xdata() for line in ax.get_lines() if len(line.get_xdata()) > 2])
+    assert x.max() == pytest.approx(0.1, rel=1e-6) and x.min() == pytest.approx(-0.1, rel=1e-2)
+    assert "mJ" in ax.get_title()
+    assert fig.loop["energy"] == pytest.approx(4 * 0.3 * (1e-4 - 0.3e-4), rel=1e-3)
+
+
+def test_describing_function_matches_the_closed_form():
+    k_t, slip = 1e4, 0.3
+    A = slip / k_t * np.logspace(-1, 2, 25)
+    d = W.describing_function(k_t, slip, A)
+    np.testing.assert_allclose(d["k_eq"], d["k_eq_closed"], atol=1e-3 * k_t)
+    np.testing.assert_allclose(d["d_eq"], d["d_eq_closed"], atol=1e-3 * k_t)
+    stuck = A < slip / k_t
+    np.testing.assert_allclose(d["k_eq"][stuck], k_t, rtol=1e-9)
+    np.testing.assert_allclose(d["d_eq"][stuck], 0.0, atol=1e-9 * k_t)
+    # largest damping at twice the slip amplitude: d_eq = k_T / pi
+    x = np.array([2.0])
+    assert W.closed_form_jenkins(k_t, slip, x * slip / k_t)[1][0] == pytest.approx(k_t / np.pi)
+    with pytest.raises(ValueError):
+        W.describing_function(k_t, slip, [0.0])
+
+
+def test_describing_function_figure_data():
+    fig = W.describing_function_figure(k_t_kn_per_m=10.0, slip_force_n=0.3, amplitude_mm=0.1)
+    assert len(fig.axes) == 2
+    d = fig.data
+    np.testing.assert_allclose(d["energy"], d["energy_closed"], atol=1e-3 * d["energy_closed"].max())
+
+
+def test_interactive_view_keeps_the_signature_and_returns_none():
+    view = W.interactive_view(W.hysteresis_figure)
+    assert list(inspect.signature(view).parameters) == list(inspect.signature(W.hysteresis_figure).parameters)
+    assert view(amplitude_mm=0.05) is None
+
+
+# ----- friction oscillator ---------------------------------------------------------------
+def test_oscillator_hbm_matches_time_integration_and_balances_energy():
+    d = W.oscillator_comparison(normal_load=3.0, forcing=2.0)
+    assert d["frf"].success and np.all(d["time_converged"])
+    np.testing.assert_allclose(d["hbm_at_time"], d["time_amplitude"], rtol=0.01)
+    e = d["energy"]
+    assert np.abs(e[:, 0] - e[:, 1] - e[:, 2]).max() <= 1e-6 * np.abs(e[:, 0]).max()
+    # friction dissipates: the contact's work per cycle is never negative
+    assert e[:, 2].min() >= -1e-9 * np.abs(e[:, 0]).max()
+
+
+def test_oscillator_stuck_limit_is_linear():
+    d = W.oscillator_comparison(normal_load=1000.0, forcing=2.0, time_omegas=())
+    np.testing.assert_allclose(d["hbm"], d["stuck"], rtol=1e-6)
+
+
+def test_oscillator_figure_memoised():
+    fig = W.oscillator_figure(normal_load=3.0, forcing=2.0)
+    assert fig.data is W.oscillator_comparison(3.0, 2.0)
+    assert fig.axes[0].get_yscale() == "log"
+
+
+# ----- reference disk ----------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def cache():
+    return W.DiskFRFCache()
+
+
+def test_disk_frf_matches_continuation_and_warm_starts(cache):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ref_peak, ref_f, _ = peak_response(bd.reference_disk("cylinder", 1e-3))
+    r = W.disk_frf("cylinder", 1.0, cache=cache)
+    assert r.method in ("cold", "warm")
+    assert r.peak_tip == pytest.approx(ref_peak, rel=1e-3)
+    assert r.resonance_hz == pytest.approx(ref_f, abs=0.02)
+    again = W.disk_frf("cylinder", 1.0, cache=cache)
+    assert again is r and cache.stats["memo"] >= 1
+    nb = W.disk_frf("cylinder", 1.2, cache=cache)
+    assert nb.method == "warm"
+    assert nb.seconds < 5.0          # "about a second" on an idle machine; generous on a loaded CI
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ref12 = peak_response(bd.reference_disk("cylinder", 1.2e-3))[0]
+    assert nb.peak_tip == pytest.approx(ref12, rel=1e-3)
+
+
+def test_undamped_frf_is_the_calibrated_peak(cache):
+    r = W.undamped_frf(cache=cache)
+    assert r.method == "linear"
+    assert r.peak_tip == pytest.approx(1.6996e-3, rel=1e-3)
+    assert r.resonance_hz == pytest.approx(95.0, abs=0.02)
+
+
+def test_disk_frf_figure_and_reduction(cache):
+    fig = W.disk_frf_figure(1.0, "cylinder", cache=cache)
+    damped, free = fig.data
+    assert damped.reduction(free) == pytest.approx(0.712, abs=0.01)      # calibrated ~71 %
+    line = fig.axes[0].get_lines()[1]
+    np.testing.assert_allclose(line.get_ydata(), 1e3 * damped.tip[:, 0])
+    assert "reduction" in fig.axes[0].get_title()
+    with pytest.raises(ValueError):
+        W.disk_frf("plate", 1.0, cache=cache)
+    with pytest.raises(ValueError):
+        W.disk_frf("cylinder", 0.0, cache=cache)
+
+
+def test_mass_sweep_peaks_has_an_interior_optimum(cache):
+    sw = W.mass_sweep_peaks("cylinder", [0.3, 1.0, 5.0], cache=cache)
+    assert sw["best_mass_g"] == 1.0
+    assert sw["reduction"][0] < sw["best_reduction"] and sw["reduction"][-1] < sw["best_reduction"]
+    fig = W.mass_study_figure(1.0, "cylinder", sweeps={"cylinder": sw}, cache=cache)
+    assert len(fig.axes) == 2
+
+
+def test_contact_state_at_peak_matches_the_study(cache):
+    frf = W.disk_frf("cylinder", 1.0, cache=cache)
+    ours = W.contact_state_at_peak(frf)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ref = contact_state(bd.reference_disk("cylinder", 1e-3))
+    np.testing.assert_allclose(ours.normal_load, ref.normal_load, rtol=1e-3)
+    np.testing.assert_allclose(ours.w_star, ref.w_star, atol=0.05 * np.abs(ref.w_star).max())
+    np.testing.assert_allclose(ours.F_star, ref.F_star, atol=0.03 * np.abs(ref.F_star).max())
+    # symmetric platforms: the two contacts slide in antiphase
+    assert np.all(np.abs(ours.w_star) > 1)
+    assert ours.F_star[0] == pytest.approx(-ours.F_star[1], abs=0.05)
+    with pytest.raises(ValueError):
+        W.contact_state_at_peak(W.undamped_frf(cache=cache))
+
+
+def test_platform_angle_figure_asymmetric_contact_sticks_on_one_side(cache):
+    fig = W.platform_angle_figure(85.0, "cylinder", 1.0, cache=cache)
+    damped, free, state = fig.data
+    assert abs(state.w_star[0]) < 1 < abs(state.w_star[1])     # paper Fig. 11: OL sticks, OR slides
+    assert state.normal_load[0] > state.normal_load[1]
+    assert len(fig.axes) == 2
+
+
+def test_engine_order_zero_cylinder_rolls(cache):
+    fig = W.engine_order_figure(0, "cylinder", 1.0, cache=cache)
+    damped, free = fig.data
+    assert damped.reduction(free) < 0.01        # no relative motion: no friction damping
+
+
+def test_platform_angle_warm_starts_from_the_nearest_angle(cache):
+    W.disk_frf("cylinder", 1.0, gamma_right_deg=35.0, cache=cache)
+    r = W.disk_frf("cylinder", 1.0, gamma_right_deg=45.0, cache=cache)
+    assert r.method == "warm"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        import dataclasses
+        disk = dataclasses.replace(bd.reference_disk("cylinder", 1e-3), gamma_right=np.radians(45.0))
+        ref = peak_response(disk)[0]
+    assert r.peak_tip == pytest.approx(ref, rel=1e-3)
