@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from typing import Callable, Protocol
 
 import numpy as np
+import scipy.sparse as sp
 
 from .fourier import HarmonicBasis
 
@@ -60,16 +61,44 @@ class HarmonicBalanceSystem:
     excitation: Callable[[float], tuple[np.ndarray, np.ndarray]]
     couplings: list[Coupling] = field(default_factory=list)
     static_stiffness: np.ndarray | None = None
+    _sparse_parts: tuple | None = field(default=None, init=False, repr=False)
+
+    @property
+    def sparse(self) -> bool:
+        """Whether the system is assembled with scipy.sparse matrices."""
+        return any(sp.issparse(m) for m in (self.mass, self.damping, self.stiffness)) or \
+            any(sp.issparse(c.matrix) for c in self.couplings)
 
     @property
     def n_dof(self) -> int:
+        if sp.issparse(self.mass):
+            return self.mass.shape[0]
         return np.atleast_2d(self.mass).shape[0]
 
     @property
     def n_unknowns(self) -> int:
         return self.n_dof * self.basis.n_coeffs
 
+    def _sparse_dynamic_stiffness(self, omega: float):
+        """Sparse A = K_0 - Omega^2 M_2 + Omega G and dA/dOmega, the three parts assembled once
+        (harmonic-major Kronecker products, as :meth:`HarmonicBasis.dynamic_stiffness`)."""
+        if self._sparse_parts is None:
+            basis = self.basis
+            C = basis.n_coeffs
+            mass, damping, stiffness = (sp.csr_matrix(m) for m in (self.mass, self.damping, self.stiffness))
+            K0 = sp.kron(sp.identity(C), stiffness, format="csc")
+            if self.static_stiffness is not None and basis.has_static:
+                sel = sp.csr_matrix(([1.0], ([basis.cos_index(0)], [basis.cos_index(0)])), shape=(C, C))
+                K0 = K0 + sp.kron(sel, sp.csr_matrix(self.static_stiffness), format="csc")
+            M2 = sp.kron(sp.diags(basis.order.astype(float) ** 2), mass, format="csc")
+            G = sp.kron(sp.csr_matrix(basis.derivative), damping, format="csc")
+            self._sparse_parts = (K0.tocsc(), M2.tocsc(), G.tocsc())
+        K0, M2, G = self._sparse_parts
+        return (K0 - omega ** 2 * M2 + omega * G).tocsc(), (-2 * omega * M2 + G).tocsc()
+
     def _dynamic_stiffness(self, omega: float):
+        if self.sparse:
+            return self._sparse_dynamic_stiffness(omega)
         A, dA = self.basis.dynamic_stiffness(omega, self.mass, self.damping, self.stiffness)
         if self.static_stiffness is not None and self.basis.has_static:
             n = self.n_dof
@@ -81,6 +110,9 @@ class HarmonicBalanceSystem:
         """Solution without the nonlinear elements (initial guess, scaling)."""
         A, _ = self._dynamic_stiffness(omega)
         f, _ = self.excitation(omega)
+        if sp.issparse(A):
+            from scipy.sparse.linalg import splu
+            return splu(A.tocsc()).solve(f)
         return np.linalg.lstsq(A, f, rcond=None)[0]
 
     def residual(self, x: np.ndarray, omega: float, jacobian: bool = True):
@@ -90,6 +122,7 @@ class HarmonicBalanceSystem:
         A, dA = self._dynamic_stiffness(omega)
         f, df = self.excitation(omega)
         R = A @ x - f
+        sparse = sp.issparse(A)
         J = A.copy() if jacobian else None
         Rw = dA @ x - df if jacobian else None
         for c in self.couplings:
@@ -97,9 +130,15 @@ class HarmonicBalanceSystem:
             force, jac, domega = c.element.harmonic_forces(local, basis, omega, jacobian)
             R += c.matrix.T @ force.ravel()
             if jacobian:
-                J += c.matrix.T @ jac @ c.matrix
+                if sparse:
+                    T = sp.csr_matrix(c.matrix)
+                    J = J + T.T @ sp.csr_matrix(jac) @ T
+                else:
+                    J += c.matrix.T @ jac @ c.matrix
                 if domega is not None:
                     Rw += c.matrix.T @ domega
+        if sparse and jacobian:
+            J = J.tocsc()
         return R, J, Rw
 
     def excitation_work(self, x: np.ndarray, omega: float) -> float:
@@ -113,7 +152,8 @@ class HarmonicBalanceSystem:
         C = self.basis.n_coeffs
         X = x.reshape(C, -1)
         velocity = omega * (self.basis.derivative @ X)
-        return float(np.sum(self.basis.work_per_cycle(velocity @ np.atleast_2d(self.damping).T, X)))
+        damping = self.damping if sp.issparse(self.damping) else np.atleast_2d(self.damping)
+        return float(np.sum(self.basis.work_per_cycle(np.asarray((damping @ velocity.T).T), X)))
 
     def element_dissipation(self, x: np.ndarray, omega: float) -> list[float]:
         """Energy absorbed by each nonlinear element per period [J] (oint f . dw)."""

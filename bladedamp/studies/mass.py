@@ -111,12 +111,18 @@ def mass_sweep(disk: TunedDisk, masses, f_range_hz=(90.0, 105.0), harmonics=(1,)
 
 @dataclass
 class MassOptimum:
-    """Optimal damper mass [kg], its peak tip amplitude [m], the undamped peak [m]."""
+    """Optimal damper mass [kg], its peak tip amplitude [m], the undamped peak [m].
+
+    ``failed_masses`` [kg]: masses whose response could not be computed (e.g. a very light
+    damper bouncing off both platforms, beyond the harmonic balance's reach); the optimiser
+    treats them as no better than the undamped blade and never returns one of them.
+    """
 
     mass: float
     peak_tip: float
     undamped_peak_tip: float
     evaluations: int
+    failed_masses: tuple = ()
 
     @property
     def reduction(self) -> float:
@@ -133,17 +139,25 @@ def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0),
     _validate.positive("mass bounds", [lo, hi])
     if not lo < hi:
         raise ValueError(f"mass bounds must satisfy 0 < low < high (got {bounds})")
-    cache = {}
+    undamped, _, _ = peak_response(dataclasses.replace(disk, damper=None), f_range_hz, harmonics)
+    cache, failed = {}, []
 
     def objective(logm):
         m = float(np.exp(logm))
         if m not in cache:
-            cache[m] = peak_response(with_mass(disk, m), f_range_hz, harmonics)[0]
+            try:
+                cache[m] = peak_response(with_mass(disk, m), f_range_hz, harmonics)[0]
+            except RuntimeError:
+                failed.append(m)
+                cache[m] = 10 * undamped   # not computable: never the optimum
         return cache[m]
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         res = minimize_scalar(objective, bounds=(np.log(lo), np.log(hi)), method="bounded",
                               options={"xatol": xatol})
-    undamped, _, _ = peak_response(dataclasses.replace(disk, damper=None), f_range_hz, harmonics)
-    return MassOptimum(float(np.exp(res.x)), float(res.fun), undamped, len(cache))
+    ok = {m: p for m, p in cache.items() if m not in failed}
+    if not ok:
+        raise RuntimeError(f"no damper mass in {bounds} kg gave a computable response")
+    best = min(ok, key=ok.get)   # the best computed point (the optimiser's last one, or better)
+    return MassOptimum(best, ok[best], undamped, len(cache), tuple(failed))

@@ -1,0 +1,642 @@
+"""Mistuned bladed disk: the full assembly of n blades and n dampers (Eq. 16-20).
+
+Every blade has its own :class:`~bladedamp.blade.ModalBlade` (natural frequencies, modal
+damping, optionally mode shapes) and every damper its own mass, friction coefficient and
+geometry (the paper's "contact mistuning"). Unknowns, harmonic-major as everywhere in
+:mod:`bladedamp.hbm`: the modal coordinates of blade 0, 1, ..., n-1, then the six rigid-body
+coordinates of each damper that has a mass. Damper k sits between blade k (its OL platform)
+and blade k+1 (that blade's OR platform), exactly as in :class:`~bladedamp.disk.TunedDisk`;
+each damper's coupling is built by the TunedDisk of its own blade and damper (geometry,
+``platform_offsets``, ``G_P``, ``G_D``, seating / static approach, centrifugal force), so a
+tuned MistunedDisk is the TunedDisk written out blade by blade.
+
+Engine-order excitation: blade k's first-harmonic force is f e^{i k dphi}, dphi = 2 pi EO / n,
+so that the tuned solution is blade 0's cyclic solution with harmonic h of blade k turned by
+e^{i h k dphi} (Eq. 24, 25).
+
+Cyclic sectors of several blades: with ``len(blades) = s`` dividing ``n_blades`` the model is
+one sector of s blades of a disk that repeats it n/s times; the last damper then couples
+blade s-1 to blade 0 of the next sector, whose harmonic h is blade 0's times e^{i h s dphi}.
+``s = n`` is the full assembly (e^{i h n dphi} = 1), ``s = 1`` the tuned disk, ``s = 2`` the
+paper's alternating mistuning (case d).
+
+Time sampling (AFT): the contact forces are evaluated at ``n_samples`` instants per period, and
+blade k's motion is blade 0's shifted by k dphi; the discrete friction laws are shift-invariant
+only when that shift is a whole number of samples. By default ``n_samples`` is therefore
+rounded up to a multiple of n / gcd(n, EO) (n = 16, EO = 1: 64, as the tuned disk); with
+another ``n_samples`` a tuned full assembly differs from the cyclic solution by the AFT
+discretisation error (measured: ~1e-3 relative with 6 blades, EO = 1, 64 samples).
+
+The Jacobian is sparse (each damper couples two neighbours): the structural matrices and
+the contact map are scipy.sparse matrices and the continuation factorises with
+``scipy.sparse.linalg.splu``. The contact points of all dampers are evaluated in one call of
+the point-contact kernel when the dampers share their normal law (always for frequency or
+mass mistuning), otherwise damper by damper.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Sequence
+
+import numpy as np
+import scipy.sparse as sp
+
+from . import _validate
+from .blade import ModalBlade
+from .contact.laws import LinearNormalLaw
+from .contact.point import point_contact_forces
+from .damper.kinetics import seat
+from .disk import DAMPER_DOFS, DamperContacts, TunedDisk
+from .hbm.continuation import continuation, solve
+from .hbm.fourier import HarmonicBasis
+from .hbm.system import Coupling, HarmonicBalanceSystem
+from .response import FrequencyResponse
+
+
+def sparse_real_form(basis: HarmonicBasis, per_harmonic) -> sp.csr_matrix:
+    """Sparse version of :meth:`HarmonicBasis.real_form`: ``per_harmonic(h)`` returns a complex
+    scipy.sparse (or dense) (n_out, n_in) matrix; block [[Gr, Gi], [-Gi, Gr]] per harmonic."""
+    blocks = {h: sp.coo_matrix(per_harmonic(h)) for h in basis.harmonics}
+    n_out, n_in = blocks[basis.harmonics[0]].shape
+    C = basis.n_coeffs
+    rows, cols, vals = [], [], []
+    for h, g in blocks.items():
+        j = basis.cos_index(h)
+        r, c, v = g.row, g.col, g.data
+        gr, gi = np.real(v), np.imag(v)
+        if h == 0:
+            if np.any(np.abs(gi) > 1e-12 * (1 + np.abs(v).max(initial=0.0))):
+                raise ValueError("the static (h = 0) block of a linear map must be real")
+            rows.append(j * n_out + r), cols.append(j * n_in + c), vals.append(gr)
+            continue
+        for dr, dc, val in ((0, 0, gr), (0, 1, gi), (1, 0, -gi), (1, 1, gr)):
+            rows.append((j + dr) * n_out + r), cols.append((j + dc) * n_in + c), vals.append(val)
+    out = sp.coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                        shape=(C * n_out, C * n_in)).tocsr()
+    out.eliminate_zeros()
+    return out
+
+
+@dataclass
+class AssemblyContacts:
+    """The contacts of all dampers of an assembly as one harmonic-balance element.
+
+    Local coordinates: the 12 relative motions (OL, OR) of each damper in turn
+    (``n_local = 12 * n_dampers``). ``contacts[d]`` is damper d's :class:`DamperContacts`
+    (built by its TunedDisk). Returns a sparse block-diagonal local Jacobian.
+    """
+
+    contacts: list[DamperContacts]
+    n_local: int = 0
+    _batch: tuple | None = field(default=None, init=False, repr=False)
+    _index: dict = field(default_factory=dict, init=False, repr=False)
+    _last_approach: tuple | None = field(default=None, init=False, repr=False)
+
+    def __post_init__(self):
+        self.n_local = 12 * len(self.contacts)
+
+    @property
+    def n_dampers(self) -> int:
+        return len(self.contacts)
+
+    def _stacked(self):
+        """Batched point data of all dampers, or None if their patches do not share a normal law."""
+        if self._batch is None:
+            stacks = [c._stack() for c in self.contacts]
+            ok = all(s is not None for s in stacks) and all(
+                s[5] == stacks[0][5] and s[1].shape == stacks[0][1].shape for s in stacks)
+            if not ok:
+                self._batch = (False,)
+            else:
+                self._batch = (True, np.stack([s[1] for s in stacks]), np.concatenate([s[2] for s in stacks]),
+                               np.concatenate([s[3] for s in stacks]), np.concatenate([s[4] for s in stacks]),
+                               stacks[0][5])
+        return self._batch if self._batch[0] else None
+
+    def _block_index(self, C: int):
+        """COO indices of the (n_d, C, 12, C, 12) per-damper blocks in the local Jacobian."""
+        if C not in self._index:
+            nd = self.n_dampers
+            d, a, m, b, k = np.meshgrid(np.arange(nd), np.arange(C), np.arange(12), np.arange(C), np.arange(12),
+                                        indexing="ij")
+            self._index[C] = ((a * 12 * nd + 12 * d + m).ravel(), (b * 12 * nd + 12 * d + k).ravel())
+        return self._index[C]
+
+    def _forces(self, local, basis, offsets, jacobian):
+        """Forces (C, n_d, 12) and Jacobian blocks (n_d, C, 12, C, 12) or None."""
+        C, nd = basis.n_coeffs, self.n_dampers
+        stack = self._stacked()
+        if stack is None:
+            force = np.zeros((C, nd, 12))
+            blocks = np.zeros((nd, C, 12, C, 12)) if jacobian else None
+            for d, c in enumerate(self.contacts):
+                f, j = c._forces(local[:, d], basis, offsets[d], jacobian)
+                force[:, d] = f
+                if jacobian:
+                    blocks[d] = j.reshape(C, 12, C, 12)
+            return force, blocks
+        _, B, k_t, mu, weights, law = stack                      # B (n_d, 2, P, 3, 6)
+        P = B.shape[2]
+        coeffs = np.einsum("dqpij,cdqj->cdqpi", B, local.reshape(C, nd, 2, 6)).reshape(C, nd * 2 * P, 3)
+        pts = point_contact_forces(coeffs, basis, k_t, mu, law, weights, np.ravel(offsets), jacobian=jacobian)
+        f_points = basis.to_coeffs(np.moveaxis(pts.force, 1, 0)).reshape(C, nd, 2, P, 3)
+        force = np.einsum("cdqpi,dqpij->cdqj", f_points, B).reshape(C, nd, 12)
+        if not jacobian:
+            return force, None
+        T = basis.n_samples
+        jp = np.matmul(basis.analysis, pts.jacobian.reshape(nd * 2 * P, T, 9 * C)).reshape(nd, 2, P, C, 3, 3, C)
+        q_blocks = np.einsum("dqpamkb,dqpkn->dqambn", np.einsum("dqpim,dqpaikb->dqpamkb", B, jp), B)
+        blocks = np.zeros((nd, C, 2, 6, C, 2, 6))
+        for q in range(2):
+            blocks[:, :, q, :, :, q, :] = q_blocks[:, q]
+        return force, blocks.reshape(nd, C, 12, C, 12)
+
+    def _approach(self, omega):
+        """Static approach (n_d, 2, P) of every damper and its omega-derivative (last omega cached)."""
+        if self._last_approach is None or self._last_approach[0] != omega:
+            out = [c.approach(omega) for c in self.contacts]
+            self._last_approach = (omega, np.array([o[0] for o in out]), np.array([o[1] for o in out]))
+        return self._last_approach[1], self._last_approach[2]
+
+    def _sparse(self, blocks, C):
+        rows, cols = self._block_index(C)
+        n = C * self.n_local
+        return sp.csr_matrix((blocks.ravel(), (rows, cols)), shape=(n, n))
+
+    def evaluate(self, local, basis, omega, jacobian=True):
+        """``(force (C, n_d, 12), Jacobian blocks (n_d, C*12, C*12) or None, d force / d omega
+        (C, n_d, 12) or None)``; damper d's block in its own (coefficient, coordinate) order."""
+        C, nd = basis.n_coeffs, self.n_dampers
+        local = np.asarray(local).reshape(C, nd, 12)
+        offsets, doffsets = self._approach(omega)
+        force, blocks = self._forces(local, basis, offsets, jacobian)
+        if not jacobian:
+            return force, None, None
+        domega = None
+        if np.any(doffsets != 0):
+            # as DamperContacts.harmonic_forces: Euler's identity for linear normal laws, else
+            # a central difference in omega of all dampers at once
+            norms = np.einsum("dqp,dqp->d", offsets, offsets)
+            kappa = np.where(norms > 0, np.einsum("dqp,dqp->d", doffsets, offsets) / np.where(norms > 0, norms, 1), 0.0)
+            linear = all(isinstance(p.normal_law, LinearNormalLaw) for c in self.contacts for p in c.geometry.patches)
+            homogeneous = np.abs(doffsets - kappa[:, None, None] * offsets).max() <= 1e-12 * np.abs(doffsets).max()
+            if linear and homogeneous:
+                jw = np.einsum("dambn,bdn->adm", blocks, local)
+                domega = (force - jw) * kappa[None, :, None]
+            else:
+                h = 1e-6 * omega
+                fp, _ = self._forces(local, basis, offsets + h * doffsets, False)
+                fm, _ = self._forces(local, basis, offsets - h * doffsets, False)
+                domega = (fp - fm) / (2 * h)
+        return force, blocks.reshape(nd, C * 12, C * 12), domega
+
+    def harmonic_forces(self, local, basis, omega, jacobian=True):
+        C = basis.n_coeffs
+        force, blocks, domega = self.evaluate(local, basis, omega, jacobian)
+        if not jacobian:
+            return force.reshape(C, self.n_local), None, None
+        jac = self._sparse(blocks, C)
+        return force.reshape(C, self.n_local), jac, None if domega is None else domega.ravel()
+
+
+@dataclass
+class AssemblySystem(HarmonicBalanceSystem):
+    """HarmonicBalanceSystem of a MistunedDisk with a fast sparse assembly of the Jacobian.
+
+    Same residual as the generic sparse path of HarmonicBalanceSystem (tested against it); the
+    contact term T^T J_c T is formed damper by damper as small dense products on the 2 n_m + 6
+    structural DOFs each damper touches, and the Jacobian's CSC pattern is computed once.
+    """
+
+    def __post_init__(self):
+        basis, N = self.basis, self.n_dof
+        C = basis.n_coeffs
+        self._sparse_dynamic_stiffness(1.0)
+        K0, M2, G = self._sparse_parts
+        parts = [m.tocoo() for m in (K0, M2, G)]
+        self._lin = parts
+        rows = [p.row for p in parts]
+        cols = [p.col for p in parts]
+        self._contact = None
+        if self.couplings:
+            c = self.couplings[0]
+            T = sp.csr_matrix(c.matrix)
+            nd = c.element.n_dampers
+            Tb, idx = [], []
+            for d in range(nd):
+                r = (np.arange(C)[:, None] * 12 * nd + 12 * d + np.arange(12)[None, :]).ravel()
+                Td = T[r]
+                cols_d = np.unique(Td.indices)
+                Tb.append(Td[:, cols_d].toarray())
+                idx.append(cols_d)
+            if len({len(i) for i in idx}) == 1:
+                Tb, idx = np.array(Tb), np.array(idx)
+                self._contact = (T, T.T.tocsr(), Tb, np.swapaxes(Tb, 1, 2).copy(), idx)
+                m = idx.shape[1]
+                rows.append(np.broadcast_to(idx[:, :, None], (nd, m, m)).ravel())
+                cols.append(np.broadcast_to(idx[:, None, :], (nd, m, m)).ravel())
+        rows, cols = np.concatenate(rows), np.concatenate(cols)
+        key = cols.astype(np.int64) * N * C + rows
+        unique, inverse = np.unique(key, return_inverse=True)
+        n = N * C
+        self._pattern = (inverse, (unique % n).astype(np.int32),
+                         np.searchsorted(unique // n, np.arange(n + 1)).astype(np.int32), len(unique))
+
+    def residual(self, x, omega, jacobian=True):
+        if self.couplings and self._contact is None:
+            return super().residual(x, omega, jacobian)
+        basis = self.basis
+        C = basis.n_coeffs
+        K0, M2, G = self._sparse_parts
+        f, df = self.excitation(omega)
+        m2x, gx = M2 @ x, G @ x
+        R = K0 @ x - omega ** 2 * m2x + omega * gx - f
+        Rw = -2 * omega * m2x + gx - df if jacobian else None
+        values = [self._lin[0].data, -omega ** 2 * self._lin[1].data, omega * self._lin[2].data]
+        if self.couplings:
+            T, TT, Tb, TbT, _ = self._contact
+            element = self.couplings[0].element
+            force, blocks, domega = element.evaluate((T @ x).reshape(C, element.n_local), basis, omega, jacobian)
+            R += TT @ force.ravel()
+            if jacobian:
+                values.append(np.matmul(TbT, np.matmul(blocks, Tb)).ravel())
+                if domega is not None:
+                    Rw += TT @ domega.ravel()
+        if not jacobian:
+            return R, None, None
+        inverse, indices, indptr, nnz = self._pattern
+        data = np.bincount(inverse, weights=np.concatenate(values), minlength=nnz)
+        n = x.size
+        return R, sp.csc_matrix((data, indices, indptr), shape=(n, n)), Rw
+
+
+def _as_list(name, value, n):
+    if isinstance(value, (list, tuple)):
+        if len(value) != n:
+            raise ValueError(f"{name} must have one entry per blade of the model ({n}), got {len(value)}")
+        return list(value)
+    return [value] * n
+
+
+@dataclass
+class MistunedDisk:
+    """Bladed disk with an individual blade and damper at every position (Eq. 16-20).
+
+    Parameters
+    ----------
+    blades : sequence of s ModalBlade (same number of modes and the same point positions;
+        natural frequencies, damping ratios and mode shapes may differ)
+    dampers : one damper for all positions, or a sequence of s dampers (CylinderDamper,
+        WedgeDamper or None; None or mass 0: no damper at that position); damper k sits
+        between blade k (OL) and blade k+1 (OR)
+    n_blades : blades of the whole disk; default s (full assembly). Must be a multiple of s:
+        the model is then one cyclic sector of s blades (s = 1: the tuned disk)
+    engine_order, gamma_left, gamma_right, damper_radius, excitation, rotor_speed,
+    damper_inertia : as :class:`~bladedamp.disk.TunedDisk` (the same for every position)
+    """
+
+    blades: Sequence[ModalBlade]
+    dampers: object = None
+    n_blades: int | None = None
+    engine_order: int = 1
+    gamma_left: float = np.radians(35.0)
+    gamma_right: float = np.radians(35.0)
+    damper_radius: float = 0.1
+    excitation: np.ndarray = field(default_factory=lambda: np.array([0.1, 0, 0, 0, 0, 0]))
+    rotor_speed: float | None = None
+    damper_inertia: bool = True
+
+    def __post_init__(self):
+        if isinstance(self.blades, ModalBlade) or len(self.blades) == 0:
+            raise ValueError("blades must be a non-empty sequence of ModalBlade (one per blade of the model)")
+        self.blades = list(self.blades)
+        s = len(self.blades)
+        if self.n_blades is None:
+            self.n_blades = s
+        self.n_blades = _validate.integer("n_blades", self.n_blades, minimum=2)
+        if self.n_blades % s:
+            raise ValueError(f"n_blades ({self.n_blades}) must be a multiple of len(blades) ({s})")
+        nm = self.blades[0].n_modes
+        for k, b in enumerate(self.blades):
+            if not isinstance(b, ModalBlade):
+                raise ValueError(f"blades[{k}] must be a ModalBlade (got {type(b).__name__})")
+            if b.n_modes != nm:
+                raise ValueError(f"blades must have the same number of modes (blades[0]: {nm}, blades[{k}]: {b.n_modes})")
+            if set(b.points) != set(self.blades[0].points) or any(
+                    not np.allclose(b.points[p], self.blades[0].points[p]) for p in b.points):
+                raise ValueError(f"blades must have the same point positions (blades[{k}] differs from blades[0])")
+        self.dampers = _as_list("dampers", self.dampers, s)
+        # one TunedDisk per position: validates the shared parameters and builds each coupling
+        self.sectors = [TunedDisk(b, d, self.n_blades, self.engine_order, self.gamma_left, self.gamma_right,
+                                  self.damper_radius, self.excitation, self.rotor_speed, self.damper_inertia)
+                        for b, d in zip(self.blades, self.dampers)]
+        self.excitation = self.sectors[0].excitation
+
+    @classmethod
+    def from_tuned(cls, disk: TunedDisk, kappa=None, dampers="same", n_sector: int | None = None) -> "MistunedDisk":
+        """The disk of ``disk`` with blade k's frequencies times ``kappa[k]`` (the paper's
+        mistuning factor, all modes alike) and optionally its own ``dampers``.
+
+        ``kappa``: None (tuned) or n_sector values > 0; ``dampers``: "same" (the disk's damper
+        everywhere), None (no dampers), one damper or a list; ``n_sector``: blades in the model
+        (default ``disk.n_blades``, the full assembly)."""
+        s = disk.n_blades if n_sector is None else _validate.integer("n_sector", n_sector, minimum=1)
+        if kappa is None:
+            kappa = np.ones(s)
+        kappa = np.asarray(_validate.positive("kappa (mistuning factors)", kappa), dtype=float)
+        if kappa.shape != (s,):
+            raise ValueError(f"kappa (mistuning factors) must have {s} entries, one per blade (got shape {kappa.shape})")
+        blades = [disk.blade.scaled(k) for k in kappa]
+        same = isinstance(dampers, str) and dampers == "same"
+        return cls(blades, disk.damper if same else dampers, disk.n_blades, disk.engine_order,
+                   disk.gamma_left, disk.gamma_right, disk.damper_radius, disk.excitation, disk.rotor_speed,
+                   disk.damper_inertia)
+
+    # ----- layout ----------------------------------------------------------------------
+    @property
+    def n_sector(self) -> int:
+        """Blades in the model (s)."""
+        return len(self.blades)
+
+    @property
+    def n_modes(self) -> int:
+        return self.blades[0].n_modes
+
+    @property
+    def interblade_phase(self) -> float:
+        return 2 * np.pi * self.engine_order / self.n_blades
+
+    @property
+    def active_dampers(self) -> list[int]:
+        """Positions whose damper has a mass."""
+        return [k for k, d in enumerate(self.sectors) if d.has_damper]
+
+    @property
+    def n_dof(self) -> int:
+        return self.n_sector * self.n_modes + 6 * len(self.active_dampers)
+
+    def blade_slice(self, k: int) -> slice:
+        return slice(k * self.n_modes, (k + 1) * self.n_modes)
+
+    def damper_slice(self, d: int) -> slice:
+        """DOFs of the d-th active damper."""
+        start = self.n_sector * self.n_modes + 6 * d
+        return slice(start, start + 6)
+
+    @property
+    def dof_names(self) -> tuple[str, ...]:
+        modes = self.blades[0].mode_names or tuple(f"q{j + 1}" for j in range(self.n_modes))
+        names = [f"b{k}_q_{m}" for k in range(self.n_sector) for m in modes]
+        names += [f"d{k}_{n}" for k in self.active_dampers for n in DAMPER_DOFS]
+        return tuple(names)
+
+    # ----- harmonic balance ------------------------------------------------------------
+    def default_samples(self, harmonics) -> int:
+        """HarmonicBasis' default sample count rounded up to a multiple of n / gcd(n, EO), so that
+        the interblade shift is a whole number of samples (see the module notes)."""
+        default = HarmonicBasis(tuple(harmonics)).n_samples
+        p = self.n_blades // np.gcd(self.n_blades, self.engine_order) if self.engine_order else 1
+        return int(-(-default // p) * p)
+
+    def hbm_system(self, harmonics=(1,), n_samples=None, static_retention: float = 1e-4) -> HarmonicBalanceSystem:
+        """The sparse harmonic balance of the model (see TunedDisk.hbm_system for ``static_retention``)."""
+        if n_samples is None:
+            n_samples = self.default_samples(harmonics)
+        basis = HarmonicBasis(tuple(harmonics), n_samples)
+        C, nm, s, N = basis.n_coeffs, self.n_modes, self.n_sector, self.n_dof
+        active = self.active_dampers
+        mass, damp, stiff = sp.lil_matrix((N, N)), sp.lil_matrix((N, N)), sp.lil_matrix((N, N))
+        forces = []
+        for k, b in enumerate(self.blades):
+            w0 = b.natural_angular_frequencies
+            sl = self.blade_slice(k)
+            mass[sl, sl] = np.eye(nm)
+            stiff[sl, sl] = np.diag(w0 ** 2)
+            damp[sl, sl] = np.diag(2 * b.damping_ratios * w0)     # Eq. 5
+            forces.append(b.shape("excitation").T @ self.excitation)
+        geometries, contacts, maps, static = [], [], [], None
+        if basis.has_static and active:
+            static = sp.lil_matrix((N, N))
+        for d, k in enumerate(active):
+            sector = self.sectors[k]
+            g = sector.damper_geometry()
+            geometries.append(g)
+            sl = self.damper_slice(d)
+            if self.damper_inertia:
+                mass[sl, sl] = g.inertia
+            maps.append((g.G_D, g.G_P(sector.platform_offsets(g))))
+            contacts.append(DamperContacts(g, sector._approach_function(g, basis)))
+            if static is not None:
+                k_n = sum(p.normal_law.stiffness for p in g.patches)
+                static[sl, sl] = static_retention * k_n * np.diag([1, 1, 1, 1e-4, 1e-4, 1e-4])
+        dphi = self.interblade_phase
+
+        def contact_map(h):
+            T = sp.lil_matrix((12 * len(active), N), dtype=complex)
+            for d, k in enumerate(active):
+                G_D, G_P = maps[d]
+                nxt = (k + 1) % s
+                phase = np.exp(1j * h * s * dphi) if k + 1 == s else 1.0   # next sector's blade 0
+                rows = slice(12 * d, 12 * d + 12)
+                T[rows, self.blade_slice(k)] = -G_P[:, :6] @ self.blades[k].shape("OL")
+                T[rows, self.blade_slice(nxt)] = T[rows, self.blade_slice(nxt)].toarray() \
+                    - phase * (G_P[:, 6:] @ self.blades[nxt].shape("OR"))
+                T[rows, self.damper_slice(d)] = G_D
+            return T.tocsr()
+
+        couplings = []
+        if active:
+            couplings.append(Coupling(AssemblyContacts(contacts), sparse_real_form(basis, contact_map), "damper contacts"))
+        j1 = basis.cos_index(1)
+        f1 = np.zeros((C, N))
+        for k, f in enumerate(forces):
+            theta = k * dphi                                   # X = F e^{i k dphi} = a - i b
+            f1[j1, self.blade_slice(k)] = f * np.cos(theta)
+            f1[j1 + 1, self.blade_slice(k)] = -f * np.sin(theta)
+
+        def excitation(omega):
+            f, df = f1.copy(), np.zeros((C, N))
+            if basis.has_static:
+                for d, k in enumerate(active):
+                    F, dF = self.sectors[k].centrifugal_force(omega)
+                    z = self.damper_slice(d).start + 2       # radially outwards on the damper
+                    f[basis.cos_index(0), z] = F
+                    df[basis.cos_index(0), z] = dF
+            return f.ravel(), df.ravel()
+
+        return AssemblySystem(basis, mass.tocsr(), damp.tocsr(), stiff.tocsr(), excitation, couplings,
+                              None if static is None else static.tocsr())
+
+    def initial_guess(self, system: HarmonicBalanceSystem, omega: float) -> np.ndarray:
+        """Stuck linear solution (one Newton step from the static state; see TunedDisk._initial_guess)."""
+        x = np.zeros(system.n_unknowns)
+        if system.basis.has_static:
+            X = x.reshape(system.basis.n_coeffs, system.n_dof)
+            for d, k in enumerate(self.active_dampers):
+                sector = self.sectors[k]
+                u_seat, _, _ = seat(sector.damper_geometry(), sector.centrifugal_force(omega)[0])
+                X[system.basis.cos_index(0), self.damper_slice(d)] = u_seat
+        R, J, _ = system.residual(x, omega)
+        return x - solve(J, R)
+
+    def scales(self, system: HarmonicBalanceSystem, w0: float, w1: float) -> np.ndarray:
+        """Scale of each unknown (as TunedDisk._scales), pooled over the blades for each mode and
+        over the dampers for each damper DOF, so that every blade is measured alike, times sqrt(s)."""
+        C, N, nm, s = system.basis.n_coeffs, system.n_dof, self.n_modes, self.n_sector
+        X = np.array([np.abs(self.initial_guess(system, w)).reshape(C, N).max(axis=0)
+                      for w in np.linspace(w0, w1, 7)]).max(axis=0)
+        q = X[:s * nm].reshape(s, nm).max(axis=0)
+        q = np.maximum(q, 1e-3 * q.max() + 1e-300)
+        out = [np.tile(q, s)]
+        nd = len(self.active_dampers)
+        if nd:
+            u = X[s * nm:].reshape(nd, 6).max(axis=0)
+            phi = np.abs(np.stack([np.stack([b.shape("OL"), b.shape("OR")]) for b in self.blades]))
+            for g, platform in ((slice(0, 3), phi[:, :, :3].max()), (slice(3, 6), phi[:, :, 3:].max())):
+                u[g] = np.maximum(u[g], max(1e-3 * u[g].max(), 1e-3 * q.max() * platform) + 1e-300)
+            out.append(np.tile(u, nd))
+        # x sqrt(s): the scaled norm of s blades equals that of one sector, so the arc-length
+        # steps (and the number of points) are those of the tuned cyclic model
+        return np.sqrt(s) * np.tile(np.concatenate(out), C)
+
+    def frequency_response(self, f_start_hz: float, f_end_hz: float, harmonics=(1,), n_samples=None,
+                           max_step: float = 0.02, tuned_peak_tip: float | None = None,
+                           **continuation_options) -> "MistunedResponse":
+        """Forced response of every blade from ``f_start_hz`` to ``f_end_hz`` [Hz] by continuation.
+
+        ``tuned_peak_tip`` [m]: the tuned disk's peak, kept for amplification factors."""
+        _validate.positive("f_start_hz", f_start_hz)
+        _validate.positive("f_end_hz", f_end_hz)
+        if f_start_hz == f_end_hz:
+            raise ValueError("f_end_hz must differ from f_start_hz")
+        system = self.hbm_system(harmonics, n_samples)
+        w0, w1 = 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz
+        x0 = self.initial_guess(system, w0)
+        branch = continuation(system.residual, x0, w0, w1, x_scale=self.scales(system, w0, w1),
+                              max_step=max_step, **continuation_options)
+        return MistunedResponse.from_branch(self, system, branch, tuned_peak_tip)
+
+
+def _refined_peak(f, a):
+    """(peak, frequency) of samples a(f): largest sample refined by the parabola through it and
+    its neighbours (as studies.mass.peak_response)."""
+    i = int(np.argmax(a))
+    peak, fp = float(a[i]), float(f[i])
+    if 0 < i < len(a) - 1:
+        x, y = f[i - 1:i + 2], a[i - 1:i + 2]
+        if np.all(np.diff(x) > 0):
+            c = np.polyfit(x - x[1], y, 2)
+            if c[0] < 0:
+                fv = -c[1] / (2 * c[0])
+                if x[0] - x[1] <= fv <= x[2] - x[1]:
+                    peak, fp = max(peak, float(np.polyval(c, fv))), float(x[1] + fv)
+    return peak, fp
+
+
+@dataclass
+class MistunedResponse(FrequencyResponse):
+    """Frequency response of every blade of a :class:`MistunedDisk`.
+
+    tip_amplitude : (n_points, s, 3) first-harmonic tip amplitude of each blade in x, y, z [m]
+    excitation_work, viscous_dissipation, dissipated_energy : (n_points,) per period, whole model [J]
+    damper_dissipation : (n_points, n_active_dampers) friction dissipation of each damper [J]
+    tuned_peak_tip : the tuned disk's peak u_x [m] if given (amplification factors)
+    """
+
+    tip_amplitude: np.ndarray = None
+    excitation_work: np.ndarray = None
+    viscous_dissipation: np.ndarray = None
+    dissipated_energy: np.ndarray = None
+    damper_dissipation: np.ndarray = None
+    tuned_peak_tip: float | None = None
+    disk: MistunedDisk = None
+
+    @classmethod
+    def from_branch(cls, disk: MistunedDisk, system: HarmonicBalanceSystem, branch, tuned_peak_tip=None):
+        basis = system.basis
+        C, N, nm, s = basis.n_coeffs, system.n_dof, disk.n_modes, disk.n_sector
+        X = branch.x.reshape(-1, C, N)
+        j1 = basis.cos_index(1)
+        q1 = (X[:, j1, :s * nm] - 1j * X[:, j1 + 1, :s * nm]).reshape(-1, s, nm)
+        tips = np.stack([b.shape("tip")[:3] for b in disk.blades])            # (s, 3, nm)
+        tip = np.abs(np.einsum("pkm,kim->pki", q1, tips))
+        nd = len(disk.active_dampers)
+        exc, visc, diss = [], [], np.zeros((len(branch.omega), nd))
+        for i, (x, w) in enumerate(zip(branch.x, branch.omega)):
+            exc.append(system.excitation_work(x, w))
+            visc.append(system.viscous_dissipation(x, w))
+            if nd:
+                c = system.couplings[0]
+                local = (c.matrix @ x).reshape(C, c.element.n_local)
+                force, _, _ = c.element.harmonic_forces(local, basis, w, False)
+                diss[i] = basis.work_per_cycle(force, local).reshape(nd, 12).sum(axis=1)
+        return cls(branch.omega, X, basis, disk.dof_names, branch.success, branch.message, branch.iterations,
+                   branch.turning_points, tip_amplitude=tip, excitation_work=np.array(exc),
+                   viscous_dissipation=np.array(visc), dissipated_energy=diss.sum(axis=1), damper_dissipation=diss,
+                   tuned_peak_tip=tuned_peak_tip, disk=disk)
+
+    @property
+    def n_sector(self) -> int:
+        return self.tip_amplitude.shape[1]
+
+    def peaks(self, direction: int = 0) -> tuple[np.ndarray, np.ndarray]:
+        """(peak tip amplitude [m], its frequency [Hz]) of every blade, parabola-refined."""
+        out = [_refined_peak(self.frequency_hz, self.tip_amplitude[:, k, direction]) for k in range(self.n_sector)]
+        return np.array([o[0] for o in out]), np.array([o[1] for o in out])
+
+    @property
+    def peak_tip(self) -> np.ndarray:
+        """(s,) peak first-harmonic tip amplitude u_x of every blade [m]."""
+        return self.peaks()[0]
+
+    @property
+    def peak_frequency_hz(self) -> np.ndarray:
+        return self.peaks()[1]
+
+    @property
+    def peak_at_range_end(self) -> np.ndarray:
+        """(s,) bool: the blade's largest amplitude is at an end of the computed range."""
+        i = np.argmax(self.tip_amplitude[:, :, 0], axis=0)
+        return (i == 0) | (i == len(self.omega) - 1)
+
+    def amplification(self, tuned_peak_tip: float | None = None) -> np.ndarray:
+        """(s,) peak of each blade over the tuned disk's peak."""
+        ref = self.tuned_peak_tip if tuned_peak_tip is None else tuned_peak_tip
+        if ref is None:
+            raise ValueError("tuned_peak_tip is needed for amplification factors (give it here or to frequency_response)")
+        return self.peak_tip / _validate.positive("tuned_peak_tip", ref)
+
+    def energy_balance_error(self) -> np.ndarray:
+        """|W_exc - W_visc - W_friction| / W_exc at every point (whole model)."""
+        return np.abs(self.excitation_work - self.viscous_dissipation - self.dissipated_energy) / np.abs(self.excitation_work)
+
+    def plot(self, ax=None, tuned=None, direction: int = 0, highlight=None, title: str | None = None):
+        """Tip amplitude of every blade [mm] over frequency [Hz] (the paper's Figs. 13-17);
+        ``tuned``: a tuned DiskResponse drawn as a thick dashed line; ``highlight``: blade
+        indices (0-based) drawn in colour and labelled (default: largest and smallest peak)."""
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            _, ax = plt.subplots(figsize=(7, 4.5))
+        peaks = self.peak_tip
+        if highlight is None:
+            highlight = sorted({int(np.argmax(peaks)), int(np.argmin(peaks))})
+        for k in range(self.n_sector):
+            if k in highlight:
+                ax.plot(self.frequency_hz, 1e3 * self.tip_amplitude[:, k, direction], lw=1.6,
+                        label=f"blade {k + 1} (peak {1e3 * peaks[k]:.3f} mm)")
+            else:
+                ax.plot(self.frequency_hz, 1e3 * self.tip_amplitude[:, k, direction], color="0.6", lw=0.8)
+        if tuned is not None:
+            ax.plot(tuned.frequency_hz, 1e3 * tuned.tip_amplitude[:, direction], "k--", lw=2, label="tuned")
+        elif self.tuned_peak_tip is not None:
+            ax.axhline(1e3 * self.tuned_peak_tip, color="k", ls="--", lw=1.5, label="tuned peak")
+        ax.set_xlabel("excitation frequency [Hz]")
+        ax.set_ylabel(f"tip amplitude u_{'xyz'[direction]} [mm]")
+        if title:
+            ax.set_title(title)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+        if not self.success:
+            ax.set_title(f"incomplete: {self.message}", fontsize=8)
+        return ax

@@ -1,0 +1,186 @@
+"""Helpers of notebook 04 (contact in 3D): plain functions, values in, data or figures out.
+
+* :func:`embed_scene` / :func:`save_scene`: show a recorded meshcat :class:`~bladedamp.viz.Scene`
+  in a notebook cell (an ``<iframe srcdoc>`` of its standalone HTML) or write it to a file and
+  link it. Neither starts a meshcat server: the scene is recorded in-process.
+* :func:`wedge_disk`, :func:`liftoff_case`, :func:`liftoff_figure`: the reference wedge's
+  lift-off map (Fig. 9) for a contact height and tip excitation, memoised, so a slider moved
+  back answers at once (a new value costs one continuation run over a narrow window, ~1 s).
+* :func:`misfit_wedge_disk`: the wedge with one face angle off by a few degrees
+  (:func:`bladedamp.geometry.misfit_gaps` -> ``TunedDisk(initial_gaps=...)``).
+* :func:`cycle_figure`: the contact state of every patch point over one vibration cycle and its
+  lift-off ratio, from :func:`bladedamp.viz.meshcat_view.cycle_data` (a flat picture of what the
+  3D contact maps animate).
+* :func:`tangential_ratio`: Eq. 27's normalised first-harmonic tangential amplitude
+  |w*| = |w_xi,1| c_T / (mu F_N) of OL and OR at one point of a response (Fig. 11).
+
+Units: SI inside; arguments named ``*_mm``, ``*_g``, ``*_deg``, ``*_n`` carry slider units.
+"""
+from __future__ import annotations
+
+import dataclasses
+import html as _html
+import os
+from functools import lru_cache
+
+import numpy as np
+
+STATE_COLORS = ("#2a9e2c", "#e64d1a", "#8c8c99")   # stick, slip, separated (as in the 3D maps)
+STATE_NAMES = ("stick", "slip", "separated")
+
+
+# --------------------------------------------------------------------------------------
+# showing recorded meshcat scenes
+# --------------------------------------------------------------------------------------
+def scene_iframe(scene, height: int = 480) -> str:
+    """HTML of an iframe whose ``srcdoc`` is the scene's standalone page (no server)."""
+    return ('<div style="height: {h}px; width: 100%; resize: both; overflow: hidden">'
+            '<iframe srcdoc="{doc}" style="width: 100%; height: 100%; border: none"></iframe></div>'
+            .format(h=int(height), doc=_html.escape(scene.html(), quote=True)))
+
+
+def embed_scene(scene, height: int = 480):
+    """``IPython.display.HTML`` showing ``scene`` in the cell (about 1.5 MB of output)."""
+    from IPython.display import HTML
+
+    return HTML(scene_iframe(scene, height))
+
+
+def save_scene(scene, path, text: str | None = None):
+    """Write ``scene`` as standalone HTML to ``path`` and return an ``IPython.display.HTML`` link
+    to it (relative to the notebook's folder, opens in a new tab)."""
+    from IPython.display import HTML
+
+    path = os.fspath(path)
+    directory = os.path.dirname(path)
+    if directory:
+        os.makedirs(directory, exist_ok=True)
+    scene.save_html(path)
+    link = path.replace(os.sep, "/")
+    label = _html.escape(text or f"open {os.path.basename(path)}")
+    return HTML(f'<a href="{_html.escape(link, quote=True)}" target="_blank">{label}</a> '
+                f'(standalone page, {os.path.getsize(path) / 1e6:.1f} MB)')
+
+
+# --------------------------------------------------------------------------------------
+# wedge lift-off (Fig. 9)
+# --------------------------------------------------------------------------------------
+def wedge_disk(contact_height_mm: float = 2.0, force_n: float = 0.1, mass_g: float = 1.0):
+    """The reference disk with a wedge of contact height h_C and tip excitation F_x."""
+    from ..reference import reference_disk
+
+    disk = reference_disk("wedge", 1e-3 * mass_g, excitation=np.array([force_n, 0, 0, 0, 0, 0], dtype=float))
+    return dataclasses.replace(disk, damper=dataclasses.replace(disk.damper, contact_height=1e-3 * contact_height_mm))
+
+
+@lru_cache(maxsize=256)
+def _liftoff_case(contact_height_mm, force_n, mass_g, f_range_hz):
+    from ..studies.design import wedge_liftoff_map
+
+    return wedge_liftoff_map(wedge_disk(contact_height_mm, force_n, mass_g), f_range_hz)
+
+
+def liftoff_case(contact_height_mm: float = 2.0, force_n: float = 0.1, mass_g: float = 1.0,
+                 f_range_hz=(94.0, 98.0)):
+    """:class:`~bladedamp.studies.design.LiftoffMap` of the wedge at its 1F resonance (memoised on
+    the values rounded to 1e-6; the window widens by itself if the peak leaves it)."""
+    key = (round(float(contact_height_mm), 6), round(float(force_n), 6), round(float(mass_g), 6),
+           tuple(round(float(f), 6) for f in f_range_hz))
+    return _liftoff_case(*key)
+
+
+def liftoff_figure(contact_height_mm: float = 2.0, force_n: float = 0.1, mass_g: float = 1.0,
+                   f_range_hz=(94.0, 98.0)):
+    """Slider callback: the lift-off ratio r of every point of OL and OR (Fig. 9) as two maps."""
+    import matplotlib.pyplot as plt
+
+    m = liftoff_case(contact_height_mm, force_n, mass_g, f_range_hz)
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.4), sharey=True, constrained_layout=True)
+    vmax = max(2.0, float(np.ceil(m.ratio.max())))
+    for c, ax in enumerate(axes):
+        sc = ax.scatter(m.eta_star, m.xi_star, c=m.ratio[c], s=140, cmap="viridis", vmin=0, vmax=vmax,
+                        marker="s")
+        lift = m.lifts_off[c]
+        ax.scatter(m.eta_star[lift], m.xi_star[lift], s=260, facecolors="none", edgecolors="r", lw=1.5)
+        ax.set_xlabel("eta* = eta / l_C (along the damper)")
+        ax.set_title(f"{('OL', 'OR')[c]}: max r = {m.ratio[c].max():.2f}")
+        ax.set_xlim(-0.65, 0.65)
+        ax.set_ylim(-0.65, 0.65)
+    axes[0].set_ylabel("xi* = xi / h_C (across the height)")
+    fig.colorbar(sc, ax=axes, label="r = |w_zeta,1| / a_static  (r > 1, red ring: lifts off)")
+    fig.suptitle(f"wedge {mass_g:g} g, h_C = {contact_height_mm:g} mm, F_x = {force_n:g} N: "
+                 f"resonance {m.resonance_hz:.2f} Hz, tip {1e3 * m.peak_tip:.3f} mm", fontsize=10)
+    return fig
+
+
+# --------------------------------------------------------------------------------------
+# a wedge that does not fit
+# --------------------------------------------------------------------------------------
+def misfit_wedge_disk(misfit_deg: float = 2.0, force_n: float = 0.05, mass_g: float = 1.0,
+                      contact_height_mm: float = 2.0):
+    """The wedge whose OL face angle is ``misfit_deg`` larger than the platform's, with the initial
+    gaps of the mesh dropped into the groove (:func:`bladedamp.geometry.misfit_gaps`).
+    Returns (disk, gaps (2, P) [m])."""
+    from .. import geometry as bgeo
+
+    disk = wedge_disk(contact_height_mm, force_n, mass_g)
+    shape = bgeo.wedge_mesh(disk.damper, disk.gamma_left + np.radians(misfit_deg), disk.gamma_right)
+    gaps = bgeo.misfit_gaps(disk, shape)
+    return dataclasses.replace(disk, initial_gaps=gaps), gaps
+
+
+# --------------------------------------------------------------------------------------
+# one cycle, flat
+# --------------------------------------------------------------------------------------
+def cycle_figure(data, title: str = ""):
+    """Contact state of every point over the cycle (OL, OR: rows = points numbered along the
+    rows of the patch grid, columns = time samples) and the lift-off ratio per point.
+    ``data``: a :class:`~bladedamp.viz.meshcat_view.CycleData`."""
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+
+    states = data.states                                  # (T, 2, P)
+    T, _, P = states.shape
+    ratio = np.where(np.isfinite(data.liftoff_ratio), data.liftoff_ratio, np.nan)
+    fig, axes = plt.subplots(1, 3, figsize=(11, 3.2), gridspec_kw=dict(width_ratios=(1, 1, 0.8)),
+                             constrained_layout=True)
+    cmap = ListedColormap(STATE_COLORS)
+    phase = np.linspace(0, 360, T + 1)
+    for c, ax in enumerate(axes[:2]):
+        ax.pcolormesh(phase, np.arange(P + 1) + 0.5, states[:, c, :].T, cmap=cmap, vmin=-0.5, vmax=2.5)
+        ax.set_xlabel("phase in the cycle [deg]")
+        ax.set_title(("OL", "OR")[c])
+        ax.set_xticks([0, 90, 180, 270, 360])
+    axes[0].set_ylabel("point")
+    axes[1].legend(handles=[Patch(color=STATE_COLORS[k], label=STATE_NAMES[k]) for k in range(3)],
+                   fontsize=8, loc="upper right", framealpha=0.9)
+    for c in range(2):
+        finite = np.isfinite(ratio[c])
+        axes[2].plot(np.arange(1, P + 1)[finite], ratio[c][finite], "o-", label=("OL", "OR")[c])
+        opened = ~finite
+        if opened.any():   # a_static <= 0: r is infinite, marked at the top of the axis
+            top = max(2.0, 1.1 * np.nanmax(np.where(np.isfinite(ratio), ratio, np.nan)))
+            axes[2].plot(np.arange(1, P + 1)[opened], np.full(opened.sum(), top), "x", color=f"C{c}", ms=10,
+                         label=f"{('OL', 'OR')[c]}: open at rest (r = inf)")
+    axes[2].axhline(1.0, color="r", lw=0.8, ls="--")
+    axes[2].set_xlabel("point")
+    axes[2].set_ylabel("lift-off ratio r")
+    axes[2].legend(fontsize=8)
+    axes[2].grid(True, alpha=0.3)
+    fig.suptitle(title or f"{data.frequency_hz:.2f} Hz, tip {1e3 * data.tip_amplitude:.3f} mm", fontsize=10)
+    return fig
+
+
+def tangential_ratio(result, index: int | None = None) -> np.ndarray:
+    """(2,) complex w* = w_xi,1 c_T / (mu F_N) of OL and OR (Eq. 27, Fig. 11) at ``index`` of
+    ``result`` (default: the largest tip amplitude). |w*| > 1: the contact slips on part of the
+    cycle; |w*| < 1: it sticks throughout."""
+    i = int(np.argmax(result.tip_amplitude[:, 0])) if index is None else int(index)
+    disk = result.disk
+    w1 = result.basis.to_complex(result.relative_motion[i])[1]
+    patches = disk.damper_geometry().patches
+    c_t = np.array([p.tangential_stiffness for p in patches])
+    mu = np.array([p.friction_coefficient for p in patches])
+    F_N = np.asarray(disk.static_normal_loads(result.omega[i]), dtype=float)
+    return w1[[0, 6]] * c_t / (mu * F_N)

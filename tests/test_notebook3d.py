@@ -1,0 +1,85 @@
+"""Helpers of notebook 04 (contact in 3D): scene embedding without a server, the memoised wedge
+lift-off callback, the misfit wedge, the flat cycle picture and Eq. 27's |w*|."""
+import html
+import time
+
+import numpy as np
+import pytest
+
+pytest.importorskip("meshcat")
+pytest.importorskip("trimesh")
+
+import matplotlib  # noqa: E402
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+import bladedamp as bd  # noqa: E402
+from bladedamp.viz import meshcat_view as mv  # noqa: E402
+from bladedamp.viz import notebook3d as nb3  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def cylinder_frf():
+    frf = bd.frequency_response(bd.reference_disk("cylinder", 1e-3), (94.0, 97.0))
+    assert frf.success
+    return frf
+
+
+def test_embedding_and_saving_start_no_server(cylinder_frf, tmp_path):
+    scene = mv.contact_map_scene(cylinder_frf, n_frames=6)
+    out = nb3.scene_iframe(scene, height=300)
+    assert out.count("<iframe srcdoc=") == 1 and "height: 300px" in out
+    doc = out.split('srcdoc="', 1)[1].split('" style=', 1)[0]
+    assert '"' not in doc                                          # attribute safely quoted
+    assert html.unescape(doc) == scene.html()
+    link = nb3.save_scene(scene, tmp_path / "views" / "maps.html")
+    assert (tmp_path / "views" / "maps.html").read_text(encoding="utf-8") == scene.html()
+    assert "maps.html" in link.data and "<a href=" in link.data
+    assert not mv._LIVE and scene._window.server_proc is None
+
+
+def test_liftoff_callback_is_memoised_and_follows_the_physics():
+    nb3._liftoff_case.cache_clear()
+    low = nb3.liftoff_case(2.0, 0.05)
+    t = time.perf_counter()
+    assert nb3.liftoff_case(2.0, 0.05 + 1e-9) is low                 # same key after rounding: cached
+    assert time.perf_counter() - t < 0.01
+    ref = nb3.liftoff_case(2.0, 0.1)
+    # Fig. 9: the reference wedge (1 g, 0.1 N) lifts off at its edges; half the load does not
+    assert not low.lifts_off.any() and ref.lifts_off.any()
+    assert ref.ratio.max() > low.ratio.max()
+    # the time-sample ratio is the first-harmonic one up to the sampling of the peak
+    c = np.cos(np.pi / ref.n_samples)
+    assert np.all(ref.ratio_time <= ref.ratio * (1 + 1e-9)) and np.all(ref.ratio_time >= c * ref.ratio * (1 - 1e-9))
+    fig = nb3.liftoff_figure(2.0, 0.1)
+    try:
+        assert len(fig.axes) == 3                                  # OL, OR, colour bar
+        assert "max r = %.2f" % ref.ratio[0].max() in fig.axes[0].get_title()
+        np.testing.assert_allclose(fig.axes[0].collections[0].get_array(), ref.ratio[0])
+    finally:
+        plt.close(fig)
+
+
+def test_misfit_wedge_has_an_open_edge():
+    disk, gaps = nb3.misfit_wedge_disk(2.0)
+    n_xi = disk.damper.contact.points_across_height
+    assert gaps.shape == (2, n_xi * disk.damper.contact.points_along_length)
+    assert gaps[0].max() > 1e-5 and np.abs(gaps[1]).max() < 1e-9
+    np.testing.assert_array_equal(disk.initial_gaps, gaps)
+
+
+def test_cycle_figure_and_tangential_ratio(cylinder_frf):
+    data = mv.cycle_data(cylinder_frf)
+    fig = nb3.cycle_figure(data)
+    try:
+        mesh = fig.axes[0].collections[0]
+        np.testing.assert_array_equal(np.asarray(mesh.get_array()).reshape(data.states.shape[2], -1),
+                                      data.states[:, 0, :].T)
+    finally:
+        plt.close(fig)
+    w = nb3.tangential_ratio(cylinder_frf)
+    # the 1 g cylinder at resonance slips (|w*| > 1) and its points stick on part of the cycle
+    assert np.all(np.abs(w) > 1)
+    share = cylinder_frf.point_state[data.index]
+    assert np.all(share[..., 0] > 0) and np.all(share[..., 1] > 0)
