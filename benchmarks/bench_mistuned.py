@@ -33,6 +33,7 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 
+from _timing import best_of  # noqa: E402
 from bladedamp.mistuned import MistunedDisk  # noqa: E402
 from bladedamp.reference import reference_disk  # noqa: E402
 from bladedamp.studies import mistuning as mt  # noqa: E402
@@ -43,12 +44,7 @@ MAX_STEP = 0.05
 
 def timed(fun, repeat):
     fun()                                  # warm-up (numba caches, imports)
-    best, out = np.inf, None
-    for _ in range(repeat):
-        t = time.perf_counter()
-        out = fun()
-        best = min(best, time.perf_counter() - t)
-    return best, out
+    return best_of(fun, repeat)
 
 
 def frf(disk, f_range=F_RANGE):
