@@ -1,4 +1,4 @@
-"""Timing helper shared by the benchmark scripts (run them as ``python benchmarks/bench_*.py``)."""
+"""Helpers shared by the benchmark scripts (run them as ``python benchmarks/bench_*.py``)."""
 from __future__ import annotations
 
 import time
@@ -14,3 +14,15 @@ def best_of(fun, repeat):
         out = fun()
         best = min(best, time.perf_counter() - t0)
     return best, out
+
+
+def solved_response(disk, f_range, max_step):
+    """The disk's FRF over ``f_range`` [Hz]; raises if the continuation did not cover it."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = disk.frequency_response(*f_range, max_step=max_step)
+    if not r.success:
+        raise RuntimeError(r.message)
+    return r

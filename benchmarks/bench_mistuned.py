@@ -24,16 +24,13 @@ import os
 import platform
 import sys
 import time
-import warnings
 
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
-import numpy as np  # noqa: E402
-
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 
-from _timing import best_of  # noqa: E402
+from _timing import best_of, solved_response  # noqa: E402
 from bladedamp.mistuned import MistunedDisk  # noqa: E402
 from bladedamp.reference import reference_disk  # noqa: E402
 from bladedamp.studies import mistuning as mt  # noqa: E402
@@ -48,14 +45,7 @@ def timed(fun, repeat):
 
 
 def frf(disk, f_range=F_RANGE):
-    def run():
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            r = disk.frequency_response(*f_range, max_step=MAX_STEP)
-        if not r.success:
-            raise RuntimeError(r.message)
-        return r
-    return run
+    return lambda: solved_response(disk, f_range, MAX_STEP)
 
 
 def cost_ratio(repeat):

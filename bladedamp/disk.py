@@ -28,7 +28,7 @@ from . import _validate
 from .blade import ModalBlade
 from .contact.laws import LinearNormalLaw
 from .contact.point import point_contact_forces
-from .damper.geometry import CONTACTS, CylinderDamper, DamperGeometry, WedgeDamper
+from .damper.geometry import CylinderDamper, DamperGeometry, WedgeDamper
 from .damper.kinetics import centrifugal_force, seat
 from .hbm.continuation import continuation
 from .hbm.fourier import HarmonicBasis

@@ -47,7 +47,6 @@ def seat(geometry: DamperGeometry, radial_force: float, tol: float = 1e-12, max_
     """
     _validate.nonnegative("radial_force", radial_force)
     G = geometry.G_D.reshape(2, 6, 6)
-    P = geometry.patches[0].n_points
     if radial_force == 0:
         return np.zeros(6), -np.array([p.initial_gap for p in geometry.patches]), np.zeros(2)
     # start: uniform approach carrying the frictionless loads

@@ -154,8 +154,8 @@ def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0),
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        res = minimize_scalar(objective, bounds=(np.log(lo), np.log(hi)), method="bounded",
-                              options={"xatol": xatol})
+        minimize_scalar(objective, bounds=(np.log(lo), np.log(hi)), method="bounded",
+                        options={"xatol": xatol})
     ok = {m: p for m, p in cache.items() if m not in failed}
     if not ok:
         raise RuntimeError(f"no damper mass in {bounds} kg gave a computable response")

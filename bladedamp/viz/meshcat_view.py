@@ -679,7 +679,6 @@ def ods_scene(result, index: int | None = None, frequency_hz: float | None = Non
         pose(vis, phase)
 
     # contact maps
-    bbox_top = g.total_length
     map_origin = np.array([0.04, 0.0, z_p + 0.06])
     if layout == "disk":
         map_origin = np.array([0.09, -0.06, z_p + 0.04])
