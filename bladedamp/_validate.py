@@ -57,3 +57,15 @@ def integer(name: str, value, minimum: int = 0, maximum: int | None = None) -> i
     if value < minimum or (maximum is not None and value > maximum):
         raise ValueError(f"{name} must be an integer in [{minimum}, {hi} (got {value!r})")
     return value
+
+
+def interval(name: str, value, unit: str = "") -> tuple[float, float]:
+    """Check a pair (low, high) with 0 < low < high, both finite; returns it as floats."""
+    unit = f" {unit}" if unit else ""
+    try:
+        lo, hi = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a pair (low, high) with 0 < low < high{unit} (got {value!r})") from None
+    if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi):
+        raise ValueError(f"{name} must satisfy 0 < low < high{unit} (got {value!r})")
+    return lo, hi

@@ -33,23 +33,11 @@ ROLLING_TOLERANCE = 0.01   # an optimum less than 1 % below the undamped peak co
 # input checks
 # ---------------------------------------------------------------------------------------
 def _check_f_range(f_range_hz):
-    try:
-        lo, hi = (float(f) for f in f_range_hz)
-    except (TypeError, ValueError):
-        raise ValueError(f"f_range_hz must be a pair (low, high) with 0 < low < high Hz (got {f_range_hz!r})")
-    if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi):
-        raise ValueError(f"f_range_hz must satisfy 0 < low < high Hz (got {f_range_hz!r})")
-    return lo, hi
+    return _validate.interval("f_range_hz", f_range_hz, "Hz")
 
 
 def _check_mass_bounds(mass_bounds):
-    try:
-        lo, hi = (float(b) for b in mass_bounds)
-    except (TypeError, ValueError):
-        raise ValueError(f"mass_bounds must be a pair (low, high) with 0 < low < high kg (got {mass_bounds!r})")
-    if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi):
-        raise ValueError(f"mass_bounds must satisfy 0 < low < high kg (got {mass_bounds!r})")
-    return lo, hi
+    return _validate.interval("mass_bounds", mass_bounds, "kg")
 
 
 def _check_disk(disk):

@@ -27,9 +27,7 @@ def peak_response(disk: TunedDisk, f_range_hz=(90.0, 105.0), harmonics=(1,), max
     The peak is refined by a parabola through the largest point and its neighbours.
     Raises RuntimeError if the continuation does not cover the range (never a silent number).
     """
-    lo, hi = (float(f) for f in f_range_hz)
-    if not 0 < lo < hi:
-        raise ValueError(f"f_range_hz must satisfy 0 < low < high Hz (got {f_range_hz})")
+    lo, hi = _validate.interval("f_range_hz", f_range_hz, "Hz")
     for _ in range(max_widenings + 1):
         r = disk.frequency_response(lo, hi, harmonics=harmonics, max_step=max_step)
         if not r.success:
@@ -135,10 +133,7 @@ def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0),
 
     ``bounds`` [kg], 0 < low < high; ``xatol`` tolerance in log(mass).
     """
-    lo, hi = (float(b) for b in bounds)
-    _validate.positive("mass bounds", [lo, hi])
-    if not lo < hi:
-        raise ValueError(f"mass bounds must satisfy 0 < low < high (got {bounds})")
+    lo, hi = _validate.interval("mass bounds", bounds, "kg")
     undamped, _, _ = peak_response(dataclasses.replace(disk, damper=None), f_range_hz, harmonics)
     cache, failed = {}, []
 
