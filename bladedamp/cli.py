@@ -294,7 +294,7 @@ def _mistuning_report(s: dict) -> str:
 def monte_carlo_command(args) -> int:
     """``bladedamp montecarlo``: peak amplification of N mistuned reference disks on Dask."""
     from .reference import reference_disk
-    from .studies.mistuning import monte_carlo
+    from .studies.mistuning import MONTE_CARLO_MAX_STEP, MONTE_CARLO_TOL, monte_carlo
 
     if args.scheduler != "serial":
         try:
@@ -306,7 +306,9 @@ def monte_carlo_command(args) -> int:
     progress = Progress()
     result = monte_carlo(reference_disk(args.damper, args.mass * 1e-3), args.disks, std=args.std, seed=args.seed,
                          scheduler=None if args.scheduler == "local" else args.scheduler, n_workers=args.workers,
-                         progress=progress.bar("Monte Carlo disks"), out=None)
+                         progress=progress.bar("Monte Carlo disks"), out=None,
+                         max_step=MONTE_CARLO_MAX_STEP if args.max_step is None else args.max_step,
+                         tol=MONTE_CARLO_TOL if args.tol is None else args.tol)
     args.out.mkdir(parents=True, exist_ok=True)
     result.save(args.out / "montecarlo")
     lo, hi = result.confidence_interval()
@@ -453,6 +455,11 @@ def main(argv=None) -> int:
     mc.add_argument("--workers", type=int, default=None, help="local Dask workers (default: every core)")
     mc.add_argument("--scheduler", default="local",
                     help="'local' (a local Dask cluster, no set-up), 'serial' (no Dask) or the address of a Dask scheduler")
+    mc.add_argument("--max-step", type=float, default=None,
+                    help="continuation step per disk (default: the Monte Carlo's peak-only setting, "
+                         "bladedamp.studies.mistuning.MONTE_CARLO_MAX_STEP; 0.05 for full FRF accuracy)")
+    mc.add_argument("--tol", type=float, default=None,
+                    help="continuation tolerance per disk (default MONTE_CARLO_TOL; 1e-10 for full FRF accuracy)")
     mc.add_argument("--out", type=Path, default=Path("results"), help="output directory (montecarlo.npz, .json)")
     args = parser.parse_args(argv)
     if args.command == "reproduce":

@@ -279,16 +279,27 @@ class TunedDisk:
                 static_stiffness = np.zeros((n, n))
                 static_stiffness[nm:, nm:] = static_retention * k_n * np.diag([1, 1, 1, 1e-4, 1e-4, 1e-4])
 
+        centrifugal = self._centrifugal_law() if self.has_damper and basis.has_static else None
+
         def excitation(omega):
             f, df = np.zeros((C, n)), np.zeros((C, n))
             f[j1, :nm] = modal_force
-            if self.has_damper and basis.has_static:
-                F, dF = self.centrifugal_force(omega)
+            if centrifugal is not None:
+                F, dF = centrifugal(omega)
                 f[basis.cos_index(0), nm + 2] = F       # radially outwards on the damper
                 df[basis.cos_index(0), nm + 2] = dF
             return f.ravel(), df.ravel()
 
         return HarmonicBalanceSystem(basis, M, D, K, excitation, couplings, static_stiffness)
+
+    def _centrifugal_law(self):
+        """omega -> (F_CG [N], dF_CG / dOmega_E) of Eq. 26, its parameters validated once here
+        (the residual calls it at every evaluation): F = c Omega_E^2, or constant at a given
+        rotor speed."""
+        c, _ = self.centrifugal_force(1.0)
+        if self.rotor_speed is not None:
+            return lambda omega: (c, 0.0)
+        return lambda omega: (c * omega ** 2, 2 * c * omega)
 
     def _approach_function(self, geometry: DamperGeometry, basis: HarmonicBasis):
         """omega -> (per-point static approach (2, P) [m], its omega-derivative)."""
@@ -318,9 +329,10 @@ class TunedDisk:
         exponent = getattr(geometry.patches[0].normal_law, "exponent", 1.0)
         F_ref = 1.0
         _, approach_ref, _ = seat(geometry, F_ref)
+        centrifugal = self._centrifugal_law()
 
         def approach(omega):
-            F, dF = self.centrifugal_force(omega)
+            F, dF = centrifugal(omega)
             if F <= 0:
                 return np.zeros_like(approach_ref), np.zeros_like(approach_ref)
             scale = (F / F_ref) ** (1 / exponent)

@@ -1,6 +1,7 @@
 """Result objects of frequency responses: named arrays and ``.plot()``."""
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -32,6 +33,19 @@ class FrequencyResponse:
     message: str
     iterations: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     turning_points: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+
+    def reversed(self):
+        """The same branch in the opposite order (a downward sweep as rising frequency): every
+        per-point array is flipped, turning points renumbered."""
+        n = len(self.omega)
+        changes = {}
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if f.name == "turning_points":
+                changes[f.name] = np.sort(n - 1 - np.asarray(value, dtype=int))
+            elif isinstance(value, np.ndarray) and value.ndim and value.shape[0] == n:
+                changes[f.name] = value[::-1].copy()
+        return dataclasses.replace(self, **changes)
 
     @property
     def frequency_hz(self) -> np.ndarray:

@@ -56,3 +56,9 @@ def test_montecarlo_command_writes_results_loadable_without_pickle(tmp_path):
     assert result.kappa.shape == (2, 16) and np.all(np.isfinite(result.peak_tip))
     # the largest blade of a 2 % mistuned disk at the tuned optimum stays within +-50 % of the tuned peak
     assert np.all((result.amplification > 0.5) & (result.amplification < 1.5)), result.amplification
+    assert result.meta["max_step"] == 0.1 and result.meta["tol"] == 1e-6   # the peak-only defaults
+
+
+def test_montecarlo_command_rejects_a_bad_step(tmp_path, capsys):
+    with pytest.raises(ValueError, match="max_step"):
+        main(["montecarlo", "--disks", "1", "--scheduler", "serial", "--max-step", "-1", "--out", str(tmp_path)])

@@ -110,6 +110,50 @@ def test_tuned_full_assembly_equals_cyclic(n, eo, harmonics, opts):
     assert rf.energy_balance_error().max() < 1e-6
 
 
+def test_tuned_full_assembly_with_asymmetric_platforms_and_misfit_equals_cyclic():
+    """gamma_R = 50 deg (gamma_L = 35) and a misfit (two OR points 0.2 um off), the same at every
+    position: the full assembly equals the cyclic TunedDisk with those parameters."""
+    gaps = np.zeros((2, 5))
+    gaps[1, :2] = 2e-7
+    td = dataclasses.replace(tuned(4, 1), gamma_right=np.radians(50.0), initial_gaps=gaps)
+    err, rf, rt = compare_full_to_cyclic(td, n_check=4)
+    print(f"\n[tuned full vs cyclic, 35/50 deg, misfit] max rel. difference {err:.2e}")
+    assert err < 1e-8, f"differs from the cyclic solution by {err:.2e}"
+
+
+def test_per_position_platform_angles_and_gaps_repeat_as_a_sector():
+    """Platform angles and misfits given per position, alternating on 4 blades: the full assembly
+    equals the two-blade cyclic sector with the first two entries (polished at the same
+    frequencies), and the two positions respond differently."""
+    td = tuned(4, 1)
+    gaps = np.zeros((2, 5))
+    gaps[0, -2:] = 2e-7
+    angles = np.radians([35.0, 50.0])
+    full = MistunedDisk.from_tuned(td)
+    full = dataclasses.replace(full, gamma_right=list(angles) * 2, initial_gaps=[None, gaps] * 2)
+    sector = dataclasses.replace(MistunedDisk.from_tuned(td, np.ones(2), n_sector=2), gamma_right=angles,
+                                 initial_gaps=[None, gaps])
+    assert full.sectors[1].gamma_right == angles[1] and full.sectors[2].initial_gaps is None
+    rf, rs = run(full, (90.0, 104.0)), run(sector, (90.0, 104.0))
+    ss = sector.hbm_system()
+    scale = np.maximum(np.abs(rs.coefficients).max(axis=0).ravel(), 1e-3 * np.abs(rs.coefficients).max())
+    tip = np.stack([b.shape("tip")[0] for b in sector.blades])
+    j, nm = ss.basis.cos_index(1), td.blade.n_modes
+    a = rf.tip_amplitude[:, :, 0]
+    worst = 0.0
+    for i in np.linspace(1, len(rf.omega) - 2, 5).astype(int):
+        x = polish(ss, rs.coefficients[np.argmin(np.abs(rs.omega - rf.omega[i]))].ravel(), rf.omega[i], scale)
+        X = x.reshape(ss.basis.n_coeffs, -1)
+        q = (X[j, :2 * nm] - 1j * X[j + 1, :2 * nm]).reshape(2, nm)
+        worst = max(worst, np.abs(np.abs((q * tip).sum(axis=1)) - a[i, :2]).max() / a.max())
+    print(f"\n[per-position angles and gaps] full vs two-blade sector {worst:.1e}; peaks {1e3 * rf.peak_tip} mm")
+    assert worst < 1e-7, f"full assembly differs from the two-blade sector by {worst:.2e}"
+    assert abs(rf.peak_tip[0] - rf.peak_tip[1]) > 1e-3 * rf.peak_tip.max()
+    assert rf.energy_balance_error().max() < 1e-6
+    with pytest.raises(ValueError, match="gamma_right"):
+        dataclasses.replace(full, gamma_right=[0.6] * 3)
+
+
 def test_tuned_16_blade_reference_equals_cyclic():
     """The paper's 16-blade reference disk (cylinder 1 g, EO = 1) written out blade by blade."""
     err, rf, rt = compare_full_to_cyclic(reference_disk("cylinder", 1e-3), n_check=4)
@@ -138,15 +182,19 @@ def test_jacobian_against_finite_differences_and_generic_assembly():
     generic = HarmonicBalanceSystem(s.basis, s.mass, s.damping, s.stiffness, s.excitation, s.couplings)
     Rg, Jg, Rwg = generic.residual(x, w)
     assert np.abs(R - Rg).max() <= 1e-12 * np.abs(R).max() + 1e-12 * np.abs(s.excitation(w)[0]).max()
-    assert relative_matrix_error(J.toarray(), Jg.toarray()) < 1e-12
+    assert isinstance(J, np.ndarray), "a small assembly returns a dense Jacobian"
+    assert relative_matrix_error(J, Jg.toarray()) < 1e-12
+    s.dense = False                                      # the sparse assembly of large systems
+    assert relative_matrix_error(s.residual(x, w)[1].toarray(), J) == 0
+    s.dense = True
     assert np.abs(Rw - Rwg).max() <= 1e-10 * np.abs(Rwg).max()
     step = 1e-6 * np.maximum(np.abs(r.coefficients).max(axis=0).ravel(), 1e-9)
     J_fd = central_difference(lambda y: s.residual(y, w, False)[0], x, step)
     scale = step / 1e-6
-    e_j = relative_matrix_error(J.toarray() * scale, J_fd * scale)   # columns in the unknowns' own sizes
+    e_j = relative_matrix_error(J * scale, J_fd * scale)   # columns in the unknowns' own sizes
     Rw_fd = (s.residual(x, w * (1 + 1e-7), False)[0] - s.residual(x, w * (1 - 1e-7), False)[0]) / (2e-7 * w)
     e_w = np.abs(Rw - Rw_fd).max() / np.abs(Rw_fd).max()
-    print(f"\n[jacobian] 3 blades: dR/dx vs central differences {e_j:.2e}, dR/domega {e_w:.2e}, nnz {J.nnz}")
+    print(f"\n[jacobian] 3 blades: dR/dx vs central differences {e_j:.2e}, dR/domega {e_w:.2e}")
     assert e_j < 1e-5, f"dR/dx differs from central differences by {e_j:.2e}"
     assert e_w < 1e-5, f"dR/domega differs from central differences by {e_w:.2e}"
 
@@ -206,6 +254,42 @@ def test_energy_balance_random_mistuning_and_contact_mistuning():
           f"friction share up to {100 * frac:.1f} % of the excitation work")
     assert e.max() < 1e-6, f"energy balance error {e.max():.2e}"
     assert frac > 0.1, "friction should dissipate a sizeable share near the resonance"
+
+
+def test_extended_response_equals_a_fresh_one_over_the_wider_range():
+    """A response continued past both ends (extend_response) covers the union of the ranges in
+    order, satisfies the energy balance at every point, and has the peaks of a fresh response
+    over that range (different continuation grids only)."""
+    td = tuned(4, 1)
+    md = MistunedDisk.from_tuned(td, np.array([0.98, 1.01, 1.0, 1.02]))
+    part = run(md, (93.5, 96.0))
+    wider = md.extend_response(md.extend_response(part, 91.0, max_step=MAX_STEP), 99.0, max_step=MAX_STEP)
+    fresh = run(md, (91.0, 99.0))
+    f = wider.frequency_hz
+    assert wider.success and f[0] == pytest.approx(91.0) and f[-1] == pytest.approx(99.0) and np.all(np.diff(f) > 0)
+    assert np.isin(part.omega, wider.omega).all(), "the known part is kept, not recomputed"
+    assert wider.energy_balance_error().max() < 1e-6
+    rel = np.abs(wider.peak_tip / fresh.peak_tip - 1).max()
+    print(f"\n[extend] {len(part.omega)} -> {len(wider.omega)} points (fresh: {len(fresh.omega)}), peaks differ {rel:.1e}")
+    assert rel < 2e-3, f"peaks differ by {rel:.2e}"
+    with pytest.raises(ValueError, match="f_end_hz"):
+        md.extend_response(part, 95.0)
+
+
+@pytest.mark.slow
+def test_monte_carlo_settings_keep_the_amplification_of_fine_frfs():
+    """The Monte Carlo's coarse continuation (MONTE_CARLO_MAX_STEP, MONTE_CARLO_TOL) against fine
+    FRFs (max_step 0.05, tol 1e-10) on 6 random 16-blade reference disks: the largest blade peak
+    of each disk agrees to 2e-3 relative (measured: see benchmarks/README.md)."""
+    disk = reference_disk("cylinder", 1e-3)
+    worst = 0.0
+    for i in range(6):
+        kappa = mt.random_kappa(16, 0.02, seed=[7, i])
+        fast = mt.mistuned_response(disk, kappa, max_step=mt.MONTE_CARLO_MAX_STEP, tol=mt.MONTE_CARLO_TOL)
+        fine = mt.mistuned_response(disk, kappa, max_step=0.05, tol=1e-10)
+        worst = max(worst, abs(fast.peak_tip.max() / fine.peak_tip.max() - 1))
+    print(f"\n[monte carlo settings] largest peak of 6 disks: worst relative error {worst:.1e}")
+    assert worst < 2e-3, f"largest peak differs by {worst:.2e}"
 
 
 # ---------------------------------------------------------------------------------------

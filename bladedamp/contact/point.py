@@ -15,6 +15,12 @@ The steady periodic state is found by repeating the period (return map) until th
 position at the period end repeats. The derivative of the sampled forces with respect to
 each point's own harmonic coefficients is propagated through the same steps (chain rule
 through the return map), which gives the exact Jacobian of the AFT forces.
+
+:func:`point_contact_forces` works on given point coefficients; :func:`damper_contact_forces`
+is the same computation fused for the two patches of many dampers (point motion from the
+damper coordinates, normal law, return map, AFT and the projection back, in one numba call),
+used by :class:`bladedamp.mistuned.AssemblyContacts`. Both run the per-point return map
+:func:`_point_return_map`.
 """
 from __future__ import annotations
 
@@ -46,114 +52,565 @@ def slider_step(u0, u1, s0, s1, k_t, radius, in_contact):
     return f0, f1, u0 - f0 / k_t, u1 - f1 / k_t, SLIP
 
 
+# Closed-form periodic slider derivative (see _point_return_map): it is used when
+# |det(I - Phi)| >= SINGULAR_DET, Phi the 2x2 one-period transfer of the slider derivative;
+# below, the derivative is iterated pass by pass (_iterate_passes) as before.
+SINGULAR_DET = 1e-6
+_VARIANT_B = True
+
+
+@njit(cache=True)
+def _slider_pass(ut, normal, kt, mu, s0, s1, f_out, state_out):
+    """One period of the slider without derivatives: (s0, s1 at the end, moved, slip work);
+    writes f_out[:, 0:2] and state_out."""
+    moved = False
+    work = 0.0
+    for t in range(ut.shape[0]):
+        n = normal[t]
+        f0, f1, n_s0, n_s1, st = slider_step(ut[t, 0], ut[t, 1], s0, s1, kt, mu * n, n > 0.0)
+        f_out[t, 0] = f0
+        f_out[t, 1] = f1
+        state_out[t] = st
+        if st != STICK:
+            moved = True
+            work += f0 * (n_s0 - s0) + f1 * (n_s1 - s1)
+        s0 = n_s0
+        s1 = n_s1
+    return s0, s1, moved, work
+
+
+@njit(cache=True)
+def _derivative_pass(ut, normal, dnormal, synthesis, kt, mu, s0, s1, f_out, df_out, state_out, ds,
+                     transfer, track):
+    """One period of the slider carrying its derivative ds (2, 3C) (updated in place) and
+    writing df_out (see :func:`_point_return_map`); returns (s0, s1, moved, slip work).
+
+    With ``track``, transfer[t] = (M00, M01, M10, M11) of M_t = A_t ... A_0, the derivative
+    transfer d ds_t / d ds_begin up to sample t: A = I in stick, A = g (I - e e^T) in slip,
+    A = 0 when separated (then ds is reset). The derivative pass itself is the same
+    arithmetic with and without ``track``.
+    """
+    T = ut.shape[0]
+    C = synthesis.shape[1]
+    n3 = 3 * C
+    ds0 = ds[0]
+    ds1 = ds[1]
+    m00 = 1.0
+    m01 = 0.0
+    m10 = 0.0
+    m11 = 1.0
+    moved = False
+    work = 0.0
+    for t in range(T):
+        u0 = ut[t, 0]
+        u1 = ut[t, 1]
+        sp0 = s0
+        sp1 = s1
+        n = normal[t]
+        f0, f1, n_s0, n_s1, st = slider_step(u0, u1, s0, s1, kt, mu * n, n > 0.0)
+        f_out[t, 0] = f0
+        f_out[t, 1] = f1
+        state_out[t] = st
+        if st != STICK:
+            moved = True
+            work += f0 * (n_s0 - s0) + f1 * (n_s1 - s1)
+        s0 = n_s0
+        s1 = n_s1
+        df0 = df_out[t, 0]
+        df1 = df_out[t, 1]
+        if st == SEPARATED:
+            # no force; the slider follows the displacement
+            for j in range(n3):
+                df0[j] = 0.0
+                df1[j] = 0.0
+            for j in range(C):
+                ds0[j] = synthesis[t, j]
+                ds1[j] = 0.0
+                ds0[C + j] = 0.0
+                ds1[C + j] = synthesis[t, j]
+                ds0[2 * C + j] = 0.0
+                ds1[2 * C + j] = 0.0
+            if track:
+                m00 = 0.0
+                m01 = 0.0
+                m10 = 0.0
+                m11 = 0.0
+                transfer[t, 0] = 0.0
+                transfer[t, 1] = 0.0
+                transfer[t, 2] = 0.0
+                transfer[t, 3] = 0.0
+            continue
+        if st == STICK:
+            # d(trial)/dc with trial = k_T (u - s_previous); the slider stays
+            for j in range(C):
+                kE = kt * synthesis[t, j]
+                df0[j] = -kt * ds0[j] + kE
+                df1[j] = -kt * ds1[j]
+                df0[C + j] = -kt * ds0[C + j]
+                df1[C + j] = -kt * ds1[C + j] + kE
+                df0[2 * C + j] = -kt * ds0[2 * C + j]
+                df1[2 * C + j] = -kt * ds1[2 * C + j]
+            if track:
+                transfer[t, 0] = m00
+                transfer[t, 1] = m01
+                transfer[t, 2] = m10
+                transfer[t, 3] = m11
+            continue
+        # slip: f = mu N e, e = trial/|trial|: df = e mu dN + mu N (I - e e^T) dtrial / |trial|
+        radius = mu * n
+        stretch = np.sqrt((u0 - sp0) ** 2 + (u1 - sp1) ** 2)
+        e0 = (u0 - sp0) / stretch
+        e1 = (u1 - sp1) / stretch
+        g = radius / (kt * stretch)
+        mdn = mu * dnormal[t]
+        for j in range(C):
+            E = synthesis[t, j]
+            kE = kt * E
+            # xi block
+            d0 = -kt * ds0[j] + kE
+            d1 = -kt * ds1[j]
+            proj = e0 * d0 + e1 * d1
+            h0 = g * (d0 - e0 * proj)
+            h1 = g * (d1 - e1 * proj)
+            df0[j] = h0
+            df1[j] = h1
+            ds0[j] = -h0 / kt + E
+            ds1[j] = -h1 / kt
+            # eta block
+            jj = C + j
+            d0 = -kt * ds0[jj]
+            d1 = -kt * ds1[jj] + kE
+            proj = e0 * d0 + e1 * d1
+            h0 = g * (d0 - e0 * proj)
+            h1 = g * (d1 - e1 * proj)
+            df0[jj] = h0
+            df1[jj] = h1
+            ds0[jj] = -h0 / kt
+            ds1[jj] = -h1 / kt + E
+            # zeta block (through the normal load)
+            jj = 2 * C + j
+            d0 = -kt * ds0[jj]
+            d1 = -kt * ds1[jj]
+            proj = e0 * d0 + e1 * d1
+            dr = mdn * E
+            h0 = g * (d0 - e0 * proj) + e0 * dr
+            h1 = g * (d1 - e1 * proj) + e1 * dr
+            df0[jj] = h0
+            df1[jj] = h1
+            ds0[jj] = -h0 / kt
+            ds1[jj] = -h1 / kt
+        if track:
+            # M <- g (I - e e^T) M
+            a00 = g * e1 * e1
+            a01 = -g * e0 * e1
+            a11 = g * e0 * e0
+            n00 = a00 * m00 + a01 * m10
+            n01 = a00 * m01 + a01 * m11
+            n10 = a01 * m00 + a11 * m10
+            n11 = a01 * m01 + a11 * m11
+            if abs(n00) + abs(n01) + abs(n10) + abs(n11) < 1e-200:
+                n00 = 0.0       # negligible (and no subnormal arithmetic)
+                n01 = 0.0
+                n10 = 0.0
+                n11 = 0.0
+            m00 = n00
+            m01 = n01
+            m10 = n10
+            m11 = n11
+            transfer[t, 0] = m00
+            transfer[t, 1] = m01
+            transfer[t, 2] = m10
+            transfer[t, 3] = m11
+    return s0, s1, moved, work
+
+
+@njit(cache=True)
+def _initial_derivative(ds, C, static_index):
+    """The slider derivative at the first pass: zero, or seated at the mean (d s / d c_mean = I)."""
+    ds[:, :] = 0.0
+    if static_index >= 0:
+        ds[0, static_index] = 1.0
+        ds[1, C + static_index] = 1.0
+
+
+@njit(cache=True)
+def _slip_scale(normal, kt, mu):
+    """mu max N / k_T: the slider position scale of the periodicity test."""
+    nmax = 0.0
+    for t in range(normal.shape[0]):
+        if normal[t] > nmax:
+            nmax = normal[t]
+    return mu * nmax / kt + 1e-300
+
+
+@njit(cache=True)
+def _iterate_passes(ut, normal, dnormal, synthesis, kt, mu, s0, s1, static_index, max_passes, tol,
+                    want_jac, f_out, df_out, state_out, ds, ds_begin):
+    """Repeat the period until the slider position repeats (and, with the Jacobian, its
+    derivative too: ``abs(ds - ds_begin) <= tol``), at most ``max_passes`` times.
+    Returns (slip work, passes)."""
+    C = synthesis.shape[1]
+    n3 = 3 * C
+    _initial_derivative(ds, C, static_index)
+    scale = _slip_scale(normal, kt, mu)
+    work = 0.0
+    passes = 0
+    for it in range(max_passes):
+        b0 = s0
+        b1 = s1
+        passes += 1
+        if want_jac:
+            for j in range(n3):
+                ds_begin[0, j] = ds[0, j]
+                ds_begin[1, j] = ds[1, j]
+            # (no transfer tracking: ds_begin only stands in for the unused transfer array)
+            s0, s1, moved, work = _derivative_pass(ut, normal, dnormal, synthesis, kt, mu, s0, s1, f_out,
+                                                   df_out, state_out, ds, ds_begin, False)
+        else:
+            s0, s1, moved, work = _slider_pass(ut, normal, kt, mu, s0, s1, f_out, state_out)
+        if not moved:
+            break  # no slip, no separation: this period is already periodic
+        if it >= 1 and abs(s0 - b0) <= tol * scale and abs(s1 - b1) <= tol * scale:
+            # periodic slider; with the Jacobian its derivative must have settled too
+            # (in near-1D slip the cross-direction derivative needs many more passes)
+            if not want_jac:
+                break
+            settled = True
+            for j in range(n3):
+                if not (abs(ds[0, j] - ds_begin[0, j]) <= tol and abs(ds[1, j] - ds_begin[1, j]) <= tol):
+                    settled = False
+                    break
+            if settled:
+                break
+    return work, passes
+
+
+@njit(cache=True)
+def _point_return_map(ut, normal, dnormal, synthesis, kt, mu, s0, s1, static_index, max_passes, tol,
+                      want_jac, f_out, df_out, state_out, ds, ds_begin, transfer, closed_form):
+    """Periodic return map of one point (see :func:`_return_map`).
+
+    ut (T,2); normal, dnormal (T,); s0, s1 the initial slider position; outputs f_out (T,>=2),
+    df_out (T,>=2,3C) (rows 0, 1 written; untouched without the Jacobian), state_out (T,);
+    ds, ds_begin: (2,3C) work arrays; transfer: (T,4) work array. Returns (slip work, passes
+    without derivative, passes with derivative).
+
+    Slider: the period is repeated until the slider position at its end repeats (to ``tol``
+    of mu max N / k_T, at least two passes) or no sample slips or separates, at most
+    ``max_passes`` times; forces, states and work are those of the last pass.
+
+    Jacobian: the slider derivative ds = d s / d c (2, 3C) is carried through the samples,
+    column by column (blocks xi | eta | zeta of C columns each); E = synthesis[t]:
+    trial derivative dtr = -k_T ds + k_T E (xi row: xi block, eta row: eta block); stick:
+    df = dtr; slip: df = g (I - e e^T) dtr + e mu dN/du_zeta E (zeta block), ds = -df / k_T
+    + E (own block), g = mu N / |trial|; separated: df = 0, ds = E (own block).
+    Per sample ds_new = A_t ds + (terms independent of ds), A_t = I (stick), g (I - e e^T)
+    (slip), 0 (separated), so over the period ds_end = Phi ds_begin + psi with the 2x2
+    Phi = A_{T-1} ... A_0, the same for all 3C columns.
+
+    ``closed_form`` (default of the callers): the slider is iterated without derivatives;
+    the last pass is then repeated from its start with the derivative from ds_begin = 0
+    and the transfers M_t = A_t ... A_0 (Phi = M_{T-1}, psi = ds_end), the periodic
+    derivative is ds* = (I - Phi)^{-1} psi (the fixed point of the pass iteration, its
+    limit for infinitely many passes), and df_t += -k_T M_t ds* moves the pass's df to the
+    start ds*. A point that never slips nor separates keeps the initial derivative (0, or
+    the mean's identity with a static harmonic: the slider seated at the mean). The passes
+    are iterated with the derivative (``closed_form`` False, the previous method) when
+    |det(I - Phi)| < SINGULAR_DET (an eigenvalue of Phi near 1: the periodic state is not
+    unique or barely attracting, e.g. a point that slips only a tiny distance per period,
+    or slips in one pass and sticks in the next) -- there the result depends on the initial
+    slider and its derivative convention, and the previous iteration defines it.
+    """
+    if not (want_jac and closed_form):
+        work, passes = _iterate_passes(ut, normal, dnormal, synthesis, kt, mu, s0, s1, static_index, max_passes,
+                                       tol, want_jac, f_out, df_out, state_out, ds, ds_begin)
+        return work, (0 if want_jac else passes), (passes if want_jac else 0)
+    T = ut.shape[0]
+    C = synthesis.shape[1]
+    n3 = 3 * C
+    start0 = s0
+    start1 = s1
+    scale = _slip_scale(normal, kt, mu)
+    b0 = s0
+    b1 = s1
+    moved = False
+    passes = 0
+    for it in range(max_passes):
+        b0 = s0
+        b1 = s1
+        passes += 1
+        s0, s1, moved, work = _slider_pass(ut, normal, kt, mu, s0, s1, f_out, state_out)
+        if not moved:
+            break
+        if it >= 1 and abs(s0 - b0) <= tol * scale and abs(s1 - b1) <= tol * scale:
+            break
+    if not moved:
+        if passes > 1:
+            # it slipped or separated before it stuck for good: the derivative depends on that
+            # transient (Phi = I); iterate as before
+            work, jp = _iterate_passes(ut, normal, dnormal, synthesis, kt, mu, start0, start1, static_index,
+                                       max_passes, tol, True, f_out, df_out, state_out, ds, ds_begin)
+            return work, passes, jp
+        # stuck throughout from the start: ds is the initial derivative at every sample
+        _initial_derivative(ds, C, static_index)
+        ds0 = ds[0]
+        ds1 = ds[1]
+        for t in range(T):
+            df0 = df_out[t, 0]
+            df1 = df_out[t, 1]
+            for j in range(C):
+                kE = kt * synthesis[t, j]
+                df0[j] = -kt * ds0[j] + kE
+                df1[j] = -kt * ds1[j]
+                df0[C + j] = -kt * ds0[C + j]
+                df1[C + j] = -kt * ds1[C + j] + kE
+                df0[2 * C + j] = -kt * ds0[2 * C + j]
+                df1[2 * C + j] = -kt * ds1[2 * C + j]
+        return work, passes, 0
+    # the last pass again, from the same start, with the derivative from ds_begin = 0
+    ds[:, :] = 0.0
+    if _VARIANT_B:
+        b0 = s0
+        b1 = s1
+    s0, s1, moved, work = _derivative_pass(ut, normal, dnormal, synthesis, kt, mu, b0, b1, f_out, df_out,
+                                           state_out, ds, transfer, True)
+    a = 1.0 - transfer[T - 1, 0]           # I - Phi = [[a, b], [c, d]]
+    b = -transfer[T - 1, 1]
+    c = -transfer[T - 1, 2]
+    d = 1.0 - transfer[T - 1, 3]
+    det = a * d - b * c
+    if abs(det) < SINGULAR_DET:
+        work, jp = _iterate_passes(ut, normal, dnormal, synthesis, kt, mu, start0, start1, static_index,
+                                   max_passes, tol, True, f_out, df_out, state_out, ds, ds_begin)
+        return work, passes, 1 + jp
+    # ds* = (I - Phi)^{-1} psi (psi = ds now), column by column
+    ia = a / det
+    ib = b / det
+    ic = c / det
+    id_ = d / det
+    for j in range(n3):
+        p0 = ds[0, j]
+        p1 = ds[1, j]
+        ds[0, j] = id_ * p0 - ib * p1
+        ds[1, j] = -ic * p0 + ia * p1
+    # df_t(ds*) = df_t(0) - k_T M_t ds*
+    for t in range(T):
+        m00 = transfer[t, 0]
+        m01 = transfer[t, 1]
+        m10 = transfer[t, 2]
+        m11 = transfer[t, 3]
+        if m00 == 0.0 and m01 == 0.0 and m10 == 0.0 and m11 == 0.0:
+            continue
+        df0 = df_out[t, 0]
+        df1 = df_out[t, 1]
+        for j in range(n3):
+            x0 = ds[0, j]
+            x1 = ds[1, j]
+            df0[j] -= kt * (m00 * x0 + m01 * x1)
+            df1[j] -= kt * (m10 * x0 + m11 * x1)
+    return work, passes, 1
+
+
 @njit(cache=True)
 def _return_map(ut, normal, dnormal, synthesis, k_t, mu, s_start, static_index,
-                max_passes, tol, want_jac, f_out, df_out, state_out, slip_work):
+                max_passes, tol, want_jac, f_out, df_out, state_out, slip_work, passes, closed_form):
     """Tangential forces of P points over T samples (see module docstring).
 
     ut (P,T,2) tangential displacement samples; normal (P,T) normal load N >= 0;
     dnormal (P,T) dN/du_zeta; synthesis (T,C); k_t, mu (P,); s_start (P,2) initial slider;
-    static_index: coefficient index of the mean (slider seated at the mean) or -1.
+    static_index: coefficient index of the mean (slider seated at the mean) or -1;
+    closed_form: periodic slider derivative in closed form (see :func:`_point_return_map`).
     Outputs: f_out (P,T,2), df_out (P,T,2,3C) (d force / d point coefficients, blocks
-    xi|eta|zeta), state_out (P,T), slip_work (P,) = sum f . ds over the last period.
+    xi|eta|zeta), state_out (P,T), slip_work (P,) = sum f . ds over the last period,
+    passes (P,2) int: passes without and with the derivative.
     """
     P, T = ut.shape[0], ut.shape[1]
-    C = synthesis.shape[1]
-    n3 = 3 * C
+    n3 = 3 * synthesis.shape[1]
     ds = np.zeros((2, n3))
-    dtr = np.zeros((2, n3))
-    dfs = np.zeros((2, n3))
     ds_begin = np.zeros((2, n3))
+    transfer = np.zeros((T, 4))
     for p in range(P):
-        kt = k_t[p]
-        s0 = s_start[p, 0]
-        s1 = s_start[p, 1]
-        ds[:, :] = 0.0
-        if static_index >= 0:
-            ds[0, static_index] = 1.0
-            ds[1, C + static_index] = 1.0
-        nmax = 0.0
-        for t in range(T):
-            if normal[p, t] > nmax:
-                nmax = normal[p, t]
-        scale = mu[p] * nmax / kt + 1e-300
-        for it in range(max_passes):
-            b0 = s0
-            b1 = s1
+        dfp = df_out[p] if want_jac else df_out[0]
+        w, n_plain, n_jac = _point_return_map(ut[p], normal[p], dnormal[p], synthesis, k_t[p], mu[p],
+                                              s_start[p, 0], s_start[p, 1], static_index, max_passes, tol,
+                                              want_jac, f_out[p], dfp, state_out[p], ds, ds_begin, transfer,
+                                              closed_form)
+        slip_work[p] = w
+        passes[p, 0] = n_plain
+        passes[p, 1] = n_jac
+
+
+LAW_LINEAR, LAW_POWER = 0, 1
+
+
+def normal_law_parameters(law):
+    """(kind, parameters) of a normal law the fused kernel evaluates itself, or None.
+
+    LinearNormalLaw: (LAW_LINEAR, [k_N, 0, 0]); RoughnessNormalLaw: (LAW_POWER, [N_ref, a_ref, p]).
+    Exact types only (a subclass may change ``force``)."""
+    from .laws import LinearNormalLaw, RoughnessNormalLaw
+    if type(law) is LinearNormalLaw:
+        return LAW_LINEAR, np.array([float(law.stiffness), 0.0, 0.0])
+    if type(law) is RoughnessNormalLaw:
+        return LAW_POWER, np.array([float(law.reference_load), float(law.reference_approach), float(law.exponent)])
+    return None
+
+
+@njit(cache=True)
+def damper_contact_forces(B, local, synthesis, analysis, k_t, mu, weight, approach_offset, law_kind,
+                          law_params, static_index, max_passes, tol, want_jac, force, blocks,
+                          closed_form=True):
+    """Fused AFT of the two contact patches of n_d dampers (the batched path of AssemblyContacts).
+
+    Per point (d, q, p): coefficients c = B[d, q, p] @ local[:, d, 6q:6q+6], samples
+    synthesis @ c, normal law (``law_kind``/``law_params``, see :func:`normal_law_parameters`)
+    with lift-off, the periodic slider (:func:`_point_return_map`, seated at the mean if
+    ``static_index`` >= 0), force coefficients analysis @ f projected back with B^T, and the
+    Jacobian B^T (analysis @ df/dc) B: the same numbers as :func:`point_contact_forces`
+    followed by those projections, without the (n_points, T, 3, 3C) intermediates.
+
+    B (n_d,2,P,3,6); local (C,n_d,12); synthesis (T,C); analysis (C,T); k_t, mu, weight,
+    approach_offset (n_d*2*P,) in (d, q, p) order; law_params float (3,). Outputs
+    (overwritten): force (C,n_d,12); blocks (n_d,C,12,C,12) if ``want_jac`` (patch q of
+    damper d fills [d, :, 6q:6q+6, :, 6q:6q+6], the rest is zero), any array otherwise.
+    """
+    nd, P = B.shape[0], B.shape[2]
+    T, C = synthesis.shape[0], synthesis.shape[1]
+    n3 = 3 * C
+    n3p = (n3 + 3) // 4 * 4          # padded rows of the point derivative (whole SIMD vectors)
+    ut = np.empty((T, 2))
+    uz = np.empty(T)
+    normal = np.empty(T)
+    dnormal = np.empty(T)
+    f_t = np.empty((T, 2))
+    df = np.zeros((T, 2, n3p))       # d f_tangential / d c of the last pass; padding stays 0
+    df_flat = df.reshape((T, 2 * n3p))
+    state = np.empty(T, dtype=np.int8)
+    ds = np.zeros((2, n3))
+    ds_begin = np.zeros((2, n3))
+    transfer = np.zeros((T, 4))
+    c = np.empty((C, 3))
+    jt = np.empty((C, 2 * n3p))
+    jn = np.empty((C, C))
+    bj = np.empty((C, 6, 3, C))      # sum_i B[i, m] jp[a, i, k, b]
+    acc = np.empty((C, 6, C, 6))     # one patch's block
+    force[:, :, :] = 0.0
+    if want_jac:
+        blocks[:, :, :, :, :] = 0.0
+    k_law = law_params[0]
+    a_ref = law_params[1]
+    expo = law_params[2]
+    for d in range(nd):
+        for q in range(2):
+            col = 6 * q
             if want_jac:
-                ds_begin[:, :] = ds
-            moved = False
-            work = 0.0
-            for t in range(T):
-                u0 = ut[p, t, 0]
-                u1 = ut[p, t, 1]
-                sp0 = s0
-                sp1 = s1
-                n = normal[p, t]
-                f0, f1, n_s0, n_s1, st = slider_step(u0, u1, s0, s1, kt, mu[p] * n, n > 0.0)
-                f_out[p, t, 0] = f0
-                f_out[p, t, 1] = f1
-                state_out[p, t] = st
-                if st != STICK:
-                    moved = True
-                    work += f0 * (n_s0 - s0) + f1 * (n_s1 - s1)
-                s0 = n_s0
-                s1 = n_s1
+                acc[:, :, :, :] = 0.0
+            for p in range(P):
+                g = (d * 2 + q) * P + p
+                Bp = B[d, q, p]
+                # point coefficients and samples
+                for a in range(C):
+                    for i in range(3):
+                        s = 0.0
+                        for j in range(6):
+                            s += Bp[i, j] * local[a, d, col + j]
+                        c[a, i] = s
+                for t in range(T):
+                    x0 = 0.0
+                    x1 = 0.0
+                    x2 = 0.0
+                    for a in range(C):
+                        sa = synthesis[t, a]
+                        x0 += sa * c[a, 0]
+                        x1 += sa * c[a, 1]
+                        x2 += sa * c[a, 2]
+                    ut[t, 0] = x0
+                    ut[t, 1] = x1
+                    uz[t] = x2
+                # normal law N(a), a = offset - u_zeta (as laws.py); dnormal = dN/du_zeta = -dN/da
+                w = weight[g]
+                off = approach_offset[g]
+                for t in range(T):
+                    app = off - uz[t]
+                    if app > 0.0:
+                        if law_kind == LAW_LINEAR:
+                            kw = k_law * w
+                            normal[t] = kw * app
+                            dnormal[t] = -kw
+                        else:
+                            ratio = app / a_ref
+                            n_ref = k_law * w
+                            normal[t] = n_ref * ratio ** expo
+                            dnormal[t] = -(n_ref * expo / a_ref * ratio ** (expo - 1.0))
+                    else:
+                        normal[t] = 0.0
+                        dnormal[t] = 0.0
+                if static_index >= 0:
+                    s0 = c[static_index, 0]
+                    s1 = c[static_index, 1]
+                else:
+                    s0 = 0.0
+                    s1 = 0.0
+                _point_return_map(ut, normal, dnormal, synthesis, k_t[g], mu[g], s0, s1, static_index,
+                                  max_passes, tol, want_jac, f_t, df, state, ds, ds_begin, transfer, closed_form)
+                # force coefficients of the point (normal force -N), projected with B^T
+                for a in range(C):
+                    a0 = 0.0
+                    a1 = 0.0
+                    a2 = 0.0
+                    for t in range(T):
+                        an = analysis[a, t]
+                        a0 += an * f_t[t, 0]
+                        a1 += an * f_t[t, 1]
+                        a2 -= an * normal[t]
+                    for j in range(6):
+                        force[a, d, col + j] += a0 * Bp[0, j] + a1 * Bp[1, j] + a2 * Bp[2, j]
                 if not want_jac:
                     continue
-                if st == SEPARATED:
-                    # no force; the slider follows the displacement
-                    for j in range(n3):
-                        df_out[p, t, 0, j] = 0.0
-                        df_out[p, t, 1, j] = 0.0
-                        ds[0, j] = 0.0
-                        ds[1, j] = 0.0
-                    for j in range(C):
-                        ds[0, j] = synthesis[t, j]
-                        ds[1, C + j] = synthesis[t, j]
-                    continue
-                # d(trial)/dc with trial = k_T (u - s_previous)
-                for j in range(n3):
-                    dtr[0, j] = -kt * ds[0, j]
-                    dtr[1, j] = -kt * ds[1, j]
-                for j in range(C):
-                    dtr[0, j] += kt * synthesis[t, j]
-                    dtr[1, C + j] += kt * synthesis[t, j]
-                if st == STICK:
-                    for j in range(n3):
-                        df_out[p, t, 0, j] = dtr[0, j]
-                        df_out[p, t, 1, j] = dtr[1, j]
-                    continue
-                # slip: f = mu N e, e = trial/|trial|: df = e mu dN + mu N (I - e e^T) dtrial / |trial|
-                radius = mu[p] * n
-                stretch = np.sqrt((u0 - sp0) ** 2 + (u1 - sp1) ** 2)
-                e0 = (u0 - sp0) / stretch
-                e1 = (u1 - sp1) / stretch
-                g = radius / (kt * stretch)
-                for j in range(n3):
-                    proj = e0 * dtr[0, j] + e1 * dtr[1, j]
-                    dfs[0, j] = g * (dtr[0, j] - e0 * proj)
-                    dfs[1, j] = g * (dtr[1, j] - e1 * proj)
-                for j in range(C):
-                    dr = mu[p] * dnormal[p, t] * synthesis[t, j]
-                    dfs[0, 2 * C + j] += e0 * dr
-                    dfs[1, 2 * C + j] += e1 * dr
-                for j in range(n3):
-                    df_out[p, t, 0, j] = dfs[0, j]
-                    df_out[p, t, 1, j] = dfs[1, j]
-                    ds[0, j] = -dfs[0, j] / kt
-                    ds[1, j] = -dfs[1, j] / kt
-                for j in range(C):
-                    ds[0, j] += synthesis[t, j]
-                    ds[1, C + j] += synthesis[t, j]
-            slip_work[p] = work
-            if not moved:
-                break  # no slip, no separation: this period is already periodic
-            if it >= 1 and abs(s0 - b0) <= tol * scale and abs(s1 - b1) <= tol * scale:
-                # periodic slider; with the Jacobian its derivative must have settled too
-                # (in near-1D slip the cross-direction derivative needs more passes)
-                if not want_jac or np.abs(ds - ds_begin).max() <= tol:
-                    break
+                # jt[a, i n3p + k C + b] = sum_t analysis[a, t] df[t, i, k C + b] (tangential rows i);
+                # jn[a, b] = sum_t analysis[a, t] dN/da E[t, b] (normal row, zeta columns only);
+                # separated samples carry no force and no derivative
+                jt[:, :] = 0.0
+                jn[:, :] = 0.0
+                for t in range(T):
+                    if state[t] == SEPARATED:
+                        continue
+                    row = df_flat[t]
+                    dnda = -dnormal[t]
+                    for a in range(C):
+                        an = analysis[a, t]
+                        out = jt[a]
+                        for r in range(2 * n3p):
+                            out[r] += an * row[r]
+                        for b in range(C):
+                            jn[a, b] += an * (dnda * synthesis[t, b])
+                # acc[a, m, b, n] += sum_ik B[i, m] jp[a, i, k, b] B[k, n], jp the point block
+                # d f_coef[a, i] / d c[b, k] (normal row i = 2: zeta column k = 2 only)
+                for a in range(C):
+                    for m in range(6):
+                        B0 = Bp[0, m]
+                        B1 = Bp[1, m]
+                        B2 = Bp[2, m]
+                        for k in range(3):
+                            for b in range(C):
+                                v = B0 * jt[a, k * C + b] + B1 * jt[a, n3p + k * C + b]
+                                if k == 2:
+                                    v += B2 * jn[a, b]
+                                bj[a, m, k, b] = v
+                for a in range(C):
+                    for m in range(6):
+                        for b in range(C):
+                            v0 = bj[a, m, 0, b]
+                            v1 = bj[a, m, 1, b]
+                            v2 = bj[a, m, 2, b]
+                            for n in range(6):
+                                acc[a, m, b, n] += v0 * Bp[0, n] + v1 * Bp[1, n] + v2 * Bp[2, n]
+            if want_jac:
+                for a in range(C):
+                    for m in range(6):
+                        for b in range(C):
+                            for n in range(6):
+                                blocks[d, a, col + m, b, col + n] = acc[a, m, b, n]
 
 
 @dataclass
@@ -179,7 +636,7 @@ class PointContactSamples:
 
 
 def point_contact_forces(coeffs, basis, tangential_stiffness, friction_coefficient, normal_law,
-                         weight, approach_offset, jacobian=True, max_passes=20, tol=1e-10):
+                         weight, approach_offset, jacobian=True, max_passes=20, tol=1e-10, closed_form=True):
     """Periodic forces of P point contacts from their harmonic displacement coefficients.
 
     Parameters
@@ -193,6 +650,11 @@ def point_contact_forces(coeffs, basis, tangential_stiffness, friction_coefficie
     approach_offset : (P,) approach [m] at zero normal displacement (static preload; with a
         static harmonic it is minus the initial gap and the preload comes from the solution)
     jacobian : bool, also return d force / d coefficients
+    max_passes, tol : at most that many periods are repeated until the slider position at the
+        period end repeats to ``tol`` of mu max N / k_T
+    closed_form : the periodic slider derivative in closed form (default); False iterates the
+        passes until the derivative repeats to ``tol`` as well (the previous method; with
+        many passes, the reference of the closed form)
     """
     coeffs = np.asarray(coeffs, dtype=float)
     disp = np.ascontiguousarray(np.einsum("tc,cpi->pti", basis.synthesis, coeffs))
@@ -213,9 +675,10 @@ def point_contact_forces(coeffs, basis, tangential_stiffness, friction_coefficie
     df = np.zeros((P, T, 3, 3 * C)) if jacobian else np.zeros((1, 1, 2, 1))
     state = np.empty((P, T), dtype=np.int8)
     slip_work = np.zeros(P)
+    passes = np.zeros((P, 2), dtype=np.int64)
     _return_map(np.ascontiguousarray(disp[:, :, :2]), np.ascontiguousarray(normal),
                 np.ascontiguousarray(dnormal), basis.synthesis, k_t, mu, s_start, static_index,
-                max_passes, tol, jacobian, f_t, df, state, slip_work)
+                max_passes, tol, jacobian, f_t, df, state, slip_work, passes, closed_form)
     force = np.empty((P, T, 3))
     force[:, :, :2] = f_t
     force[:, :, 2] = -normal

@@ -17,16 +17,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import splu
 
 from .. import _validate
-
-
-def solve(A, b):
-    """Solve A y = b for a dense ndarray or a scipy.sparse matrix (sparse LU, COLAMD ordering)."""
-    if sp.issparse(A):
-        return splu(sp.csc_matrix(A)).solve(np.asarray(b, dtype=float))
-    return np.linalg.solve(A, b)
+from .linsolve import factorize as lu_factorize
+from .linsolve import solve  # noqa: F401  (re-exported: bladedamp.hbm.continuation.solve)
 
 
 def _scale_columns(J, s):
@@ -68,6 +62,18 @@ def _border(J, column=None, row=None):
     return out
 
 
+def _bordered(J, column, row, column_scale, factor):
+    """[[J diag(column_scale), column] factor; row] (J square, dense or sparse); dense in one pass."""
+    if sp.issparse(J):
+        return _border(_scale_columns(J, column_scale * factor), column * factor, row)
+    n = J.shape[0]
+    A = np.empty((n + 1, n + 1))
+    np.multiply(J, column_scale * factor, out=A[:n, :n])
+    A[:n, n] = column * factor
+    A[n] = row
+    return A
+
+
 class ConvergenceWarning(UserWarning):
     """A Newton or continuation run stopped without converging."""
 
@@ -80,22 +86,26 @@ class NewtonResult:
     residual_norm: float
 
 
-def newton(fun, x0, omega, x_scale, residual_scale, tol=1e-10, max_iter=30):
+def newton(fun, x0, omega, x_scale, residual_scale, tol=1e-10, max_iter=30, factorize=lu_factorize):
     """Solve R(x, omega) = 0 at fixed omega. Converged when the scaled residual is below ``tol``
-    and the last scaled update below sqrt(tol)."""
+    and the Newton update computed there is below sqrt(tol) (scaled); that update is applied,
+    so the returned point is one step beyond the last residual evaluated (``residual_norm``).
+    ``factorize(J) -> solve``: the linear solver (default: dense or sparse LU,
+    :func:`bladedamp.hbm.linsolve.factorize`)."""
     x = np.array(x0, dtype=float)
     rnorm = np.inf
-    step_norm = np.inf
     for it in range(1, max_iter + 1):
         R, J, _ = fun(x, omega)
         rnorm = np.linalg.norm(R) / residual_scale
         if not np.all(np.isfinite(R)):
             return NewtonResult(x, False, it, rnorm)
-        if rnorm < tol and step_norm < np.sqrt(tol):
-            return NewtonResult(x, True, it, rnorm)
-        dx = -solve(J, R)
+        try:
+            dx = -factorize(J)(R)
+        except (np.linalg.LinAlgError, RuntimeError):   # singular (RuntimeError: splu)
+            return NewtonResult(x, False, it, rnorm)
         x = x + dx
-        step_norm = np.linalg.norm(dx / x_scale)
+        if rnorm < tol and np.linalg.norm(dx / x_scale) < np.sqrt(tol):
+            return NewtonResult(x, True, it, rnorm)
     return NewtonResult(x, False, max_iter, rnorm)
 
 
@@ -122,7 +132,7 @@ class Branch:
 
 def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=None,
                  step=None, max_step=None, min_step=None, max_points=5000, tol=1e-10,
-                 max_corrector=12, target_iterations=5):
+                 max_corrector=12, target_iterations=5, factorize=lu_factorize):
     """Pseudo-arclength continuation of R(x, omega) = 0 from ``omega_start`` to ``omega_end``.
 
     Parameters
@@ -136,6 +146,9 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
     max_points : stop after this many points
     tol : Newton tolerance on the scaled step and residual
     target_iterations : corrector iterations for which the step is kept; fewer -> grow, more -> shrink
+    factorize : ``factorize(A) -> solve``, the linear solver for Newton and the bordered systems
+        (default: dense or sparse LU; a structured one such as
+        :class:`~bladedamp.hbm.linsolve.BlockCondensation` for assemblies)
     """
     _validate.finite("omega_start", omega_start)
     _validate.finite("omega_end", omega_end)
@@ -156,7 +169,7 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
     min_step = 1e-7 if min_step is None else min_step
     n = x0.size
 
-    first = newton(fun, x0, omega_start, x_scale, residual_scale, tol=tol)
+    first = newton(fun, x0, omega_start, x_scale, residual_scale, tol=tol, factorize=factorize)
     if not first.converged:
         msg = f"Newton did not converge at the start, omega = {omega_start:.6g} rad/s " \
               f"(scaled residual {first.residual_norm:.3g})"
@@ -172,29 +185,34 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
     def scale():
         return np.append(x_scale, w_scale)
 
-    def scaled_system(y):
+    def scaled_system(y, row):
+        """Scaled residual and the bordered scaled Jacobian [[dR/dy, dR/dw]; row]."""
         x, w = y[:n] * x_scale, y[n] * w_scale
         R, J, Rw = fun(x, w)
-        return R / residual_scale, _border(_scale_columns(J, x_scale), Rw * w_scale) / residual_scale
+        return R / residual_scale, _bordered(J, Rw * w_scale, row, x_scale, 1.0 / residual_scale)
 
     def tangent_at(y, prev):
-        _, Jy = scaled_system(y)
         if prev is None:
             prev = np.zeros(n + 1)
             prev[n] = direction
         else:
             prev = prev / scale()
             prev /= np.linalg.norm(prev)
-        t = solve(_border(Jy, row=prev), np.append(np.zeros(n), 1.0))
+        t = factorize(scaled_system(y, prev)[1])(np.append(np.zeros(n), 1.0))
         t /= np.linalg.norm(t)
         return t if t @ prev > 0 else -t
 
     message, success = "", False
     h = step
     hops = 0  # consecutive fixed-omega hops over corners
+    next_tangent = None  # from the last corrector's factorisation (scaled, then unscaled)
     while len(points) < max_points:
         y = points[-1] / scale()
-        tangent = tangent_at(y, tangent_prev)
+        if next_tangent is None:
+            tangent = tangent_at(y, tangent_prev)
+        else:
+            tangent = next_tangent / scale()      # unscaled -> scaled by the current x_scale
+            tangent /= np.linalg.norm(tangent)
         accepted = False
         while h >= min_step:
             yp = y + h * tangent
@@ -202,21 +220,33 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
             ok = False
             step_norm = np.inf
             for it in range(1, max_corrector + 1):
-                R, Jy = scaled_system(yc)
+                R, A = scaled_system(yc, tangent)
                 if not np.all(np.isfinite(R)):
                     break
-                # converged: residual at the noise level and the last update small
+                G = np.append(R, tangent @ (yc - yp))
+                try:
+                    bordered = factorize(A)
+                except (np.linalg.LinAlgError, RuntimeError):   # singular (RuntimeError: splu)
+                    break
+                dy = -bordered(G)
+                yc = yc + dy
+                previous_norm, step_norm = step_norm, np.linalg.norm(dy)
+                # converged: residual at the noise level and the update computed there small
                 if np.linalg.norm(R) < tol and step_norm < np.sqrt(tol):
                     ok = True
                     break
-                G = np.append(R, tangent @ (yc - yp))
-                dy = -solve(_border(Jy, row=tangent), G)
-                yc = yc + dy
-                step_norm = np.linalg.norm(dy)
+                if step_norm >= previous_norm:
+                    # Newton updates that do not contract: the corrector diverges or cycles
+                    # (measured: such runs go on to |omega| of hundreds of Hz); halve the step
+                    break
             # reject corrector results that jump back along the branch
             if ok and (yc - y) @ tangent > 0:
                 accepted = True
                 hops = 0
+                # the next tangent solves [J; tangent] t = e_{n+1}: the matrix just factorised
+                # at the converged point (to the last update), so it costs one back-substitution
+                next_tangent = bordered(np.append(np.zeros(n), 1.0))
+                next_tangent *= np.sign(next_tangent @ tangent) / np.linalg.norm(next_tangent)
                 break
             h /= 2
         if not accepted and h < step and hops < 5:
@@ -226,7 +256,7 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
             w_last = points[-1][n]
             for frac in (1e-3, 1e-2, 1e-1):
                 w_try = w_last + direction * frac * max_step * w_scale
-                jump = newton(fun, points[-1][:n], w_try, x_scale, residual_scale, tol=tol)
+                jump = newton(fun, points[-1][:n], w_try, x_scale, residual_scale, tol=tol, factorize=factorize)
                 # only a short hop along the same branch, never a jump to another one
                 if jump.converged and np.linalg.norm((jump.x - points[-1][:n]) / x_scale) < 2 * max_step:
                     break
@@ -235,7 +265,7 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
                 yc = np.append(jump.x, w_try) / scale()
                 it = jump.iterations
                 accepted = True
-                tangent = None
+                tangent = next_tangent = None
         if not accepted:
             w_stop = points[-1][n]
             message = f"continuation did not converge after omega = {w_stop:.6g} rad/s " \
@@ -243,6 +273,7 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
             warnings.warn(message, ConvergenceWarning, stacklevel=2)
             break
         tangent_prev = None if tangent is None else tangent * scale()
+        next_tangent = None if next_tangent is None else next_tangent * scale()
         h = max(h, step) if tangent is None else h
         points.append(yc * scale())
         its.append(it)
@@ -262,7 +293,7 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
             break
         if direction * (points[-1][n] - omega_end) >= 0:
             # land exactly on omega_end
-            end = newton(fun, points[-1][:n], omega_end, x_scale, residual_scale, tol=tol)
+            end = newton(fun, points[-1][:n], omega_end, x_scale, residual_scale, tol=tol, factorize=factorize)
             if end.converged:
                 points[-1] = np.append(end.x, omega_end)
             success, message = True, "reached the end of the frequency range"

@@ -18,6 +18,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .fourier import HarmonicBasis
+from .linsolve import factorize as lu_factorize
 
 
 class NonlinearElement(Protocol):
@@ -114,6 +115,12 @@ class HarmonicBalanceSystem:
             from scipy.sparse.linalg import splu
             return splu(A.tocsc()).solve(f)
         return np.linalg.lstsq(A, f, rcond=None)[0]
+
+    def factorize(self, A):
+        """The linear solver for this system's Newton and arc-length steps: ``A`` (dR/dx, or it
+        bordered by one row and column) -> ``solve(b)``. Dense or sparse LU here; assemblies
+        override it with a structured one."""
+        return lu_factorize(A)
 
     def residual(self, x: np.ndarray, omega: float, jacobian: bool = True):
         """``(R, dR/dx, dR/domega)``; the last two are None when ``jacobian`` is False."""

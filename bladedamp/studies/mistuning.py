@@ -118,30 +118,56 @@ def auto_range(disk: TunedDisk, kappa, margin: float = 0.03) -> tuple[float, flo
 
 
 def mistuned_response(disk: TunedDisk, kappa, f_range_hz=None, harmonics=(1,), max_step: float = 0.05,
-                      tuned_peak_tip: float | None = None, max_widenings: int = 3, n_sector: int | None = None
-                      ) -> MistunedResponse:
-    """Full-assembly response of ``disk`` with blade frequencies times ``kappa``; the range
-    (default :func:`auto_range`) is widened (by its width on that side) while some blade's
-    largest amplitude is at an end of it. ``n_sector``: a cyclic sector of that many blades
-    (``kappa`` then has n_sector entries; e.g. 2 for alternating mistuning, exact, see the tests).
+                      tuned_peak_tip: float | None = None, max_widenings: int = 3, n_sector: int | None = None,
+                      n_samples: int | None = None, tol: float = 1e-10) -> MistunedResponse:
+    """Full-assembly response of ``disk`` with blade frequencies times ``kappa``; while some
+    blade's largest amplitude is at an end of the range (default :func:`auto_range`), the branch
+    is continued beyond that end by half the range's width (:meth:`MistunedDisk.extend_response`).
+    If the upward sweep fails (it can leave the response curve at a branch point), the range is
+    swept downwards, then both ways at half the step; the first complete sweep is returned in
+    rising frequency.
+    ``n_sector``: a cyclic sector of that many blades (``kappa`` then has n_sector entries; e.g. 2
+    for alternating mistuning, exact, see the tests). ``n_samples``, ``tol``: AFT samples and
+    continuation tolerance (defaults: the model's and the continuation's).
     Raises RuntimeError if the continuation does not cover the range."""
     md = MistunedDisk.from_tuned(disk, kappa, n_sector=n_sector)
     if f_range_hz is None:
         f_range_hz = auto_range(disk, kappa)
     lo, hi = (float(f) for f in f_range_hz)
-    for _ in range(max_widenings + 1):
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            r = md.frequency_response(lo, hi, harmonics=harmonics, max_step=max_step, tuned_peak_tip=tuned_peak_tip)
-        if not r.success:
-            raise RuntimeError(f"mistuned frequency response incomplete: {r.message}")
-        a = r.tip_amplitude[:, :, 0]
-        i = np.argmax(a, axis=0)
-        at_lo, at_hi = np.any(i == 0), np.any(i == len(a) - 1)
-        if not (at_lo or at_hi):
-            return r
-        width = hi - lo
-        lo, hi = (max(lo - width, 0.5 * lo) if at_lo else lo), (hi + width if at_hi else hi)
+    options = dict(max_step=max_step, tol=tol)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")     # success is checked below
+        # the upward sweep can leave the response curve at a branch point and follow another
+        # branch back out of the range (measured on 2 of 24 random 2 % disks: the cylinder's
+        # rolling branch, at max_step 0.05 or 0.1); the downward sweep, then both at half the
+        # step, are tried before giving up
+        failures = []
+        sweeps = ((lo, hi, max_step), (hi, lo, max_step), (lo, hi, max_step / 2), (hi, lo, max_step / 2))
+        for start, end, step in sweeps:
+            r = md.frequency_response(start, end, harmonics=harmonics, n_samples=n_samples,
+                                      tuned_peak_tip=tuned_peak_tip, max_step=step, tol=tol)
+            if r.success:
+                r = r if end > start else r.reversed()
+                break
+            failures.append(f"{start:.4g} -> {end:.4g} Hz, max_step {step:g}: {r.message}")
+        else:
+            raise RuntimeError("mistuned frequency response incomplete: " + "; ".join(failures))
+        for widening in range(max_widenings + 1):
+            if not r.success:
+                raise RuntimeError(f"mistuned frequency response incomplete while widening the range: {r.message}")
+            i = np.argmax(r.tip_amplitude[:, :, 0], axis=0)
+            at_lo, at_hi = np.any(i == 0), np.any(i == len(r.omega) - 1)
+            if not (at_lo or at_hi):
+                return r
+            if widening == max_widenings:
+                break
+            width = hi - lo
+            if at_lo:
+                lo = max(lo - width / 2, 0.5 * lo)
+                r = md.extend_response(r, lo, **options)
+            if at_hi and r.success:
+                hi = hi + width / 2
+                r = md.extend_response(r, hi, **options)
     raise RuntimeError(f"no interior resonance peak for every blade up to {lo:.4g}-{hi:.4g} Hz")
 
 
@@ -303,10 +329,18 @@ def plot_cases(cases: dict[str, MistuningCase], path=None):
 # ---------------------------------------------------------------------------------------
 # Monte Carlo on Dask
 # ---------------------------------------------------------------------------------------
-def _one_disk(disk, kappa, f_range_hz, harmonics, max_step):
+#: Monte Carlo per-disk continuation: only the peaks are kept, so the branch is coarser and the
+#: tolerance looser than an FRF's (0.05, 1e-10). Measured against those on 24 disks of the
+#: reference disk (benchmarks/bench_mistuned.py --accuracy): largest amplification error
+#: see benchmarks/README.md; 1.7x fewer points and fewer corrector iterations.
+MONTE_CARLO_MAX_STEP = 0.1
+MONTE_CARLO_TOL = 1e-6
+
+
+def _one_disk(disk, kappa, f_range_hz, settings):
     """Peaks (n,) and their frequencies (n,) of one mistuned disk (runs on a worker)."""
     try:
-        r = mistuned_response(disk, kappa, f_range_hz, harmonics, max_step)
+        r = mistuned_response(disk, kappa, f_range_hz, **settings)
         p, f = r.peaks()
         return p, f, ""
     except RuntimeError as e:  # keep the study going; the failure is recorded
@@ -405,9 +439,14 @@ class MonteCarloResult:
 
 
 def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f_range_hz=None,
-                harmonics=(1,), max_step: float = 0.05, scheduler=None, n_workers: int | None = None,
-                progress=None, out=None, tuned_peak_tip: float | None = None) -> MonteCarloResult:
+                harmonics=(1,), max_step: float = MONTE_CARLO_MAX_STEP, scheduler=None, n_workers: int | None = None,
+                progress=None, out=None, tuned_peak_tip: float | None = None, tol: float = MONTE_CARLO_TOL,
+                n_samples: int | None = None) -> MonteCarloResult:
     """Peak amplification of ``n_disks`` randomly mistuned copies of ``disk`` (full assemblies).
+
+    max_step, tol, n_samples : continuation step, tolerance and AFT samples of each disk
+        (see :data:`MONTE_CARLO_MAX_STEP`); the tuned peak (unless given) is an FRF at the
+        default accuracy of :func:`tuned_peak`.
 
     scheduler : None -> a local Dask cluster (``n_workers`` processes, one thread each; default
         the CPU count), no set-up needed; an address ("tcp://host:8786") -> that Dask cluster;
@@ -419,14 +458,16 @@ def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f
     n_disks = _validate.integer("n_disks", n_disks, minimum=1)
     n = disk.n_blades
     kappas = np.array([random_kappa(n, std, seed=[int(seed), i]) for i in range(n_disks)])
+    settings = dict(harmonics=tuple(harmonics), max_step=_validate.positive("max_step", max_step),
+                    tol=_validate.positive("tol", tol), n_samples=n_samples)
     t0 = time.perf_counter()
     if tuned_peak_tip is None:
-        tuned_peak_tip = tuned_peak(disk, f_range_hz or auto_range(disk, [1.0], 0.05), harmonics, max_step)[0]
+        tuned_peak_tip = tuned_peak(disk, f_range_hz or auto_range(disk, [1.0], 0.05), harmonics)[0]
     results = [None] * n_disks
     used = "serial"
     if scheduler == "serial":
         for i, k in enumerate(kappas):
-            results[i] = _one_disk(disk, k, f_range_hz, harmonics, max_step)
+            results[i] = _one_disk(disk, k, f_range_hz, settings)
             if progress:
                 progress(i + 1, n_disks)
     else:
@@ -443,7 +484,7 @@ def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f
             used = f"scheduler {scheduler}"
         try:
             disk_future = client.scatter(disk, broadcast=True)
-            futures = [client.submit(_one_disk, disk_future, k, f_range_hz, harmonics, max_step, pure=False)
+            futures = [client.submit(_one_disk, disk_future, k, f_range_hz, settings, pure=False)
                        for k in kappas]
             index = {f.key: i for i, f in enumerate(futures)}
             for done, fut in enumerate(as_completed(futures), 1):
@@ -458,7 +499,8 @@ def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f
     res = MonteCarloResult(kappas, np.array([r[0] for r in results]), np.array([r[1] for r in results]),
                            float(tuned_peak_tip), [r[2] for r in results],
                            {"std": std, "seed": int(seed), "f_range_hz": None if f_range_hz is None else list(f_range_hz), "harmonics": list(harmonics),
-                            "max_step": max_step, "executor": used, "elapsed_s": elapsed,
+                            "max_step": max_step, "tol": tol, "n_samples": n_samples, "executor": used,
+                            "elapsed_s": elapsed,
                             "disk": {"n_blades": n, "engine_order": disk.engine_order,
                                      "damper": None if disk.damper is None else disk.damper.kind,
                                      "mass_g": None if disk.damper is None else 1e3 * disk.damper.mass}})

@@ -1,0 +1,167 @@
+"""The fused contact kernel of the mistuned assembly (contact.point.damper_contact_forces).
+
+AssemblyContacts._forces evaluates all contact points of all dampers in one numba call
+(point motion, normal law, return map, AFT, projection to the dampers' 12 relative
+coordinates and the Jacobian blocks). The reference is the previous numpy path,
+AssemblyContacts._forces_numpy (point_contact_forces plus einsum projections), on the
+16-blade reference disks with random mistuning: cylinder and wedge dampers, linear and
+rough (power-law) normal contact, one harmonic and a static term with harmonics 0, 1, 2,
+at converged Newton points (stick and slip) and at random large motions (stick, slip and
+lift-off). The Jacobian is also checked against central differences of the forces.
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from bladedamp.contact.laws import LinearNormalLaw
+from bladedamp.contact.point import SEPARATED, SLIP, STICK, normal_law_parameters, point_contact_forces
+from bladedamp.hbm.continuation import newton
+from bladedamp.mistuned import MistunedDisk
+from bladedamp.reference import reference_damper, reference_disk
+from bladedamp.studies.mistuning import random_kappa
+
+HARMONICS = [(1,), (0, 1, 2)]
+# frequencies [Hz] walked by Newton from the stuck linear guess to a converged point with
+# stick and slip (measured with random_kappa(16, 0.02, seed=2))
+CONVERGED_PATH = {"cylinder": (97.0,), "wedge": (93.0, 94.0, 94.5, 95.0, 95.5)}
+
+
+def mistuned(kind, exponent=1.0):
+    disk = reference_disk(kind, 1e-3)
+    if exponent != 1.0:
+        disk = dataclasses.replace(disk, damper=reference_damper(kind, 1e-3, roughness_exponent=exponent))
+    return MistunedDisk.from_tuned(disk, random_kappa(16, 0.02, seed=2))
+
+
+def contact_state(system, x, omega):
+    """(AssemblyContacts, local coefficients (C, n_d, 12), approach offsets (n_d, 2, P))."""
+    c = system.couplings[0]
+    element = c.element
+    local = (c.matrix @ x).reshape(system.basis.n_coeffs, element.n_dampers, 12)
+    return element, local, element._approach(omega)[0]
+
+
+def state_counts(element, local, basis, offsets):
+    """Samples in stick, slip and lift-off over all points (from point_contact_forces)."""
+    _, B, k_t, mu, weights, law = element._stacked()
+    C, nd = basis.n_coeffs, element.n_dampers
+    coeffs = np.einsum("dqpij,cdqj->cdqpi", B, local.reshape(C, nd, 2, 6)).reshape(C, -1, 3)
+    pts = point_contact_forces(coeffs, basis, k_t, mu, law, weights, np.ravel(offsets), jacobian=False)
+    return np.bincount(pts.state.ravel(), minlength=3)
+
+
+def converged_point(md, system, frequencies):
+    x = None
+    for f in frequencies:
+        w = 2 * np.pi * f
+        x0 = md.initial_guess(system, w) if x is None else x
+        scale = np.maximum(np.abs(x0), 1e-3 * np.abs(x0).max())
+        res = newton(system.residual, x0, w, scale, np.linalg.norm(system.excitation(w)[0]), tol=1e-10, max_iter=40)
+        assert res.converged, f"Newton did not converge at {f} Hz"
+        x = res.x
+    return x, w
+
+
+def relative(a, b):
+    return float(np.abs(a - b).max() / np.abs(b).max())
+
+
+def compare(element, local, basis, offsets):
+    """Largest relative difference fused - numpy of (forces, Jacobian blocks, forces without Jacobian)."""
+    f_new, j_new = element._forces(local, basis, offsets, True)
+    f_old, j_old = element._forces_numpy(local, basis, offsets, True)
+    g_new, none = element._forces(local, basis, offsets, False)
+    g_old, _ = element._forces_numpy(local, basis, offsets, False)
+    assert none is None and j_new.shape == j_old.shape == (element.n_dampers,) + (basis.n_coeffs, 12) * 2
+    return relative(f_new, f_old), relative(j_new, j_old), relative(g_new, g_old)
+
+
+@pytest.mark.parametrize("harmonics", HARMONICS, ids=["h1", "h012"])
+@pytest.mark.parametrize("kind", ["cylinder", "wedge"])
+def test_fused_kernel_equals_numpy_path(kind, harmonics):
+    md = mistuned(kind)
+    system = md.hbm_system(harmonics)
+    basis = system.basis
+    x, w = converged_point(md, system, CONVERGED_PATH[kind])
+    x0 = md.initial_guess(system, w)
+    rng = np.random.default_rng(7)
+    cases = {"converged": x, "random x3": x0 * (1 + 3 * rng.standard_normal(x0.size)),
+             "random x30": x0 * (1 + 30 * rng.standard_normal(x0.size))}
+    seen = np.zeros(3, dtype=int)
+    for label, xc in cases.items():
+        element, local, offsets = contact_state(system, xc, w)
+        counts = state_counts(element, local, basis, offsets)
+        seen += counts
+        if label == "converged":
+            assert counts[STICK] > 0 and counts[SLIP] > 0, f"converged point without stick and slip: {counts}"
+        e_f, e_j, e_g = compare(element, local, basis, offsets)
+        print(f"\n[fused {kind} {harmonics} {label}] stick/slip/lift-off {counts}: forces {e_f:.1e}, "
+              f"Jacobian {e_j:.1e}, forces without Jacobian {e_g:.1e}")
+        assert e_f < 1e-12 and e_g < 1e-12, f"{label}: forces differ from the numpy path by {max(e_f, e_g):.2e}"
+        assert e_j < 1e-12, f"{label}: Jacobian blocks differ from the numpy path by {e_j:.2e}"
+    assert np.all(seen[[STICK, SLIP, SEPARATED]] > 0), f"not all contact states covered: {seen}"
+
+
+@pytest.mark.parametrize("harmonics", HARMONICS, ids=["h1", "h012"])
+def test_fused_kernel_power_law(harmonics):
+    """Rough-surface normal law N ~ a^1.5 evaluated inside the kernel."""
+    md = mistuned("cylinder", exponent=1.5)
+    system = md.hbm_system(harmonics)
+    w = 2 * np.pi * 97.0
+    x0 = md.initial_guess(system, w)
+    rng = np.random.default_rng(3)
+    basis = system.basis
+    element = system.couplings[0].element
+    assert normal_law_parameters(element._stacked()[5]) is not None
+    for scale in (0.0, 3.0):
+        element, local, offsets = contact_state(system, x0 * (1 + scale * rng.standard_normal(x0.size)), w)
+        e_f, e_j, e_g = compare(element, local, basis, offsets)
+        print(f"\n[fused power law {harmonics} x{scale}] {state_counts(element, local, basis, offsets)}: "
+              f"forces {e_f:.1e}, Jacobian {e_j:.1e}")
+        assert max(e_f, e_j, e_g) < 1e-12
+
+
+def test_unknown_normal_law_falls_back_to_the_numpy_path():
+    class OtherLaw(LinearNormalLaw):
+        """A law the kernel does not know (a subclass may change ``force``)."""
+
+    md = mistuned("cylinder")
+    system = md.hbm_system((1,))
+    w = 2 * np.pi * 97.0
+    x0 = md.initial_guess(system, w)
+    element, local, offsets = contact_state(system, 2 * x0, w)
+    f_ref, j_ref = element._forces(local, system.basis, offsets, True)
+    law = element._stacked()[5]
+    element._batch = element._batch[:5] + (OtherLaw(law.stiffness),)
+    assert normal_law_parameters(element._stacked()[5]) is None
+    f, j = element._forces(local, system.basis, offsets, True)
+    assert relative(f, f_ref) < 1e-12 and relative(j, j_ref) < 1e-12
+
+
+def test_fused_jacobian_against_central_differences():
+    """Cylinder disk, harmonics (0, 1, 2), at a converged point with stick and slip: the Jacobian
+    blocks equal central differences of the forces (step 1e-7 of each coordinate's size)."""
+    md = mistuned("cylinder")
+    system = md.hbm_system((0, 1, 2))
+    basis = system.basis
+    x, w = converged_point(md, system, CONVERGED_PATH["cylinder"])
+    element, local, offsets = contact_state(system, x, w)
+    C = basis.n_coeffs
+    _, blocks = element._forces(local, basis, offsets, True)
+    size = np.maximum(np.abs(local).max(axis=0), 1e-3 * np.abs(local).max())   # (n_d, 12)
+    fd = np.zeros_like(blocks)
+    for a in range(C):
+        for m in range(12):
+            h = 1e-7 * size[:, m]
+            lp, lm = local.copy(), local.copy()
+            lp[a, :, m] += h
+            lm[a, :, m] -= h
+            # each damper's forces depend on its own coordinates only: all dampers at once
+            diff = (element._forces(lp, basis, offsets, True)[0] - element._forces(lm, basis, offsets, True)[0])
+            fd[:, :, :, a, m] = np.moveaxis(diff / (2 * h[None, :, None]), 1, 0)
+    err = relative(blocks * size[:, None, None, None, :], fd * size[:, None, None, None, :])
+    print(f"\n[fused Jacobian vs central differences] {state_counts(element, local, basis, offsets)}: {err:.1e}")
+    assert err < 1e-6, f"Jacobian blocks differ from central differences by {err:.2e}"
