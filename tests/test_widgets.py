@@ -206,3 +206,33 @@ def test_platform_angle_warm_starts_from_the_nearest_angle(cache):
         disk = dataclasses.replace(bd.reference_disk("cylinder", 1e-3), gamma_right=np.radians(45.0))
         ref = peak_response(disk)[0]
     assert r.peak_tip == pytest.approx(ref, rel=1e-3)
+
+
+# ---------------------------------------------------------------------------------------
+# notebook 05: the mistuning explorer
+# ---------------------------------------------------------------------------------------
+def test_mistuning_explorer_figure_matches_the_study_and_memoises():
+    """A 4-blade disk (EO = 1): the figure's amplification is the study's mistuned response over
+    the tuned peak; alternating mistuning repeats its two blades; a second call is cached; a bad
+    pattern is a ValueError naming the allowed patterns."""
+    import dataclasses
+
+    from bladedamp.studies import mistuning as mt
+
+    disk = dataclasses.replace(bd.reference_disk("cylinder", 1e-3), n_blades=4)
+    tuned_peak_tip, _, tuned = mt.tuned_peak(disk, mt.auto_range(disk, [1.0], 0.05))
+    ex = W.MistuningExplorer(disk, tuned, tuned_peak_tip, max_step=0.05)
+    fig = ex.figure("random", seed=3, std_percent=2.0)
+    kappa = mt.random_kappa(4, 0.02, seed=3)
+    ref = mt.mistuned_response(disk, kappa, max_step=0.05)
+    assert np.array_equal(fig.kappa, kappa)
+    assert np.allclose(fig.amplification, ref.peak_tip / tuned_peak_tip, rtol=1e-12)
+    plt.close(fig)
+    assert ex.response("random", 3, 0.02) is ex.response("random", 3, 0.02 + 1e-9)   # memoised
+    fig = ex.figure("alternating", std_percent=2.0)
+    assert np.allclose(fig.amplification[0::2], fig.amplification[0]) and np.allclose(fig.amplification[1::2],
+                                                                                       fig.amplification[1])
+    assert abs(fig.amplification[0] - fig.amplification[1]) > 1e-3
+    plt.close(fig)
+    with pytest.raises(ValueError, match="pattern must be one of"):
+        ex.figure("sorted")

@@ -106,6 +106,23 @@ def reorder(kappa) -> np.ndarray:
     return order
 
 
+PATTERNS = ("tuned", "random", "reordered", "alternating")
+
+
+def pattern_kappa(pattern: str, n_blades: int, std: float = PAPER_STD, seed=PAPER_SEED) -> np.ndarray:
+    """The (n_blades,) mistuning factors of one of the paper's patterns (Fig. 12): "tuned" (all 1),
+    "random" (Gaussian, ``std``, ``seed``), "reordered" (the same blades by :func:`reorder`) or
+    "alternating" (+-``std``)."""
+    if pattern not in PATTERNS:
+        raise ValueError(f"pattern must be one of {PATTERNS} (got {pattern!r})")
+    if pattern == "tuned":
+        return np.ones(_validate.integer("n_blades", n_blades, minimum=2))
+    if pattern == "alternating":
+        return alternating(n_blades, std)
+    k = random_kappa(n_blades, std, seed=seed)
+    return k[reorder(k)] if pattern == "reordered" else k
+
+
 # ---------------------------------------------------------------------------------------
 # peaks of a mistuned disk
 # ---------------------------------------------------------------------------------------

@@ -674,3 +674,79 @@ def platform_angle_figure(gamma_right_deg=35.0, kind="cylinder", mass_g=1.0, cac
     fig.tight_layout()
     fig.data = (damped, free, state)
     return fig
+
+
+# ---------------------------------------------------------------------------------------
+# 4. mistuning (notebook 05)
+# ---------------------------------------------------------------------------------------
+class MistuningExplorer:
+    """Mistuned responses of one disk by pattern, memoised, and the slider figure of notebook 05.
+
+    ``disk`` : the tuned reference (its damper at every position); ``tuned_response`` : its
+    DiskResponse (drawn for comparison) and ``tuned_peak_tip`` [m] (amplification factors);
+    ``max_step`` : continuation step of each FRF. The alternating pattern is solved as its exact
+    two-blade cyclic sector (see :func:`bladedamp.studies.mistuning.mistuned_response`).
+    """
+
+    def __init__(self, disk, tuned_response, tuned_peak_tip: float, max_step: float = 0.05):
+        self.disk = disk
+        self.tuned_response = tuned_response
+        self.tuned_peak_tip = float(tuned_peak_tip)
+        self.max_step = max_step
+        self._responses = {}
+
+    def kappa(self, pattern="random", seed=0, std=0.02) -> np.ndarray:
+        from ..studies.mistuning import pattern_kappa
+
+        return pattern_kappa(pattern, self.disk.n_blades, std, seed)
+
+    def response(self, pattern="random", seed=0, std=0.02):
+        """The MistunedResponse of a pattern (memoised by pattern, seed, std)."""
+        from ..studies.mistuning import mistuned_response
+
+        key = (pattern, int(seed), round(float(std), 5))
+        if key not in self._responses:
+            k = self.kappa(pattern, seed, std)
+            sector = 2 if pattern == "alternating" else None
+            self._responses[key] = mistuned_response(self.disk, k[:2] if sector else k, max_step=self.max_step,
+                                                     tuned_peak_tip=self.tuned_peak_tip, n_sector=sector)
+        return self._responses[key]
+
+    def figure(self, pattern="random", seed=0, std_percent=2.0):
+        """Slider callback: kappa pattern, all-blade FRF and amplification per blade.
+        ``fig.amplification`` (n,) (None if the continuation failed; the message is drawn
+        instead) and ``fig.kappa`` (n,) are the data behind it."""
+        n = self.disk.n_blades
+        blade_no = np.arange(1, n + 1)
+        k = self.kappa(pattern, seed, std_percent / 100)
+        t0 = time.perf_counter()
+        try:
+            r = self.response(pattern, seed, std_percent / 100)
+        except RuntimeError as e:                         # the continuation did not cover the range
+            fig, ax = _figure(figsize=(8, 1.5))
+            ax.axis("off")
+            ax.text(0, 0.5, f"no response for this pattern: {e}", fontsize=9, wrap=True)
+            fig.amplification, fig.kappa = None, k
+            return fig
+        elapsed = time.perf_counter() - t0
+        amp = np.resize(r.amplification(), n)            # a two-blade sector repeated around the disk
+        fig, axes = _figure(1, 3, figsize=(15, 3.8), gridspec_kw={"width_ratios": [0.8, 1.5, 1]})
+        axes[0].bar(blade_no, k - 1, color="C0")
+        axes[0].set_xlabel("blade")
+        axes[0].set_ylabel("kappa - 1")
+        axes[0].set_title(f"{pattern}" + ("" if pattern == "alternating" else f", seed {seed}")
+                          + f", {std_percent:.1f} %", fontsize=9)
+        r.plot(ax=axes[1], tuned=self.tuned_response)
+        model = "two-blade sector" if r.n_sector == 2 else f"{n} blades"
+        axes[1].set_title(f"{model}: {len(r.omega)} points, " + ("cached" if elapsed < 0.05 else f"{elapsed:.1f} s"),
+                          fontsize=9)
+        colours = ["C3" if b == amp.argmax() else "C2" if b == amp.argmin() else "0.6" for b in range(n)]
+        axes[2].bar(blade_no, amp, color=colours)
+        axes[2].axhline(1.0, color="k", ls="--", lw=1)
+        axes[2].set_xlabel("blade")
+        axes[2].set_ylabel("amplification")
+        axes[2].set_title(f"largest {amp.max():.3f} (blade {amp.argmax() + 1}), smallest {amp.min():.3f} "
+                          f"(blade {amp.argmin() + 1})", fontsize=9)
+        fig.tight_layout()
+        fig.amplification, fig.kappa = amp, k
+        return fig
