@@ -7,7 +7,8 @@ AssemblyContacts._forces_numpy (point_contact_forces plus einsum projections), o
 16-blade reference disks with random mistuning: cylinder and wedge dampers, linear and
 rough (power-law) normal contact, one harmonic and a static term with harmonics 0, 1, 2,
 at converged Newton points (stick and slip) and at random large motions (stick, slip and
-lift-off). The Jacobian is also checked against central differences of the forces.
+lift-off). The Jacobian is also checked against central differences of the forces, and
+(closed-form periodic slider derivative) against the previous pass iteration run to its limit.
 """
 from __future__ import annotations
 
@@ -17,7 +18,8 @@ import numpy as np
 import pytest
 
 from bladedamp.contact.laws import LinearNormalLaw
-from bladedamp.contact.point import SEPARATED, SLIP, STICK, normal_law_parameters, point_contact_forces
+from bladedamp.contact.point import (SEPARATED, SLIP, STICK, damper_contact_forces, normal_law_parameters,
+                                    point_contact_forces)
 from bladedamp.hbm.continuation import newton
 from bladedamp.mistuned import MistunedDisk
 from bladedamp.reference import reference_damper, reference_disk
@@ -165,3 +167,46 @@ def test_fused_jacobian_against_central_differences():
     err = relative(blocks * size[:, None, None, None, :], fd * size[:, None, None, None, :])
     print(f"\n[fused Jacobian vs central differences] {state_counts(element, local, basis, offsets)}: {err:.1e}")
     assert err < 1e-6, f"Jacobian blocks differ from central differences by {err:.2e}"
+
+
+def kernel(element, local, basis, offsets, max_passes=20, tol=1e-10, closed_form=True):
+    """(forces, Jacobian blocks) of damper_contact_forces with the given return-map settings."""
+    _, B, k_t, mu, weights, law = element._stacked()
+    kind, params = normal_law_parameters(law)
+    C, nd = basis.n_coeffs, element.n_dampers
+    force, blocks = np.empty((C, nd, 12)), np.empty((nd, C, 12, C, 12))
+    damper_contact_forces(B, np.ascontiguousarray(local, dtype=float), basis.synthesis, basis.analysis, k_t, mu,
+                          weights, np.ascontiguousarray(offsets, dtype=float).ravel(), kind, params,
+                          basis.cos_index(0) if basis.has_static else -1, max_passes, tol, True, force, blocks,
+                          closed_form)
+    return force, blocks
+
+
+@pytest.mark.parametrize("harmonics", HARMONICS, ids=["h1", "h012"])
+@pytest.mark.parametrize("kind", ["cylinder", "wedge"])
+def test_fused_closed_form_jacobian_is_the_many_pass_limit(kind, harmonics):
+    """The kernel's Jacobian blocks (closed-form periodic slider derivative, what
+    AssemblyContacts uses) equal those of the previous pass iteration run to its limit (5000
+    passes, tol 1e-14), at the converged point (where 20 passes leave near-1D slip derivatives
+    unsettled) and at a random motion; the forces equal the limit's too."""
+    md = mistuned(kind)
+    system = md.hbm_system(harmonics)
+    basis = system.basis
+    x, w = converged_point(md, system, CONVERGED_PATH[kind])
+    x0 = md.initial_guess(system, w)
+    rng = np.random.default_rng(7)
+    for label, xc in {"converged": x, "random x3": x0 * (1 + 3 * rng.standard_normal(x0.size))}.items():
+        element, local, offsets = contact_state(system, xc, w)
+        f_new, j_new = kernel(element, local, basis, offsets)
+        f_ref, j_ref = kernel(element, local, basis, offsets, 5000, 1e-14, closed_form=False)
+        f_old, j_old = kernel(element, local, basis, offsets, closed_form=False)
+        f_used, j_used = element._forces(local, basis, offsets, True)
+        assert np.array_equal(f_used, f_new) and np.array_equal(j_used, j_new)
+        e_j, e_old, e_f = relative(j_new, j_ref), relative(j_old, j_ref), relative(f_new, f_ref)
+        print(f"\n[{kind} {harmonics} {label}] {state_counts(element, local, basis, offsets)}: Jacobian vs 5000 "
+              f"passes: closed form {e_j:.1e}, 20 passes {e_old:.1e}; forces {e_f:.1e} (20 passes "
+              f"{relative(f_old, f_ref):.1e})")
+        # (the closed form linearises about the slider start of the last pass, within ~tol / det(I - Phi)
+        # of the periodic one: 5e-9 at the wedge's converged point with harmonics 0, 1, 2)
+        assert e_j < 1e-7, f"{label}: Jacobian blocks differ from the many-pass limit by {e_j:.2e}"
+        assert e_f < 1e-12, f"{label}: forces differ from the many-pass limit by {e_f:.2e}"

@@ -14,7 +14,12 @@ point is damper minus platform. The returned force is the force *on the platform
 The steady periodic state is found by repeating the period (return map) until the slider
 position at the period end repeats. The derivative of the sampled forces with respect to
 each point's own harmonic coefficients is propagated through the same steps (chain rule
-through the return map), which gives the exact Jacobian of the AFT forces.
+through the return map), which gives the exact Jacobian of the AFT forces. Within one period
+the slider derivative is affine in its value at the period start, with a 2x2 transfer Phi
+common to all coefficients, so its periodic value is solved for in closed form from one
+pass (the limit of infinitely many passes) instead of repeating passes until it settles; the
+same 2x2 solve is a Newton step making the slider start periodic (see
+:func:`_point_return_map`).
 
 :func:`point_contact_forces` works on given point coefficients; :func:`damper_contact_forces`
 is the same computation fused for the two patches of many dampers (point motion from the
@@ -52,11 +57,21 @@ def slider_step(u0, u1, s0, s1, k_t, radius, in_contact):
     return f0, f1, u0 - f0 / k_t, u1 - f1 / k_t, SLIP
 
 
-# Closed-form periodic slider derivative (see _point_return_map): it is used when
-# |det(I - Phi)| >= SINGULAR_DET, Phi the 2x2 one-period transfer of the slider derivative;
-# below, the derivative is iterated pass by pass (_iterate_passes) as before.
+# Periodic slider derivative in closed form (see _point_return_map), Phi the 2x2 transfer of
+# the slider derivative over one period: the closed form is used when |det(I - Phi)| >=
+# SINGULAR_DET, else the derivative is iterated pass by pass as before (_iterate_passes).
+# det(I - Phi) = 1 - lambda, lambda the eigenvalue of the rank-1 Phi (|lambda| <= product of
+# g = mu N / |trial| over the slip samples). Measured on 7500 slipping points of the reference
+# disks (converged, random and FRF states; 3400 of random point motions) it is either
+# >= 1.9e-3 or <= 8e-16 (Phi = I, or a "slip" by rounding at the friction limit, g = 1 - 1e-16:
+# a stuck slider, whose periodic position is not unique); the threshold sits in that gap. The
+# closed form loses about eps / det of relative accuracy (2e-10 at the threshold); below it the
+# previous iteration, which keeps the initial slider and its derivative convention, defines it.
 SINGULAR_DET = 1e-6
-_VARIANT_B = True
+# Largest Newton step of the periodic slider start position, relative to mu max N / k_T,
+# applied to the forces and slip work as a linear correction (see _point_return_map): after
+# the position test the step is ~tol / det; a larger one is no small correction.
+NEWTON_STEP_MAX = 1e-6
 
 
 @njit(cache=True)
@@ -83,12 +98,14 @@ def _slider_pass(ut, normal, kt, mu, s0, s1, f_out, state_out):
 def _derivative_pass(ut, normal, dnormal, synthesis, kt, mu, s0, s1, f_out, df_out, state_out, ds,
                      transfer, track):
     """One period of the slider carrying its derivative ds (2, 3C) (updated in place) and
-    writing df_out (see :func:`_point_return_map`); returns (s0, s1, moved, slip work).
+    writing df_out (see :func:`_point_return_map`); returns (s0, s1, moved, slip work, gw0, gw1).
 
-    With ``track``, transfer[t] = (M00, M01, M10, M11) of M_t = A_t ... A_0, the derivative
-    transfer d ds_t / d ds_begin up to sample t: A = I in stick, A = g (I - e e^T) in slip,
-    A = 0 when separated (then ds is reset). The derivative pass itself is the same
-    arithmetic with and without ``track``.
+    With ``track``, transfer[t] = (M00, M01, M10, M11) of M_t = A_t ... A_0, the transfer
+    d ds_t / d ds_begin up to sample t (A = I in stick, A = g (I - e e^T) in slip, A = 0
+    when separated), which is also d s_t / d s_begin, d f_t / d s_begin = -k_T M_t; and
+    (gw0, gw1) = d (slip work) / d s_begin. Without ``track`` transfer is not touched and
+    gw = 0; the pass itself is the same arithmetic either way. (df_out is indexed, not
+    sliced into row views: a view per sample costs atomic reference counting.)
     """
     T = ut.shape[0]
     C = synthesis.shape[1]
@@ -99,6 +116,8 @@ def _derivative_pass(ut, normal, dnormal, synthesis, kt, mu, s0, s1, f_out, df_o
     m01 = 0.0
     m10 = 0.0
     m11 = 1.0
+    gw0 = 0.0
+    gw1 = 0.0
     moved = False
     work = 0.0
     for t in range(T):
@@ -116,13 +135,11 @@ def _derivative_pass(ut, normal, dnormal, synthesis, kt, mu, s0, s1, f_out, df_o
             work += f0 * (n_s0 - s0) + f1 * (n_s1 - s1)
         s0 = n_s0
         s1 = n_s1
-        df0 = df_out[t, 0]
-        df1 = df_out[t, 1]
         if st == SEPARATED:
             # no force; the slider follows the displacement
             for j in range(n3):
-                df0[j] = 0.0
-                df1[j] = 0.0
+                df_out[t, 0, j] = 0.0
+                df_out[t, 1, j] = 0.0
             for j in range(C):
                 ds0[j] = synthesis[t, j]
                 ds1[j] = 0.0
@@ -144,12 +161,12 @@ def _derivative_pass(ut, normal, dnormal, synthesis, kt, mu, s0, s1, f_out, df_o
             # d(trial)/dc with trial = k_T (u - s_previous); the slider stays
             for j in range(C):
                 kE = kt * synthesis[t, j]
-                df0[j] = -kt * ds0[j] + kE
-                df1[j] = -kt * ds1[j]
-                df0[C + j] = -kt * ds0[C + j]
-                df1[C + j] = -kt * ds1[C + j] + kE
-                df0[2 * C + j] = -kt * ds0[2 * C + j]
-                df1[2 * C + j] = -kt * ds1[2 * C + j]
+                df_out[t, 0, j] = -kt * ds0[j] + kE
+                df_out[t, 1, j] = -kt * ds1[j]
+                df_out[t, 0, C + j] = -kt * ds0[C + j]
+                df_out[t, 1, C + j] = -kt * ds1[C + j] + kE
+                df_out[t, 0, 2 * C + j] = -kt * ds0[2 * C + j]
+                df_out[t, 1, 2 * C + j] = -kt * ds1[2 * C + j]
             if track:
                 transfer[t, 0] = m00
                 transfer[t, 1] = m01
@@ -172,8 +189,8 @@ def _derivative_pass(ut, normal, dnormal, synthesis, kt, mu, s0, s1, f_out, df_o
             proj = e0 * d0 + e1 * d1
             h0 = g * (d0 - e0 * proj)
             h1 = g * (d1 - e1 * proj)
-            df0[j] = h0
-            df1[j] = h1
+            df_out[t, 0, j] = h0
+            df_out[t, 1, j] = h1
             ds0[j] = -h0 / kt + E
             ds1[j] = -h1 / kt
             # eta block
@@ -183,8 +200,8 @@ def _derivative_pass(ut, normal, dnormal, synthesis, kt, mu, s0, s1, f_out, df_o
             proj = e0 * d0 + e1 * d1
             h0 = g * (d0 - e0 * proj)
             h1 = g * (d1 - e1 * proj)
-            df0[jj] = h0
-            df1[jj] = h1
+            df_out[t, 0, jj] = h0
+            df_out[t, 1, jj] = h1
             ds0[jj] = -h0 / kt
             ds1[jj] = -h1 / kt + E
             # zeta block (through the normal load)
@@ -195,8 +212,8 @@ def _derivative_pass(ut, normal, dnormal, synthesis, kt, mu, s0, s1, f_out, df_o
             dr = mdn * E
             h0 = g * (d0 - e0 * proj) + e0 * dr
             h1 = g * (d1 - e1 * proj) + e1 * dr
-            df0[jj] = h0
-            df1[jj] = h1
+            df_out[t, 0, jj] = h0
+            df_out[t, 1, jj] = h1
             ds0[jj] = -h0 / kt
             ds1[jj] = -h1 / kt
         if track:
@@ -213,6 +230,12 @@ def _derivative_pass(ut, normal, dnormal, synthesis, kt, mu, s0, s1, f_out, df_o
                 n01 = 0.0
                 n10 = 0.0
                 n11 = 0.0
+            # slip work f . (s_t - s_{t-1}): gradient wrt the start position,
+            # df_t = -k_T M_t, d s_t = M_t, d s_{t-1} = M_{t-1}
+            q0 = s0 - sp0
+            q1 = s1 - sp1
+            gw0 += -kt * (n00 * q0 + n10 * q1) + (n00 - m00) * f0 + (n10 - m10) * f1
+            gw1 += -kt * (n01 * q0 + n11 * q1) + (n01 - m01) * f0 + (n11 - m11) * f1
             m00 = n00
             m01 = n01
             m10 = n10
@@ -221,7 +244,7 @@ def _derivative_pass(ut, normal, dnormal, synthesis, kt, mu, s0, s1, f_out, df_o
             transfer[t, 1] = m01
             transfer[t, 2] = m10
             transfer[t, 3] = m11
-    return s0, s1, moved, work
+    return s0, s1, moved, work, gw0, gw1
 
 
 @njit(cache=True)
@@ -264,8 +287,8 @@ def _iterate_passes(ut, normal, dnormal, synthesis, kt, mu, s0, s1, static_index
                 ds_begin[0, j] = ds[0, j]
                 ds_begin[1, j] = ds[1, j]
             # (no transfer tracking: ds_begin only stands in for the unused transfer array)
-            s0, s1, moved, work = _derivative_pass(ut, normal, dnormal, synthesis, kt, mu, s0, s1, f_out,
-                                                   df_out, state_out, ds, ds_begin, False)
+            s0, s1, moved, work, _, _ = _derivative_pass(ut, normal, dnormal, synthesis, kt, mu, s0, s1, f_out,
+                                                         df_out, state_out, ds, ds_begin, False)
         else:
             s0, s1, moved, work = _slider_pass(ut, normal, kt, mu, s0, s1, f_out, state_out)
         if not moved:
@@ -292,34 +315,43 @@ def _point_return_map(ut, normal, dnormal, synthesis, kt, mu, s0, s1, static_ind
 
     ut (T,2); normal, dnormal (T,); s0, s1 the initial slider position; outputs f_out (T,>=2),
     df_out (T,>=2,3C) (rows 0, 1 written; untouched without the Jacobian), state_out (T,);
-    ds, ds_begin: (2,3C) work arrays; transfer: (T,4) work array. Returns (slip work, passes
-    without derivative, passes with derivative).
+    ds, ds_begin: (2,3C) and transfer: (T,4) work arrays. Returns (slip work, passes without
+    the derivative, passes with it).
 
     Slider: the period is repeated until the slider position at its end repeats (to ``tol``
-    of mu max N / k_T, at least two passes) or no sample slips or separates, at most
+    of mu max N / k_T, at least two passes) or a pass neither slips nor separates, at most
     ``max_passes`` times; forces, states and work are those of the last pass.
 
     Jacobian: the slider derivative ds = d s / d c (2, 3C) is carried through the samples,
     column by column (blocks xi | eta | zeta of C columns each); E = synthesis[t]:
     trial derivative dtr = -k_T ds + k_T E (xi row: xi block, eta row: eta block); stick:
     df = dtr; slip: df = g (I - e e^T) dtr + e mu dN/du_zeta E (zeta block), ds = -df / k_T
-    + E (own block), g = mu N / |trial|; separated: df = 0, ds = E (own block).
-    Per sample ds_new = A_t ds + (terms independent of ds), A_t = I (stick), g (I - e e^T)
-    (slip), 0 (separated), so over the period ds_end = Phi ds_begin + psi with the 2x2
-    Phi = A_{T-1} ... A_0, the same for all 3C columns.
+    + E (own block), g = mu N / |trial|; separated: df = 0, ds = E (own block). So per sample
+    ds_new = A_t ds + (terms independent of ds), A_t = I (stick), g (I - e e^T) (slip), 0
+    (separated), and over a period ds_end = Phi ds_begin + psi, Phi = A_{T-1} ... A_0 (2x2,
+    the same for all 3C columns; rank 1 if anything slips or separates).
 
-    ``closed_form`` (default of the callers): the slider is iterated without derivatives;
-    the last pass is then repeated from its start with the derivative from ds_begin = 0
-    and the transfers M_t = A_t ... A_0 (Phi = M_{T-1}, psi = ds_end), the periodic
-    derivative is ds* = (I - Phi)^{-1} psi (the fixed point of the pass iteration, its
-    limit for infinitely many passes), and df_t += -k_T M_t ds* moves the pass's df to the
-    start ds*. A point that never slips nor separates keeps the initial derivative (0, or
-    the mean's identity with a static harmonic: the slider seated at the mean). The passes
-    are iterated with the derivative (``closed_form`` False, the previous method) when
-    |det(I - Phi)| < SINGULAR_DET (an eigenvalue of Phi near 1: the periodic state is not
-    unique or barely attracting, e.g. a point that slips only a tiny distance per period,
-    or slips in one pass and sticks in the next) -- there the result depends on the initial
-    slider and its derivative convention, and the previous iteration defines it.
+    ``closed_form`` False (the previous method): the passes carry the derivative, from 0 (or,
+    with a static harmonic, d s / d c_mean = I: the slider seated at the mean), and repeat
+    until the derivative repeats to ``tol`` too; in near-1D slip (an eigenvalue of Phi near
+    1) that may take many more passes than the position, or never end within max_passes.
+
+    ``closed_form`` True (the callers' default): the passes carry no derivative. When the
+    position repeated, one more pass carries it from ds_begin = 0 with the transfers
+    M_t = A_t ... A_0 (Phi = M_{T-1}, psi = ds_end), and the periodic derivative, the fixed
+    point (and the infinitely-many-pass limit) of the iteration above, is
+    ds* = (I - Phi)^{-1} psi; df_t(ds*) = df_t(0) - k_T M_t ds*. Phi is also the derivative
+    of the end position with respect to the start position, so the same 2x2 solve gives the
+    Newton step dp = (I - Phi)^{-1} (s_end - s_begin) to the periodic start; the forces
+    (f_t - k_T M_t dp) and the slip work are corrected to first order, leaving them periodic
+    to second order in the ~tol-sized step (states unchanged; skipped if |dp| > NEWTON_STEP_MAX
+    mu max N / k_T). The result does not depend on the initial slider or its derivative
+    convention. Where that is not so, the previous method is used and its numbers are
+    reproduced exactly:
+    * a last pass without slip or separation (Phi = I: any stuck slider is periodic): the
+      derivative is the initial one, or the one carried through the earlier passes;
+    * the position did not repeat within max_passes (no periodic state to linearise about);
+    * |det(I - Phi)| < SINGULAR_DET (a barely attracting periodic state; see there).
     """
     if not (want_jac and closed_form):
         work, passes = _iterate_passes(ut, normal, dnormal, synthesis, kt, mu, s0, s1, static_index, max_passes,
@@ -331,10 +363,10 @@ def _point_return_map(ut, normal, dnormal, synthesis, kt, mu, s0, s1, static_ind
     start0 = s0
     start1 = s1
     scale = _slip_scale(normal, kt, mu)
-    b0 = s0
-    b1 = s1
     moved = False
+    periodic = False
     passes = 0
+    work = 0.0
     for it in range(max_passes):
         b0 = s0
         b1 = s1
@@ -343,37 +375,45 @@ def _point_return_map(ut, normal, dnormal, synthesis, kt, mu, s0, s1, static_ind
         if not moved:
             break
         if it >= 1 and abs(s0 - b0) <= tol * scale and abs(s1 - b1) <= tol * scale:
+            periodic = True
             break
     if not moved:
-        if passes > 1:
-            # it slipped or separated before it stuck for good: the derivative depends on that
-            # transient (Phi = I); iterate as before
-            work, jp = _iterate_passes(ut, normal, dnormal, synthesis, kt, mu, start0, start1, static_index,
-                                       max_passes, tol, True, f_out, df_out, state_out, ds, ds_begin)
-            return work, passes, jp
-        # stuck throughout from the start: ds is the initial derivative at every sample
+        # no slip and no separation in the last pass: the slider stays, ds is constant over
+        # the period (Phi = I, no closed form): the initial derivative if it never moved,
+        # else the derivative carried through the passes before, as _iterate_passes does
+        # (it stops there too: no earlier pass repeated the position)
         _initial_derivative(ds, C, static_index)
+        if passes > 1:
+            s0 = start0
+            s1 = start1
+            for it in range(passes - 1):
+                s0, s1, moved, work, _, _ = _derivative_pass(ut, normal, dnormal, synthesis, kt, mu, s0, s1, f_out,
+                                                             df_out, state_out, ds, transfer, False)
+            s0, s1, moved, work = _slider_pass(ut, normal, kt, mu, s0, s1, f_out, state_out)
         ds0 = ds[0]
         ds1 = ds[1]
         for t in range(T):
-            df0 = df_out[t, 0]
-            df1 = df_out[t, 1]
             for j in range(C):
                 kE = kt * synthesis[t, j]
-                df0[j] = -kt * ds0[j] + kE
-                df1[j] = -kt * ds1[j]
-                df0[C + j] = -kt * ds0[C + j]
-                df1[C + j] = -kt * ds1[C + j] + kE
-                df0[2 * C + j] = -kt * ds0[2 * C + j]
-                df1[2 * C + j] = -kt * ds1[2 * C + j]
-        return work, passes, 0
-    # the last pass again, from the same start, with the derivative from ds_begin = 0
+                df_out[t, 0, j] = -kt * ds0[j] + kE
+                df_out[t, 1, j] = -kt * ds1[j]
+                df_out[t, 0, C + j] = -kt * ds0[C + j]
+                df_out[t, 1, C + j] = -kt * ds1[C + j] + kE
+                df_out[t, 0, 2 * C + j] = -kt * ds0[2 * C + j]
+                df_out[t, 1, 2 * C + j] = -kt * ds1[2 * C + j]
+        return work, passes + (1 if passes > 1 else 0), passes - 1
+    if not periodic:
+        # the slider position did not repeat within max_passes: no periodic state to
+        # linearise about; the derivative of the passes made, as before
+        work, jp = _iterate_passes(ut, normal, dnormal, synthesis, kt, mu, start0, start1, static_index,
+                                   max_passes, tol, True, f_out, df_out, state_out, ds, ds_begin)
+        return work, passes, jp
+    # one more pass, with the derivative from ds_begin = 0 and the transfers M_t
     ds[:, :] = 0.0
-    if _VARIANT_B:
-        b0 = s0
-        b1 = s1
-    s0, s1, moved, work = _derivative_pass(ut, normal, dnormal, synthesis, kt, mu, b0, b1, f_out, df_out,
-                                           state_out, ds, transfer, True)
+    b0 = s0
+    b1 = s1
+    s0, s1, moved, work, gw0, gw1 = _derivative_pass(ut, normal, dnormal, synthesis, kt, mu, b0, b1, f_out,
+                                                     df_out, state_out, ds, transfer, True)
     a = 1.0 - transfer[T - 1, 0]           # I - Phi = [[a, b], [c, d]]
     b = -transfer[T - 1, 1]
     c = -transfer[T - 1, 2]
@@ -383,17 +423,25 @@ def _point_return_map(ut, normal, dnormal, synthesis, kt, mu, s0, s1, static_ind
         work, jp = _iterate_passes(ut, normal, dnormal, synthesis, kt, mu, start0, start1, static_index,
                                    max_passes, tol, True, f_out, df_out, state_out, ds, ds_begin)
         return work, passes, 1 + jp
-    # ds* = (I - Phi)^{-1} psi (psi = ds now), column by column
-    ia = a / det
+    ia = a / det                           # (I - Phi)^{-1} = [[id_, -ib], [-ic, ia]]
     ib = b / det
     ic = c / det
     id_ = d / det
+    # ds* = (I - Phi)^{-1} psi (psi = ds now), column by column
     for j in range(n3):
         p0 = ds[0, j]
         p1 = ds[1, j]
         ds[0, j] = id_ * p0 - ib * p1
         ds[1, j] = -ic * p0 + ia * p1
-    # df_t(ds*) = df_t(0) - k_T M_t ds*
+    # the same Newton step for the slider position: the periodic start is b + dp
+    r0 = s0 - b0
+    r1 = s1 - b1
+    dp0 = id_ * r0 - ib * r1
+    dp1 = -ic * r0 + ia * r1
+    shift = abs(dp0) <= NEWTON_STEP_MAX * scale and abs(dp1) <= NEWTON_STEP_MAX * scale
+    if shift:
+        work += gw0 * dp0 + gw1 * dp1
+    # df_t(ds*) = df_t(0) - k_T M_t ds*, f_t(b + dp) = f_t(b) - k_T M_t dp
     for t in range(T):
         m00 = transfer[t, 0]
         m01 = transfer[t, 1]
@@ -401,13 +449,14 @@ def _point_return_map(ut, normal, dnormal, synthesis, kt, mu, s0, s1, static_ind
         m11 = transfer[t, 3]
         if m00 == 0.0 and m01 == 0.0 and m10 == 0.0 and m11 == 0.0:
             continue
-        df0 = df_out[t, 0]
-        df1 = df_out[t, 1]
         for j in range(n3):
             x0 = ds[0, j]
             x1 = ds[1, j]
-            df0[j] -= kt * (m00 * x0 + m01 * x1)
-            df1[j] -= kt * (m10 * x0 + m11 * x1)
+            df_out[t, 0, j] -= kt * (m00 * x0 + m01 * x1)
+            df_out[t, 1, j] -= kt * (m10 * x0 + m11 * x1)
+        if shift:
+            f_out[t, 0] -= kt * (m00 * dp0 + m01 * dp1)
+            f_out[t, 1] -= kt * (m10 * dp0 + m11 * dp1)
     return work, passes, 1
 
 
@@ -473,6 +522,8 @@ def damper_contact_forces(B, local, synthesis, analysis, k_t, mu, weight, approa
     approach_offset (n_d*2*P,) in (d, q, p) order; law_params float (3,). Outputs
     (overwritten): force (C,n_d,12); blocks (n_d,C,12,C,12) if ``want_jac`` (patch q of
     damper d fills [d, :, 6q:6q+6, :, 6q:6q+6], the rest is zero), any array otherwise.
+    ``closed_form``: the periodic slider derivative in closed form (default; False: the
+    previous pass iteration, see :func:`_point_return_map`).
     """
     nd, P = B.shape[0], B.shape[2]
     T, C = synthesis.shape[0], synthesis.shape[1]
@@ -575,13 +626,12 @@ def damper_contact_forces(B, local, synthesis, analysis, k_t, mu, weight, approa
                 for t in range(T):
                     if state[t] == SEPARATED:
                         continue
-                    row = df_flat[t]
                     dnda = -dnormal[t]
                     for a in range(C):
                         an = analysis[a, t]
-                        out = jt[a]
+                        # (indexed, not row views: a view per sample costs reference counting)
                         for r in range(2 * n3p):
-                            out[r] += an * row[r]
+                            jt[a, r] += an * df_flat[t, r]
                         for b in range(C):
                             jn[a, b] += an * (dnda * synthesis[t, b])
                 # acc[a, m, b, n] += sum_ik B[i, m] jp[a, i, k, b] B[k, n], jp the point block
