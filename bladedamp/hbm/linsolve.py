@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
+from numba import njit
 from scipy.linalg import LinAlgWarning, lu_factor, lu_solve
 from scipy.sparse.linalg import splu
 
@@ -99,40 +100,140 @@ class BlockCondensation:
         return self._layout[n]
 
     def __call__(self, A):
-        A = A.toarray() if sp.issparse(A) else np.asarray(A, dtype=float)
+        A = A.toarray() if sp.issparse(A) else np.ascontiguousarray(A, dtype=float)
         n = A.shape[0]
         exterior, coupled, pos = self.layout(n)
         q = self.interior
         nb, b = q.shape
         m = coupled.shape[1]
         ne = exterior.size
-        Aqq = A[q[:, :, None], q[:, None, :]]                  # (nb, b, b)
-        try:
-            inv = np.linalg.inv(Aqq)
-        except np.linalg.LinAlgError:
+        S = np.empty((ne, ne))
+        inv, X, Acq = np.empty((nb, b, b)), np.empty((nb, b, m)), np.empty((nb, m, b))
+        condition = _condense(A, q, coupled, pos, exterior, S, inv, X, Acq)
+        if not np.isfinite(condition) or condition > self.max_condition:
             return factorize(A)
-        condition = np.abs(Aqq).sum(axis=1).max(axis=1) * np.abs(inv).sum(axis=1).max(axis=1)
-        if not np.all(np.isfinite(condition)) or condition.max() > self.max_condition:
-            return factorize(A)
-        Aqc = A[q[:, :, None], coupled[:, None, :]]            # (nb, b, m)
-        Acq = A[coupled[:, :, None], q[:, None, :]]            # (nb, m, b)
-        X = inv @ Aqc                                          # Aqq^-1 Aqc
-        S = A[exterior[:, None], exterior[None, :]]
-        flat = (pos[:, :, None] * ne + pos[:, None, :]).ravel()
-        S -= np.bincount(flat, (Acq @ X).ravel(), minlength=ne * ne).reshape(ne, ne)
         solve_exterior = factorize(S)
 
         def solve(rhs):
             rhs = np.asarray(rhs, dtype=float)
             extra = rhs.shape[1:]
-            yq = inv @ rhs[q].reshape(nb, b, -1)               # Aqq^-1 b_q: (nb, b, k)
-            be = rhs[exterior].reshape(ne, -1).copy()
-            np.subtract.at(be, pos.ravel(), (Acq @ yq).reshape(nb * m, -1))
+            r = np.ascontiguousarray(rhs.reshape(n, -1))
+            yq, be = _condensed_rhs(r, q, pos, exterior, inv, Acq)
             xe = solve_exterior(be)
-            xq = yq - X @ xe[pos]
-            out = np.empty((n, xe.shape[1]))
-            out[exterior] = xe
-            out[q.ravel()] = xq.reshape(nb * b, -1)
-            return out.reshape((n,) + extra)
+            return _condensed_back(r, xe, yq, q, pos, exterior, X).reshape((n,) + extra)
 
         return solve
+
+
+@njit(cache=True)
+def _condense(A, q, coupled, pos, exterior, S, inv, X, Acq):
+    """S = A_ee - sum_k A_ck A_kk^-1 A_kc (scattered to the coupled rows/columns of block k);
+    fills inv = A_kk^-1, X = A_kk^-1 A_kc, Acq = A_ck. Returns the largest 1-norm condition
+    number of the blocks (inf if one is singular). Gauss-Jordan with partial pivoting per block."""
+    nb, b = q.shape
+    m = coupled.shape[1]
+    ne = exterior.size
+    for i in range(ne):
+        ei = exterior[i]
+        for j in range(ne):
+            S[i, j] = A[ei, exterior[j]]
+    worst = 0.0
+    work = np.empty((b, 2 * b))
+    for k in range(nb):
+        norm_a = 0.0
+        for j in range(b):
+            col = 0.0
+            for i in range(b):
+                v = A[q[k, i], q[k, j]]
+                work[i, j] = v
+                work[i, b + j] = 1.0 if i == j else 0.0
+                col += abs(v)
+            norm_a = max(norm_a, col)
+        for c in range(b):
+            p = c
+            for i in range(c + 1, b):
+                if abs(work[i, c]) > abs(work[p, c]):
+                    p = i
+            if work[p, c] == 0.0:
+                return np.inf
+            if p != c:
+                for j in range(2 * b):
+                    work[c, j], work[p, j] = work[p, j], work[c, j]
+            d = 1.0 / work[c, c]
+            for j in range(2 * b):
+                work[c, j] *= d
+            for i in range(b):
+                if i != c and work[i, c] != 0.0:
+                    f = work[i, c]
+                    for j in range(2 * b):
+                        work[i, j] -= f * work[c, j]
+        norm_inv = 0.0
+        for j in range(b):
+            col = 0.0
+            for i in range(b):
+                inv[k, i, j] = work[i, b + j]
+                col += abs(work[i, b + j])
+            norm_inv = max(norm_inv, col)
+        worst = max(worst, norm_a * norm_inv)
+        for i in range(m):
+            for j in range(b):
+                Acq[k, i, j] = A[coupled[k, i], q[k, j]]
+        for i in range(b):
+            for j in range(m):
+                s = 0.0
+                for l in range(b):
+                    s += inv[k, i, l] * A[q[k, l], coupled[k, j]]
+                X[k, i, j] = s
+        for i in range(m):
+            pi = pos[k, i]
+            for j in range(m):
+                s = 0.0
+                for l in range(b):
+                    s += Acq[k, i, l] * X[k, l, j]
+                S[pi, pos[k, j]] -= s
+    return worst
+
+
+@njit(cache=True)
+def _condensed_rhs(r, q, pos, exterior, inv, Acq):
+    """yq = A_kk^-1 r_k per block and the exterior right-hand side r_e - sum_k A_ck yq_k."""
+    nb, b = q.shape
+    m = pos.shape[1]
+    nr = r.shape[1]
+    yq = np.zeros((nb, b, nr))
+    be = np.empty((exterior.size, nr))
+    for i in range(exterior.size):
+        for c in range(nr):
+            be[i, c] = r[exterior[i], c]
+    for k in range(nb):
+        for i in range(b):
+            for l in range(b):
+                v = inv[k, i, l]
+                for c in range(nr):
+                    yq[k, i, c] += v * r[q[k, l], c]
+        for i in range(m):
+            for l in range(b):
+                v = Acq[k, i, l]
+                for c in range(nr):
+                    be[pos[k, i], c] -= v * yq[k, l, c]
+    return yq, be
+
+
+@njit(cache=True)
+def _condensed_back(r, xe, yq, q, pos, exterior, X):
+    """The full solution: exterior part xe, interior x_k = yq_k - X_k xe[coupled_k]."""
+    nb, b = q.shape
+    m = pos.shape[1]
+    nr = r.shape[1]
+    out = np.empty(r.shape)
+    for i in range(exterior.size):
+        for c in range(nr):
+            out[exterior[i], c] = xe[i, c]
+    for k in range(nb):
+        for i in range(b):
+            for c in range(nr):
+                s = yq[k, i, c]
+                for j in range(m):
+                    s -= X[k, i, j] * xe[pos[k, j], c]
+                out[q[k, i], c] = s
+    return out
