@@ -132,7 +132,7 @@ class Branch:
 
 def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=None,
                  step=None, max_step=None, min_step=None, max_points=5000, tol=1e-10,
-                 max_corrector=12, target_iterations=5, factorize=lu_factorize):
+                 max_corrector=12, target_iterations=5, factorize=lu_factorize, leave_margin=1.0):
     """Pseudo-arclength continuation of R(x, omega) = 0 from ``omega_start`` to ``omega_end``.
 
     Parameters
@@ -149,6 +149,8 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
     factorize : ``factorize(A) -> solve``, the linear solver for Newton and the bordered systems
         (default: dense or sparse LU; a structured one such as
         :class:`~bladedamp.hbm.linsolve.BlockCondensation` for assemblies)
+    leave_margin : the run stops (unsuccessful) when the branch turns back and passes
+        ``omega_start`` by more than this fraction of the range's width
     """
     _validate.finite("omega_start", omega_start)
     _validate.finite("omega_end", omega_end)
@@ -282,9 +284,9 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
             h = min(h * 1.5, max_step)
         elif it > target_iterations + 1:
             h = max(h / 1.5, min_step)
-        if direction * (omega_start - points[-1][n]) > w_scale:
-            # the branch turned back and left the range by more than its width: it is not the
-            # response curve asked for (an FRF never runs to zero or negative frequency)
+        if direction * (omega_start - points[-1][n]) > leave_margin * w_scale:
+            # the branch turned back and left the range (by default by more than its width): it
+            # is not the response curve asked for (an FRF never runs to zero or negative frequency)
             message = f"continuation turned back and left the range below omega = {points[-1][n]:.6g} rad/s; " \
                       f"branch kept up to there"
             points.pop()

@@ -151,7 +151,8 @@ def mistuned_response(disk: TunedDisk, kappa, f_range_hz=None, harmonics=(1,), m
     if f_range_hz is None:
         f_range_hz = auto_range(disk, kappa)
     lo, hi = (float(f) for f in f_range_hz)
-    common = dict(harmonics=harmonics, n_samples=n_samples, tuned_peak_tip=tuned_peak_tip, tol=tol)
+    # a sweep that turns back and leaves the range by 5 % of its width has left the curve (below)
+    common = dict(harmonics=harmonics, n_samples=n_samples, tuned_peak_tip=tuned_peak_tip, tol=tol, leave_margin=0.05)
 
     def sweep(lo, hi):
         # the upward sweep can leave the response curve at a branch point and follow another
@@ -171,7 +172,7 @@ def mistuned_response(disk: TunedDisk, kappa, f_range_hz=None, harmonics=(1,), m
         # continue the branch; if that leaves the curve too (3 of 1000 disks), at half the step,
         # then a new sweep over the whole widened range
         for step in (max_step, max_step / 2):
-            longer = md.extend_response(r, f_end, max_step=step, tol=tol)
+            longer = md.extend_response(r, f_end, max_step=step, tol=tol, leave_margin=0.05)
             if longer.success:
                 return longer
         return sweep(lo, hi)
