@@ -132,7 +132,7 @@ def part_a(repeat):
     ut[0, :, 0] = basis.synthesis @ local[:, 0]
     args = (ut, np.full((1, T), OSC["normal_load"]), np.zeros((1, T)), basis.synthesis, np.array([1e4]),
             np.array([0.3]), np.zeros((1, 2)), -1, 20, 1e-10, True, np.empty((1, T, 2)),
-            np.zeros((1, T, 3, 3 * C)), np.empty((1, T), np.int8), np.zeros(1))
+            np.zeros((1, T, 3, 3 * C)), np.empty((1, T), np.int8), np.zeros(1), np.zeros((1, 2), np.int64), True)
     timings = {
         "residual + Jacobian": per_call(lambda: system.residual(x, w)),
         "residual only": per_call(lambda: system.residual(x, w, jacobian=False)),
@@ -158,13 +158,14 @@ def part_a(repeat):
     stats = pstats.Stats(prof)
     total = max(v[3] for v in stats.stats.values())
 
-    def cum(name):
-        return sum(v[3] for k, v in stats.stats.items() if k[2] == name)
+    def cum(names):
+        return sum(v[3] for k, v in stats.stats.items() if k[2] in names.split("|"))
 
     print("    continuation profile (cProfile, inflates Python overhead): share of the run time")
     for label, name in [("residual evaluations", "residual"), ("  contact AFT (harmonic_forces)", "harmonic_forces"),
                         ("    numba return map", "_return_map"), ("  dynamic stiffness", "dynamic_stiffness"),
-                        ("tangent computations", "tangent_at"), ("linear solves", "solve")]:
+                        ("tangent computations", "tangent_at"),
+                        ("linear solves (factorise + solve)", "factorize|lu_factor|lu_solve|solve")]:
         print(f"      {label:<34} {100 * cum(name) / total:5.1f} %")
     return dict(err_ti=err_ti, err_hbm=err_hbm, t_ti=t_ti / OMEGAS.size, t_newton=t_newton / OMEGAS.size,
                 t_cont=t_cont / n_cont)
