@@ -47,8 +47,8 @@ from .contact.laws import LinearNormalLaw
 from .contact.point import damper_contact_forces, normal_law_parameters, point_contact_forces
 from .damper.kinetics import seat
 from .disk import DAMPER_DOFS, DamperContacts, TunedDisk
-from .hbm.continuation import Branch, continuation, solve
-from .hbm.linsolve import BlockCondensation
+from .hbm.continuation import Branch, continuation
+from .hbm.linsolve import BlockCondensation, solve
 from .hbm.linsolve import factorize as lu_factorize
 from .hbm.fourier import HarmonicBasis
 from .hbm.system import Coupling, HarmonicBalanceSystem

@@ -6,9 +6,11 @@ Both work on a residual ``fun(x, omega) -> (R, dR/dx, dR/domega)`` (see
 that does not converge says so and keeps what it has: the returned :class:`Branch` carries
 every converged point, ``success`` and a ``message`` naming the frequency where it stopped.
 
-``fun`` may return ``dR/dx`` as a ``scipy.sparse`` matrix: linear systems (Newton steps and
-the bordered arc-length systems) are then factorised with ``scipy.sparse.linalg.splu``, so
-the cost of a large, sparsely coupled problem (a mistuned disk) grows about linearly with its size.
+``fun`` may return ``dR/dx`` dense or as a ``scipy.sparse`` matrix. Each Newton step and
+bordered arc-length system is factorised once by ``factorize`` (default: dense LU, or
+``scipy.sparse.linalg.splu`` whose cost grows about linearly for a sparsely coupled problem;
+a structured solver such as :class:`~bladedamp.hbm.linsolve.BlockCondensation` for assemblies),
+and the same factorisation gives the corrector's update and the next tangent.
 """
 from __future__ import annotations
 
@@ -20,7 +22,6 @@ import scipy.sparse as sp
 
 from .. import _validate
 from .linsolve import factorize as lu_factorize
-from .linsolve import solve  # noqa: F401  (re-exported: bladedamp.hbm.continuation.solve)
 
 
 def _scale_columns(J, s):
