@@ -81,17 +81,25 @@ def compare(element, local, basis, offsets):
     return relative(f_new, f_old), relative(j_new, j_old), relative(g_new, g_old)
 
 
-@pytest.mark.parametrize("harmonics", HARMONICS, ids=["h1", "h012"])
-@pytest.mark.parametrize("kind", ["cylinder", "wedge"])
-def test_fused_kernel_equals_numpy_path(kind, harmonics):
+def states(kind, harmonics, spreads):
+    """(system, omega, {label: unknowns}): the converged point of the mistuned disk's FRF and the
+    stuck initial guess there scaled by 1 + a N(0, 1) for each a in ``spreads`` (seed 7)."""
     md = mistuned(kind)
     system = md.hbm_system(harmonics)
-    basis = system.basis
     x, w = converged_point(md, system, CONVERGED_PATH[kind])
     x0 = md.initial_guess(system, w)
     rng = np.random.default_rng(7)
-    cases = {"converged": x, "random x3": x0 * (1 + 3 * rng.standard_normal(x0.size)),
-             "random x30": x0 * (1 + 30 * rng.standard_normal(x0.size))}
+    cases = {"converged": x}
+    for a in spreads:
+        cases[f"random x{a}"] = x0 * (1 + a * rng.standard_normal(x0.size))
+    return system, w, cases
+
+
+@pytest.mark.parametrize("harmonics", HARMONICS, ids=["h1", "h012"])
+@pytest.mark.parametrize("kind", ["cylinder", "wedge"])
+def test_fused_kernel_equals_numpy_path(kind, harmonics):
+    system, w, cases = states(kind, harmonics, (3, 30))
+    basis = system.basis
     seen = np.zeros(3, dtype=int)
     for label, xc in cases.items():
         element, local, offsets = contact_state(system, xc, w)
@@ -189,13 +197,9 @@ def test_fused_closed_form_jacobian_is_the_many_pass_limit(kind, harmonics):
     AssemblyContacts uses) equal those of the previous pass iteration run to its limit (5000
     passes, tol 1e-14), at the converged point (where 20 passes leave near-1D slip derivatives
     unsettled) and at a random motion; the forces equal the limit's too."""
-    md = mistuned(kind)
-    system = md.hbm_system(harmonics)
+    system, w, cases = states(kind, harmonics, (3,))
     basis = system.basis
-    x, w = converged_point(md, system, CONVERGED_PATH[kind])
-    x0 = md.initial_guess(system, w)
-    rng = np.random.default_rng(7)
-    for label, xc in {"converged": x, "random x3": x0 * (1 + 3 * rng.standard_normal(x0.size))}.items():
+    for label, xc in cases.items():
         element, local, offsets = contact_state(system, xc, w)
         f_new, j_new = kernel(element, local, basis, offsets)
         f_ref, j_ref = kernel(element, local, basis, offsets, 5000, 1e-14, closed_form=False)
