@@ -16,13 +16,14 @@ def best_of(fun, repeat):
     return best, out
 
 
-def solved_response(disk, f_range, max_step):
-    """The disk's FRF over ``f_range`` [Hz]; raises if the continuation did not cover it."""
+def solved_response(disk, f_range, max_step, harmonics=(1,)):
+    """The disk's FRF over ``f_range`` [Hz] (the paper's one-harmonic setting unless
+    ``harmonics`` says otherwise); raises if the continuation did not cover it."""
     import warnings
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        r = disk.frequency_response(*f_range, max_step=max_step)
+        r = disk.frequency_response(*f_range, harmonics=harmonics, max_step=max_step)
     if not r.success:
         raise RuntimeError(r.message)
     return r

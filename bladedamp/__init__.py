@@ -22,8 +22,10 @@ __all__ = ["BeamBladeGeometry", "ModalBlade", "reference_blade", "ContactPatch",
            "HarmonicBasis", "FrictionOscillator", "FrequencyResponse", "reference_disk", "frequency_response"]
 
 
-def frequency_response(model, f_range_hz, harmonics=(1,), **options):
-    """Forced response of ``model`` (a TunedDisk) over ``f_range_hz = (start, end)`` [Hz] by
-    harmonic balance and arc-length continuation; returns a :class:`DiskResponse`."""
+def frequency_response(model, f_range_hz, harmonics="auto", **options):
+    """Forced response of ``model`` (a TunedDisk or MistunedDisk) over ``f_range_hz = (start, end)``
+    [Hz] by harmonic balance and arc-length continuation. ``harmonics="auto"`` (default) chooses
+    them to the tolerance ``harmonic_tolerance`` (see :mod:`bladedamp.hbm.accuracy`); ``(1,)`` is
+    the paper's setting. Returns the model's response (:class:`DiskResponse`, ...)."""
     start, end = f_range_hz
     return model.frequency_response(start, end, harmonics=harmonics, **options)

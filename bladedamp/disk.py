@@ -30,10 +30,12 @@ from .contact.laws import LinearNormalLaw
 from .contact.point import point_contact_forces
 from .damper.geometry import CylinderDamper, DamperGeometry, WedgeDamper
 from .damper.kinetics import centrifugal_force, seat
+from .hbm.accuracy import HARMONIC_TOLERANCE, converged_response
 from .hbm.continuation import continuation
+from .hbm.start import robust_start
 from .hbm.fourier import HarmonicBasis
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import FrequencyResponse
+from .response import FrequencyResponse, physical_checks, with_checks
 
 DAMPER_DOFS = ("uD_x", "uD_y", "uD_z", "phiD_x", "phiD_y", "phiD_z")
 
@@ -346,61 +348,85 @@ class TunedDisk:
             return np.zeros(2)
         return seat(self.damper_geometry(), self.centrifugal_force(omega)[0])[2]
 
-    def frequency_response(self, f_start_hz: float, f_end_hz: float, harmonics=(1,), n_samples=None,
-                           max_step: float = 0.02, **continuation_options) -> "DiskResponse":
+    def frequency_response(self, f_start_hz: float, f_end_hz: float, harmonics="auto", n_samples=None,
+                           max_step: float = 0.02, harmonic_tolerance: float = HARMONIC_TOLERANCE,
+                           max_harmonic: int = 3, **continuation_options) -> "DiskResponse":
         """Forced response from ``f_start_hz`` to ``f_end_hz`` [Hz] by continuation.
 
-        ``max_step`` is the largest arc-length step in scaled units (smaller: more points).
+        ``harmonics``: ``"auto"`` (default) chooses the harmonic set whose first-harmonic tip
+        amplitudes are converged to ``harmonic_tolerance`` (relative to the peak; see
+        :mod:`bladedamp.hbm.accuracy`); a tuple such as ``(1,)`` (the paper's setting) or
+        ``(0, 1, 2, 3)`` is used as given, and its error estimate is reported. ``max_harmonic``
+        caps the automatic choice (default 3: the cost of a sector's FRF grows steeply with the
+        harmonics; a result above the tolerance says so, and a larger cap may meet it).
+        ``max_step`` is the largest arc-length step in scaled units (the frequency range is 1;
+        smaller: more points). The result is ``success`` only if the branch reached the end and
+        passed :func:`bladedamp.response.physical_checks`.
         """
         _validate.positive("f_start_hz", f_start_hz)
         _validate.positive("f_end_hz", f_end_hz)
         if f_start_hz == f_end_hz:
             raise ValueError("f_end_hz must differ from f_start_hz")
-        system = self.hbm_system(harmonics, n_samples)
         w0, w1 = 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz
-        scales = self._scales(system, w0, w1)
-        x0 = self._start_solution(system, w0, scales)
-        branch = continuation(system.residual, x0, w0, w1, x_scale=scales,
-                              max_step=max_step, **continuation_options)
-        return DiskResponse.from_branch(self, system, branch)
+
+        def solve(H):
+            system = self.hbm_system(H, n_samples)
+            scales = self._scales(system, w0, w1)
+            x0 = self._start_solution(system, w0, scales)
+            branch = continuation(system.residual, x0, w0, w1, x_scale=scales,
+                                  max_step=max_step, **continuation_options)
+            response = DiskResponse.from_branch(self, system, branch)
+            dissipation = response.point_dissipation.sum(axis=-1) if self.has_damper and len(branch.omega) \
+                else np.zeros((len(branch.omega), 0))
+            return with_checks(response, physical_checks(branch.omega, (w0, w1), dissipation,
+                                                         response.excitation_work, max_step, system.basis.n_samples))
+
+        return converged_response(self, solve, harmonics, harmonic_tolerance, max_harmonic)
+
+    # ----- the protocol of bladedamp.hbm.accuracy ----------------------------------------
+    def output_amplitudes(self, coefficients: np.ndarray, basis: HarmonicBasis) -> np.ndarray:
+        """(n, 3) first-harmonic tip amplitudes [m] of coefficients (n, C, n_dof)."""
+        j1, nm = basis.cos_index(1), self.blade.n_modes
+        q1 = coefficients[:, j1, :nm] - 1j * coefficients[:, j1 + 1, :nm]
+        return np.abs(q1 @ self.blade.shape("tip")[:3].T)
+
+    def lift(self, coefficients: np.ndarray, basis: HarmonicBasis, system: HarmonicBalanceSystem,
+             omega: float) -> np.ndarray:
+        """A solution (C, n_dof) of ``basis`` as the initial guess in ``system``'s basis; a static
+        term that ``basis`` lacks starts from the damper seated under F_CG (Eq. 26)."""
+        X = basis.embed(coefficients, system.basis)
+        if self.has_damper and system.basis.has_static and not basis.has_static:
+            u_seat, _, _ = seat(self.damper_geometry(), self.centrifugal_force(omega)[0])
+            X[system.basis.cos_index(0), self.blade.n_modes:] = u_seat
+        return X.ravel()
+
+    def unknown_scales(self, system: HarmonicBalanceSystem, omega_start: float, omega_end: float) -> np.ndarray:
+        """Scale of each unknown of ``system`` over omega_start..omega_end [rad/s]."""
+        return self._scales(system, omega_start, omega_end)
 
     def _start_solution(self, system, omega, scales, tol=1e-10):
-        """Solution at the first frequency, robust in gross slip.
+        """Solution at the first frequency, robust in gross slip (:func:`bladedamp.hbm.start.robust_start`).
 
-        Newton with a backtracking line search from the stuck linear solution; if that fails
-        (a light damper sliding far from its stuck state), the excitation is ramped up from 10 %
-        (homotopy), each level started from the previous solution. Returns the best iterate
-        (the continuation then reports honestly if it is not a solution)."""
-        f_full = system.excitation
+        Damped Newton from the stuck linear solution; if that fails (a light damper sliding far
+        from its stuck state), an excitation homotopy on the dynamic excitation (the centrifugal
+        preload stays), from the seated damper. Returns the best iterate (the continuation then
+        reports honestly if it is not a solution)."""
+        f = system.excitation(omega)[0].reshape(system.basis.n_coeffs, system.n_dof).copy()
+        if system.basis.has_static:
+            f[system.basis.cos_index(0)] = 0.0          # the preload is not ramped
+        base = self._static_state(system, omega)
+        residual_scale = max(np.linalg.norm(system.residual(np.zeros(system.n_unknowns), omega, False)[0]), 1e-300)
+        return robust_start(system.residual, {"stuck linear solution": self._initial_guess(system, omega)},
+                            omega, scales, f.ravel(), base=base, residual_scale=residual_scale, tol=tol).x
 
-        def solve(x, level):
-            system.excitation = lambda w: tuple(level * v for v in f_full(w))
-            try:
-                for _ in range(60):
-                    R, J, _ = system.residual(x, omega)
-                    r0 = np.linalg.norm(R)
-                    if r0 <= tol * max(np.linalg.norm(f_full(omega)[0]), 1e-300):
-                        return x, True
-                    dx = -np.linalg.solve(J, R)
-                    t = 1.0
-                    while t > 1e-4:
-                        x_new = x + t * dx
-                        if np.linalg.norm(system.residual(x_new, omega, False)[0]) < (1 - 1e-4 * t) * r0:
-                            break
-                        t /= 2
-                    x = x_new
-                    if np.linalg.norm(t * dx / scales) < 1e-14:
-                        break
-                return x, False
-            finally:
-                system.excitation = f_full
-
-        x, ok = solve(self._initial_guess(system, omega), 1.0)
-        if ok:
-            return x
-        x = self._initial_guess(system, omega)
-        for level in np.linspace(0.1, 1.0, 10):
-            x, ok = solve(x, level)
+    def _static_state(self, system, omega):
+        """The state without dynamic motion: rest, or with a static harmonic the damper seated
+        frictionlessly under F_CG (``seat``)."""
+        x = np.zeros(system.n_unknowns)
+        if self.has_damper and system.basis.has_static:
+            u_seat, _, _ = seat(self.damper_geometry(), self.centrifugal_force(omega)[0])
+            nm = self.blade.n_modes
+            x.reshape(system.basis.n_coeffs, system.n_dof)[system.basis.cos_index(0), nm:] = u_seat
         return x
 
     def _initial_guess(self, system, omega):
@@ -410,11 +436,7 @@ class TunedDisk:
         point is open and the Jacobian there has no contact stiffness at all), so the step
         starts from the damper seated frictionlessly under F_CG (``seat``) instead of from rest.
         """
-        x = np.zeros(system.n_unknowns)
-        if self.has_damper and system.basis.has_static:
-            u_seat, _, _ = seat(self.damper_geometry(), self.centrifugal_force(omega)[0])
-            nm = self.blade.n_modes
-            x.reshape(system.basis.n_coeffs, system.n_dof)[system.basis.cos_index(0), nm:] = u_seat
+        x = self._static_state(system, omega)
         R, J, _ = system.residual(x, omega)
         return x - np.linalg.solve(J, R)
 
@@ -437,6 +459,17 @@ class TunedDisk:
         for g, platform_floor in groups:
             X[g] = np.maximum(X[g], max(1e-3 * X[g].max(), platform_floor) + 1e-300)
         return np.tile(X, C)
+
+    def time_response(self, f_hz, **options):
+        """Steady state at each excitation frequency ``f_hz`` [Hz] (scalar or array) by time
+        integration of the full assembly (``MistunedDisk.from_tuned(self)``: every blade and
+        damper written out, no cyclic reduction), from the static equilibrium under F_CG (Eq. 26);
+        see :func:`bladedamp.timedomain.disk_time_response` for ``options``.
+        Returns a :class:`bladedamp.timedomain.DiskTimeResponse` (tip amplitudes of every blade)."""
+        from .mistuned import MistunedDisk
+        from .timedomain import disk_time_response
+
+        return disk_time_response(MistunedDisk.from_tuned(self), f_hz, **options)
 
 
 @dataclass

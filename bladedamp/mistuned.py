@@ -47,12 +47,14 @@ from .contact.laws import LinearNormalLaw
 from .contact.point import damper_contact_forces, normal_law_parameters, point_contact_forces
 from .damper.kinetics import seat
 from .disk import DAMPER_DOFS, DamperContacts, TunedDisk
+from .hbm.accuracy import HARMONIC_TOLERANCE, converged_response
 from .hbm.continuation import Branch, continuation
+from .hbm.start import robust_start
 from .hbm.linsolve import BlockCondensation, solve
 from .hbm.linsolve import factorize as lu_factorize
 from .hbm.fourier import HarmonicBasis
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import FrequencyResponse
+from .response import FrequencyResponse, physical_checks, with_checks
 
 
 def sparse_real_form(basis: HarmonicBasis, per_harmonic) -> sp.csr_matrix:
@@ -551,8 +553,8 @@ class MistunedDisk:
         return AssemblySystem(basis, mass.tocsr(), damp.tocsr(), stiff.tocsr(), excitation, couplings,
                               None if static is None else static.tocsr())
 
-    def initial_guess(self, system: HarmonicBalanceSystem, omega: float) -> np.ndarray:
-        """Stuck linear solution (one Newton step from the static state; see TunedDisk._initial_guess)."""
+    def _static_state(self, system: HarmonicBalanceSystem, omega: float) -> np.ndarray:
+        """Rest, or with a static harmonic every damper seated frictionlessly under F_CG."""
         x = np.zeros(system.n_unknowns)
         if system.basis.has_static:
             X = x.reshape(system.basis.n_coeffs, system.n_dof)
@@ -560,8 +562,25 @@ class MistunedDisk:
                 sector = self.sectors[k]
                 u_seat, _, _ = seat(sector.damper_geometry(), sector.centrifugal_force(omega)[0])
                 X[system.basis.cos_index(0), self.damper_slice(d)] = u_seat
+        return x
+
+    def initial_guess(self, system: HarmonicBalanceSystem, omega: float) -> np.ndarray:
+        """Stuck linear solution (one Newton step from the static state; see TunedDisk._initial_guess)."""
+        x = self._static_state(system, omega)
         R, J, _ = system.residual(x, omega)
         return x - solve(J, R)
+
+    def start_solution(self, system: HarmonicBalanceSystem, omega: float, scales) -> np.ndarray:
+        """Solution at the first frequency (:func:`bladedamp.hbm.start.robust_start`, as the tuned
+        disk's): damped Newton from the stuck linear solution, then an excitation homotopy on the
+        dynamic excitation from the seated dampers. Returns the best iterate."""
+        f = system.excitation(omega)[0].reshape(system.basis.n_coeffs, system.n_dof).copy()
+        if system.basis.has_static:
+            f[system.basis.cos_index(0)] = 0.0          # the preload is not ramped
+        residual_scale = max(np.linalg.norm(system.residual(np.zeros(system.n_unknowns), omega, False)[0]), 1e-300)
+        return robust_start(system.residual, {"stuck linear solution": self.initial_guess(system, omega)}, omega,
+                            scales, f.ravel(), base=self._static_state(system, omega),
+                            residual_scale=residual_scale, factorize=system.factorize).x
 
     def scales(self, system: HarmonicBalanceSystem, w0: float, w1: float) -> np.ndarray:
         """Scale of each unknown (as TunedDisk._scales), pooled over the blades for each mode and
@@ -583,22 +602,53 @@ class MistunedDisk:
         # steps (and the number of points) are those of the tuned cyclic model
         return np.sqrt(s) * np.tile(np.concatenate(out), C)
 
-    def frequency_response(self, f_start_hz: float, f_end_hz: float, harmonics=(1,), n_samples=None,
+    def frequency_response(self, f_start_hz: float, f_end_hz: float, harmonics="auto", n_samples=None,
                            max_step: float = 0.02, tuned_peak_tip: float | None = None,
+                           harmonic_tolerance: float = HARMONIC_TOLERANCE, max_harmonic: int = 3,
                            **continuation_options) -> "MistunedResponse":
         """Forced response of every blade from ``f_start_hz`` to ``f_end_hz`` [Hz] by continuation.
 
-        ``tuned_peak_tip`` [m]: the tuned disk's peak, kept for amplification factors."""
+        ``harmonics``, ``harmonic_tolerance``, ``max_harmonic``: as :meth:`TunedDisk.frequency_response`
+        (the error estimate is over every blade's tip). ``tuned_peak_tip`` [m]: the tuned disk's
+        peak, kept for amplification factors."""
         _validate.positive("f_start_hz", f_start_hz)
         _validate.positive("f_end_hz", f_end_hz)
         if f_start_hz == f_end_hz:
             raise ValueError("f_end_hz must differ from f_start_hz")
-        system = self.hbm_system(harmonics, n_samples)
         w0, w1 = 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz
-        x0 = self.initial_guess(system, w0)
-        branch = continuation(system.residual, x0, w0, w1, x_scale=self.scales(system, w0, w1),
-                              factorize=system.factorize, max_step=max_step, **continuation_options)
-        return MistunedResponse.from_branch(self, system, branch, tuned_peak_tip)
+
+        def solve(H):
+            system = self.hbm_system(H, n_samples)
+            scales = self.scales(system, w0, w1)
+            x0 = self.start_solution(system, w0, scales)
+            branch = continuation(system.residual, x0, w0, w1, x_scale=scales,
+                                  factorize=system.factorize, max_step=max_step, **continuation_options)
+            response = MistunedResponse.from_branch(self, system, branch, tuned_peak_tip)
+            return with_checks(response, physical_checks(branch.omega, (w0, w1), response.damper_dissipation,
+                                                         response.excitation_work, max_step, system.basis.n_samples))
+
+        return converged_response(self, solve, harmonics, harmonic_tolerance, max_harmonic)
+
+    # ----- the protocol of bladedamp.hbm.accuracy ----------------------------------------
+    def output_amplitudes(self, coefficients: np.ndarray, basis: HarmonicBasis) -> np.ndarray:
+        """(n, 3 s) first-harmonic tip amplitudes of every blade [m] of coefficients (n, C, n_dof)."""
+        j1, nm, s = basis.cos_index(1), self.n_modes, self.n_sector
+        q1 = (coefficients[:, j1, :s * nm] - 1j * coefficients[:, j1 + 1, :s * nm]).reshape(-1, s, nm)
+        tips = np.stack([b.shape("tip")[:3] for b in self.blades])            # (s, 3, nm)
+        return np.abs(np.einsum("pkm,kim->pki", q1, tips)).reshape(len(coefficients), -1)
+
+    def lift(self, coefficients, basis: HarmonicBasis, system: HarmonicBalanceSystem, omega: float) -> np.ndarray:
+        """A solution (C, n_dof) of ``basis`` as the initial guess in ``system``'s basis; a static
+        term that ``basis`` lacks starts from the dampers seated under F_CG."""
+        X = basis.embed(coefficients, system.basis)
+        if system.basis.has_static and not basis.has_static:
+            j0 = system.basis.cos_index(0)
+            X[j0] = self._static_state(system, omega).reshape(system.basis.n_coeffs, system.n_dof)[j0]
+        return X.ravel()
+
+    def unknown_scales(self, system: HarmonicBalanceSystem, omega_start: float, omega_end: float) -> np.ndarray:
+        """Scale of each unknown of ``system`` over omega_start..omega_end [rad/s] (:meth:`scales`)."""
+        return self.scales(system, omega_start, omega_end)
 
     def extend_response(self, response: "MistunedResponse", f_end_hz: float, max_step: float = 0.02,
                         **continuation_options) -> "MistunedResponse":
@@ -643,6 +693,15 @@ class MistunedDisk:
         message = piece.message if not piece.success else response.message
         branch = Branch(omega, x, iterations, success, message, np.sort(turning).astype(int))
         return MistunedResponse.from_branch(self, system, branch, response.tuned_peak_tip)
+
+    def time_response(self, f_hz, **options):
+        """Steady state of every blade at each excitation frequency ``f_hz`` [Hz] (scalar or
+        array) by time integration of the full assembly (``len(blades) == n_blades``), from the
+        static equilibrium under F_CG (Eq. 26); see :func:`bladedamp.timedomain.disk_time_response`.
+        Returns a :class:`bladedamp.timedomain.DiskTimeResponse`."""
+        from .timedomain import disk_time_response
+
+        return disk_time_response(self, f_hz, **options)
 
 
 def _refined_peak(f, a):

@@ -18,11 +18,13 @@ import numpy as np
 from . import _validate
 from .contact.laws import LinearNormalLaw
 from .contact.point import PointContactElement
+from .hbm.accuracy import HARMONIC_TOLERANCE, converged_response
 from .hbm.continuation import continuation
+from .hbm.start import robust_start
 from .hbm.elements import CubicSpring
 from .hbm.fourier import HarmonicBasis
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import FrequencyResponse
+from .response import FrequencyResponse, physical_checks, with_checks
 from .timedomain import TimeResponse, _oscillator_steady_state
 
 
@@ -104,24 +106,65 @@ class FrictionOscillator:
         return HarmonicBalanceSystem(basis, [[self.mass]], [[self.damping]], [[self.stiffness]],
                                      lambda omega: (f, np.zeros(C)), couplings)
 
-    def frequency_response(self, omega_start: float, omega_end: float, harmonics=(1,), n_samples=None,
+    def frequency_response(self, omega_start: float, omega_end: float, harmonics="auto", n_samples=None,
+                           harmonic_tolerance: float = HARMONIC_TOLERANCE, max_harmonic: int = 9,
                            **continuation_options) -> FrequencyResponse:
         """FRF by harmonic balance and pseudo-arclength continuation from ``omega_start`` to ``omega_end`` [rad/s].
 
-        ``continuation_options`` go to :func:`bladedamp.hbm.continuation.continuation`
-        (``max_step`` sets the point density).
+        ``harmonics``: ``"auto"`` (default) chooses the set whose first-harmonic amplitude is
+        converged to ``harmonic_tolerance`` (see :mod:`bladedamp.hbm.accuracy`; the static term
+        is always in it: an inclined contact's normal load varies with the motion); a tuple is
+        used as given, with its error estimate; ``max_harmonic`` caps the automatic choice
+        (default 9: one DOF is cheap). ``continuation_options`` go to
+        :func:`bladedamp.hbm.continuation.continuation` (``max_step`` sets the point density).
+        The result is ``success`` only if the branch reached the end and passed
+        :func:`bladedamp.response.physical_checks`.
         """
         _validate.positive("omega_start", omega_start)
         _validate.positive("omega_end", omega_end)
-        system = self.hbm_system(harmonics, n_samples)
-        x0 = system.linear_solution(omega_start)
         scale = max(self.linear_amplitude([omega_start, omega_end], stuck=False).max(),
                     abs(self.forcing) / self.stiffness, 1e-300)
-        branch = continuation(system.residual, x0, omega_start, omega_end, x_scale=scale,
-                              **continuation_options)
-        C = system.basis.n_coeffs
-        return FrequencyResponse(branch.omega, branch.x.reshape(-1, C, 1), system.basis, ("x",),
-                                 branch.success, branch.message, branch.iterations, branch.turning_points)
+
+        def solve(H):
+            system = self.hbm_system(H, n_samples)
+            x0 = self._start_solution(system, omega_start, scale)
+            branch = continuation(system.residual, x0, omega_start, omega_end, x_scale=scale,
+                                  **continuation_options)
+            C = system.basis.n_coeffs
+            response = FrequencyResponse(branch.omega, branch.x.reshape(-1, C, 1), system.basis, ("x",),
+                                         branch.success, branch.message, branch.iterations, branch.turning_points)
+            energy = self.energy_balance(response) if len(branch.omega) else np.zeros((0, 3))
+            return with_checks(response, physical_checks(branch.omega, (omega_start, omega_end), energy[:, 2:],
+                                                         energy[:, 0], continuation_options.get("max_step") or 0.02,
+                                                         system.basis.n_samples))
+
+        return converged_response(self, solve, harmonics, harmonic_tolerance, max_harmonic)
+
+    def _start_solution(self, system: HarmonicBalanceSystem, omega: float, scale: float) -> np.ndarray:
+        """Solution at the first frequency by :func:`bladedamp.hbm.start.robust_start`: damped
+        Newton from the stuck linear solution (one Newton step from rest, where the contact
+        sticks), then from the free one (no contact force), then the excitation homotopy."""
+        R, J, _ = system.residual(np.zeros(system.n_unknowns), omega)
+        stuck = -np.linalg.solve(J, R)
+        free = system.linear_solution(omega)
+        forcing = system.excitation(omega)[0]
+        return robust_start(system.residual, {"stuck linear": stuck, "free linear": free}, omega, scale,
+                            forcing).x
+
+    # ----- the protocol of bladedamp.hbm.accuracy ----------------------------------------
+    def output_amplitudes(self, coefficients: np.ndarray, basis: HarmonicBasis) -> np.ndarray:
+        """(n, 1) first-harmonic amplitude of x [m] of coefficients (n, C, 1)."""
+        j1 = basis.cos_index(1)
+        return np.hypot(coefficients[:, j1], coefficients[:, j1 + 1])
+
+    def lift(self, coefficients, basis: HarmonicBasis, system: HarmonicBalanceSystem, omega: float) -> np.ndarray:
+        """A solution (C, 1) of ``basis`` as the initial guess in ``system``'s basis."""
+        return basis.embed(coefficients, system.basis).ravel()
+
+    def unknown_scales(self, system: HarmonicBalanceSystem, omega_start: float, omega_end: float):
+        """Scale of the unknowns: the free linear amplitude over the range [m]."""
+        return max(self.linear_amplitude([omega_start, omega_end], stuck=False).max(),
+                   abs(self.forcing) / self.stiffness, 1e-300)
 
     def energy_balance(self, response: FrequencyResponse):
         """Per point: (excitation work, viscous dissipation, contact dissipation) per cycle [J]."""

@@ -6,7 +6,62 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .hbm.continuation import branch_checks
 from .hbm.fourier import HarmonicBasis
+
+
+def physical_checks(omega, omega_range, dissipation, excitation_work, max_step=None,
+                    n_samples: int = 64) -> dict[str, str]:
+    """Sanity of a branch beyond the energy balance (which holds for any harmonic truncation).
+
+    ``omega`` (n,) [rad/s]; ``omega_range`` (start, end) [rad/s]; ``dissipation`` (n, m) energy
+    absorbed per period by each of m friction contacts [J]; ``excitation_work`` (n,) [J];
+    ``max_step``: largest allowed frequency step as a fraction of the range (None: unchecked);
+    ``n_samples``: the AFT's time samples per period T.
+    Returns {check: what was found} for every failed check (empty: all pass):
+
+    * ``range``: every point inside the requested range (no negative frequency, no point
+      beyond the ends);
+    * ``dissipation``: each contact's dissipation >= 0 at every point: a passive friction
+      contact cannot give energy back over a period. To the accuracy of the AFT's time
+      sampling: the work of the sampled return map differs from the continuous one by
+      O(dtau^2), dtau = 2 pi / T, so the floor is -(2 pi / T)^2 times the point's excitation
+      work (measured on a nearly stuck contact, EO 0 wedge: -2.6e-4 at T = 64, -2.9e-5 at
+      T = 256; a truncation artifact such as a contact separated half the cycle with one
+      harmonic gives percents);
+    * ``step``: no step between neighbouring points longer in frequency than ``max_step``
+      allows. Range and step are :func:`bladedamp.hbm.continuation.branch_checks`, the
+      continuation's own contract, checked again on the result.
+    """
+    omega = np.asarray(omega, dtype=float)
+    failed = {}
+    if omega.size == 0:
+        return failed
+    lo, hi = min(omega_range), max(omega_range)
+    contract = branch_checks(omega, lo, hi, np.inf if max_step is None else max_step)   # the continuation's own
+    if not contract["inside_range"]:
+        outside = (omega < lo) | (omega > hi)
+        failed["range"] = (f"{int(outside.sum())} points outside {lo / (2 * np.pi):.6g}-{hi / (2 * np.pi):.6g} Hz "
+                           f"(down to {omega.min() / (2 * np.pi):.6g} Hz, up to {omega.max() / (2 * np.pi):.6g} Hz)")
+    d = np.atleast_2d(np.asarray(dissipation, dtype=float).reshape(omega.size, -1))
+    work = np.maximum(np.abs(np.asarray(excitation_work, dtype=float)), 1e-300)
+    relative = d.min(axis=1, initial=0.0) / work
+    bad = relative < -(2 * np.pi / n_samples) ** 2
+    if bad.any():
+        failed["dissipation"] = (f"negative friction dissipation at {int(bad.sum())} points "
+                                 f"(down to {100 * relative.min():.3g} % of the excitation work there)")
+    if not contract["step_within_max_step"]:
+        failed["step"] = (f"a step of {np.abs(np.diff(omega)).max() / (2 * np.pi):.4g} Hz, longer than max_step = "
+                          f"{max_step:g} of the range allows ({max_step * (hi - lo) / (2 * np.pi):.4g} Hz)")
+    return failed
+
+
+def with_checks(response, failed: dict):
+    """``response`` with its failed checks recorded: not ``success``, the message says why."""
+    if not failed:
+        return response
+    message = response.message + "; failed checks: " + "; ".join(f"{k}: {v}" for k, v in failed.items())
+    return dataclasses.replace(response, success=False, message=message, failed_checks=dict(failed))
 
 
 @dataclass
@@ -23,6 +78,13 @@ class FrequencyResponse:
     message : why it stopped
     iterations : (n,) Newton iterations per point
     turning_points : indices of the points where d omega / ds changed sign (folds)
+    harmonic_error : estimated error of the first-harmonic output amplitudes from the harmonic
+        truncation, relative to the peak amplitude (see :mod:`bladedamp.hbm.accuracy`); nan if
+        not estimated
+    harmonic_tolerance : the tolerance it was held to
+    harmonics_converged : whether the estimate met the tolerance (None: not estimated)
+    failed_checks : physical sanity checks the branch failed (name -> what was found); a
+        branch that fails one is not ``success``
     """
 
     omega: np.ndarray
@@ -33,6 +95,10 @@ class FrequencyResponse:
     message: str
     iterations: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     turning_points: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    harmonic_error: float = float("nan")
+    harmonic_tolerance: float = float("nan")
+    harmonics_converged: bool | None = None
+    failed_checks: dict = field(default_factory=dict)
 
     def reversed(self):
         """The same branch in the opposite order (a downward sweep as rising frequency): every

@@ -3,6 +3,14 @@
 The friction oscillator is integrated with the explicit central-difference scheme (second
 order), the contact force advanced by the same return-map step the AFT uses
 (:func:`bladedamp.contact.point.slider_step`), from rest until the response is periodic.
+
+The bladed disk (:func:`disk_time_response`, behind ``TunedDisk.time_response`` and
+``MistunedDisk.time_response``) is integrated the same way as the full assembly of blades and
+dampers, with the HBM model's own matrices, contact maps, patches and loads, from the static
+equilibrium under the centrifugal load, until every blade's first harmonic is steady; a state
+that is not periodic (a cylinder that keeps rolling, a damper that walks) is detected and
+reported as such (:class:`DiskTimeResponse`). :func:`hbm_tip_at` gives the HBM at the same
+frequencies for comparison.
 """
 from __future__ import annotations
 
@@ -99,3 +107,788 @@ class TimeResponse:
         ax.grid(True, alpha=0.3)
         ax.legend()
         return ax
+
+
+# =========================================================================================
+# The bladed disk in the time domain: the full assembly of blades and dampers
+# =========================================================================================
+#
+# Scheme: explicit central differences (second order, no numerical damping), step from the
+# highest natural frequency of the stuck linearised assembly. Why explicit: with modal blades
+# (identity mass, diagonal modal damping and stiffness) and rigid dampers (6 x 6 inertia, no
+# structural damping) the mass and damping matrices are block diagonal, so one step costs one
+# evaluation of the point contacts and no solve; the contact law (elastic Coulomb slider by
+# return map, normal law with lift-off) is then advanced exactly as in the HBM's AFT, with no
+# Newton iteration on non-smooth stick / slip / lift-off transitions. An implicit scheme
+# (Newmark, HHT) could take ~10x longer steps but each step needs a Newton solve of the whole
+# assembly over a non-smooth contact law, which costs more than the 10 explicit steps it
+# replaces (and adds numerical damping with HHT) - an estimate, not measured here. The stiff
+# direction (damper on its contacts: omega_max = 4.4e4 rad/s for the reference 1 g cylinder,
+# 7.2e4 rad/s for the 0.3 g wedge) needs 290 / 480 steps per 1F period at 0.8 of the stability
+# limit; accuracy asks for 512 (MIN_STEPS_PER_PERIOD). Cost: ~20 / 36 us per step for the
+# 16-blade reference assembly (160 unknowns, 160 / 800 contact points) on the 2-core test box.
+
+_LAW_LINEAR, _LAW_POWER = 0, 1          # as contact.point.LAW_LINEAR / LAW_POWER
+# Fewest steps per period by default (accuracy, not stability): the central differences shorten
+# the modal mass by (Omega dt)^2 / 12, which moves a resonance and, on the steep flank of the
+# lightly damped stuck 1F peak, changes the amplitude ~25x as much. Measured on the reference
+# 1 g cylinder at 95 Hz (stuck; HBM 0.226976 mm): 287 steps (the stability limit x 0.8)
+# 0.226339 mm (-0.28 %), 574 steps 0.226781 mm (-0.086 %): second order.
+MIN_STEPS_PER_PERIOD = 512
+
+
+@njit(cache=True)
+def _normal_force(law_kind, p0, p1, p2, weight, approach):
+    """(N, dN/da) of one point (contact.laws: linear k_N w a, or power w N_ref (a / a_ref)^p)."""
+    if approach <= 0.0:
+        return 0.0, 0.0
+    if law_kind == _LAW_LINEAR:
+        k = p0 * weight
+        return k * approach, k
+    ratio = approach / p1
+    n_ref = p0 * weight
+    return n_ref * ratio ** p2, n_ref * p2 / p1 * ratio ** (p2 - 1.0)
+
+
+@njit(cache=True)
+def _disk_period(steps, dt, n_q, m_q, c_q, k_q, minv, f_static, f_cos, f_sin,
+                 Tb, idx, pt_local, B, k_t, mu, weight, offset, law_kind, law_par, t_nnz, t_col, b_nnz, b_col,
+                 tip, x, x_prev, slider,
+                 tip_samples, tip_dft, damper_mean, damper_dft, damper_work, point_states, energies):
+    """Integrate one excitation period of the assembly by central differences (in place).
+
+    Unknowns x (N,): n_q modal coordinates of the blades (first), then 6 per damper. EOM
+    M x'' + D x' + K x + T^T f_c(T x) = f_static + f_cos cos(Omega t) + f_sin sin(Omega t)
+    (the HBM's residual written in time, Eq. 1-5, 12, 16-20): blades m_q, c_q, k_q diagonal
+    (modal, Eq. 5), dampers by their inverse inertia minv (n_d, 6, 6). Contact map of damper d:
+    w_d (12) = Tb[d] (12, m) @ x[idx[d]] (m,) (Eq. 6-9); point p of damper d's patch q
+    (pt_local[p] = 12 d + 6 q) moves by u_p = B[p] (3, 6) @ w_d[6q:6q+6] (Eq. 7); the point
+    force on the platform (f_xi, f_eta, -N) goes back by B^T and Tb^T (Eq. 11). The slider
+    (slider (P, 2)) is advanced by :func:`slider_step`, the AFT's own return-map step. Both maps
+    are applied through their nonzeros only: row r of Tb[d] has t_nnz[d, r] nonzero columns
+    t_col[d, r, :t_nnz[d, r]], row i of B[p] b_nnz[p, i] nonzero columns b_col[p, i, :]
+    (the rigid point map has 7 of 18).
+
+    Outputs of the period (overwritten): tip_samples (s, 3, steps) tip displacement (tip (s,3,nm_blade)
+    maps blade k's modal coordinates, assumed at x[k*nm:(k+1)*nm]); tip_dft (s, 3, 2) first-harmonic
+    cosine / sine coefficients; damper_mean, damper_dft (n_d, 6) and (n_d, 6, 2); damper_work
+    (n_d,) slip work; point_states (P, 3) samples in stick / slip / separated; energies (2,):
+    excitation work of the harmonic load, viscous dissipation (all per period, J).
+    """
+    N = x.shape[0]
+    nd = Tb.shape[0]
+    P = B.shape[0]
+    s_bl = tip.shape[0]
+    nm = tip.shape[2]
+    fc = np.zeros(N)
+    w = np.zeros(12 * nd)
+    fl = np.zeros(12 * nd)
+    x_new = np.zeros(N)
+    tip_dft[:, :, :] = 0.0
+    damper_mean[:, :] = 0.0
+    damper_dft[:, :, :] = 0.0
+    damper_work[:] = 0.0
+    point_states[:, :] = 0
+    w_exc = 0.0
+    w_visc = 0.0
+    two_pi = 2.0 * np.pi
+    inv_dt2 = 1.0 / (dt * dt)
+    for j in range(steps):
+        ph = two_pi * j / steps
+        cj = np.cos(ph)
+        sj = np.sin(ph)
+        # relative motion at the contacts (Eq. 6)
+        for d in range(nd):
+            for r in range(12):
+                acc = 0.0
+                for e in range(t_nnz[d, r]):
+                    c = t_col[d, r, e]
+                    acc += Tb[d, r, c] * x[idx[d, c]]
+                w[12 * d + r] = acc
+        fl[:] = 0.0
+        for p in range(P):
+            base = pt_local[p]
+            u0 = 0.0
+            u1 = 0.0
+            u2 = 0.0
+            for e in range(b_nnz[p, 0]):
+                c = b_col[p, 0, e]
+                u0 += B[p, 0, c] * w[base + c]
+            for e in range(b_nnz[p, 1]):
+                c = b_col[p, 1, e]
+                u1 += B[p, 1, c] * w[base + c]
+            for e in range(b_nnz[p, 2]):
+                c = b_col[p, 2, e]
+                u2 += B[p, 2, c] * w[base + c]
+            normal, _ = _normal_force(law_kind[p], law_par[p, 0], law_par[p, 1], law_par[p, 2], weight[p],
+                                      offset[p] - u2)
+            s0 = slider[p, 0]
+            s1 = slider[p, 1]
+            f0, f1, n0, n1, st = slider_step(u0, u1, s0, s1, k_t[p], mu[p] * normal, normal > 0.0)
+            if st == 1:
+                damper_work[base // 12] += f0 * (n0 - s0) + f1 * (n1 - s1)
+            slider[p, 0] = n0
+            slider[p, 1] = n1
+            point_states[p, st] += 1
+            f2 = -normal
+            for e in range(b_nnz[p, 0]):
+                c = b_col[p, 0, e]
+                fl[base + c] += B[p, 0, c] * f0
+            for e in range(b_nnz[p, 1]):
+                c = b_col[p, 1, e]
+                fl[base + c] += B[p, 1, c] * f1
+            for e in range(b_nnz[p, 2]):
+                c = b_col[p, 2, e]
+                fl[base + c] += B[p, 2, c] * f2
+        fc[:] = 0.0
+        for d in range(nd):
+            for r in range(12):
+                fr = fl[12 * d + r]
+                for e in range(t_nnz[d, r]):
+                    c = t_col[d, r, e]
+                    fc[idx[d, c]] += Tb[d, r, c] * fr
+        # blades: (M/dt^2 + D/(2 dt)) x+ = f - K x - T^T f_c + M (2x - x-)/dt^2 + D x- / (2 dt)
+        for i in range(n_q):
+            f = f_static[i] + f_cos[i] * cj + f_sin[i] * sj
+            rhs = f - k_q[i] * x[i] - fc[i] + m_q[i] * (2.0 * x[i] - x_prev[i]) * inv_dt2 \
+                + c_q[i] * x_prev[i] / (2.0 * dt)
+            x_new[i] = rhs / (m_q[i] * inv_dt2 + c_q[i] / (2.0 * dt))
+        # dampers: x+ = 2x - x- + dt^2 I_D^-1 (f - T^T f_c) (Eq. 12 with inertia)
+        for d in range(nd):
+            o = n_q + 6 * d
+            for a in range(6):
+                acc = 0.0
+                for b in range(6):
+                    acc += minv[d, a, b] * (f_static[o + b] + f_cos[o + b] * cj + f_sin[o + b] * sj - fc[o + b])
+                x_new[o + a] = 2.0 * x[o + a] - x_prev[o + a] + dt * dt * acc
+        # per-period statistics at sample j (x at t_j), velocities by central differences
+        for i in range(N):
+            v = (x_new[i] - x_prev[i]) / (2.0 * dt)
+            if i < n_q:
+                w_visc += c_q[i] * v * v * dt
+            w_exc += (f_cos[i] * cj + f_sin[i] * sj) * v * dt
+        for k in range(s_bl):
+            for a in range(3):
+                acc = 0.0
+                for q in range(nm):
+                    acc += tip[k, a, q] * x[k * nm + q]
+                tip_samples[k, a, j] = acc
+                tip_dft[k, a, 0] += acc * cj
+                tip_dft[k, a, 1] += acc * sj
+        for d in range(nd):
+            o = n_q + 6 * d
+            for a in range(6):
+                damper_mean[d, a] += x[o + a]
+                damper_dft[d, a, 0] += x[o + a] * cj
+                damper_dft[d, a, 1] += x[o + a] * sj
+        for i in range(N):
+            x_prev[i] = x[i]
+            x[i] = x_new[i]
+    scale = 2.0 / steps
+    for k in range(s_bl):
+        for a in range(3):
+            tip_dft[k, a, 0] *= scale
+            tip_dft[k, a, 1] *= scale
+    for d in range(nd):
+        for a in range(6):
+            damper_mean[d, a] /= steps
+            damper_dft[d, a, 0] *= scale
+            damper_dft[d, a, 1] *= scale
+    energies[0] = w_exc
+    energies[1] = w_visc
+
+
+@dataclass
+class _AssemblyArrays:
+    """The HBM model of a full assembly as arrays of the time integration (see
+    :func:`_assembly_arrays`)."""
+
+    system: object
+    n_q: int
+    m_q: np.ndarray
+    c_q: np.ndarray
+    k_q: np.ndarray
+    minv: np.ndarray
+    Tb: np.ndarray
+    idx: np.ndarray
+    pt_local: np.ndarray
+    B: np.ndarray
+    k_t: np.ndarray
+    mu: np.ndarray
+    weight: np.ndarray
+    offset: np.ndarray
+    law_kind: np.ndarray
+    law_par: np.ndarray
+    tip: np.ndarray
+    point_map: object          # scipy.sparse (3P, N): x -> point displacements (xi, eta, zeta)
+    geometries: list
+    stiffness: object          # scipy.sparse (N, N)
+    mass: object               # scipy.sparse (N, N)
+
+
+def _assembly_arrays(disk) -> _AssemblyArrays:
+    """Arrays of the time integration, taken from the HBM model of ``disk`` (a full-assembly
+    :class:`~bladedamp.mistuned.MistunedDisk`), so that both solve the same equations.
+
+    ``disk.hbm_system((0, 1))`` gives M, D, K (Eq. 5, 12), the contact map T of every damper
+    (its static block: in the full assembly the map is real and the same for every harmonic,
+    Eq. 16-20, 6-9), the loads (static F_CG on each damper, Eq. 26; the first-harmonic
+    excitation with the engine-order phase of each blade) and the contact patches (point maps,
+    k_T, mu, weights, normal law, initial gaps) of :class:`~bladedamp.mistuned.AssemblyContacts`.
+    """
+    import scipy.sparse as sp
+
+    from .contact.point import normal_law_parameters
+
+    system = disk.hbm_system((0, 1))
+    N = system.n_dof
+    s, nm = disk.n_sector, disk.n_modes
+    n_q = s * nm
+    M = sp.csr_matrix(system.mass)
+    D = sp.csr_matrix(system.damping)
+    K = sp.csr_matrix(system.stiffness)
+    blade = slice(0, n_q)
+    # the explicit scheme relies on the structure of Eq. 5 and 12: diagonal modal blocks, one
+    # inertia block per damper, no damper stiffness or damping, no coupling in M, D, K
+    for name, A, diag_blades in (("mass", M, True), ("damping", D, True), ("stiffness", K, True)):
+        Ab = A[blade, blade]
+        off = Ab - sp.diags(Ab.diagonal())
+        if diag_blades and abs(off).sum() > 0:
+            raise ValueError(f"time_response needs diagonal modal {name} matrices of the blades")
+        if abs(A[blade, n_q:]).sum() + abs(A[n_q:, blade]).sum() > 0:
+            raise ValueError(f"time_response needs {name} matrices without blade-damper coupling")
+    nd = (N - n_q) // 6
+    minv = np.zeros((nd, 6, 6))
+    for d in range(nd):
+        sl = slice(n_q + 6 * d, n_q + 6 * d + 6)
+        Md = M[sl, sl].toarray()
+        if abs(D[sl, :]).sum() + abs(K[sl, :]).sum() > 0:
+            raise ValueError("time_response needs dampers without structural stiffness or damping")
+        if not np.all(np.linalg.eigvalsh(Md) > 0):
+            raise ValueError("time_response needs the damper inertia (damper_inertia=True): the explicit "
+                             "scheme integrates every damper as a rigid body with mass")
+        minv[d] = np.linalg.inv(Md)
+        if np.abs(M[sl, :].toarray()).sum() - np.abs(Md).sum() > 0:
+            raise ValueError("time_response needs damper inertia blocks without coupling")
+    tip = np.stack([b.shape("tip")[:3] for b in disk.blades])          # (s, 3, nm)
+    if nd == 0:
+        e = np.zeros
+        return _AssemblyArrays(system, n_q, M.diagonal()[:n_q], D.diagonal()[:n_q], K.diagonal()[:n_q], minv,
+                               e((0, 12, 1)), np.zeros((0, 1), dtype=np.int64), np.zeros(0, dtype=np.int64),
+                               e((0, 3, 6)), e(0), e(0), e(0), e(0), np.zeros(0, dtype=np.int64), e((0, 3)), tip,
+                               sp.csr_matrix((0, N)), [], K, M)
+    coupling = system.couplings[0]
+    element = coupling.element
+    n_local = element.n_local
+    T = sp.csr_matrix(coupling.matrix)[:n_local, :N]          # static block (cos_index(0) = 0)
+    Tb_list, idx_list = [], []
+    for d in range(nd):
+        Td = T[12 * d:12 * d + 12]
+        cols = np.unique(Td.indices)
+        Tb_list.append(Td[:, cols].toarray())
+        idx_list.append(cols)
+    m = max(len(c) for c in idx_list)
+    Tb = np.zeros((nd, 12, m))
+    idx = np.zeros((nd, m), dtype=np.int64)
+    for d, (tb, cols) in enumerate(zip(Tb_list, idx_list)):
+        Tb[d, :, :len(cols)] = tb
+        idx[d, :len(cols)] = cols
+    pts = dict(pt_local=[], B=[], k_t=[], mu=[], weight=[], offset=[], law_kind=[], law_par=[])
+    geometries = []
+    for d, contact in enumerate(element.contacts):
+        geometries.append(contact.geometry)
+        for q, patch in enumerate(contact.geometry.patches):
+            law = normal_law_parameters(patch.normal_law)
+            if law is None:
+                raise ValueError("time_response supports the LinearNormalLaw and RoughnessNormalLaw normal laws "
+                                 f"(got {type(patch.normal_law).__name__})")
+            P = patch.n_points
+            pts["pt_local"].append(np.full(P, 12 * d + 6 * q))
+            pts["B"].append(patch.point_map)
+            pts["k_t"].append(patch.tangential_stiffness * patch.weights)     # as DamperContacts._stack
+            pts["mu"].append(np.full(P, patch.friction_coefficient))
+            pts["weight"].append(patch.weights)
+            pts["offset"].append(-patch.initial_gap)                          # approach at w = 0
+            pts["law_kind"].append(np.full(P, law[0]))
+            pts["law_par"].append(np.tile(law[1], (P, 1)))
+    arr = {k: np.ascontiguousarray(np.concatenate(v)) for k, v in pts.items()}
+    arr["pt_local"] = arr["pt_local"].astype(np.int64)
+    arr["law_kind"] = arr["law_kind"].astype(np.int64)
+    P = arr["B"].shape[0]
+    rows = (3 * np.arange(P)[:, None, None] + np.arange(3)[None, :, None]) * np.ones((1, 1, 6))
+    cols = arr["pt_local"][:, None, None] + np.arange(6)[None, None, :] * np.ones((1, 3, 1))
+    Bs = sp.csr_matrix((arr["B"].ravel(), (rows.ravel().astype(int), cols.ravel().astype(int))), shape=(3 * P, n_local))
+    return _AssemblyArrays(system, n_q, M.diagonal()[:n_q].copy(), D.diagonal()[:n_q].copy(), K.diagonal()[:n_q].copy(),
+                           minv, Tb, idx, tip=tip, point_map=(Bs @ T).tocsr(), geometries=geometries, stiffness=K,
+                           mass=M, **arr)
+
+
+def _normal_law_numpy(arrays: _AssemblyArrays, approach: np.ndarray):
+    """(N, dN/da) of every point (numpy version of :func:`_normal_force`)."""
+    a = np.maximum(approach, 0.0)
+    p0, p1, p2 = arrays.law_par.T
+    linear = arrays.law_kind == _LAW_LINEAR
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(linear, 1.0, a / np.where(linear, 1.0, p1))
+        n_pow = p0 * arrays.weight * ratio ** p2
+        k_pow = np.where(a > 0, p0 * arrays.weight * p2 / np.where(linear, 1.0, p1) * ratio ** (p2 - 1.0), 0.0)
+    normal = np.where(linear, p0 * arrays.weight * a, n_pow)
+    stiff = np.where(approach > 0, np.where(linear, p0 * arrays.weight, k_pow), 0.0)
+    return normal, stiff
+
+
+def _static_state(arrays: _AssemblyArrays, f_static: np.ndarray, tol: float = 1e-12, max_iter: int = 60):
+    """Static equilibrium under the centrifugal load F_CG (Eq. 26) with frictionless contacts:
+    K x - Z^T N(offset - Z x) = f_static, Z the normal displacement of every point. Newton
+    from every damper seated on rigid platforms (:func:`~bladedamp.damper.kinetics.seat`); the
+    directions no normal force fixes (axial position, the cylinder's roll) stay at zero
+    (minimum-norm steps). With friction this is the equilibrium with every slider at its
+    point's tangential displacement (zero tangential force). Returns x (N,)."""
+    from .damper.kinetics import seat
+
+    N = arrays.stiffness.shape[0]
+    x = np.zeros(N)
+    for d, g in enumerate(arrays.geometries):
+        o = arrays.n_q + 6 * d
+        x[o:o + 6] = seat(g, max(float(f_static[o + 2]), 0.0))[0]
+    if not arrays.geometries:
+        return np.asarray(np.linalg.lstsq(arrays.stiffness.toarray(), f_static, rcond=None)[0])
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import spsolve
+
+    Z = arrays.point_map[2::3]                            # (P, N) sparse: u_zeta of every point
+    K = arrays.stiffness
+    scale = np.abs(f_static).max() + 1e-300
+    # the free directions (zero stiffness) get a spring 1e-12 of the contact stiffness: their
+    # right-hand side is zero, so they stay at zero (to rounding), as minimum-norm steps would
+    n_free = np.zeros(N)
+    n_free[arrays.n_q:] = 1e-12 * (arrays.law_par[:, 0].max() + arrays.k_t.sum())
+    for _ in range(max_iter):
+        normal, dn = _normal_law_numpy(arrays, arrays.offset - Z @ x)
+        R = K @ x - Z.T @ normal - f_static
+        J = (K + Z.T @ sp.diags(dn) @ Z + sp.diags(n_free)).tocsc()
+        dx = -spsolve(J, R)
+        x = x + dx
+        if np.abs(R).max() <= tol * scale and np.linalg.norm(dx) <= 1e-9 * (np.linalg.norm(x) + 1e-300):
+            return x
+    normal, _ = _normal_law_numpy(arrays, arrays.offset - Z @ x)
+    R = K @ x - Z.T @ normal - f_static
+    if np.abs(R).max() > 1e-8 * scale:
+        raise RuntimeError(f"static equilibrium under the centrifugal load did not converge (residual {np.abs(R).max():.3g} N)")
+    return x
+
+
+def _highest_frequency(arrays: _AssemblyArrays, x_static: np.ndarray) -> float:
+    """Highest natural frequency [rad/s] of the assembly linearised about the static state with
+    every contact point stuck (k_T tangential, dN/da normal; the power law's stiffness at twice
+    the static approach): the stability limit of the central differences is dt < 2 / omega_max."""
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import eigsh
+
+    K = arrays.stiffness
+    if arrays.geometries:
+        W = arrays.point_map
+        approach = arrays.offset - W[2::3] @ x_static
+        a_ref = np.where(approach > 0, 2.0 * approach, np.maximum(approach.max(), 0.0) * 2.0)
+        _, kn = _normal_law_numpy(arrays, a_ref)
+        if not np.any(kn > 0):
+            kn = _normal_law_numpy(arrays, np.full_like(approach, 1e-9))[1]
+        k = np.column_stack([arrays.k_t, arrays.k_t, kn]).ravel()
+        K = K + W.T @ sp.diags(k) @ W
+    # M^-1/2 K M^-1/2 (M block diagonal: modal masses, 6 x 6 damper inertias)
+    N = K.shape[0]
+    L = sp.lil_matrix((N, N))
+    L[np.arange(arrays.n_q), np.arange(arrays.n_q)] = 1.0 / np.sqrt(arrays.m_q)
+    for d in range(arrays.minv.shape[0]):
+        lam, V = np.linalg.eigh(arrays.minv[d])
+        o = arrays.n_q + 6 * d
+        L[o:o + 6, o:o + 6] = (V * np.sqrt(lam)) @ V.T
+    L = L.tocsr()
+    A = (L @ K @ L).tocsc()
+    if N <= 12:
+        return float(np.sqrt(max(np.linalg.eigvalsh(A.toarray()).max(), 0.0)))
+    lam = eigsh(A, k=1, which="LA", return_eigenvectors=False, tol=1e-6)
+    return float(np.sqrt(max(lam.max(), 0.0)))
+
+
+@dataclass
+class DiskTimeResponse:
+    """Steady state of a bladed disk by time integration of the full assembly, one run per
+    excitation frequency (see :func:`disk_time_response`).
+
+    Attributes (n frequencies, s blades, n_d dampers, P contact points, S steps per period)
+    ----------
+    omega : (n,) excitation frequency Omega_E [rad/s]
+    tip_amplitude : (n, s, 3) first-harmonic tip amplitude of every blade in x, y, z [m]
+        (last period; for a drifting state whose first harmonics fluctuate from period to
+        period, their mean over the last 2 drift_periods periods)
+    tip_harmonic : (n, s, 3) complex first harmonic X (tip = Re(X e^{i Omega t})) [m]
+    tip_samples : (n, s, 3, S) tip displacement over the last period [m]
+    dissipated_energy : (n,) friction dissipation per period, all contacts [J]
+    damper_dissipation : (n, n_d) friction dissipation of each damper per period [J]
+    excitation_work : (n,) work of the harmonic excitation per period [J]
+    viscous_dissipation : (n,) modal damping dissipation of the blades per period [J]
+    periods : (n,) periods integrated
+    periodic : (n,) a steady periodic state was reached
+    status : (n,) "periodic", "drifting", "not settled" or "unstable"
+    message : (n,) what was found, with the numbers
+    settling : (n,) change of the first harmonics in the last period, relative to the largest
+    damper_mean : (n, n_d, 6) mean damper displacement over the last period [m, rad]
+    damper_drift : (n, n_d, 6) change of that mean in the last period [m, rad per period]
+    point_state : (n, P, 3) share of the last period each point sticks, slips, is separated
+    steps_per_period : S; time_step : (n,) [s]
+    static_state : (n, N) static equilibrium under F_CG the run started from
+    tip_history : n arrays (periods, s, 3) complex, the first harmonic of every period (settling)
+    damper_history : n arrays (periods, n_d, 6), the period mean of the damper coordinates
+    """
+
+    omega: np.ndarray
+    tip_amplitude: np.ndarray
+    tip_harmonic: np.ndarray
+    tip_samples: np.ndarray
+    dissipated_energy: np.ndarray
+    damper_dissipation: np.ndarray
+    excitation_work: np.ndarray
+    viscous_dissipation: np.ndarray
+    periods: np.ndarray
+    periodic: np.ndarray
+    status: np.ndarray
+    message: np.ndarray
+    settling: np.ndarray
+    damper_mean: np.ndarray
+    damper_drift: np.ndarray
+    point_state: np.ndarray
+    steps_per_period: int
+    time_step: np.ndarray
+    static_state: np.ndarray
+    tip_history: list
+    damper_history: list
+
+    @property
+    def frequency_hz(self) -> np.ndarray:
+        return self.omega / (2 * np.pi)
+
+    @property
+    def n_blades(self) -> int:
+        return self.tip_amplitude.shape[1]
+
+    def energy_balance_error(self) -> np.ndarray:
+        """|W_exc - W_visc - W_friction| / W_exc per frequency (last period)."""
+        return np.abs(self.excitation_work - self.viscous_dissipation - self.dissipated_energy) / np.abs(self.excitation_work)
+
+    def plot(self, ax=None, direction: int = 0, blades=None, **kwargs):
+        """First-harmonic tip amplitude [mm] over frequency [Hz], one marker series per blade
+        (``blades``: indices, default all; a tuned disk's blades coincide); points that are not
+        periodic are drawn as open markers."""
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            _, ax = plt.subplots(figsize=(6, 4))
+        blades = range(self.n_blades) if blades is None else blades
+        kwargs.setdefault("marker", "o")
+        kwargs.setdefault("linestyle", "none")
+        label = kwargs.pop("label", "time integration")
+        f = self.frequency_hz
+        for i, k in enumerate(blades):
+            a = 1e3 * self.tip_amplitude[:, k, direction]
+            line, = ax.plot(f[self.periodic], a[self.periodic], label=label if i == 0 else None, **kwargs)
+            if np.any(~self.periodic):
+                kw = dict(kwargs, color=line.get_color(), markerfacecolor="none")
+                ax.plot(f[~self.periodic], a[~self.periodic],
+                        label="not periodic" if i == 0 else None, **kw)
+        ax.set_xlabel("excitation frequency [Hz]")
+        ax.set_ylabel(f"tip amplitude u_{'xyz'[direction]} [mm]")
+        ax.grid(True, alpha=0.3)
+        ax.legend()
+        return ax
+
+
+_DOF = ("u_x", "u_y", "u_z", "phi_x", "phi_y", "phi_z")
+
+
+def _drift_verdict(means, scale, tol):
+    """(damper, coordinate, rate per period) if the period means (W+1, n_d, 6) of the damper
+    coordinates move steadily: monotonic over the window (net change >= 0.9 x the sum of the
+    per-period changes), at an undiminished rate (second half >= 0.8 x first half) that is
+    well above the settling tolerance (> 10 tol x ``scale`` (6,), the vibration amplitude of
+    that kind of coordinate). A transient of the mean oscillates or decays and fails one of
+    these; a rolling cylinder or a damper walking axially passes all. Else None."""
+    inc = np.diff(means, axis=0)                               # (W, n_d, 6)
+    net = means[-1] - means[0]
+    total = np.abs(inc).sum(axis=0)
+    half = inc.shape[0] // 2
+    first = np.abs(inc[:half].sum(axis=0))
+    second = np.abs(inc[half:2 * half].sum(axis=0))
+    rate = net / inc.shape[0]
+    steady = (np.abs(net) >= 0.9 * total) & (second >= 0.8 * first) & (np.abs(rate) > 10 * tol * scale[None, :])
+    if not np.any(steady):
+        return None
+    rel = np.where(steady, np.abs(rate) / scale[None, :], 0.0)
+    d, a = np.unravel_index(np.argmax(rel), rel.shape)
+    return int(d), int(a), float(rate[d, a])
+
+
+def _row_nonzeros(A):
+    """(nnz (n, r) int64, columns (n, r, c) int64) of the rows of a stack of matrices (n, r, c)."""
+    nz = A != 0
+    nnz = nz.sum(axis=2).astype(np.int64)
+    cols = np.zeros(A.shape, dtype=np.int64)
+    for idx in np.ndindex(A.shape[:2]):
+        c = np.flatnonzero(nz[idx])
+        cols[idx][:len(c)] = c
+    return nnz, cols
+
+
+def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max_periods: int = 4000,
+                       n_stable: int = 5, drift_periods: int = 40, steps_per_period: int | None = None,
+                       stability_margin: float = 0.8, fluctuation_tol: float = 2e-4) -> DiskTimeResponse:
+    """Steady-state forced response of a full-assembly MistunedDisk by time integration.
+
+    Each frequency f_hz [Hz] is a separate run: the assembly starts at rest in its static
+    equilibrium under the centrifugal load F_CG = m R Omega_E^2 / EO^2 (Eq. 26, constant during
+    the run; :func:`_static_state`: frictionless seating on the flexible blades, every slider
+    at its point's tangential displacement, so no tangential force), then the harmonic
+    excitation of the HBM (blade k's tip load f cos(Omega t + k dphi), dphi = 2 pi EO / n, as
+    :meth:`MistunedDisk.hbm_system`) is switched on at t = 0. Central differences
+    (:func:`_disk_period`), ``steps_per_period`` steps, the same for every frequency of the
+    call (default: the more of MIN_STEPS_PER_PERIOD = 512, for accuracy, and the steps at
+    ``stability_margin`` x the stability limit 2 / omega_max of the stuck linearised assembly;
+    a given value below that limit is a ValueError).
+
+    Parameters: f_hz scalar or (n,) [Hz]; tol relative change of the first harmonics per period
+    in (0, 0.1]; min_periods, max_periods periods integrated at least / at most; n_stable
+    consecutive settled periods; drift_periods window of the drift test; fluctuation_tol see
+    below.
+
+    Steady state: the complex first harmonic of every blade's tip (3 directions, DFT of each
+    period) changes by at most ``tol`` x the largest of them for ``n_stable`` consecutive
+    periods (after at least ``min_periods``), and the period mean of every damper coordinate
+    changes by at most ``tol`` x the vibration amplitude of its kind (translations, rotations).
+    The remaining transient is then about tol / (2 pi zeta_eff) of the amplitude (zeta_eff the
+    effective damping ratio; ~5e-4 at the defaults for the reference dampers). If the first
+    harmonics settle but a damper's mean keeps moving at an undiminished rate for
+    ``drift_periods`` periods (a cylinder rolling along the platforms, a damper walking
+    axially), the motion is not periodic: status "drifting", with the rate. First harmonics
+    that keep fluctuating from period to period (by more than ``tol``; measured 6e-5 on a
+    4-blade mistuned wedge disk, a period-2 pattern: most likely the undamped ringing of the
+    dampers on their contact springs, which the model does not damp; or the beat of a lightly
+    damped transient) are judged by their mean over 2 ``drift_periods`` periods: "periodic
+    within a fluctuation" when that mean settles (a trend <= tol per period) and the
+    fluctuation is at most ``fluctuation_tol`` per period; the tip amplitudes are then that
+    mean (a beat of the transient averages out of it).
+
+    Status "not settled" after ``max_periods``; "unstable" if the integration diverges.
+
+    Returns a :class:`DiskTimeResponse`.
+    """
+    from . import _validate
+
+    f_hz = np.atleast_1d(np.asarray(_validate.positive("f_hz (excitation frequency, Hz)", f_hz), dtype=float))
+    if f_hz.ndim != 1:
+        raise ValueError("f_hz must be a scalar or a 1-D array of frequencies in Hz")
+    _validate.in_range("tol", tol, 0.0, 0.1, closed="right")
+    min_periods = _validate.integer("min_periods", min_periods, minimum=1)
+    max_periods = _validate.integer("max_periods", max_periods, minimum=min_periods)
+    n_stable = _validate.integer("n_stable", n_stable, minimum=1)
+    drift_periods = _validate.integer("drift_periods", drift_periods, minimum=2)
+    _validate.in_range("stability_margin", stability_margin, 0.0, 1.0, closed="right")
+    _validate.in_range("fluctuation_tol", fluctuation_tol, 0.0, 0.1, closed="right")
+    if disk.n_sector != disk.n_blades:
+        raise ValueError(f"time_response integrates the full assembly: len(blades) must equal n_blades "
+                         f"({disk.n_blades}), got a cyclic sector of {disk.n_sector}")
+    arrays = _assembly_arrays(disk)
+    system = arrays.system
+    N, C = system.n_dof, system.basis.n_coeffs
+    omega = 2 * np.pi * f_hz
+    loads, statics = [], []
+    w_max = 0.0
+    for w in omega:
+        f = system.excitation(w)[0].reshape(C, N)        # rows: static (F_CG), cos, sin (basis (0, 1))
+        loads.append(f)
+        x0 = _static_state(arrays, f[0])
+        statics.append(x0)
+        w_max = max(w_max, _highest_frequency(arrays, x0))
+    dt_limit = 2.0 / w_max
+    needed = int(np.ceil(2 * np.pi / omega.min() / (stability_margin * dt_limit)))
+    if steps_per_period is None:
+        steps = max(MIN_STEPS_PER_PERIOD, needed)
+    else:
+        steps = _validate.integer("steps_per_period", steps_per_period, minimum=16)
+        if 2 * np.pi / omega.min() / steps > dt_limit:
+            raise ValueError(f"steps_per_period must be at least {int(np.ceil(2 * np.pi / omega.min() / dt_limit))} "
+                             f"(stability limit of the explicit scheme, omega_max = {w_max:.4g} rad/s; got {steps})")
+    s, nd, P = disk.n_sector, arrays.minv.shape[0], arrays.B.shape[0]
+    n = omega.size
+    out = dict(tip_harmonic=np.zeros((n, s, 3), complex), tip_samples=np.zeros((n, s, 3, steps)),
+               dissipated_energy=np.zeros(n), damper_dissipation=np.zeros((n, nd)), excitation_work=np.zeros(n),
+               viscous_dissipation=np.zeros(n), periods=np.zeros(n, dtype=int), periodic=np.zeros(n, dtype=bool),
+               status=np.empty(n, dtype=object), message=np.empty(n, dtype=object), settling=np.zeros(n),
+               damper_mean=np.zeros((n, nd, 6)), damper_drift=np.zeros((n, nd, 6)), point_state=np.zeros((n, P, 3)),
+               time_step=2 * np.pi / omega / steps, static_state=np.array(statics), tip_history=[],
+               damper_history=[])
+    t_nnz, t_col = _row_nonzeros(arrays.Tb)
+    b_nnz, b_col = _row_nonzeros(arrays.B)
+    tip_dft = np.zeros((s, 3, 2))
+    damper_mean = np.zeros((nd, 6))
+    damper_dft = np.zeros((nd, 6, 2))
+    damper_work = np.zeros(nd)
+    point_states = np.zeros((P, 3), dtype=np.int64)
+    energies = np.zeros(2)
+    for i, w in enumerate(omega):
+        f = loads[i]
+        x = statics[i].copy()
+        x_prev = x.copy()
+        slider = np.ascontiguousarray((arrays.point_map @ x).reshape(P, 3)[:, :2]) if P else np.zeros((0, 2))
+        dt = 2 * np.pi / w / steps
+        X_old, mean_old = None, None
+        stable = 0
+        changes = []
+        status, message = "not settled", ""
+        change = np.inf
+        tip_hist, mean_hist = [], []
+        for period in range(max_periods):
+            _disk_period(steps, dt, arrays.n_q, arrays.m_q, arrays.c_q, arrays.k_q, arrays.minv, f[0], f[1], f[2],
+                         arrays.Tb, arrays.idx, arrays.pt_local, arrays.B, arrays.k_t, arrays.mu, arrays.weight,
+                         arrays.offset, arrays.law_kind, arrays.law_par, t_nnz, t_col, b_nnz, b_col, arrays.tip,
+                         x, x_prev, slider,
+                         out["tip_samples"][i], tip_dft, damper_mean, damper_dft, damper_work, point_states, energies)
+            X = tip_dft[:, :, 0] - 1j * tip_dft[:, :, 1]
+            tip_hist.append(X)
+            mean_hist.append(damper_mean.copy())
+            if not np.all(np.isfinite(X)) or not np.all(np.isfinite(x)):
+                status = "unstable"
+                message = (f"unstable: the explicit integration diverged in period {period + 1} "
+                           f"({steps} steps per period); give more steps_per_period")
+                break
+            if X_old is not None:
+                change = np.abs(X - X_old).max() / max(np.abs(X).max(), 1e-300)
+                stable = stable + 1 if change <= tol else 0
+            drift = damper_mean - mean_old if mean_old is not None else np.full((nd, 6), np.inf)
+            X_old, mean_old = X, damper_mean.copy()
+            amp = np.abs(damper_dft[:, :, 0] - 1j * damper_dft[:, :, 1])
+            scale = np.array([amp[:, :3].max(initial=0.0), amp[:, 3:].max(initial=0.0)]) + 1e-300
+            rel = np.abs(drift) / np.repeat(scale, 3)[None, :] if nd else np.zeros((0, 6))
+            changes.append(change)
+            p = period + 1
+            if p < min_periods:
+                continue
+            settled = stable >= n_stable
+            if settled and (nd == 0 or rel.max() <= tol):
+                # the first harmonics are periodic, and so are the damper positions
+                status = "periodic"
+                message = f"periodic: first harmonics settled to {change:.1e} per period after {p} periods"
+                break
+            W = drift_periods
+            if nd == 0 or p <= W or not (settled or p % max(W // 4, 1) == 0):
+                continue
+            verdict = _drift_verdict(np.array(mean_hist[-W - 1:]), np.repeat(scale, 3), tol)
+            trend = None
+            if not settled and p >= 4 * W:
+                # first harmonics that fluctuate from period to period (undamped ringing of the
+                # dampers on their contact stiffness: the model has no contact damping) may
+                # still settle on average: compare their means over the last 2 W periods and
+                # the 2 W before (a trend of at most tol per period)
+                recent = np.mean(tip_hist[-2 * W:], axis=0)
+                before = np.mean(tip_hist[-4 * W:-2 * W], axis=0)
+                trend = np.abs(recent - before).max() / max(np.abs(recent).max(), 1e-300) / (2 * W)
+                jitter = float(np.mean(changes[-2 * W:]))
+            if verdict is None:
+                if stable >= W:
+                    # the damper means fluctuate but do not drift over W periods: periodic
+                    status = "periodic"
+                    message = (f"periodic: first harmonics settled to {change:.1e} per period after {p} periods "
+                               f"(damper means fluctuate by up to {rel.max():.1e} of the vibration amplitude "
+                               f"per period, without drift over {W} periods)")
+                    break
+                if trend is not None and trend <= tol and jitter <= fluctuation_tol:
+                    X = recent                    # report the mean first harmonic
+                    status = "periodic"
+                    message = (f"periodic within a fluctuation: first harmonics fluctuate by {jitter:.1e} per period "
+                               f"(mean over {2 * W}; <= fluctuation_tol {fluctuation_tol:g}) about a mean that settled "
+                               f"to {trend:.1e} per period, after {p} periods (the tip amplitudes are that mean over "
+                               f"the last {2 * W} periods); the dampers do not drift")
+                    break
+                continue
+            if not settled:
+                # a steady drift while the first harmonics still change: wait until their mean settles
+                if trend is None or trend > tol:
+                    continue
+                X = recent                        # not periodic: report the mean first harmonic
+            d, a, rate = verdict
+            kind = "rotation" if a >= 3 else "translation"
+            unit = "rad" if a >= 3 else "m"
+            status = "drifting"
+            how = (f"settled to {change:.1e} per period" if settled else
+                   f"fluctuate by {np.mean(changes[-2 * W:]):.1e} per period about a mean that settled to "
+                   f"{trend:.1e} per period (the tip amplitudes are that mean over the last {2 * W} periods)")
+            message = (f"drifting: damper {kind} {_DOF[a]} grows by {rate:.3g} {unit} per period "
+                       f"(damper {disk.active_dampers[d]}, {100 * abs(rate) / scale[a // 3]:.3g} % of the dampers' "
+                       f"{kind} amplitude, steadily over the last {W} periods) while the first harmonics {how}; "
+                       f"after {p} periods")
+            break
+        else:
+            message = (f"not settled: first harmonics changed by {change:.2g} per period "
+                       f"(tol {tol:g}) after {max_periods} periods")
+        out["tip_harmonic"][i] = X
+        out["dissipated_energy"][i] = damper_work.sum()
+        out["damper_dissipation"][i] = damper_work
+        out["excitation_work"][i] = energies[0]
+        out["viscous_dissipation"][i] = energies[1]
+        out["periods"][i] = period + 1
+        out["periodic"][i] = status == "periodic"
+        out["status"][i] = status
+        out["message"][i] = message
+        out["settling"][i] = change
+        out["damper_mean"][i] = damper_mean
+        out["damper_drift"][i] = drift if np.all(np.isfinite(drift)) else np.nan
+        out["point_state"][i] = point_states / steps
+        out["tip_history"].append(np.array(tip_hist))
+        out["damper_history"].append(np.array(mean_hist).reshape(len(mean_hist), nd, 6))
+    return DiskTimeResponse(omega, np.abs(out["tip_harmonic"]), steps_per_period=steps, **out)
+
+
+def hbm_tip_at(disk, f_hz, harmonics=(0, 1, 2, 3), pad_hz: float = 1.0, max_step: float = 0.02,
+               **continuation_options) -> np.ndarray:
+    """First-harmonic tip amplitude of the harmonic balance at the exact frequencies ``f_hz``
+    [Hz], to compare with a :class:`DiskTimeResponse`: the FRF by continuation over the range
+    (``pad_hz`` beyond it at both ends), the branch interpolated linearly at each frequency and
+    corrected there by Newton on the HBM residual (to 1e-12 of the solution).
+
+    ``harmonics=None`` uses ``frequency_response``'s default. Returns (n, 3) [m] for a
+    TunedDisk (the reference blade), (n, s, 3) for a MistunedDisk (every blade).
+    """
+    import warnings
+
+    from . import _validate
+    from .disk import TunedDisk
+
+    f_hz = np.atleast_1d(np.asarray(_validate.positive("f_hz (excitation frequency, Hz)", f_hz), dtype=float))
+    _validate.positive("pad_hz", pad_hz)
+    kw = {} if harmonics is None else {"harmonics": tuple(harmonics)}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = disk.frequency_response(f_hz.min() - pad_hz, f_hz.max() + pad_hz, max_step=max_step,
+                                    **kw, **continuation_options)
+    if not r.success:
+        raise RuntimeError(f"HBM continuation failed: {r.message}")
+    from .hbm.continuation import newton
+
+    basis = r.basis
+    system = disk.hbm_system(basis.harmonics, basis.n_samples)
+    X = r.coefficients.reshape(len(r.omega), -1)
+    scales = disk.unknown_scales(system, float(r.omega.min()), float(r.omega.max()))
+    order = np.argsort(r.omega)
+    om, Xs = r.omega[order], X[order]
+    out = []
+    for f in f_hz:
+        w = 2 * np.pi * f
+        i = int(np.clip(np.searchsorted(om, w), 1, len(om) - 1))
+        t = (w - om[i - 1]) / (om[i] - om[i - 1])
+        x = (1 - t) * Xs[i - 1] + t * Xs[i]
+        rs = max(np.linalg.norm(system.residual(np.zeros_like(x), w, False)[0]), 1e-300)
+        sol = newton(system.residual, x, w, scales, rs, tol=1e-12, max_iter=40, factorize=system.factorize)
+        if not sol.converged:
+            raise RuntimeError(f"HBM Newton did not converge at {f} Hz")
+        out.append(disk.output_amplitudes(sol.x.reshape(1, basis.n_coeffs, -1), basis)[0])
+    out = np.array(out)                                              # (n, 3 s)
+    return out if isinstance(disk, TunedDisk) else out.reshape(len(f_hz), -1, 3)

@@ -67,5 +67,5 @@ def test_montecarlo_command_writes_results_loadable_without_pickle(tmp_path):
 
 
 def test_montecarlo_command_rejects_a_bad_step(tmp_path, capsys):
-    with pytest.raises(ValueError, match="max_step"):
+    with pytest.raises(ValueError, match="max.step"):
         main(["montecarlo", "--disks", "1", "--scheduler", "serial", "--max-step", "-1", "--out", str(tmp_path)])

@@ -119,8 +119,10 @@ class Branch:
     omega : (n,) angular frequencies of the converged points [rad/s]
     x : (n, N) unknowns at each point
     iterations : (n,) Newton iterations of each corrector
-    success : bool, whether the branch reached the end of the requested range
+    success : bool, whether the branch reached the end of the requested range with every check passing
     message : str, why it stopped
+    turning_points : indices of the folds
+    checks : {name: bool} of :func:`branch_checks` (empty for a branch not made by :func:`continuation`)
     """
 
     omega: np.ndarray
@@ -129,12 +131,48 @@ class Branch:
     success: bool
     message: str
     turning_points: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))  # indices of folds
+    checks: dict = field(default_factory=dict)   # name -> bool, see branch_checks
+
+
+def branch_checks(omega, omega_start, omega_end, max_step) -> dict:
+    """The contract of every branch :func:`continuation` returns, each check True if it holds:
+
+    ``inside_range``: every kept omega in [min(omega_start, omega_end), max(...)] (no point
+    beyond either end, no negative frequency); ``step_within_max_step``: no step between
+    consecutive points longer in omega than ``max_step`` times the range's width (max_step is
+    in scaled arc-length units, where the omega range is 1)."""
+    omega = np.asarray(omega, dtype=float)
+    lo, hi = min(omega_start, omega_end), max(omega_start, omega_end)
+    width = hi - lo
+    slack = 1e-12 * max(abs(lo), abs(hi))
+    inside = bool(np.all((omega >= lo - slack) & (omega <= hi + slack)))
+    steps = np.abs(np.diff(omega))
+    short = bool(steps.size == 0 or steps.max() <= max_step * width * (1 + 1e-9) + slack)
+    return {"inside_range": inside, "step_within_max_step": short}
+
+
+def _validate_options(step, max_step, min_step, max_points, tol, max_corrector, target_iterations, leave_margin):
+    """ValueError naming the option and its allowed range for zero, negative or NaN values."""
+    _validate.in_range("max_step", max_step, 0.0, 1.0, closed="right")
+    _validate.in_range("step", step, 0.0, max_step, closed="right")
+    _validate.in_range("min_step", min_step, 0.0, step, closed="right")
+    _validate.in_range("tol (Newton tolerance)", tol, 0.0, 1.0, closed="neither")
+    _validate.integer("max_points", max_points, minimum=2)
+    _validate.integer("max_corrector", max_corrector, minimum=1)
+    _validate.integer("target_iterations", target_iterations, minimum=1)
+    _validate.nonnegative("leave_margin", leave_margin)
 
 
 def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=None,
                  step=None, max_step=None, min_step=None, max_points=5000, tol=1e-10,
-                 max_corrector=12, target_iterations=5, factorize=lu_factorize, leave_margin=1.0):
+                 max_corrector=12, target_iterations=5, factorize=lu_factorize, leave_margin=0.0):
     """Pseudo-arclength continuation of R(x, omega) = 0 from ``omega_start`` to ``omega_end``.
+
+    Every branch it returns keeps the contract of :func:`branch_checks` (``Branch.checks``):
+    no point outside the range (a branch that turns back stops where it reaches ``omega_start``,
+    unsuccessful, its message saying it turned back; a point landing beyond ``omega_end`` is
+    replaced by the solution at ``omega_end``) and no step longer in omega than ``max_step``
+    times the range's width (a longer step is rejected and retried shorter).
 
     Parameters
     ----------
@@ -143,20 +181,28 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
     omega_start, omega_end : range [rad/s] (either direction)
     x_scale : scale of the unknowns (scalar or array); default max |x0|
     residual_scale : scale of the residual norm; default |R(0, omega_start)| (the excitation)
-    step, max_step, min_step : arc-length steps in scaled units (the scaled omega range is 1)
-    max_points : stop after this many points
-    tol : Newton tolerance on the scaled step and residual
+    step, max_step, min_step : arc-length steps in scaled units (the scaled omega range is 1):
+        0 < min_step <= step <= max_step <= 1 (defaults 1e-7, 0.01 or max_step, 0.02)
+    max_points : stop after this many points (an integer >= 2)
+    tol : Newton tolerance on the scaled step and residual, in (0, 1)
+    max_corrector : corrector iterations per step (>= 1)
     target_iterations : corrector iterations for which the step is kept; fewer -> grow, more -> shrink
     factorize : ``factorize(A) -> solve``, the linear solver for Newton and the bordered systems
         (default: dense or sparse LU; a structured one such as
         :class:`~bladedamp.hbm.linsolve.BlockCondensation` for assemblies)
-    leave_margin : the run stops (unsuccessful) when the branch turns back and passes
-        ``omega_start`` by more than this fraction of the range's width
+    leave_margin : kept for compatibility (>= 0), without effect: a branch that turns back now
+        always stops at ``omega_start`` (it used to run on until it passed ``omega_start`` by
+        this fraction of the range's width, keeping points outside the range)
     """
     _validate.finite("omega_start", omega_start)
     _validate.finite("omega_end", omega_end)
     if omega_start == omega_end:
         raise ValueError("omega_end must differ from omega_start")
+    max_step = 0.02 if max_step is None else max_step
+    _validate.in_range("max_step", max_step, 0.0, 1.0, closed="right")
+    step = min(0.01, max_step) if step is None else step
+    min_step = min(1e-7, step) if min_step is None else min_step
+    _validate_options(step, max_step, min_step, max_points, tol, max_corrector, target_iterations, leave_margin)
     x0 = np.asarray(x0, dtype=float)
     if not np.all(np.isfinite(x0)):
         raise ValueError("x0 (initial guess) must be finite")
@@ -167,17 +213,27 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
     x_scale = np.broadcast_to(np.asarray(x_scale, dtype=float), x0.shape).copy()
     if residual_scale is None:
         residual_scale = max(np.linalg.norm(fun(np.zeros_like(x0), omega_start)[0]), 1e-300)
-    step = 0.01 if step is None else step
-    max_step = 0.02 if max_step is None else max_step
-    min_step = 1e-7 if min_step is None else min_step
     n = x0.size
+    max_dw = max_step * w_scale          # the longest step in omega (item 2 of issue 12)
+
+    def finish(points, its, success, message):
+        Y = np.array(points) if points else np.zeros((0, n + 1))
+        checks = branch_checks(Y[:, n], omega_start, omega_end, max_step)
+        if success and not all(checks.values()):
+            success = False
+            message += "; branch checks failed: " + ", ".join(k for k, v in checks.items() if not v)
+            warnings.warn(message, ConvergenceWarning, stacklevel=3)
+        # turning points: where omega stops growing along the branch and turns back
+        d = np.sign(np.diff(Y[:, n]))
+        turning = np.flatnonzero(d[1:] * d[:-1] < 0) + 1
+        return Branch(Y[:, n], Y[:, :n], np.array(its, dtype=int), success, message, turning, checks)
 
     first = newton(fun, x0, omega_start, x_scale, residual_scale, tol=tol, factorize=factorize)
     if not first.converged:
         msg = f"Newton did not converge at the start, omega = {omega_start:.6g} rad/s " \
               f"(scaled residual {first.residual_norm:.3g})"
         warnings.warn(msg, ConvergenceWarning, stacklevel=2)
-        return Branch(np.zeros(0), np.zeros((0, n)), np.zeros(0, dtype=int), False, msg)
+        return finish([], [], False, msg)
 
     # unknowns are scaled by x_scale, which grows to the largest |x| met on the branch, so
     # the arc length weighs every unknown by its own size (a step is a fraction of it)
@@ -205,9 +261,18 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         t /= np.linalg.norm(t)
         return t if t @ prev > 0 else -t
 
+    def solve_at(w, x_from):
+        """Newton at fixed omega = w from the point(s) x_from (tried in turn)."""
+        for x in x_from:
+            r = newton(fun, x, w, x_scale, residual_scale, tol=tol, factorize=factorize)
+            if r.converged:
+                return r
+        return None
+
     message, success = "", False
     h = step
     hops = 0  # consecutive fixed-omega hops over corners
+    end_retries = 0  # steps past omega_end whose landing on omega_end failed
     next_tangent = None  # from the last corrector's factorisation (scaled, then unscaled)
     while len(points) < max_points:
         y = points[-1] / scale()
@@ -216,7 +281,7 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         else:
             tangent = next_tangent / scale()      # unscaled -> scaled by the current x_scale
             tangent /= np.linalg.norm(tangent)
-        accepted = False
+        accepted = hopped = False
         while h >= min_step:
             yp = y + h * tangent
             yc = yp.copy()
@@ -242,8 +307,11 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
                     # Newton updates that do not contract: the corrector diverges or cycles
                     # (measured: such runs go on to |omega| of hundreds of Hz); halve the step
                     break
-            # reject corrector results that jump back along the branch
-            if ok and (yc - y) @ tangent > 0:
+            # reject corrector results that jump back along the branch, that end farther from
+            # the predictor than the predictor is from the last point (more than 45 degrees off
+            # the tangent: another branch), or that step farther in omega than max_step allows
+            if ok and (yc - y) @ tangent > 0 and np.linalg.norm(yc - yp) <= h \
+                    and abs(yc[n] - y[n]) * w_scale <= max_dw:
                 accepted = True
                 hops = 0
                 # the next tangent solves [J; tangent] t = e_{n+1}: the matrix just factorised
@@ -258,55 +326,88 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
             hops += 1
             w_last = points[-1][n]
             for frac in (1e-3, 1e-2, 1e-1):
-                w_try = w_last + direction * frac * max_step * w_scale
+                w_try = w_last + direction * frac * max_dw
                 jump = newton(fun, points[-1][:n], w_try, x_scale, residual_scale, tol=tol, factorize=factorize)
-                # only a short hop along the same branch, never a jump to another one
-                if jump.converged and np.linalg.norm((jump.x - points[-1][:n]) / x_scale) < 2 * max_step:
+                if not jump.converged:
+                    continue
+                # only a hop along the same branch, never a jump to another one: short, or along
+                # the branch that leaves the corner (the chord within ~25 degrees of the tangent
+                # at the point reached). The second covers a corner beyond which an unknown with
+                # a small scale moves fast, e.g. the mean roll of a cylinder damper held only by
+                # the weak static retention once slip begins (the chord is then long in scaled
+                # units, yet it runs along the new piece of the branch)
+                chord = np.append(jump.x - points[-1][:n], w_try - w_last) / scale()
+                if np.linalg.norm(chord[:n]) < 2 * max_step:
+                    hop_tangent = None
                     break
-                jump.converged = False
-            if jump.converged:
+                try:
+                    hop_tangent = tangent_at(np.append(jump.x, w_try) / scale(), chord * scale())
+                except (np.linalg.LinAlgError, RuntimeError):
+                    continue
+                if hop_tangent @ chord > 0.9 * np.linalg.norm(chord):
+                    break
+            else:
+                jump = None
+            if jump is not None:
                 yc = np.append(jump.x, w_try) / scale()
                 it = jump.iterations
-                accepted = True
+                accepted = hopped = True
                 tangent = next_tangent = None
+                if hop_tangent is not None:
+                    tangent = hop_tangent     # go on along the new piece (scaled; unscaled below)
         if not accepted:
             w_stop = points[-1][n]
             message = f"continuation did not converge after omega = {w_stop:.6g} rad/s " \
                       f"({w_stop / (2 * np.pi):.6g} Hz), step fell below {min_step:g}; branch kept up to there"
             warnings.warn(message, ConvergenceWarning, stacklevel=2)
             break
+        new = yc * scale()
+        if direction * (omega_start - new[n]) > 0:
+            # the branch turned back and reached the start of the range: it stops there (never
+            # a point outside the range; an FRF never runs to zero or negative frequency)
+            last = points[-1]
+            a = (last[n] - omega_start) / (last[n] - new[n])
+            land = solve_at(omega_start, (last[:n] + a * (new[:n] - last[:n]), last[:n], new[:n]))
+            if land is not None:
+                points.append(np.append(land.x, omega_start))
+                its.append(land.iterations)
+            message = f"continuation turned back (fold at omega = {max(p[n] * direction for p in points) * direction:.6g}" \
+                      f" rad/s) and returned to the start of the range, omega = {omega_start:.6g} rad/s; " \
+                      f"branch kept up to there"
+            warnings.warn(message, ConvergenceWarning, stacklevel=2)
+            break
+        if direction * (new[n] - omega_end) >= 0:
+            # land exactly on omega_end, from the point interpolated there
+            last = points[-1]
+            a = (omega_end - last[n]) / (new[n] - last[n]) if new[n] != last[n] else 1.0
+            land = solve_at(omega_end, (last[:n] + a * (new[:n] - last[:n]), new[:n], last[:n]))
+            if land is None:
+                end_retries += 1
+                if end_retries <= 8:
+                    h /= 2
+                    tangent_prev = None if tangent is None else tangent * scale()
+                    next_tangent = None
+                    continue
+                message = f"continuation could not land on omega_end = {omega_end:.6g} rad/s; " \
+                          f"branch kept up to omega = {last[n]:.6g} rad/s"
+                warnings.warn(message, ConvergenceWarning, stacklevel=2)
+                break
+            points.append(np.append(land.x, omega_end))
+            its.append(land.iterations)
+            success, message = True, "reached the end of the frequency range"
+            break
         tangent_prev = None if tangent is None else tangent * scale()
         next_tangent = None if next_tangent is None else next_tangent * scale()
-        h = max(h, step) if tangent is None else h
-        points.append(yc * scale())
+        h = max(h, step) if hopped else h
+        points.append(new)
         its.append(it)
         x_scale = np.maximum(x_scale, np.abs(points[-1][:n]))
         if it <= target_iterations - 1:
             h = min(h * 1.5, max_step)
         elif it > target_iterations + 1:
             h = max(h / 1.5, min_step)
-        if direction * (omega_start - points[-1][n]) > leave_margin * w_scale:
-            # the branch turned back and left the range (by default by more than its width): it
-            # is not the response curve asked for (an FRF never runs to zero or negative frequency)
-            message = f"continuation turned back and left the range below omega = {points[-1][n]:.6g} rad/s; " \
-                      f"branch kept up to there"
-            points.pop()
-            its.pop()
-            warnings.warn(message, ConvergenceWarning, stacklevel=2)
-            break
-        if direction * (points[-1][n] - omega_end) >= 0:
-            # land exactly on omega_end
-            end = newton(fun, points[-1][:n], omega_end, x_scale, residual_scale, tol=tol, factorize=factorize)
-            if end.converged:
-                points[-1] = np.append(end.x, omega_end)
-            success, message = True, "reached the end of the frequency range"
-            break
     else:
         message = f"stopped after max_points = {max_points} points at omega = {points[-1][n]:.6g} rad/s"
         warnings.warn(message, ConvergenceWarning, stacklevel=2)
 
-    Y = np.array(points)
-    # turning points: where omega stops growing along the branch and turns back
-    d = np.sign(np.diff(Y[:, n]))
-    turning = np.flatnonzero(d[1:] * d[:-1] < 0) + 1
-    return Branch(Y[:, n], Y[:, :n], np.array(its), success, message, turning)
+    return finish(points, its, success, message)

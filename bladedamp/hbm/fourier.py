@@ -124,6 +124,18 @@ class HarmonicBasis:
                 out[j + 1] = -value.imag
         return out
 
+    def embed(self, coeffs: np.ndarray, target: "HarmonicBasis") -> np.ndarray:
+        """The coefficients (C, ...) of this basis written in ``target``'s (C', ...): harmonics
+        ``target`` adds are zero, harmonics it lacks are dropped (the same signal, band-limited)."""
+        coeffs = np.asarray(coeffs)
+        out = np.zeros((target.n_coeffs,) + coeffs.shape[1:])
+        for h in self.harmonics:
+            if h in target.harmonics:
+                j, k = self.cos_index(h), target.cos_index(h)
+                width = 1 if h == 0 else 2
+                out[k:k + width] = coeffs[j:j + width]
+        return out
+
     def work_per_cycle(self, force: np.ndarray, displacement: np.ndarray) -> np.ndarray:
         """Work of ``force`` along ``displacement`` over one period, oint f dw [J].
 

@@ -63,6 +63,9 @@ class EngineOrderSweep:
     undamped_peak_tip : (k,) peak tip amplitude without damper [m]
     reduction : (k,) 1 - optimal / undamped [-]
     failures : {EO: message} of engine orders whose frequency response failed (their entries NaN)
+    certified : (k,) bool, the optimum is global over the mass bounds (``MassOptimum.success``:
+        every mass the optimiser could not solve has a partial branch above the optimum peak)
+    messages : {EO: MassOptimum.message}, how each optimum was found and which masses failed
     """
 
     kind: str
@@ -72,6 +75,8 @@ class EngineOrderSweep:
     undamped_peak_tip: np.ndarray
     reduction: np.ndarray
     failures: dict = field(default_factory=dict)
+    certified: np.ndarray = None
+    messages: dict = field(default_factory=dict)
 
     def plot(self, ax=None, **kwargs):
         """Resonance amplitude [mm] (and optimal mass [g], right axis) over engine order."""
@@ -141,7 +146,7 @@ def engine_order_sweep(kind: str, engine_orders=range(0, 9), mass_bounds=(1e-5, 
 
     k = eos.size
     m_opt, p_opt, p_und = np.full(k, np.nan), np.full(k, np.nan), np.full(k, np.nan)
-    failures = {}
+    certified, messages, failures = np.zeros(k, dtype=bool), {}, {}
     cases = [(kind, int(eo), bounds, f_range, xatol, rotor_speed_eo0, disk_kwargs) for eo in eos]
     for j, (eo, result) in enumerate(zip(eos, parallel_map(_engine_order_case, cases, processes, progress))):
         if isinstance(result, str):
@@ -149,11 +154,42 @@ def engine_order_sweep(kind: str, engine_orders=range(0, 9), mass_bounds=(1e-5, 
             warnings.warn(f"engine order {eo}: {result}", RuntimeWarning, stacklevel=2)
             continue
         p_und[j] = result.undamped_peak_tip
+        certified[j], messages[int(eo)] = result.success, result.message
         if result.peak_tip >= (1 - ROLLING_TOLERANCE) * result.undamped_peak_tip:
             p_opt[j] = result.undamped_peak_tip          # no mass helps (the rolling cylinder)
         else:
             m_opt[j], p_opt[j] = result.mass, result.peak_tip
-    return EngineOrderSweep(kind, eos.astype(int), m_opt, p_opt, p_und, 1 - p_opt / p_und, failures)
+    return EngineOrderSweep(kind, eos.astype(int), m_opt, p_opt, p_und, 1 - p_opt / p_und, failures,
+                            certified, messages)
+
+
+# tolerances of the EO trend verdicts ("reduction / optimal mass grow with EO"): a value may
+# fall below its predecessor by no more than this before the trend counts as broken
+REDUCTION_TREND_TOLERANCE = 0.005   # 0.5 percentage points of reduction: the optimiser's xatol
+                                    # = 0.02 in log(mass) moves the optimum's peak by far less (a
+                                    # parabola, ~ curvature * xatol^2), so a larger dip is physics
+MASS_TREND_TOLERANCE = 0.10         # 10 % of the optimal mass: at high EO the valley is flat;
+                                    # measured (cylinder, EO 7, optimum 11.43 g, 0.0354 mm): 0.9 and
+                                    # 1.1 times that mass give 0.0362 and 0.0358 mm, i.e. 0.05
+                                    # percentage points of reduction, so the mass is no better defined
+
+
+def eo_trend(values, tolerance: float, relative: bool = False) -> dict:
+    """Does ``values`` (over consecutive engine orders) grow, within ``tolerance``?
+
+    Grows: no NaN, the last value above the first, and no step down by more than
+    ``tolerance`` (absolute, or a fraction of the previous value when ``relative``).
+    Returns {'grows': bool, 'dips': [(index, drop)] of the steps down beyond the tolerance,
+    'missing': [indices of NaN]}.
+    """
+    v = np.asarray(values, dtype=float)
+    missing = [int(i) for i in np.flatnonzero(~np.isfinite(v))]
+    drops = v[:-1] - v[1:]
+    if relative:
+        drops = drops / np.abs(v[:-1])
+    dips = [(int(i + 1), float(d)) for i, d in enumerate(drops) if np.isfinite(d) and d > tolerance]
+    grows = not missing and not dips and len(v) > 1 and v[-1] > v[0]
+    return {"grows": bool(grows), "dips": dips, "missing": missing}
 
 
 # ---------------------------------------------------------------------------------------

@@ -18,20 +18,21 @@ def with_mass(disk: TunedDisk, mass: float) -> TunedDisk:
 
 
 def peak_response(disk: TunedDisk, f_range_hz=(90.0, 105.0), harmonics=(1,), max_step=0.05, direction: int = 0,
-                  max_widenings: int = 4):
+                  max_widenings: int = 4, **continuation_options):
     """(peak first-harmonic tip amplitude [m], frequency [Hz], response) over ``f_range_hz``.
 
     ``direction`` is the tip DOF (0..2: u_x, u_y, u_z). If the largest amplitude sits at an end
     of the range, the range is widened by its own width on that side (at most
     ``max_widenings`` times) so that a reported peak is always a true interior maximum.
     The peak is refined by a parabola through the largest point and its neighbours.
+    ``continuation_options`` (e.g. ``max_points``) go to ``disk.frequency_response``.
     Raises RuntimeError if the continuation does not cover the range (never a silent number).
     """
     lo, hi = _validate.interval("f_range_hz", f_range_hz, "Hz")
     for _ in range(max_widenings + 1):
-        r = disk.frequency_response(lo, hi, harmonics=harmonics, max_step=max_step)
+        r = disk.frequency_response(lo, hi, harmonics=harmonics, max_step=max_step, **continuation_options)
         if not r.success:
-            raise RuntimeError(f"frequency response incomplete: {r.message}")
+            raise IncompleteResponse(f"frequency response incomplete: {r.message}", r, direction)
         a = r.tip_amplitude[:, direction]
         i = int(np.argmax(a))
         if 0 < i < len(a) - 1:
@@ -40,15 +41,148 @@ def peak_response(disk: TunedDisk, f_range_hz=(90.0, 105.0), harmonics=(1,), max
         lo, hi = (max(lo - width, 0.5 * lo), hi) if i == 0 else (lo, hi + width)
     else:
         raise RuntimeError(f"no interior resonance peak found up to the range {lo:.4g}-{hi:.4g} Hz")
-    peak, f = a[i], r.frequency_hz[i]
-    x, y = r.frequency_hz[i - 1:i + 2], a[i - 1:i + 2]
-    if np.all(np.diff(x) > 0):
+    peak, f = _refined_peak(r.frequency_hz, a, i)
+    return peak, f, r
+
+
+def _refined_peak(freq, a, i):
+    """(peak, frequency) of point ``i`` refined by the parabola through it and its neighbours."""
+    peak, f = a[i], freq[i]
+    x, y = freq[i - 1:i + 2], a[i - 1:i + 2]
+    if len(x) == 3 and np.all(np.diff(x) > 0):
         c = np.polyfit(x, y, 2)
         if c[0] < 0:
             f_v = -c[1] / (2 * c[0])
             if x[0] <= f_v <= x[2]:
                 peak, f = max(peak, np.polyval(c, f_v)), f_v
-    return float(peak), float(f), r
+    return float(peak), float(f)
+
+
+class IncompleteResponse(RuntimeError):
+    """A frequency response whose continuation stopped early; ``response`` keeps the converged
+    part of the branch and ``lower_bound`` its largest tip amplitude [m] (every point of it
+    is a solution, so the true peak is at least that; NaN if nothing converged)."""
+
+    def __init__(self, message, response=None, direction: int = 0):
+        super().__init__(message)
+        self.response = response
+        self.lower_bound = _lower_bound(response, direction)
+
+
+def _checks(response) -> set:
+    return set(getattr(response, "failed_checks", None) or ())
+
+
+def _lower_bound(response, direction: int) -> float:
+    """Largest tip amplitude of the converged points of a (partial) branch; NaN when it has none
+    or when its points fail the dissipation check (then they are no physical solutions)."""
+    if response is None or not len(response.frequency_hz) or "dissipation" in _checks(response):
+        return np.nan
+    return float(response.tip_amplitude[:, direction].max())
+
+
+def _joinable(response) -> bool:
+    """A partial branch whose points cover its frequencies without gaps and are physical."""
+    return response is not None and len(response.frequency_hz) > 1 and not (_checks(response) - {"range"})
+
+
+# -- robust peak: the continuation settings tried, in order, when a frequency response fails --
+# Each run is capped at ROBUST_MAX_POINTS points: a complete branch at max_step 0.02 has about
+# 600-1100 points (measured on the reference disk), while a continuation trapped in a cycle
+# ran to the default 5000 points (72-124 s; cylinder 7.9 g at EO 7) before failing.
+ROBUST_MAX_POINTS = 1500
+ROBUST_ATTEMPTS = ({"max_step": 0.05}, {"max_step": 0.02})
+
+
+@dataclass
+class PeakEvaluation:
+    """Peak tip amplitude of one disk found by :func:`robust_peak`.
+
+    success : the peak is the interior maximum of a frequency response that covers the range
+    peak_tip : [m] (NaN if not success); resonance_hz : [Hz] (NaN if not success)
+    lower_bound : [m] if not success, the largest tip amplitude on the converged parts of the
+        branches (the true peak is at least this; NaN when no part converged)
+    message : how the peak was obtained, or why every attempt failed
+    attempts : number of continuation runs
+    """
+
+    success: bool
+    peak_tip: float
+    resonance_hz: float
+    lower_bound: float
+    message: str
+    attempts: int
+
+
+def robust_peak(disk: TunedDisk, f_range_hz=(90.0, 105.0), harmonics=(1,), direction: int = 0,
+                attempts=ROBUST_ATTEMPTS, max_points: int = ROBUST_MAX_POINTS, downward: bool = True,
+                give_up_above: float = np.inf) -> PeakEvaluation:
+    """:func:`peak_response` that retries a failed frequency response and never raises on one.
+
+    Tries each settings dict of ``attempts`` (upward sweeps, ``peak_response`` options); if all
+    fail, sweeps the range downwards from its upper end (finest ``max_step``) and joins the two
+    partial branches: when the upward branch reaches above the frequency where the downward one
+    stopped, every frequency of the range has a converged solution and the peak is the largest
+    amplitude of both (it must be interior). Otherwise the evaluation fails and carries the
+    largest amplitude met, a lower bound of the true peak.
+
+    ``downward=False`` skips the downward sweep. ``give_up_above`` [m]: stop retrying as soon as
+    a partial branch has reached above it (a minimiser that already has a lower peak needs no
+    more of this mass than that bound).
+    """
+    lo, hi = _validate.interval("f_range_hz", f_range_hz, "Hz")
+    messages, bound, up, runs = [], np.nan, None, 0
+    for options in attempts:
+        runs += 1
+        try:
+            p, f, _ = peak_response(disk, (lo, hi), harmonics, direction=direction, max_points=max_points, **options)
+            note = "" if runs == 1 else f" (retry {options}; before: {'; '.join(messages)})"
+            return PeakEvaluation(True, p, f, np.nan, "interior peak of a complete response" + note, runs)
+        except IncompleteResponse as exc:
+            messages.append(f"{options}: {exc}")
+            bound = np.fmax(bound, exc.lower_bound)
+            r = exc.response
+            if _joinable(r) and r.frequency_hz[0] == lo and (up is None or r.frequency_hz.max() > up.frequency_hz.max()):
+                up = r
+        except RuntimeError as exc:
+            messages.append(f"{options}: {exc}")
+        if bound > give_up_above:
+            return PeakEvaluation(False, np.nan, np.nan, float(bound),
+                                  f"given up: a partial branch reached {1e3 * bound:.4g} mm, above "
+                                  f"{1e3 * give_up_above:.4g} mm: " + "; ".join(messages), runs)
+    if not downward:
+        return PeakEvaluation(False, np.nan, np.nan, float(bound), "; ".join(messages), runs)
+    # downward sweep, joined with the farthest-reaching upward branch
+    runs += 1
+    step = min((o.get("max_step", 0.05) for o in attempts), default=0.02)
+    down = disk.frequency_response(hi, lo, harmonics=harmonics, max_step=step, max_points=max_points)
+    bound = np.fmax(bound, _lower_bound(down, direction))
+    if down.success:
+        branches = [down]
+    elif up is not None and _joinable(down) and up.frequency_hz.max() >= down.frequency_hz.min():
+        branches = [up, down]
+    else:
+        messages.append(f"downward sweep, max_step {step}: {down.message}")
+        reach = f"upward branch up to {up.frequency_hz.max():.4f} Hz" if up is not None else "no upward branch"
+        stop = f"downward branch down to {down.frequency_hz.min():.4f} Hz" if len(down.frequency_hz) else \
+            "no downward branch"
+        return PeakEvaluation(False, np.nan, np.nan, float(bound),
+                              f"range not covered ({reach}, {stop}): " + "; ".join(messages), runs)
+
+    def inside(b):                            # amplitudes of the points within the range
+        return np.where((b.frequency_hz >= lo) & (b.frequency_hz <= hi), b.tip_amplitude[:, direction], -np.inf)
+
+    b, i = max(((b, int(np.argmax(inside(b)))) for b in branches), key=lambda bi: inside(bi[0])[bi[1]])
+    f = b.frequency_hz
+    if f[i] in (lo, hi):
+        return PeakEvaluation(False, np.nan, np.nan, float(bound),
+                              f"largest amplitude at the range end {f[i]:.4g} Hz: " + "; ".join(messages), runs)
+    a = b.tip_amplitude[:, direction]
+    if b is down:                             # runs from hi to lo: the parabola wants rising frequency
+        f, a, i = f[::-1], a[::-1], len(f) - 1 - i
+    p, fp = _refined_peak(f, a, i)
+    how = "downward sweep" if len(branches) == 1 else "upward and downward partial branches joined"
+    return PeakEvaluation(True, p, fp, np.nan, f"{how} (before: {'; '.join(messages)})", runs)
 
 
 @dataclass
@@ -111,9 +245,22 @@ def mass_sweep(disk: TunedDisk, masses, f_range_hz=(90.0, 105.0), harmonics=(1,)
 class MassOptimum:
     """Optimal damper mass [kg], its peak tip amplitude [m], the undamped peak [m].
 
-    ``failed_masses`` [kg]: masses whose response could not be computed (e.g. a very light
-    damper bouncing off both platforms, beyond the harmonic balance's reach); the optimiser
-    treats them as no better than the undamped blade and never returns one of them.
+    Found by :func:`optimal_mass`: a log grid over the bounds, then a bounded local search in
+    the bracket of the best grid point.
+
+    mass, peak_tip : the best mass evaluated and its peak [kg, m]
+    undamped_peak_tip : [m]; evaluations : number of masses evaluated
+    failed_masses : (f,) [kg] masses whose response could not be computed even with the
+        retries of :func:`robust_peak` (e.g. a very light cylinder whose continuation stalls
+        just below the resonance); never returned as the optimum
+    failed_lower_bounds : (f,) [m] the largest tip amplitude on their converged partial
+        branches, a lower bound of their true peak (NaN: nothing converged)
+    failure_messages : (f,) why each failed
+    grid_mass : (g,) [kg] the bracketing grid; grid_peak_tip : (g,) [m] (NaN where failed)
+    bracket : (low, high) [kg] the grid interval of the local search
+    success : True when the optimum is certified global on the grid: every failed mass has a
+        lower bound above the optimum peak (so it cannot hide a better mass)
+    message : what was found, and which failed masses leave the claim open
     """
 
     mass: float
@@ -121,38 +268,129 @@ class MassOptimum:
     undamped_peak_tip: float
     evaluations: int
     failed_masses: tuple = ()
+    failed_lower_bounds: tuple = ()
+    failure_messages: tuple = ()
+    grid_mass: np.ndarray = None
+    grid_peak_tip: np.ndarray = None
+    bracket: tuple = ()
+    success: bool = True
+    message: str = ""
 
     @property
     def reduction(self) -> float:
         return 1 - self.peak_tip / self.undamped_peak_tip
 
 
-def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0), harmonics=(1,),
-                 xatol: float = 0.02) -> MassOptimum:
-    """Mass minimising the peak tip amplitude: bounded scalar optimisation in log(mass).
+GRID_PER_DECADE = 4   # bracketing grid density; the narrowest valley measured (cylinder, EO 7)
+                      # falls from 0.54 to 0.06 mm between 5 and 7.9 g, i.e. over 0.2 decade
 
-    ``bounds`` [kg], 0 < low < high; ``xatol`` tolerance in log(mass).
+
+def _robust_peak_case(case):
+    disk, f_range, harmonics, attempts, downward, give_up_above = case
+    return robust_peak(disk, f_range, harmonics, attempts=attempts, downward=downward, give_up_above=give_up_above)
+
+
+def bracket_minimum(fun, grid, xatol: float, fail_value: float, processes: int | None = 1, evaluate_grid=None):
+    """Global minimum of ``fun`` over the interval of ``grid`` (increasing): evaluate every grid
+    point, then a bounded Brent search in [grid[i-1], grid[i+1]] around the best one, i.
+
+    ``fun(x) -> value`` (NaN: not computable, replaced by ``fail_value`` for the search and never
+    the answer); ``evaluate_grid(grid) -> values`` evaluates the grid at once (e.g. on several
+    processes), else ``fun`` is called on each point. Returns (x_best, f_best, cache {x: value},
+    (low, high) bracket). This is the part that makes the search global: a local search from the
+    whole interval stops in whichever valley its first golden-section points fall into.
     """
+    grid = np.asarray(grid, dtype=float)
+    values = np.asarray(evaluate_grid(grid) if evaluate_grid is not None else [fun(x) for x in grid], dtype=float)
+    cache = dict(zip(map(float, grid), map(float, values)))
+    if not np.any(np.isfinite(values)):
+        return np.nan, np.nan, cache, (float(grid[0]), float(grid[-1]))
+    i = int(np.nanargmin(values))
+    a, b = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
+
+    def objective(x):
+        x = float(x)
+        if x not in cache:
+            cache[x] = float(fun(x))
+        v = cache[x]
+        return fail_value if not np.isfinite(v) else v
+
+    if b > a:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            minimize_scalar(objective, bounds=(a, b), method="bounded", options={"xatol": xatol})
+    ok = {x: v for x, v in cache.items() if np.isfinite(v)}
+    best = min(ok, key=ok.get)
+    return best, ok[best], cache, (float(a), float(b))
+
+
+def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0), harmonics=(1,),
+                 xatol: float = 0.02, grid_per_decade: float = GRID_PER_DECADE, processes: int | None = 1,
+                 progress=None) -> MassOptimum:
+    """Mass minimising the peak tip amplitude, global over ``bounds`` [kg] (0 < low < high).
+
+    A log grid of ``grid_per_decade`` points per decade (at least 5) brackets the best mass;
+    a bounded Brent search in log(mass) (tolerance ``xatol``) refines it within the grid
+    interval around the best grid point. Each mass is evaluated by :func:`robust_peak`
+    (retries with a finer continuation and a downward sweep); masses that still fail are listed
+    in the result with a lower bound of their peak, and ``success`` says whether they could
+    hide a better optimum. ``processes``: worker processes over the grid (None: every core).
+    """
+    from .parallel import parallel_map
+
     lo, hi = _validate.interval("mass bounds", bounds, "kg")
+    _validate.positive("xatol", xatol)
+    _validate.positive("grid_per_decade", grid_per_decade)
     undamped, _, _ = peak_response(dataclasses.replace(disk, damper=None), f_range_hz, harmonics)
-    cache, failed = {}, []
+    evaluations = {}
 
-    def objective(logm):
+    def record(m, ev):
+        evaluations[m] = ev
+        return ev.peak_tip if ev.success else np.nan
+
+    def best_so_far():
+        return min((ev.peak_tip for ev in evaluations.values() if ev.success), default=np.inf)
+
+    def fun(logm):
         m = float(np.exp(logm))
-        if m not in cache:
-            try:
-                cache[m] = peak_response(with_mass(disk, m), f_range_hz, harmonics)[0]
-            except RuntimeError:
-                failed.append(m)
-                cache[m] = 10 * undamped   # not computable: never the optimum
-        return cache[m]
+        return record(m, robust_peak(with_mass(disk, m), f_range_hz, harmonics, give_up_above=best_so_far()))
 
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        minimize_scalar(objective, bounds=(np.log(lo), np.log(hi)), method="bounded",
-                        options={"xatol": xatol})
-    ok = {m: p for m, p in cache.items() if m not in failed}
-    if not ok:
-        raise RuntimeError(f"no damper mass in {bounds} kg gave a computable response")
-    best = min(ok, key=ok.get)   # the best computed point (the optimiser's last one, or better)
-    return MassOptimum(best, ok[best], undamped, len(cache), tuple(failed))
+    def evaluate_grid(loggrid):
+        # first the plain response of every grid mass, then the retries of those that failed,
+        # except where a partial branch is already above the best grid peak (no optimum there)
+        masses = [float(m) for m in np.exp(loggrid)]
+        cases = [(with_mass(disk, m), f_range_hz, harmonics, ROBUST_ATTEMPTS[:1], False, np.inf) for m in masses]
+        for m, ev in zip(masses, parallel_map(_robust_peak_case, cases, processes, progress)):
+            record(m, ev)
+        best = best_so_far()
+        retry = [m for m in masses if not evaluations[m].success and not evaluations[m].lower_bound > best]
+        cases = [(with_mass(disk, m), f_range_hz, harmonics, ROBUST_ATTEMPTS[1:], True, best) for m in retry]
+        for m, ev in zip(retry, parallel_map(_robust_peak_case, cases, processes)):
+            ev.attempts += evaluations[m].attempts
+            record(m, ev)
+        return [evaluations[m].peak_tip if evaluations[m].success else np.nan for m in masses]
+
+    n = max(5, int(np.ceil(grid_per_decade * np.log10(hi / lo))) + 1)
+    loggrid = np.linspace(np.log(lo), np.log(hi), n)
+    logm, peak, _, (a, b) = bracket_minimum(fun, loggrid, xatol, 10 * undamped, evaluate_grid=evaluate_grid)
+    grid_m = np.exp(loggrid)
+    grid_p = np.array([evaluations[float(m)].peak_tip for m in grid_m])
+    failed = sorted(m for m, ev in evaluations.items() if not ev.success)
+    bounds_f = tuple(evaluations[m].lower_bound for m in failed)
+    msgs = tuple(evaluations[m].message for m in failed)
+    if not np.isfinite(logm):
+        raise RuntimeError(f"no damper mass in {bounds} kg gave a computable response: " + msgs[0])
+    best = float(np.exp(logm))
+    open_ = [m for m, lb in zip(failed, bounds_f) if not lb > peak]
+    where = "at a bound of the search" if logm in (loggrid[0], loggrid[-1]) else "interior"
+    text = (f"optimum {1e3 * best:.4g} g ({where}), peak {1e3 * peak:.4g} mm, from a {n}-point log grid and a "
+            f"bounded search in {1e3 * np.exp(a):.4g}-{1e3 * np.exp(b):.4g} g")
+    if failed:
+        text += (f"; {len(failed)} mass(es) not solved ({', '.join(f'{1e3 * m:.4g}' for m in failed)} g)")
+        if open_:
+            text += (f", of which {', '.join(f'{1e3 * m:.4g}' for m in open_)} g may hide a lower peak "
+                     "(no partial branch above the optimum): global optimum not certified")
+        else:
+            text += ", each with a partial branch already above the optimum peak: they cannot be the optimum"
+    return MassOptimum(best, peak, undamped, len(evaluations), tuple(failed), bounds_f, msgs, grid_m, grid_p,
+                       (float(np.exp(a)), float(np.exp(b))), not open_, text)

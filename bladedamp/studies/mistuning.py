@@ -505,6 +505,8 @@ def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f
     kappas = np.array([random_kappa(n, std, seed=[int(seed), i]) for i in range(n_disks)])
     settings = dict(harmonics=tuple(harmonics), max_step=_validate.positive("max_step", max_step),
                     tol=_validate.positive("tol", tol), n_samples=n_samples)
+    if n_workers is not None:
+        _validate.integer("n_workers", n_workers, minimum=1)
     t0 = time.perf_counter()
     if tuned_peak_tip is None:
         tuned_peak_tip = tuned_peak(disk, f_range_hz or auto_range(disk, [1.0], 0.05), harmonics)[0]

@@ -6,6 +6,8 @@ import os
 import warnings
 from concurrent.futures import ProcessPoolExecutor, as_completed
 
+from .. import _validate
+
 
 def _quiet(fn, item):
     with warnings.catch_warnings():
@@ -17,8 +19,10 @@ def parallel_map(fn, items, processes: int | None = None, progress=None) -> list
     """``[fn(item) for item in items]``, in order, on ``processes`` worker processes.
 
     ``fn`` must be a module-level function (picklable). ``processes=None`` uses every core;
-    1 runs in this process. ``progress(done, total)`` is called as cases finish.
+    1 runs in this process; anything else but an integer >= 1 raises ValueError. ``progress(done, total)`` is called as cases finish.
     """
+    if processes is not None:
+        processes = _validate.integer("processes (worker processes; None: every core)", processes, minimum=1)
     items = list(items)
     n = len(items)
     processes = min(processes or os.cpu_count() or 1, n) if n else 1

@@ -493,7 +493,7 @@ class DiskFRFCache:
         # fallback: arc-length continuation, then the grid by interpolation of the branch
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            resp = disk.frequency_response(lo, hi, max_step=0.05)
+            resp = disk.frequency_response(lo, hi, harmonics=system.basis.harmonics, max_step=0.05)
         order = np.argsort(resp.omega)
         fb, xb = resp.frequency_hz[order], resp.coefficients.reshape(len(resp.omega), -1)[order]
         fb, idx = np.unique(fb, return_index=True)

@@ -1,0 +1,180 @@
+"""Harmonic accuracy control: how far a harmonic balance answer is from its converged limit.
+
+The HBM truncates the Fourier series of the response. With friction and a varying normal load
+(lift-off, the wedge's inclined contacts) the nonlinear forces are not smooth, their spectrum
+decays slowly, and the paper's one-harmonic setting can miss the first-harmonic amplitude by
+tens of per cent while the energy balance still holds to rounding (it holds for any truncation).
+So every answer is checked against an enriched harmonic set:
+
+* **estimate** (:func:`harmonic_error`): at a few points of a computed branch (the peak and
+  points spread along it) the solution is lifted into the enriched set ``H+`` (the static term
+  and the next two harmonics added) and solved again at the same frequency by Newton. The
+  largest change of the first-harmonic output amplitudes (the blade tips, the oscillator's x),
+  relative to the branch's peak amplitude, is the error estimate of ``H``. It is an
+  a-posteriori estimate of the truncation error, not a bound: the first-harmonic amplitude of a
+  non-smooth system converges in steps that need not shrink monotonically.
+* **choice** (:func:`converged_response`): ``harmonics="auto"`` computes the branch with the
+  sets of :data:`AUTO_HARMONIC_SETS` in turn, each checked against the next richer one, and keeps
+  the first whose estimate meets the tolerance. The static term is in every set: it carries the
+  mean normal loads, which move when the normal loads vary (lift-off, inclined contacts).
+  When no set meets the tolerance, the richest is returned and says so (``harmonics_converged``
+  False, and the message).
+
+A model takes part by giving ``hbm_system(harmonics, n_samples)``, ``output_amplitudes
+(coefficients, basis) -> (n, k)``, ``lift(coefficients, basis, system, omega) -> x`` and
+``unknown_scales(system, omega_start, omega_end)``.
+"""
+from __future__ import annotations
+
+import dataclasses
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from .continuation import newton
+
+#: default tolerance on the first-harmonic output amplitudes, relative to the peak amplitude
+HARMONIC_TOLERANCE = 0.01
+#: the harmonic sets ``harmonics="auto"`` may try, cheapest first (see :func:`auto_sets`)
+AUTO_HARMONIC_SETS = ((0, 1), (0, 1, 2, 3), (0, 1, 2, 3, 4, 5), tuple(range(8)), tuple(range(10)))
+#: the paper's setting: the first harmonic only, static approach from frictionless seating
+PAPER_HARMONICS = (1,)
+
+
+def auto_sets(max_harmonic: int) -> tuple[tuple[int, ...], ...]:
+    """The sets of :data:`AUTO_HARMONIC_SETS` up to ``max_harmonic`` (an odd integer >= 1)."""
+    if not (isinstance(max_harmonic, (int, np.integer)) and max_harmonic >= 1):
+        raise ValueError(f"max_harmonic must be an integer >= 1 (got {max_harmonic!r})")
+    return tuple(s for s in AUTO_HARMONIC_SETS if max(s) <= max_harmonic)
+
+
+class AccuracyWarning(UserWarning):
+    """A harmonic balance answer whose harmonic error estimate exceeds the tolerance."""
+
+
+def enriched(harmonics) -> tuple[int, ...]:
+    """The set a branch computed with ``harmonics`` is checked against: with the static term
+    and the next two harmonics."""
+    h = tuple(harmonics)
+    return tuple(sorted(set(h) | {0, max(h) + 1, max(h) + 2}))
+
+
+@dataclass
+class HarmonicCheck:
+    """Result of checking a branch against an enriched harmonic set.
+
+    Attributes
+    ----------
+    harmonics : the branch's harmonics
+    enriched : the set it was checked against
+    error : largest |change of a first-harmonic output amplitude| / peak amplitude over the
+        checked points (nan when no point could be checked)
+    omega : (k,) frequencies of the checked points [rad/s]
+    errors : (k,) the same measure at each point (nan where the enriched solve failed)
+    index : (k,) indices of the checked points on the branch
+    """
+
+    harmonics: tuple
+    enriched: tuple
+    error: float
+    omega: np.ndarray
+    errors: np.ndarray
+    index: np.ndarray
+
+    @property
+    def verified(self) -> bool:
+        """Whether the peak point (the first checked) was solved in the enriched set."""
+        return bool(self.errors.size and np.isfinite(self.errors[0]))
+
+
+def check_points(amplitude: np.ndarray, turning_points=(), n_points: int = 5) -> np.ndarray:
+    """Indices to check: the peak of ``amplitude`` (n,) first, then points spread along the
+    branch, away from its turning points (where a fixed-frequency Newton is ill-posed)."""
+    n = len(amplitude)
+    if n == 0:
+        return np.zeros(0, dtype=int)
+    peak = int(np.argmax(amplitude))
+    near_fold = np.zeros(n, dtype=bool)
+    for t in np.asarray(turning_points, dtype=int):
+        near_fold[max(t - 2, 0):t + 3] = True
+    spread = np.unique(np.linspace(0, n - 1, n_points + 1).round().astype(int)[1:])
+    others = [int(i) for i in spread if i != peak and not near_fold[i]]
+    return np.array([peak] + others[:n_points - 1], dtype=int)
+
+
+def harmonic_error(model, response, harmonics=None, n_points: int = 5, tol: float = 1e-10) -> HarmonicCheck:
+    """Error estimate of ``response`` (computed by ``model``) against the enriched set
+    ``harmonics`` (default :func:`enriched` of the response's), see the module docstring."""
+    basis = response.basis
+    target = tuple(harmonics) if harmonics is not None else enriched(basis.harmonics)
+    amp = model.output_amplitudes(response.coefficients, basis)          # (n, k)
+    idx = check_points(amp.max(axis=1) if amp.size else np.zeros(0), response.turning_points, n_points)
+    errors = np.full(idx.size, np.nan)
+    if idx.size:
+        system = model.hbm_system(target)
+        w = response.omega
+        scales = model.unknown_scales(system, float(w.min()), float(w.max()))
+        peak = max(float(amp.max()), 1e-300)
+        for k, i in enumerate(idx):
+            x0 = model.lift(response.coefficients[i], basis, system, float(w[i]))
+            rs = max(np.linalg.norm(system.residual(np.zeros_like(x0), float(w[i]), False)[0]), 1e-300)
+            sol = newton(system.residual, x0, float(w[i]), scales, rs, tol=tol, max_iter=20,
+                         factorize=system.factorize)
+            if sol.converged:
+                X = sol.x.reshape(1, system.basis.n_coeffs, -1)
+                errors[k] = np.abs(model.output_amplitudes(X, system.basis)[0] - amp[i]).max() / peak
+    finite = errors[np.isfinite(errors)]
+    error = float(finite.max()) if finite.size and np.isfinite(errors[0]) else float("nan")
+    return HarmonicCheck(basis.harmonics, target, error, response.omega[idx], errors, idx)
+
+
+def annotate(response, check: HarmonicCheck, tolerance: float):
+    """``response`` with its harmonic error estimate; the message says when it is above the
+    tolerance or could not be checked (``success`` is left as the solver and the sanity checks
+    set it: an explicit harmonic set is the user's choice, the estimate tells its cost)."""
+    met = bool(np.isfinite(check.error) and check.error <= tolerance)
+    note = ""
+    if not np.isfinite(check.error):
+        note = f"harmonic error not verified: the peak point did not converge with harmonics {check.enriched}"
+    elif not met:
+        note = (f"harmonic error estimate {100 * check.error:.2g} % exceeds the tolerance "
+                f"{100 * tolerance:.2g} % (harmonics {check.harmonics} against {check.enriched})")
+    if note:
+        warnings.warn(note, AccuracyWarning, stacklevel=3)
+    message = response.message + ("; " + note if note else "")
+    return dataclasses.replace(response, harmonic_error=check.error, harmonic_tolerance=tolerance,
+                               harmonics_converged=met, message=message)
+
+
+def converged_response(model, solve, harmonics="auto", tolerance: float = HARMONIC_TOLERANCE,
+                       max_harmonic: int = 3, n_points: int = 5):
+    """The branch of ``solve(harmonics) -> response`` with its harmonic error estimate.
+
+    ``harmonics="auto"``: the sets of :func:`auto_sets` (``max_harmonic``) in turn until one meets
+    ``tolerance``; otherwise the given set, checked once. A set whose branch fails (does not reach the end of the range) is
+    followed by the next richer one in the automatic choice."""
+    if isinstance(harmonics, str):
+        if harmonics != "auto":
+            raise ValueError(f"harmonics must be 'auto' or a tuple of integers >= 0 (got {harmonics!r})")
+        if not (np.isfinite(tolerance) and tolerance > 0):
+            raise ValueError(f"harmonic_tolerance must be a finite number > 0 (got {tolerance!r})")
+        best = None
+        for H in auto_sets(max_harmonic):
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", AccuracyWarning)
+                response = solve(tuple(H))
+                check = harmonic_error(model, response, n_points=n_points) if len(response.omega) else None
+            if check is None:
+                continue
+            if response.success or best is None or not best[0].success:
+                best = (response, check)     # a complete branch is never replaced by a failed one
+            if response.success and np.isfinite(check.error) and check.error <= tolerance:
+                break
+        if best is None:
+            return response
+        return annotate(best[0], best[1], tolerance)
+    response = solve(tuple(harmonics))
+    if not len(response.omega):
+        return response
+    return annotate(response, harmonic_error(model, response, n_points=n_points), tolerance)

@@ -1,0 +1,152 @@
+"""Issue 12, items 2 (continuation part) and 6: the contract of every branch (no point outside the
+range, no step longer than max_step allows, flagged if broken) and validated options."""
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from bladedamp import FrictionOscillator
+from bladedamp.hbm.continuation import ConvergenceWarning, branch_checks, continuation
+from bladedamp.hbm.start import robust_start
+
+
+def circle(c=10.0, r=2.0):
+    """R(x, omega) = x^2 + (omega - c)^2 - r^2: a closed branch with folds at c - r and c + r."""
+    def fun(x, omega, jacobian=True):
+        R = np.array([x[0] ** 2 + (omega - c) ** 2 - r ** 2])
+        return R, np.array([[2 * x[0]]]), np.array([2 * (omega - c)])
+    return fun
+
+
+def test_a_branch_that_turns_back_stops_at_the_start_of_the_range():
+    fun = circle()
+    w0, w1 = 9.0, 14.0                      # the fold at 12 sends the branch back below 9
+    x0 = np.array([np.sqrt(4.0 - 1.0)])
+    with pytest.warns(ConvergenceWarning, match="turned back"):
+        b = continuation(fun, x0, w0, w1, x_scale=2.0, residual_scale=1.0, max_step=0.05)
+    assert not b.success and "turned back" in b.message
+    assert b.omega.min() >= w0 and b.omega.max() <= 12.0 + 1e-9
+    assert b.omega[-1] == w0                # stopped on the boundary, on the lower half of the circle
+    assert b.x[-1, 0] == pytest.approx(-np.sqrt(3.0), rel=1e-8)
+    assert b.checks == {"inside_range": True, "step_within_max_step": True}
+    assert len(b.turning_points) == 1
+
+
+def test_the_turn_back_stops_whatever_the_leave_margin():
+    """mistuned studies pass leave_margin=0.05: the branch still stops at the boundary."""
+    fun = circle()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for margin in (0.0, 0.05, 1.0):
+            b = continuation(fun, np.array([np.sqrt(3.0)]), 9.0, 14.0, x_scale=2.0, residual_scale=1.0,
+                             max_step=0.05, leave_margin=margin)
+            assert not b.success and b.omega.min() >= 9.0
+
+
+def test_downward_range_is_clipped_too():
+    fun = circle()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        b = continuation(fun, np.array([np.sqrt(3.0)]), 11.0, 6.0, x_scale=2.0, residual_scale=1.0, max_step=0.05)
+    assert not b.success and "turned back" in b.message
+    assert b.omega.max() <= 11.0 and b.omega.min() >= 8.0 - 1e-9 and b.omega[-1] == 11.0
+
+
+@pytest.mark.parametrize("max_step", [0.3, 0.05, 0.01])
+def test_no_step_longer_than_max_step(max_step):
+    """A straight branch in omega: the arc-length step control would grow the step beyond
+    max_step x range without the limit; every step lands within it and on the end exactly."""
+    fun = lambda x, w, jacobian=True: (np.array([x[0] - 0.1 * w]), np.array([[1.0]]), np.array([-0.1]))
+    b = continuation(fun, np.array([0.0]), 0.0 + 1.0, 11.0, x_scale=1.0, residual_scale=1.0, max_step=max_step)
+    assert b.success and b.omega[-1] == 11.0
+    assert np.abs(np.diff(b.omega)).max() <= max_step * 10.0 * (1 + 1e-12)
+    assert all(b.checks.values())
+
+
+def test_branch_checks_flag_violations():
+    assert branch_checks([1.0, 1.5, 2.0], 1.0, 2.0, 0.5) == {"inside_range": True, "step_within_max_step": True}
+    assert not branch_checks([1.0, 0.9, 2.0], 1.0, 2.0, 1.0)["inside_range"]
+    assert not branch_checks([1.0, -0.5], 2.0, 1.0, 1.0)["inside_range"]
+    assert not branch_checks([1.0, 1.6, 2.0], 1.0, 2.0, 0.5)["step_within_max_step"]
+
+
+def test_disk_step_no_longer_than_max_step_on_a_smooth_branch():
+    """Issue 12: one step jumped from 111.76 to 118.2 Hz (19 % of the range) at max_step 0.01;
+    since then the corrector jumped 5 Hz back to another branch. Either is now rejected."""
+    from bladedamp.blade import reference_blade
+    from bladedamp.damper.geometry import ContactProperties, CylinderDamper
+    from bladedamp.disk import TunedDisk
+
+    disk = TunedDisk(reference_blade(), CylinderDamper(0.01583, 0.002, 0.02,
+                                                       ContactProperties(0.286, 1.7e7, 1.25, 1.0, 10.0, 4, 5)),
+                     16, 5, np.radians(35.68), np.radians(35.68), 0.0261,
+                     2.28 * np.array([0.1, -0.1, 0, 0, 0, 0.001]))
+    r = disk.frequency_response(85.0, 118.2, harmonics=(1,), max_step=0.01)
+    assert r.success, r.message
+    assert np.abs(np.diff(r.frequency_hz)).max() <= 0.01 * (118.2 - 85.0) * (1 + 1e-9)
+    assert r.frequency_hz.min() >= 85.0 and r.frequency_hz.max() <= 118.2 * (1 + 1e-12)
+
+
+# ----- option validation (item 6) ----------------------------------------------------------------
+def line(x, w, jacobian=True):
+    return np.array([x[0] - w]), np.array([[1.0]]), np.array([-1.0])
+
+
+@pytest.mark.parametrize("option, value", [
+    ("max_step", 0.0), ("max_step", -0.1), ("max_step", np.nan), ("max_step", 2.0),
+    ("step", 0.0), ("step", np.nan), ("min_step", -1.0), ("min_step", np.nan),
+    ("tol", 0.0), ("tol", -1.0), ("tol", np.nan),
+    ("max_points", 0), ("max_points", -5), ("max_points", 1.5), ("max_points", np.nan),
+    ("max_corrector", 0), ("target_iterations", 0), ("leave_margin", -1.0), ("leave_margin", np.nan),
+])
+def test_continuation_options_are_validated(option, value):
+    with pytest.raises(ValueError, match=option):
+        continuation(line, np.array([1.0]), 1.0, 2.0, **{option: value})
+
+
+@pytest.mark.parametrize("option, value", [("max_step", 0.0), ("max_step", np.nan), ("tol", -1.0),
+                                           ("max_points", 0)])
+def test_frequency_response_options_are_validated(option, value):
+    with pytest.raises(ValueError, match=option):
+        FrictionOscillator().frequency_response(80.0, 120.0, **{option: value})
+
+
+@pytest.mark.parametrize("processes", [0, -3, 1.5, np.nan, "two"])
+def test_processes_are_validated(processes):
+    from bladedamp.studies.parallel import parallel_map
+
+    with pytest.raises(ValueError, match="processes"):
+        parallel_map(abs, [1, 2], processes)
+
+
+@pytest.mark.parametrize("argv, flag", [
+    (["reproduce", "--processes", "0"], "--processes"),
+    (["reproduce", "--processes", "-3"], "--processes"),
+    (["montecarlo", "--workers", "0"], "--workers"),
+    (["montecarlo", "--disks", "0"], "--disks"),
+    (["montecarlo", "--max-step", "nan"], "--max-step"),
+    (["montecarlo", "--max-step", "0"], "--max-step"),
+    (["montecarlo", "--tol", "-1"], "--tol"),
+])
+def test_cli_flags_are_validated(argv, flag):
+    from bladedamp.cli import main
+
+    with pytest.raises(ValueError, match=flag):
+        main(argv)
+
+
+# ----- the shared robust start ---------------------------------------------------------------------
+def test_robust_start_finds_the_oscillator_solution_in_gross_slip():
+    """The issue's oscillator at 0.9 rad/s: plain Newton from the free linear solution diverged."""
+    osc = FrictionOscillator(mass=1, stiffness=1, damping=0.01, contact_stiffness=1, friction_coefficient=1,
+                             normal_load=0.1, forcing=0.05)
+    system = osc.hbm_system((1,))
+    f = system.excitation(0.9)[0]
+    s = robust_start(system.residual, {"free": system.linear_solution(0.9)}, 0.9, 0.1, f)
+    assert s.converged
+    assert np.linalg.norm(system.residual(s.x, 0.9, False)[0]) < 1e-9 * np.linalg.norm(f)
+    # the homotopy alone (from a useless guess) gets there too
+    s = robust_start(system.residual, {"far": np.full(system.n_unknowns, 1e3)}, 0.9, 0.1, f)
+    assert s.converged
