@@ -395,9 +395,9 @@ class TunedDisk:
         """A solution (C, n_dof) of ``basis`` as the initial guess in ``system``'s basis; a static
         term that ``basis`` lacks starts from the damper seated under F_CG (Eq. 26)."""
         X = basis.embed(coefficients, system.basis)
-        if self.has_damper and system.basis.has_static and not basis.has_static:
-            u_seat, _, _ = seat(self.damper_geometry(), self.centrifugal_force(omega)[0])
-            X[system.basis.cos_index(0), self.blade.n_modes:] = u_seat
+        if system.basis.has_static and not basis.has_static:
+            j0 = system.basis.cos_index(0)
+            X[j0] = self._static_state(system, omega).reshape(system.basis.n_coeffs, system.n_dof)[j0]
         return X.ravel()
 
     def unknown_scales(self, system: HarmonicBalanceSystem, omega_start: float, omega_end: float) -> np.ndarray:
@@ -511,10 +511,8 @@ class DiskResponse(FrequencyResponse):
         X = branch.x.reshape(-1, C, n_dof)
         npts = len(branch.omega)
         j1 = basis.cos_index(1)
-        tip_shape = disk.blade.shape("tip")[:3]
         q1 = X[:, j1, :nm] - 1j * X[:, j1 + 1, :nm]
-        tip = np.abs(q1 @ tip_shape.T)
-        out = dict(tip_amplitude=tip, modal_amplitude=np.abs(q1),
+        out = dict(tip_amplitude=disk.output_amplitudes(X, basis), modal_amplitude=np.abs(q1),
                    excitation_work=np.array([system.excitation_work(x.ravel(), w) for x, w in zip(X, branch.omega)]),
                    viscous_dissipation=np.array([system.viscous_dissipation(x.ravel(), w)
                                                  for x, w in zip(X, branch.omega)]))

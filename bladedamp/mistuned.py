@@ -741,12 +741,9 @@ class MistunedResponse(FrequencyResponse):
     @classmethod
     def from_branch(cls, disk: MistunedDisk, system: HarmonicBalanceSystem, branch, tuned_peak_tip=None):
         basis = system.basis
-        C, N, nm, s = basis.n_coeffs, system.n_dof, disk.n_modes, disk.n_sector
+        C, N, s = basis.n_coeffs, system.n_dof, disk.n_sector
         X = branch.x.reshape(-1, C, N)
-        j1 = basis.cos_index(1)
-        q1 = (X[:, j1, :s * nm] - 1j * X[:, j1 + 1, :s * nm]).reshape(-1, s, nm)
-        tips = np.stack([b.shape("tip")[:3] for b in disk.blades])            # (s, 3, nm)
-        tip = np.abs(np.einsum("pkm,kim->pki", q1, tips))
+        tip = disk.output_amplitudes(X, basis).reshape(len(X), s, 3)
         nd = len(disk.active_dampers)
         exc, visc, diss = [], [], np.zeros((len(branch.omega), nd))
         for i, (x, w) in enumerate(zip(branch.x, branch.omega)):

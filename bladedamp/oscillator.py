@@ -122,8 +122,7 @@ class FrictionOscillator:
         """
         _validate.positive("omega_start", omega_start)
         _validate.positive("omega_end", omega_end)
-        scale = max(self.linear_amplitude([omega_start, omega_end], stuck=False).max(),
-                    abs(self.forcing) / self.stiffness, 1e-300)
+        scale = self.unknown_scales(None, omega_start, omega_end)
 
         def solve(H):
             system = self.hbm_system(H, n_samples)
@@ -161,8 +160,9 @@ class FrictionOscillator:
         """A solution (C, 1) of ``basis`` as the initial guess in ``system``'s basis."""
         return basis.embed(coefficients, system.basis).ravel()
 
-    def unknown_scales(self, system: HarmonicBalanceSystem, omega_start: float, omega_end: float):
-        """Scale of the unknowns: the free linear amplitude over the range [m]."""
+    def unknown_scales(self, system: HarmonicBalanceSystem | None, omega_start: float, omega_end: float):
+        """Scale of the unknowns: the free linear amplitude over the range [m] (the same for any
+        harmonic set, so ``system`` is not needed)."""
         return max(self.linear_amplitude([omega_start, omega_end], stuck=False).max(),
                    abs(self.forcing) / self.stiffness, 1e-300)
 
