@@ -390,16 +390,6 @@ class TunedDisk:
         q1 = coefficients[:, j1, :nm] - 1j * coefficients[:, j1 + 1, :nm]
         return np.abs(q1 @ self.blade.shape("tip")[:3].T)
 
-    def lift(self, coefficients: np.ndarray, basis: HarmonicBasis, system: HarmonicBalanceSystem,
-             omega: float) -> np.ndarray:
-        """A solution (C, n_dof) of ``basis`` as the initial guess in ``system``'s basis; a static
-        term that ``basis`` lacks starts from the damper seated under F_CG (Eq. 26)."""
-        X = basis.embed(coefficients, system.basis)
-        if system.basis.has_static and not basis.has_static:
-            j0 = system.basis.cos_index(0)
-            X[j0] = self._static_state(system, omega).reshape(system.basis.n_coeffs, system.n_dof)[j0]
-        return X.ravel()
-
     def unknown_scales(self, system: HarmonicBalanceSystem, omega_start: float, omega_end: float) -> np.ndarray:
         """Scale of each unknown of ``system`` over omega_start..omega_end [rad/s]."""
         return self._scales(system, omega_start, omega_end)
@@ -414,12 +404,12 @@ class TunedDisk:
         f = system.excitation(omega)[0].reshape(system.basis.n_coeffs, system.n_dof).copy()
         if system.basis.has_static:
             f[system.basis.cos_index(0)] = 0.0          # the preload is not ramped
-        base = self._static_state(system, omega)
+        base = self.static_state(system, omega)
         residual_scale = max(np.linalg.norm(system.residual(np.zeros(system.n_unknowns), omega, False)[0]), 1e-300)
         return robust_start(system.residual, {"stuck linear solution": self._initial_guess(system, omega)},
                             omega, scales, f.ravel(), base=base, residual_scale=residual_scale, tol=tol).x
 
-    def _static_state(self, system, omega):
+    def static_state(self, system, omega):
         """The state without dynamic motion: rest, or with a static harmonic the damper seated
         frictionlessly under F_CG (``seat``)."""
         x = np.zeros(system.n_unknowns)
@@ -436,7 +426,7 @@ class TunedDisk:
         point is open and the Jacobian there has no contact stiffness at all), so the step
         starts from the damper seated frictionlessly under F_CG (``seat``) instead of from rest.
         """
-        x = self._static_state(system, omega)
+        x = self.static_state(system, omega)
         R, J, _ = system.residual(x, omega)
         return x - np.linalg.solve(J, R)
 

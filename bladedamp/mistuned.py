@@ -553,7 +553,7 @@ class MistunedDisk:
         return AssemblySystem(basis, mass.tocsr(), damp.tocsr(), stiff.tocsr(), excitation, couplings,
                               None if static is None else static.tocsr())
 
-    def _static_state(self, system: HarmonicBalanceSystem, omega: float) -> np.ndarray:
+    def static_state(self, system: HarmonicBalanceSystem, omega: float) -> np.ndarray:
         """Rest, or with a static harmonic every damper seated frictionlessly under F_CG."""
         x = np.zeros(system.n_unknowns)
         if system.basis.has_static:
@@ -566,7 +566,7 @@ class MistunedDisk:
 
     def initial_guess(self, system: HarmonicBalanceSystem, omega: float) -> np.ndarray:
         """Stuck linear solution (one Newton step from the static state; see TunedDisk._initial_guess)."""
-        x = self._static_state(system, omega)
+        x = self.static_state(system, omega)
         R, J, _ = system.residual(x, omega)
         return x - solve(J, R)
 
@@ -579,7 +579,7 @@ class MistunedDisk:
             f[system.basis.cos_index(0)] = 0.0          # the preload is not ramped
         residual_scale = max(np.linalg.norm(system.residual(np.zeros(system.n_unknowns), omega, False)[0]), 1e-300)
         return robust_start(system.residual, {"stuck linear solution": self.initial_guess(system, omega)}, omega,
-                            scales, f.ravel(), base=self._static_state(system, omega),
+                            scales, f.ravel(), base=self.static_state(system, omega),
                             residual_scale=residual_scale, factorize=system.factorize).x
 
     def scales(self, system: HarmonicBalanceSystem, w0: float, w1: float) -> np.ndarray:
@@ -636,15 +636,6 @@ class MistunedDisk:
         q1 = (coefficients[:, j1, :s * nm] - 1j * coefficients[:, j1 + 1, :s * nm]).reshape(-1, s, nm)
         tips = np.stack([b.shape("tip")[:3] for b in self.blades])            # (s, 3, nm)
         return np.abs(np.einsum("pkm,kim->pki", q1, tips)).reshape(len(coefficients), -1)
-
-    def lift(self, coefficients, basis: HarmonicBasis, system: HarmonicBalanceSystem, omega: float) -> np.ndarray:
-        """A solution (C, n_dof) of ``basis`` as the initial guess in ``system``'s basis; a static
-        term that ``basis`` lacks starts from the dampers seated under F_CG."""
-        X = basis.embed(coefficients, system.basis)
-        if system.basis.has_static and not basis.has_static:
-            j0 = system.basis.cos_index(0)
-            X[j0] = self._static_state(system, omega).reshape(system.basis.n_coeffs, system.n_dof)[j0]
-        return X.ravel()
 
     def unknown_scales(self, system: HarmonicBalanceSystem, omega_start: float, omega_end: float) -> np.ndarray:
         """Scale of each unknown of ``system`` over omega_start..omega_end [rad/s] (:meth:`scales`)."""

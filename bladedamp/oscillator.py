@@ -156,9 +156,9 @@ class FrictionOscillator:
         j1 = basis.cos_index(1)
         return np.hypot(coefficients[:, j1], coefficients[:, j1 + 1])
 
-    def lift(self, coefficients, basis: HarmonicBasis, system: HarmonicBalanceSystem, omega: float) -> np.ndarray:
-        """A solution (C, 1) of ``basis`` as the initial guess in ``system``'s basis."""
-        return basis.embed(coefficients, system.basis).ravel()
+    def static_state(self, system: HarmonicBalanceSystem, omega: float) -> np.ndarray:
+        """The state without dynamic motion: rest (the contact's preload needs no static motion)."""
+        return np.zeros(system.n_unknowns)
 
     def unknown_scales(self, system: HarmonicBalanceSystem | None, omega_start: float, omega_end: float):
         """Scale of the unknowns: the free linear amplitude over the range [m] (the same for any

@@ -21,7 +21,8 @@ So every answer is checked against an enriched harmonic set:
   False, and the message).
 
 A model takes part by giving ``hbm_system(harmonics, n_samples)``, ``output_amplitudes
-(coefficients, basis) -> (n, k)``, ``lift(coefficients, basis, system, omega) -> x`` and
+(coefficients, basis) -> (n, k)``, ``static_state(system, omega) -> x`` (rest, or the dampers
+seated under F_CG: the static term of a lifted solution whose set had none) and
 ``unknown_scales(system, omega_start, omega_end)``.
 """
 from __future__ import annotations
@@ -103,6 +104,17 @@ def check_points(amplitude: np.ndarray, turning_points=(), n_points: int = 5) ->
     return np.array([peak] + others[:n_points - 1], dtype=int)
 
 
+def lift(model, coefficients: np.ndarray, basis, system, omega: float) -> np.ndarray:
+    """A solution (C, n_dof) of ``basis`` as the initial guess in ``system``'s basis: the same
+    harmonics (:meth:`HarmonicBasis.embed`); a static term ``basis`` lacks from the model's
+    ``static_state`` (e.g. the damper seated under F_CG, Eq. 26)."""
+    X = basis.embed(coefficients, system.basis)
+    if system.basis.has_static and not basis.has_static:
+        j0 = system.basis.cos_index(0)
+        X[j0] = model.static_state(system, omega).reshape(system.basis.n_coeffs, system.n_dof)[j0]
+    return X.ravel()
+
+
 def harmonic_error(model, response, harmonics=None, n_points: int = 5, tol: float = 1e-10) -> HarmonicCheck:
     """Error estimate of ``response`` (computed by ``model``) against the enriched set
     ``harmonics`` (default :func:`enriched` of the response's), see the module docstring."""
@@ -117,7 +129,7 @@ def harmonic_error(model, response, harmonics=None, n_points: int = 5, tol: floa
         scales = model.unknown_scales(system, float(w.min()), float(w.max()))
         peak = max(float(amp.max()), 1e-300)
         for k, i in enumerate(idx):
-            x0 = model.lift(response.coefficients[i], basis, system, float(w[i]))
+            x0 = lift(model, response.coefficients[i], basis, system, float(w[i]))
             rs = max(np.linalg.norm(system.residual(np.zeros_like(x0), float(w[i]), False)[0]), 1e-300)
             sol = newton(system.residual, x0, float(w[i]), scales, rs, tol=tol, max_iter=20,
                          factorize=system.factorize)
