@@ -93,8 +93,8 @@ def main(argv=None):
     for name, kind, mass in CASES:
         step, _ = step_for(disks[name], MIN_POINTS)
         t, r = best_of(lambda: run(disks[name], step), repeat)
-        results[name] = dict(step=step, n=len(r.omega), t=t, peak=r.peak_tip_amplitude,
-                             f=r.resonance_frequency_hz, iters=float(np.mean(r.iterations)))
+        results[name] = dict(step=step, n=len(r.omega), t=t, peak=r.peak_amplitude,
+                             f=r.peak_frequency_hz, iters=float(np.mean(r.iterations)))
     lin = results["linear"]
     per_point_lin = lin["t"] / lin["n"]
     header = f"{'case':<24}{'max_step':>9}{'points':>8}{'Newton it':>10}{'time [s]':>10}{'ms/point':>10}" \

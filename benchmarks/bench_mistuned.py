@@ -64,9 +64,9 @@ def cost_ratio(repeat):
     t_m, r_m = timed(frf(MistunedDisk.from_tuned(disk, kappa), mt.auto_range(disk, kappa)), 1)
     n_c, n_f, n_m = len(r_c.omega), len(r_f.omega), len(r_m.omega)
     print(f"cyclic tuned sector      : {t_c:7.3f} s, {n_c:4d} points, {1e3 * t_c / n_c:6.2f} ms/point, "
-          f"peak {1e3 * r_c.peak_tip_amplitude:.5f} mm")
+          f"peak {1e3 * r_c.peak_amplitude:.5f} mm")
     print(f"full tuned 16 blades     : {t_f:7.3f} s, {n_f:4d} points, {1e3 * t_f / n_f:6.2f} ms/point, "
-          f"peak {1e3 * r_f.peak_tip.max():.5f} mm")
+          f"peak {1e3 * r_f.peak_amplitude.max():.5f} mm")
     print(f"full mistuned 16 (2 %)   : {t_m:7.3f} s, {n_m:4d} points, {1e3 * t_m / n_m:6.2f} ms/point "
           f"({mt.auto_range(disk, kappa)[0]:.1f}-{mt.auto_range(disk, kappa)[1]:.1f} Hz)")
     print(f"cost ratio full / cyclic : {t_f / t_c:6.1f} per FRF (target <= 25), "
@@ -85,8 +85,8 @@ def accuracy(n_disks):
         t = time.perf_counter()
         fine = mt.mistuned_response(disk, kappa, max_step=0.05, tol=1e-10)
         t_fine += time.perf_counter() - t
-        worst_max = max(worst_max, abs(fast.peak_tip.max() / fine.peak_tip.max() - 1))
-        worst_blade = max(worst_blade, np.abs(fast.peak_tip / fine.peak_tip - 1).max())
+        worst_max = max(worst_max, abs(fast.peak_amplitude.max() / fine.peak_amplitude.max() - 1))
+        worst_blade = max(worst_blade, np.abs(fast.peak_amplitude / fine.peak_amplitude - 1).max())
     print(f"Monte Carlo settings (max_step {mt.MONTE_CARLO_MAX_STEP}, tol {mt.MONTE_CARLO_TOL:g}) vs fine FRFs "
           f"(0.05, 1e-10), {n_disks} disks: largest peak per disk within {worst_max:.1e}, every blade's "
           f"peak within {worst_blade:.1e}; {t_fast / n_disks:.2f} vs {t_fine / n_disks:.2f} s per disk")
@@ -107,7 +107,7 @@ def throughput(n_disks):
                                   workers=[addr]) for w, addr in enumerate(client.scheduler_info()["workers"])]
             client.gather(warm)
             t = time.perf_counter()
-            res = mt.monte_carlo(disk, n_disks, seed=0, scheduler=cluster.scheduler_address, tuned_peak_tip=tuned)
+            res = mt.monte_carlo(disk, n_disks, seed=0, scheduler=cluster.scheduler_address, tuned_peak_amplitude=tuned)
             times[workers] = time.perf_counter() - t
         print(f"Monte Carlo {n_disks} disks, {workers} worker(s): {times[workers]:7.1f} s "
               f"({60 * n_disks / times[workers]:.1f} disks/min, {times[workers] / n_disks:.2f} s/disk), "

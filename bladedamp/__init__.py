@@ -3,29 +3,73 @@
 Data flows one way: geometry and parameters -> model -> harmonic balance residual ->
 continuation solver -> result objects -> plots, reports and 3D views.
 """
+import importlib
+
 from . import _numba_cache
 
 NUMBA_CACHE_DIR = _numba_cache.configure()   # compiled kernels go to a per-user cache, never site-packages
 
-from .blade import BeamBladeGeometry, ModalBlade, reference_blade  # noqa: E402 (after the cache set-up)
-from .contact import ContactPatch, LinearNormalLaw, RoughnessNormalLaw
-from .damper import ContactProperties, CylinderDamper, WedgeDamper
-from .disk import DiskResponse, TunedDisk
-from .hbm import HarmonicBasis
-from .oscillator import FrictionOscillator
-from .reference import reference_disk
-from .response import FrequencyResponse
-
 __version__ = "0.1.0"
-__all__ = ["BeamBladeGeometry", "ModalBlade", "reference_blade", "ContactPatch", "LinearNormalLaw",
-           "RoughnessNormalLaw", "ContactProperties", "CylinderDamper", "WedgeDamper", "TunedDisk", "DiskResponse",
-           "HarmonicBasis", "FrictionOscillator", "FrequencyResponse", "reference_disk", "frequency_response"]
+
+# The public names, imported on first use (PEP 562): ``import bladedamp`` stays fast (the CLI's
+# --help, worker start-up) and loads numpy, scipy and numba only with the first model.
+_LAZY = {
+    "BeamBladeGeometry": "blade", "ModalBlade": "blade", "reference_blade": "blade",
+    "ContactPatch": "contact", "LinearNormalLaw": "contact", "RoughnessNormalLaw": "contact",
+    "ContactProperties": "damper", "CylinderDamper": "damper", "WedgeDamper": "damper",
+    "TunedDisk": "disk", "DiskResponse": "disk",
+    "MistunedDisk": "mistuned", "MistunedResponse": "mistuned",
+    "HarmonicBasis": "hbm",
+    "FrictionOscillator": "oscillator",
+    "reference_disk": "reference",
+    "FrequencyResponse": "response",
+    "load": "io", "save": "io",
+    "load_design": "design",
+    "nonlinear_mode": "hbm.nonlinear_modes",
+}
+__all__ = sorted(_LAZY) + ["frequency_response"]
 
 
-def frequency_response(model, f_range_hz, harmonics="auto", **options):
-    """Forced response of ``model`` (a TunedDisk or MistunedDisk) over ``f_range_hz = (start, end)``
-    [Hz] by harmonic balance and arc-length continuation. ``harmonics="auto"`` (default) chooses
-    them to the tolerance ``harmonic_tolerance`` (see :mod:`bladedamp.hbm.accuracy`); ``(1,)`` is
-    the paper's setting. Returns the model's response (:class:`DiskResponse`, ...)."""
-    start, end = f_range_hz
-    return model.frequency_response(start, end, harmonics=harmonics, **options)
+def __getattr__(name):
+    if name in _LAZY:
+        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'bladedamp' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY))
+
+
+def frequency_response(model, f_range_hz, harmonics="auto", stability: bool = False, **options):
+    """Forced response of ``model`` over ``f_range_hz = (start, end)`` [Hz] by harmonic balance
+    and arc-length continuation, the same call for every model: a :class:`FrictionOscillator`,
+    a :class:`TunedDisk` or a :class:`~bladedamp.mistuned.MistunedDisk` (each takes Hz).
+    ``harmonics="auto"`` (default) chooses them to the tolerance ``harmonic_tolerance`` (see
+    :mod:`bladedamp.hbm.accuracy`); ``(1,)`` is the paper's setting; ``options`` go to the
+    model's ``frequency_response``. Returns the model's response (:class:`FrequencyResponse`,
+    :class:`DiskResponse`, :class:`~bladedamp.mistuned.MistunedResponse`). ``stability=True``
+    adds the stability of every point (``stable``, ``floquet_exponents``, ``bifurcations``; see
+    :mod:`bladedamp.hbm.stability`: Hill's method, or the sign of det J for friction).
+
+    Raises TypeError for any other model, ValueError for a range that is not (start, end) in Hz.
+    """
+    from .disk import TunedDisk
+    from .mistuned import MistunedDisk
+    from .oscillator import FrictionOscillator
+
+    models = (FrictionOscillator, TunedDisk, MistunedDisk)
+    if not isinstance(model, models):
+        raise TypeError(f"model must be a FrictionOscillator, TunedDisk or MistunedDisk "
+                        f"(got {type(model).__module__}.{type(model).__qualname__})")
+    try:
+        start, end = (float(f) for f in f_range_hz)
+    except (TypeError, ValueError):
+        raise ValueError(f"f_range_hz must be a pair (f_start_hz, f_end_hz) in Hz (got {f_range_hz!r})") from None
+    response = model.frequency_response(start, end, harmonics=harmonics, **options)
+    if stability:
+        from .hbm.stability import with_stability
+
+        response = with_stability(model, response)
+    return response

@@ -35,13 +35,22 @@ def _writable(path: str) -> bool:
 
 def configure() -> str | None:
     """Point numba's cache at the per-user folder unless ``NUMBA_CACHE_DIR`` is set; returns
-    the folder in use (None: numba's own choice, the user's setting)."""
-    from numba.core import config
+    the folder in use (None: numba's own choice, the user's setting).
+
+    Does not import numba (0.5-1 s): if numba is not loaded yet, the folder is given through
+    ``NUMBA_CACHE_DIR``, which numba reads when it is first imported (and which worker
+    processes inherit); if it is, through ``numba.config.CACHE_DIR``."""
+    import sys
 
     if os.environ.get("NUMBA_CACHE_DIR"):
         return None
     for path in (user_cache_dir(), os.path.join(tempfile.gettempdir(), f"bladedamp-numba-{os.getuid()}")):
         if _writable(path):
-            config.CACHE_DIR = path
+            if "numba" in sys.modules:
+                from numba.core import config
+
+                config.CACHE_DIR = path
+            else:
+                os.environ["NUMBA_CACHE_DIR"] = path
             return path
     return None

@@ -69,3 +69,44 @@ def interval(name: str, value, unit: str = "") -> tuple[float, float]:
     if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi):
         raise ValueError(f"{name} must satisfy 0 < low < high{unit} (got {value!r})")
     return lo, hi
+
+
+class PlausibilityWarning(UserWarning):
+    """A value that is allowed but outside the range a real design has: most often a unit slip
+    (1 kg meant as 1 g, 20 m meant as 20 mm). The computation goes on; the warning names the
+    parameter, its value and unit, and the plausible range."""
+
+
+def _outside_caller_level() -> int:
+    """The ``stacklevel`` of the first frame outside bladedamp (and outside dataclass-generated
+    code), so that a warning points at the user's line."""
+    import os
+    import sys
+
+    package = os.path.dirname(os.path.abspath(__file__))
+    frame, level = sys._getframe(1), 1
+    while frame is not None:
+        filename = frame.f_code.co_filename
+        generated = filename.startswith("<") and frame.f_code.co_name == "__init__"    # a dataclass's __init__
+        if not (filename.startswith(package) or generated):
+            return level
+        frame, level = frame.f_back, level + 1
+    return 1
+
+
+def plausible(name: str, value, low: float, high: float, unit: str, reason: str = ""):
+    """Warn (:class:`PlausibilityWarning`) if ``value`` lies outside [low, high] ``unit``; zero
+    is exempt (it means "absent" for a damper mass). Returns ``value`` unchanged.
+
+    ``reason`` says where the range comes from; the message reads e.g. "damper mass = 1 kg is
+    outside the plausible range 1e-05-0.1 kg (...); SI units: masses in kg, lengths in m"."""
+    import warnings
+
+    arr = np.asarray(value, dtype=float)
+    outside = (arr != 0) & ((arr < low) | (arr > high))
+    if np.any(outside):
+        why = f" ({reason})" if reason else ""
+        warnings.warn(f"{name} = {value!r} {unit} is outside the plausible range {low:g}-{high:g} {unit}{why}; "
+                      "bladedamp takes SI units: masses in kg, lengths in m",
+                      PlausibilityWarning, stacklevel=_outside_caller_level())
+    return value

@@ -15,14 +15,63 @@ touches OL of one blade touches OR of its neighbour on the -x side.
 
 Units: SI everywhere (m, kg, s, rad, N).  Mass-normalised mode shapes have units
 m/sqrt(kg) (translations) and rad/sqrt(kg) (rotations); modal coordinates sqrt(kg)*m.
+
+Modal data files (:meth:`ModalBlade.from_file`, :meth:`ModalBlade.save`)
+-------------------------------------------------------------------------
+A blade is its modes at named points: natural frequencies f_0j [Hz], modal viscous damping
+ratios D_j [-] and, at every point, its position (x, y, z) [m] in the blade frame and the six
+mass-normalised mode-shape values (ux, uy, uz [m/sqrt(kg)], phix, phiy, phiz [rad/sqrt(kg)])
+of every mode, normalised so that Phi^T M Phi = I (kg-based units, not mm or tonnes).  The
+points OL, OR (platform contact control points, OL at -x, OR at +x), tip (where the tip
+amplitude is read) and excitation (where the excitation acts) are required; any other named
+point (e.g. "platform") is kept.  The suffix chooses the format:
+
+``.csv``: comma-separated text, one row per (mode, point); write it by hand or from an FE
+export.  Lines starting with ``#`` and blank lines are ignored; the first other line is the
+header.  Columns, in any order (names are case-sensitive):
+
+    mode           mode number 1, 2, ..., n_m (no gaps; the order of the modes)
+    mode_name      optional, e.g. 1F; the same on every row of a mode
+    frequency_hz   natural frequency f_0j [Hz], > 0; the same on every row of a mode
+    damping_ratio  modal damping ratio D_j [-], >= 0; the same on every row of a mode
+    point          point name: OL, OR, tip, excitation, or an extra name
+    x, y, z        point position [m]; the same on every row of the point
+    ux, uy, uz     translations of the mass-normalised mode shape [m/sqrt(kg)]
+    phix .. phiz   small rotations of the mass-normalised mode shape [rad/sqrt(kg)]
+
+Every mode lists the same points, each once.  For example (two of the four required points)::
+
+    mode,mode_name,frequency_hz,damping_ratio,point,x,y,z,ux,uy,uz,phix,phiy,phiz
+    1,1F,95.0,0.001,tip,0,0,0.2,3.480,0,0,0,23.91,0
+    1,1F,95.0,0.001,OL,-0.012,0,0.058,0.4484,0,0.1755,0,14.62,0
+
+``.npz`` (numpy, read with ``allow_pickle=False``): arrays ``natural_frequencies_hz`` (n_m,)
+[Hz], ``damping_ratios`` (n_m,) [-], ``point_names`` (n_p,) str, ``point_positions``
+(n_p, 3) [m], ``mode_shapes`` (n_p, 6, n_m) [m/sqrt(kg), rad/sqrt(kg)], rows (ux, uy, uz,
+phix, phiy, phiz); optional ``mode_names`` (n_m,) str and ``format`` (the string
+``bladedamp.ModalBlade/1``).  A bad file raises ValueError naming the file, the key or
+column (and line) and what was expected.
+
+Reduced FE matrices (:meth:`ModalBlade.from_matrices`): Craig-Bampton or Guyan exports with
+the root clamped; the modes are computed and picked at the named points.
+
+The reference blade (:func:`bladedamp.reference.reference_blade`, calibrated on the paper)
+lives in :mod:`bladedamp.reference`; ``bladedamp.blade.reference_blade`` and
+``reference_blade_geometry`` stay available here as aliases.
 """
 from __future__ import annotations
 
+import csv
 import dataclasses
+import math
+import warnings
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 import scipy.linalg
+import scipy.sparse
+import scipy.sparse.linalg
 
 from bladedamp import _validate as check
 
@@ -30,9 +79,30 @@ from bladedamp import _validate as check
 REQUIRED_POINTS = ("OL", "OR", "tip", "excitation")
 # Ordering of the paper's four modes (Table 1).
 PAPER_MODE_ORDER = ("1F", "2F", "1T", "1E")
-# The paper's Table 1: natural frequencies [Hz] and modal damping ratios [-].
-TABLE1_FREQUENCIES_HZ = (95.0, 423.0, 783.0, 1065.0)
-TABLE1_DAMPING_RATIOS = (0.001, 0.001, 0.001, 0.001)
+
+# Modal data files (format: module docstring).
+MODAL_NPZ_FORMAT = "bladedamp.ModalBlade/1"
+MODAL_NPZ_KEYS = ("format", "natural_frequencies_hz", "damping_ratios", "mode_names", "point_names",
+                  "point_positions", "mode_shapes")
+MODAL_CSV_COLUMNS = ("mode", "mode_name", "frequency_hz", "damping_ratio", "point", "x", "y", "z",
+                     "ux", "uy", "uz", "phix", "phiy", "phiz")
+# ModalBlade.from_matrices: a mode v is a rigid-body mode if K v vanishes to rounding,
+# max|K v| <= RIGID_MODE_TOLERANCE * max(|K| |v|) (|.| entry-wise). Scale-free, unlike a
+# threshold on omega^2 (the beam model's max K_ii / M_ii is 2e14 1/s^2, 5e8 times its 1F
+# omega^2, and grows as h^-4 with refinement). Measured on the beam model: the unclamped beam's
+# six rigid modes 3e-15 to 5e-13 (20 and 200 elements); the clamped blade's 1F 1.6e-6 (20
+# elements, the reference mesh), 5.7e-10 (200 elements) and 2e-11 at 600 elements, where the
+# beam is so ill-conditioned that its 1F is 9 % off anyway.
+RIGID_MODE_TOLERANCE = 1e-11
+# ModalBlade.from_matrices(solver="sparse"): shift-invert about omega^2 = -(2 pi 1 Hz)^2, just
+# below every blade frequency, so the nearest eigenvalues are the lowest and K - sigma M is
+# regular even when K has rigid-body modes (which are then found and refused).
+SHIFT_INVERT_SIGMA = -(2.0 * np.pi * 1.0) ** 2
+# ModalBlade.from_matrices(solver="auto"): dense eigh (all modes) up to this many free DOF,
+# shift-invert above. Dense eigh of 1000 DOF took 12 s on this 2-core machine under load
+# (load average 9), 1800 DOF 25 s; shift-invert of the 1800 DOF 5 s (dense input) or 0.1 s
+# (sparse input). Craig-Bampton blades have tens to hundreds of DOF: dense, the most robust.
+DENSE_SOLVER_MAX_DOF = 500
 
 # DOF indices inside a 6-vector.
 UX, UY, UZ, PHIX, PHIY, PHIZ = range(6)
@@ -260,8 +330,9 @@ class ModalBlade:
     @classmethod
     def from_arrays(cls, natural_frequencies_hz, damping_ratios, mode_shapes, points,
                     mode_names=()) -> "ModalBlade":
-        """Build from any FE export: frequencies [Hz], damping ratios, (6, n_m) shapes per point
-        (mass-normalised), (3,) point positions [m]."""
+        """Build from arrays of any FE export: frequencies [Hz], damping ratios, (6, n_m) shapes
+        per point (mass-normalised), (3,) point positions [m]. Files: :meth:`from_file`;
+        reduced FE matrices: :meth:`from_matrices`."""
         return cls(natural_frequencies_hz=natural_frequencies_hz, damping_ratios=damping_ratios,
                    mode_shapes=dict(mode_shapes), points=dict(points),
                    mode_names=tuple(mode_names or ()))
@@ -309,6 +380,173 @@ class ModalBlade:
         return cls(natural_frequencies_hz=freqs, damping_ratios=damping_ratios,
                    mode_shapes=shapes, points=points, mode_names=names)
 
+    # -- files and FE matrices ---------------------------------------------------------
+    @classmethod
+    def from_file(cls, path) -> "ModalBlade":
+        """Read a modal data file: ``.npz`` or ``.csv`` by the suffix of ``path``.
+
+        The formats (natural frequencies [Hz], damping ratios [-], point positions [m] and
+        mass-normalised 6-DOF shapes [m/sqrt(kg), rad/sqrt(kg)] at OL, OR, tip, excitation
+        and any extra points) are described in the module docstring of :mod:`bladedamp.blade`.
+        A file that breaks them raises ValueError naming the file, the key or column (and
+        the line) and what was expected; a missing file raises FileNotFoundError.
+        """
+        path = Path(path)
+        kind = _modal_file_kind(path)
+        if not path.is_file():
+            raise FileNotFoundError(f"{path}: no such modal data file")
+        fields = _read_modal_npz(path) if kind == "npz" else _read_modal_csv(path)
+        try:
+            return cls(**fields)
+        except ValueError as err:
+            raise ValueError(f"{path}: {err}") from None
+
+    def save(self, path) -> Path:
+        """Write this blade to ``path``: ``.npz`` or ``.csv`` by its suffix (formats: module
+        docstring of :mod:`bladedamp.blade`). Every value is written exactly (the CSV holds
+        the shortest decimal that reads back to the same float), so ``from_file`` gives the
+        same arrays back. Returns the path."""
+        path = Path(path)
+        kind = _modal_file_kind(path)
+        if kind == "npz":
+            names = list(self.points)
+            with open(path, "wb") as fh:   # a file object: np.savez would append .npz to ".NPZ"
+                np.savez(fh, format=np.array(MODAL_NPZ_FORMAT),
+                         natural_frequencies_hz=self.natural_frequencies_hz,
+                         damping_ratios=self.damping_ratios,
+                         mode_names=np.array(self.mode_names, dtype=str),
+                         point_names=np.array(names, dtype=str),
+                         point_positions=np.array([self.points[p] for p in names]),
+                         mode_shapes=np.array([self.mode_shapes[p] for p in names]))
+        else:
+            _write_modal_csv(self, path)
+        return path
+
+    @classmethod
+    def from_matrices(cls, mass, stiffness, dof_map: dict, *, points: dict, n_modes: int,
+                      damping_ratios, rigid_links: dict | None = None, fixed_dofs=(),
+                      mode_names=(), solver: str = "auto",
+                      symmetry_tolerance: float = 1e-8) -> "ModalBlade":
+        """Modes of reduced FE matrices (a Craig-Bampton or Guyan export) at named points.
+
+        Solves K v = omega^2 M v for the ``n_modes`` lowest modes, mass-normalises them
+        (v^T M v = 1, so the shapes are in m/sqrt(kg) and rad/sqrt(kg)) and picks their
+        values at the points of ``dof_map`` and ``rigid_links``.
+
+        Parameters
+        ----------
+        mass, stiffness : (n, n) arrays or scipy.sparse matrices in SI units (kg and kg m^2;
+            N/m and N m/rad; Craig-Bampton modal coordinates as exported). M must be positive
+            definite and K positive semi-definite on the free DOF, both symmetric to
+            ``symmetry_tolerance`` (their symmetric parts are used).
+        dof_map : point name -> indices (rows of M and K as given) of the point's six DOF
+            (ux, uy, uz, phix, phiy, phiz) or of its three translations (ux, uy, uz). A point
+            given by translations only gets zero rotations: right where only a force acts or a
+            translation is read (tip, excitation of a solid model), but OL and OR rotate the
+            damper contact, so give them 6 DOF (e.g. an RBE2/RBE3 master node) or a rigid link
+            (a warning says so otherwise).
+        points : point name -> (3,) position [m] in the blade frame, for every point of
+            ``dof_map`` and ``rigid_links`` (and no other).
+        n_modes : number of modes kept (the lowest), in [1, number of free DOF].
+        damping_ratios : modal damping ratio(s) D_j [-], >= 0, scalar or (n_modes,): FE
+            matrices carry no damping.
+        rigid_links : point name -> name of a 6-DOF point of ``dof_map`` it is rigidly
+            attached to: it moves by u + phi x r, r = its position minus the master's
+            (e.g. ``{"OL": "platform", "OR": "platform"}`` on a beam model).
+        fixed_dofs : indices of clamped DOF (e.g. the root interface of a model exported
+            with it free); they are removed before solving and have zero shape.
+        mode_names : empty or ``n_modes`` names, lowest mode first.
+        solver : "dense" (scipy.linalg.eigh, all modes), "sparse" (scipy.sparse.linalg.eigsh,
+            shift-invert about :data:`SHIFT_INVERT_SIGMA`, then Rayleigh-Ritz) or "auto"
+            (sparse above :data:`DENSE_SOLVER_MAX_DOF` free DOF). Both work on the
+            equilibrated matrices D M D, D K D with D = diag(M)^-1/2.
+        symmetry_tolerance : largest allowed max|A - A^T| / max|A| of M and K, >= 0 (FE
+            exports print a limited number of digits).
+
+        Rigid-body modes are refused: the blade of a bladed disk is clamped at its root, and a
+        Craig-Bampton model with its root interface fixed has none. A mode v counts as rigid
+        when K v vanishes to rounding, max|K v| <= :data:`RIGID_MODE_TOLERANCE` * max(|K| |v|);
+        clamp the root with ``fixed_dofs`` (or export the model clamped).
+
+        Signs: in every mode the tip's translation of largest magnitude is positive (its
+        largest rotation if the tip does not translate).
+        """
+        M = _fe_matrix("mass", mass, symmetry_tolerance)
+        K = _fe_matrix("stiffness", stiffness, symmetry_tolerance)
+        if K.shape != M.shape:
+            raise ValueError(f"stiffness must have the shape of mass {M.shape} (got {K.shape})")
+        n = M.shape[0]
+        fixed = _dof_indices("fixed_dofs", fixed_dofs, n, allow_empty=True)
+        if np.unique(fixed).size != fixed.size:
+            raise ValueError(f"fixed_dofs must not repeat an index (got {list(fixed)})")
+        free = np.setdiff1d(np.arange(n), fixed)
+        if free.size == 0:
+            raise ValueError("fixed_dofs must leave at least one free DOF")
+        n_modes = check.integer("n_modes", n_modes, minimum=1, maximum=int(free.size))
+
+        # point maps, checked before the (possibly long) eigen-solution
+        if not isinstance(dof_map, dict) or not dof_map:
+            raise ValueError("dof_map must be a non-empty dict: point name -> 6 or 3 DOF indices")
+        links = dict(rigid_links or {})
+        maps = {}
+        for name, dofs in dof_map.items():
+            idx = _dof_indices(f"dof_map[{name!r}]", dofs, n)
+            if idx.size not in (3, 6):
+                raise ValueError(
+                    f"dof_map[{name!r}] must list 6 DOF indices (ux, uy, uz, phix, phiy, phiz) "
+                    f"or 3 (ux, uy, uz) (got {idx.size})")
+            maps[name] = idx
+        for name, master in links.items():
+            if name in maps:
+                raise ValueError(f"point {name!r} is in both dof_map and rigid_links; give it in one")
+            if master not in maps or maps[master].size != 6:
+                raise ValueError(
+                    f"rigid_links[{name!r}] must name a point of dof_map with 6 DOF "
+                    f"(got {master!r}; 6-DOF points: {[p for p in maps if maps[p].size == 6]})")
+        named = set(maps) | set(links)
+        if not isinstance(points, dict) or set(points) != named:
+            given = set(points) if isinstance(points, dict) else set()
+            raise ValueError(
+                "points must give the (3,) position [m] of every point of dof_map and "
+                f"rigid_links and no other (missing: {sorted(named - given)}, "
+                f"extra: {sorted(given - named)})")
+        missing = [p for p in REQUIRED_POINTS if p not in named]
+        if missing:
+            raise ValueError(f"dof_map and rigid_links must give the required points "
+                             f"{REQUIRED_POINTS}; missing: {missing}")
+        positions = {}
+        for name, pos in points.items():
+            positions[name] = check.finite(f"points[{name!r}]", np.asarray(pos, dtype=float))
+            if np.shape(positions[name]) != (3,):
+                raise ValueError(f"points[{name!r}] must be a (3,) position [m] (got shape "
+                                 f"{np.shape(positions[name])})")
+        damping = np.asarray(check.nonnegative("damping_ratios", damping_ratios))
+        if damping.shape not in ((), (n_modes,)):
+            raise ValueError(f"damping_ratios must be a scalar or have shape ({n_modes},) = (n_modes,) "
+                             f"(got {damping.shape})")
+        mode_names = tuple(mode_names or ())
+        if mode_names and len(mode_names) != n_modes:
+            raise ValueError(f"mode_names must be empty or have n_modes = {n_modes} entries "
+                             f"(got {len(mode_names)})")
+        for name in ("OL", "OR"):
+            if name in maps and maps[name].size == 3:
+                warnings.warn(f"dof_map[{name!r}] has translations only: its rotations are taken "
+                              "as zero, which leaves out the platform rotation at the damper "
+                              "contact; give 6 DOF or a rigid link", stacklevel=2)
+
+        lam, vecs = _lowest_modes(M, K, free, n_modes, solver)
+        full = np.zeros((n, n_modes))
+        full[free] = vecs
+        shapes = {}
+        for name, idx in maps.items():
+            shapes[name] = full[idx] if idx.size == 6 else np.vstack([full[idx], np.zeros((3, n_modes))])
+        for name, master in links.items():
+            shapes[name] = rigid_offset_motion(shapes[master], positions[name] - positions[master])
+        flip = _tip_sign(shapes["tip"], shapes)
+        shapes = {name: s * flip for name, s in shapes.items()}
+        return cls(natural_frequencies_hz=np.sqrt(lam) / (2.0 * np.pi), damping_ratios=damping,
+                   mode_shapes=shapes, points=positions, mode_names=mode_names)
+
     # -- linear reference solution -----------------------------------------------------
     def linear_frf(self, omega: np.ndarray, force: np.ndarray, at: str = "excitation",
                    response_at: str = "tip") -> np.ndarray:
@@ -334,6 +572,287 @@ class ModalBlade:
         S = w0**2 - omega[:, None]**2 + 2j * self.damping_ratios * w0 * omega[:, None]  # Eq. 5
         q = modal_force[None, :] / S                                     # Eq. 4, (n, n_m)
         return q @ self.shape(response_at).T                            # Eq. 2
+
+
+# --------------------------------------------------------------------------------------
+# Modal data files and FE matrices (helpers of ModalBlade.from_file / save / from_matrices)
+# --------------------------------------------------------------------------------------
+def _modal_file_kind(path: Path) -> str:
+    kind = path.suffix.lower().lstrip(".")
+    if kind not in ("npz", "csv"):
+        raise ValueError(f"{path}: a modal data file must end in .npz or .csv (got {path.suffix!r})")
+    return kind
+
+
+def _read_modal_npz(path: Path) -> dict:
+    """ModalBlade fields from a .npz file (format: module docstring)."""
+    try:
+        data = np.load(path, allow_pickle=False)
+    except Exception as err:   # numpy raises several types for a file that is not an .npz
+        raise ValueError(f"{path}: not a readable .npz file ({err})") from None
+    if not isinstance(data, np.lib.npyio.NpzFile):
+        raise ValueError(f"{path}: expected an .npz archive of named arrays (got a single array)")
+    with data:
+        keys = set(data.files)
+        unknown = sorted(keys - set(MODAL_NPZ_KEYS))
+        missing = [k for k in MODAL_NPZ_KEYS if k not in keys and k not in ("mode_names", "format")]
+        if unknown or missing:
+            raise ValueError(f"{path}: keys {MODAL_NPZ_KEYS} expected ('mode_names', 'format' "
+                             f"optional); missing: {missing}, unknown: {unknown}")
+
+        def array(key, kind):
+            try:
+                arr = data[key]
+            except ValueError as err:   # object arrays need pickle
+                raise ValueError(f"{path}: key {key!r} must be a plain {kind} array ({err})") from None
+            if kind == "string" and arr.size and arr.dtype.kind != "U":
+                raise ValueError(f"{path}: key {key!r} must hold strings (got dtype {arr.dtype})")
+            if kind == "float":
+                if arr.dtype.kind not in "iuf":
+                    raise ValueError(f"{path}: key {key!r} must hold numbers (got dtype {arr.dtype})")
+                arr = arr.astype(float)
+            return arr
+
+        if "format" in keys and str(array("format", "string")) != MODAL_NPZ_FORMAT:
+            raise ValueError(f"{path}: key 'format' must be {MODAL_NPZ_FORMAT!r} "
+                             f"(got {str(data['format'])!r})")
+        freqs = array("natural_frequencies_hz", "float")
+        if freqs.ndim != 1 or freqs.size == 0:
+            raise ValueError(f"{path}: key 'natural_frequencies_hz' must be a non-empty (n_modes,) "
+                             f"array [Hz] (got shape {freqs.shape})")
+        n_m = freqs.size
+        names = array("point_names", "string")
+        n_p = names.size
+        expected = {"damping_ratios": (n_m,), "point_names": (n_p,), "point_positions": (n_p, 3),
+                    "mode_shapes": (n_p, 6, n_m)}
+        arrays = {"point_names": names}
+        for key in ("damping_ratios", "point_positions", "mode_shapes"):
+            arrays[key] = array(key, "float")
+        mode_names = array("mode_names", "string") if "mode_names" in keys else np.array([], dtype=str)
+        if mode_names.shape not in ((0,), (n_m,)):
+            raise ValueError(f"{path}: key 'mode_names' must have shape (0,) or ({n_m},) = (n_modes,) "
+                             f"(got {mode_names.shape})")
+        for key, shape in expected.items():
+            if arrays[key].shape != shape:
+                raise ValueError(f"{path}: key {key!r} must have shape {shape} (n_points = {n_p}, "
+                                 f"n_modes = {n_m}) (got {arrays[key].shape})")
+        names = [str(p) for p in names]
+        if len(set(names)) != len(names):
+            raise ValueError(f"{path}: key 'point_names' must not repeat a name (got {names})")
+        return dict(natural_frequencies_hz=freqs, damping_ratios=arrays["damping_ratios"],
+                    mode_shapes=dict(zip(names, arrays["mode_shapes"])),
+                    points=dict(zip(names, arrays["point_positions"])),
+                    mode_names=tuple(str(m) for m in mode_names))
+
+
+def _read_modal_csv(path: Path) -> dict:
+    """ModalBlade fields from a .csv file, one row per (mode, point) (format: module docstring)."""
+    with open(path, newline="", encoding="utf-8-sig") as fh:
+        numbered = [(n, line) for n, line in enumerate(fh, start=1)
+                    if line.strip() and not line.lstrip().startswith("#")]
+    if not numbered:
+        raise ValueError(f"{path}: no header line; expected the columns {MODAL_CSV_COLUMNS}")
+    rows = list(csv.reader(line for _, line in numbered))
+    line_of = [n for n, _ in numbered]
+    header = [c.strip() for c in rows[0]]
+    where = f"{path}: line {line_of[0]} (header)"
+    if len(header) == 1 and any(sep in header[0] for sep in ";\t"):
+        raise ValueError(f"{where}: columns must be separated by commas (got {header[0]!r})")
+    optional = ("mode_name",)
+    unknown = [c for c in header if c not in MODAL_CSV_COLUMNS]
+    missing = [c for c in MODAL_CSV_COLUMNS if c not in header and c not in optional]
+    repeated = sorted({c for c in header if header.count(c) > 1})
+    if unknown or missing or repeated:
+        raise ValueError(f"{where}: expected the columns {MODAL_CSV_COLUMNS} ('mode_name' optional), "
+                         f"in any order; missing: {missing}, unknown: {unknown}, repeated: {repeated}")
+    col = {c: header.index(c) for c in header}
+    units = {"frequency_hz": "Hz", "damping_ratio": "-", "x": "m", "y": "m", "z": "m"}
+
+    modes: dict[int, tuple] = {}        # mode -> (frequency, damping, name, line)
+    positions: dict[str, tuple] = {}    # point -> (position, line)
+    shapes: dict[tuple, list] = {}      # (mode, point) -> 6 values
+    for row, line in zip(rows[1:], line_of[1:]):
+        where = f"{path}: line {line}"
+        if len(row) != len(header):
+            raise ValueError(f"{where}: expected {len(header)} comma-separated values, one per "
+                             f"column of the header (got {len(row)})")
+        cell = {c: row[i].strip() for c, i in col.items()}
+
+        def number(c):
+            try:
+                value = float(cell[c])
+            except ValueError:
+                value = math.nan
+            if not math.isfinite(value):
+                unit = units.get(c, "m/sqrt(kg)" if c.startswith("u") else "rad/sqrt(kg)")
+                raise ValueError(f"{where}: column {c!r} must be a finite number [{unit}] "
+                                 f"(got {cell[c]!r})") from None
+            return value
+
+        try:
+            mode = int(cell["mode"])
+        except ValueError:
+            mode = 0
+        if mode < 1:
+            raise ValueError(f"{where}: column 'mode' must be a mode number 1, 2, ... (got {cell['mode']!r})")
+        point = cell["point"]
+        if not point:
+            raise ValueError(f"{where}: column 'point' must name the point (e.g. OL, OR, tip, excitation)")
+        per_mode = (number("frequency_hz"), number("damping_ratio"), cell.get("mode_name", ""))
+        if mode in modes and modes[mode][:3] != per_mode:
+            raise ValueError(
+                f"{where}: mode {mode} has frequency_hz, damping_ratio, mode_name = {per_mode}, but "
+                f"{modes[mode][:3]} on line {modes[mode][3]}; they must be the same on every row of a mode")
+        modes.setdefault(mode, per_mode + (line,))
+        xyz = (number("x"), number("y"), number("z"))
+        if point in positions and positions[point][0] != xyz:
+            raise ValueError(f"{where}: point {point!r} is at x, y, z = {xyz} [m], but at "
+                             f"{positions[point][0]} on line {positions[point][1]}; a point has one position")
+        positions.setdefault(point, (xyz, line))
+        if (mode, point) in shapes:
+            raise ValueError(f"{where}: mode {mode} at point {point!r} is given twice; once expected")
+        shapes[(mode, point)] = [number(c) for c in MODAL_CSV_COLUMNS[-6:]]
+    if not shapes:
+        raise ValueError(f"{path}: no data rows after the header; one row per (mode, point) expected")
+    n_m = max(modes)
+    gaps = sorted(set(range(1, n_m + 1)) - set(modes))
+    if gaps:
+        raise ValueError(f"{path}: column 'mode' must number the modes 1..{n_m} without gaps (missing {gaps})")
+    absent = [(m, p) for m in range(1, n_m + 1) for p in positions if (m, p) not in shapes]
+    if absent:
+        raise ValueError(f"{path}: every mode must list every point; no row for (mode, point) "
+                         f"{absent[:5]}{' ...' if len(absent) > 5 else ''}")
+    names = [modes[m][2] for m in range(1, n_m + 1)]
+    if any(names) and not all(names):
+        raise ValueError(f"{path}: column 'mode_name' must name every mode or none "
+                         f"(unnamed: modes {[m + 1 for m, s in enumerate(names) if not s]})")
+    return dict(natural_frequencies_hz=[modes[m][0] for m in range(1, n_m + 1)],
+                damping_ratios=[modes[m][1] for m in range(1, n_m + 1)],
+                mode_shapes={p: np.array([shapes[(m, p)] for m in range(1, n_m + 1)]).T for p in positions},
+                points={p: np.array(xyz) for p, (xyz, _) in positions.items()},
+                mode_names=tuple(names) if all(names) else ())
+
+
+def _write_modal_csv(blade: "ModalBlade", path: Path) -> None:
+    with open(path, "w", newline="", encoding="utf-8") as fh:
+        fh.write("# bladedamp modal blade: one row per (mode, point); format in the docstring of "
+                 "bladedamp.blade\n"
+                 "# units: frequency_hz [Hz], damping_ratio [-], x y z [m] (blade frame: x "
+                 "circumferential, y axial, z radial),\n"
+                 "#        ux uy uz [m/sqrt(kg)], phix phiy phiz [rad/sqrt(kg)]: mass-normalised "
+                 "mode shapes (Phi^T M Phi = I)\n")
+        writer = csv.writer(fh, lineterminator="\n")
+        writer.writerow(MODAL_CSV_COLUMNS)
+        for j in range(blade.n_modes):
+            name = blade.mode_names[j] if blade.mode_names else ""
+            for point, pos in blade.points.items():
+                writer.writerow([j + 1, name, repr(float(blade.natural_frequencies_hz[j])),
+                                 repr(float(blade.damping_ratios[j])), point]
+                                + [repr(float(v)) for v in pos]
+                                + [repr(float(v)) for v in blade.mode_shapes[point][:, j]])
+
+
+def _fe_matrix(name: str, value, symmetry_tolerance: float):
+    """Square, finite, symmetric (to the tolerance) FE matrix; returns its symmetric part
+    (dense float array, or CSR for a scipy.sparse input)."""
+    tol = check.nonnegative("symmetry_tolerance", symmetry_tolerance)
+    sparse = scipy.sparse.issparse(value)
+    A = scipy.sparse.csr_matrix(value, dtype=float) if sparse else np.array(value, dtype=float)
+    if A.ndim != 2 or A.shape[0] != A.shape[1] or A.shape[0] == 0:
+        raise ValueError(f"{name} must be a square (n, n) matrix (got shape {A.shape})")
+    if not np.all(np.isfinite(A.data if sparse else A)):
+        raise ValueError(f"{name} must be finite (it has NaN or inf entries)")
+    scale = abs(A).max()
+    if scale == 0:
+        raise ValueError(f"{name} must not be zero")
+    asymmetry = abs(A - A.T).max() / scale
+    if asymmetry > tol:
+        raise ValueError(f"{name} must be symmetric: max|A - A^T| / max|A| = {asymmetry:.3g} exceeds "
+                         f"symmetry_tolerance = {tol:g}")
+    return (A + A.T) * 0.5
+
+
+def _dof_indices(name: str, value, n: int, allow_empty: bool = False) -> np.ndarray:
+    """Integer DOF indices in [0, n)."""
+    arr = np.asarray(value)
+    if arr.ndim != 1 or (arr.size == 0 and not allow_empty) or (
+            arr.size and not np.all(np.mod(arr.astype(float), 1) == 0)):
+        raise ValueError(f"{name} must be a sequence of integer DOF indices in [0, {n - 1}] (got {value!r})")
+    arr = arr.astype(int)
+    if arr.size and (arr.min() < 0 or arr.max() >= n):
+        raise ValueError(f"{name} must hold DOF indices in [0, {n - 1}] (got {value!r})")
+    return arr
+
+
+def _lowest_modes(M, K, free: np.ndarray, n_modes: int, solver: str):
+    """The n_modes lowest eigenpairs of K v = lambda M v on the free DOF: (lambda, V) with
+    V^T M V = I; refuses an indefinite M or K and rigid-body modes (see from_matrices)."""
+    if solver not in ("auto", "dense", "sparse"):
+        raise ValueError(f"solver must be 'auto', 'dense' or 'sparse' (got {solver!r})")
+    sparse_input = scipy.sparse.issparse(M) or scipy.sparse.issparse(K)
+    Mf = M[free][:, free]
+    Kf = K[free][:, free]
+    m_diag, k_diag = Mf.diagonal(), Kf.diagonal()
+    bad = np.flatnonzero(m_diag <= 0)
+    if bad.size:
+        raise ValueError(f"mass must be positive definite on the free DOF: M[{free[bad[0]]}, "
+                         f"{free[bad[0]]}] = {m_diag[bad[0]]:g} (a massless DOF must be condensed out, "
+                         "e.g. by a Guyan reduction, or clamped with fixed_dofs)")
+    if not np.any(k_diag):
+        raise ValueError("stiffness must not be zero on the free DOF")
+    # Equilibrate (D M D has unit diagonal, D = diag(M)^-1/2): same eigenvalues, vectors D v.
+    # FE matrices mix translations and rotations of very different mass; equilibrating
+    # takes the beam model's cond(M) from 2.6e7 to 29.
+    d = 1.0 / np.sqrt(m_diag)
+    if sparse_input:
+        D = scipy.sparse.diags(d)
+        Me, Ke = scipy.sparse.csc_matrix(D @ Mf @ D), scipy.sparse.csc_matrix(D @ Kf @ D)
+    else:
+        Me, Ke = Mf * d[:, None] * d[None, :], Kf * d[:, None] * d[None, :]
+    use_sparse = solver == "sparse" or (solver == "auto" and free.size > DENSE_SOLVER_MAX_DOF)
+    if use_sparse and n_modes >= free.size - 1:
+        use_sparse = False                      # ARPACK needs n_modes < n - 1
+    try:
+        if use_sparse:   # eigsh factorises K - sigma M: SuperLU for sparse input, LAPACK for dense
+            _, V = scipy.sparse.linalg.eigsh(Ke, k=n_modes, M=Me, sigma=SHIFT_INVERT_SIGMA, which="LM")
+            # Rayleigh-Ritz on the found subspace: exact M-orthonormality, ascending order
+            lam, Q = scipy.linalg.eigh(V.T @ (Ke @ V), V.T @ (Me @ V))
+            V = V @ Q
+        else:
+            if scipy.sparse.issparse(Me):
+                Me, Ke = Me.toarray(), Ke.toarray()
+            # all eigenpairs: the subset driver (gvx) loses 3e-7 of the beam's 1F omega^2
+            lam, V = scipy.linalg.eigh(Ke, Me)
+            lam, V = lam[:n_modes], V[:, :n_modes]
+    except (np.linalg.LinAlgError, RuntimeError) as err:   # Cholesky of M, or ARPACK / the factorisation
+        raise ValueError(f"mass must be positive definite on the free DOF and stiffness positive "
+                         f"semi-definite (the eigen-solver failed: {err})") from None
+    V = V / np.sqrt(np.einsum("ij,ij->j", V, Me @ V))   # v^T M v = 1 (kept exact after Ritz)
+    V = V * d[:, None]
+    residual = np.abs(Kf @ V).max(axis=0) / (abs(Kf) @ np.abs(V)).max(axis=0)
+    rigid = residual <= RIGID_MODE_TOLERANCE
+    if rigid.any():
+        raise ValueError(
+            f"the matrices have {int(rigid.sum())} rigid-body (zero-frequency) mode(s) among the "
+            f"{n_modes} lowest: a blade must be clamped at its root; pass the root DOF as fixed_dofs "
+            "(or export the Craig-Bampton model with its root interface fixed)")
+    if np.any(lam <= 0):
+        raise ValueError(f"stiffness must be positive semi-definite on the free DOF (an eigenvalue "
+                         f"omega^2 = {lam.min():.4g} 1/s^2 <= 0 that is no rigid-body mode)")
+    return lam, V
+
+
+def _tip_sign(tip: np.ndarray, shapes: dict) -> np.ndarray:
+    """(n_m,) +-1 that makes each mode's largest tip translation positive (or its largest tip
+    rotation, if the tip does not translate in that mode)."""
+    reach = np.max([np.abs(s[:3]).max(axis=0) for s in shapes.values()], axis=0)   # (n_m,)
+    sign = np.ones(tip.shape[1])
+    for j in range(tip.shape[1]):
+        translates = np.abs(tip[:3, j]).max() > 1e-6 * reach[j]
+        part = tip[:3, j] if translates else tip[3:, j]
+        value = part[np.argmax(np.abs(part))]
+        sign[j] = -1.0 if value < 0 else 1.0
+    return sign
 
 
 # --------------------------------------------------------------------------------------
@@ -644,83 +1163,17 @@ def beam_modes(geometry: BeamBladeGeometry) -> BeamModes:
 
 
 # --------------------------------------------------------------------------------------
-# Reference blade (paper's tuned system, Table 1)
+# The reference blade moved to bladedamp.reference (with its calibration); aliases kept here
 # --------------------------------------------------------------------------------------
-def reference_blade_geometry() -> BeamBladeGeometry:
-    """Simplified steel model blade used for the paper's reference configuration.
-
-    The paper gives no dimensions; these are chosen physically and calibrated so that, with
-    the Table 1 frequencies and D = 0.001 substituted, F_x = 0.1 N at the tip gives the
-    paper's no-damper 1F resonance tip amplitude 1.7 mm.
-    """
-    # Material: generic blade steel (12 % Cr steels are within a few % of these values).
-    youngs_modulus = 210e9        # [Pa]
-    poisson_ratio = 0.3           # [-]
-    density = 7850.0              # [kg/m^3]
-
-    # Span 0.20 m (small turbine blade, "beam-like" model blade of the paper's Fig. 4);
-    # the platform sits at 30 % of the span above the clamped root (shank below it).
-    shank_length = 0.060          # [m] root -> platform (30 % of 0.20 m)
-    airfoil_length = 0.140        # [m] platform -> tip
-
-    # The paper's blade has a constant rectangular cross-section, so shank and airfoil
-    # share one section.
-    # thickness_x = 4.57 mm: sets the FE flatwise frequency 1F = 95.0 Hz (Table 1).
-    # chord_y = 45.5 mm: sets the blade mass (0.367 kg incl. platform) so that the 1F tip
-    # mode-shape value is 3.48 /sqrt(kg) and the no-damper 1F resonance tip amplitude
-    # under F_x = 0.1 N (Table 1 frequencies, D = 0.001) is 1.70 mm (paper, m = 0 g).
-    thickness_x = 4.57e-3         # [m]
-    chord_y = 45.5e-3             # [m]
-
-    # Platform: a steel plate centred on the platform node, 30 mm (x, circumferential)
-    # x 50 mm (y, axial, longer than the chord) x 4 mm (z).  Its volume inside the beam
-    # section is already counted by the beam, so it is subtracted.
-    plate_x, plate_y, plate_z = 0.030, 0.050, 0.004
-    platform_mass = density * (plate_x * plate_y - thickness_x * chord_y) * plate_z  # ~40.6 g
-    platform_rotary_inertia = (  # solid plate about its centre [kg m^2]
-        platform_mass * (plate_y**2 + plate_z**2) / 12.0,
-        platform_mass * (plate_x**2 + plate_z**2) / 12.0,
-        platform_mass * (plate_x**2 + plate_y**2) / 12.0,
-    )
-    # Contact control points OL/OR at x = -/+ 12 mm: centre of the inclined contact faces,
-    # 3 mm inside the plate edge; 2 mm below the node = on the platform underside where
-    # the damper sits.
-    platform_half_width = 0.012   # [m]
-    platform_contact_z_offset = 0.002  # [m]
-
-    # Mesh: 10 mm elements (6 + 14); the four FE frequencies change < 0.05 % and the
-    # calibrated amplitude < 0.01 % when the element size is halved.
-    #
-    # FE frequencies vs the paper's Table 1 (FE only provides the shapes; the Table 1
-    # values are substituted by reference_blade()):
-    #   1F  95.0 Hz vs  95 Hz (tuned),   2F 559 Hz vs 423 Hz (+32 %),
-    #   1T 743 Hz vs 783 Hz (-5 %),      1E 945 Hz vs 1065 Hz (-11 %).
-    # A uniform rectangular beam cannot match all four ratios with a ~0.37 kg mass
-    # (2F/1F = 6.27 for a plain cantilever; the platform mass lowers it to 5.9).
-    return BeamBladeGeometry(
-        shank_length=shank_length,
-        shank_thickness_x=thickness_x,
-        shank_chord_y=chord_y,
-        airfoil_length=airfoil_length,
-        airfoil_thickness_x=thickness_x,
-        airfoil_chord_y=chord_y,
-        platform_half_width=platform_half_width,
-        platform_contact_z_offset=platform_contact_z_offset,
-        platform_mass=platform_mass,
-        platform_rotary_inertia=platform_rotary_inertia,
-        youngs_modulus=youngs_modulus,
-        poisson_ratio=poisson_ratio,
-        density=density,
-        n_elements_shank=6,
-        n_elements_airfoil=14,
-        tip_point=None,        # on the axis at the tip, z = 0.20 m
-        excitation_point=None,  # = tip (paper: F_x, F_y, M_z at the blade tip)
-    )
+_IN_REFERENCE = ("reference_blade", "reference_blade_geometry", "TABLE1_FREQUENCIES_HZ",
+                 "TABLE1_DAMPING_RATIOS")
 
 
-def reference_blade() -> ModalBlade:
-    """Reference blade: FE shapes of :func:`reference_blade_geometry`, paper Table 1
-    frequencies (95, 423, 783, 1065 Hz) and D = 0.001, modes ("1F", "2F", "1T", "1E")."""
-    return ModalBlade.from_beam(reference_blade_geometry(), n_modes=4,
-                                natural_frequencies_hz=TABLE1_FREQUENCIES_HZ,
-                                damping_ratios=TABLE1_DAMPING_RATIOS)
+def __getattr__(name: str):
+    """``bladedamp.blade.reference_blade`` and the other names of :data:`_IN_REFERENCE` are
+    those of :mod:`bladedamp.reference`, imported on first use (reference.py imports this
+    module, so a top-level import here would be circular)."""
+    if name in _IN_REFERENCE:
+        from . import reference
+        return getattr(reference, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -77,11 +77,16 @@ class FrictionOscillator:
         """mu N0 [N]."""
         return self.friction_coefficient * self.normal_load
 
-    def linear_amplitude(self, omega, stuck: bool) -> np.ndarray:
-        """Amplitude of the linear system with the contact stuck or absent (k) [m].
+    def linear_amplitude(self, f_hz, stuck: bool) -> np.ndarray:
+        """Amplitude of the linear system with the contact stuck or absent (k) [m] at the
+        excitation frequencies ``f_hz`` [Hz] (scalar or array; same shape).
 
         Stuck (and never lifting off): k + k_T cos^2(alpha) + k_N sin^2(alpha).
         """
+        return self._linear_amplitude(2 * np.pi * np.asarray(f_hz, dtype=float), stuck)
+
+    def _linear_amplitude(self, omega, stuck: bool) -> np.ndarray:
+        """:meth:`linear_amplitude` at angular frequencies ``omega`` [rad/s]."""
         omega = np.asarray(omega, dtype=float)
         stuck_k = self.contact_stiffness * np.cos(self.contact_angle) ** 2 \
             + self.normal_stiffness * np.sin(self.contact_angle) ** 2
@@ -106,10 +111,12 @@ class FrictionOscillator:
         return HarmonicBalanceSystem(basis, [[self.mass]], [[self.damping]], [[self.stiffness]],
                                      lambda omega: (f, np.zeros(C)), couplings)
 
-    def frequency_response(self, omega_start: float, omega_end: float, harmonics="auto", n_samples=None,
+    def frequency_response(self, f_start_hz: float, f_end_hz: float, harmonics="auto", n_samples=None,
                            harmonic_tolerance: float = HARMONIC_TOLERANCE, max_harmonic: int = 9,
                            **continuation_options) -> FrequencyResponse:
-        """FRF by harmonic balance and pseudo-arclength continuation from ``omega_start`` to ``omega_end`` [rad/s].
+        """FRF by harmonic balance and pseudo-arclength continuation from ``f_start_hz`` to
+        ``f_end_hz`` [Hz] (as :meth:`bladedamp.disk.TunedDisk.frequency_response`; the result's
+        ``omega`` is the angular frequency [rad/s], ``frequency_hz`` the same in Hz).
 
         ``harmonics``: ``"auto"`` (default) chooses the set whose first-harmonic amplitude is
         converged to ``harmonic_tolerance`` (see :mod:`bladedamp.hbm.accuracy`; the static term
@@ -120,8 +127,11 @@ class FrictionOscillator:
         The result is ``success`` only if the branch reached the end and passed
         :func:`bladedamp.response.physical_checks`.
         """
-        _validate.positive("omega_start", omega_start)
-        _validate.positive("omega_end", omega_end)
+        _validate.positive("f_start_hz", f_start_hz)
+        _validate.positive("f_end_hz", f_end_hz)
+        if f_start_hz == f_end_hz:
+            raise ValueError("f_end_hz must differ from f_start_hz")
+        omega_start, omega_end = 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz
         scale = self.unknown_scales(None, omega_start, omega_end)
 
         def solve(H):
@@ -161,9 +171,10 @@ class FrictionOscillator:
         return np.zeros(system.n_unknowns)
 
     def unknown_scales(self, system: HarmonicBalanceSystem | None, omega_start: float, omega_end: float):
-        """Scale of the unknowns: the free linear amplitude over the range [m] (the same for any
-        harmonic set, so ``system`` is not needed)."""
-        return max(self.linear_amplitude([omega_start, omega_end], stuck=False).max(),
+        """Scale of the unknowns: the free linear amplitude over omega_start..omega_end [rad/s,
+        the residual's Omega, as every solver-protocol method] [m] (the same for any harmonic
+        set, so ``system`` is not needed)."""
+        return max(self._linear_amplitude([omega_start, omega_end], stuck=False).max(),
                    abs(self.forcing) / self.stiffness, 1e-300)
 
     def energy_balance(self, response: FrequencyResponse):
@@ -177,15 +188,20 @@ class FrictionOscillator:
         return np.array(rows)
 
     # ----- time integration -----------------------------------------------------------
-    def time_response(self, omega, steps_per_period: int = 2048, max_periods: int = 5000,
+    def time_response(self, f_hz, steps_per_period: int = 2048, max_periods: int = 5000,
                       min_periods: int = 20, tol: float = 1e-9) -> TimeResponse:
-        """Steady state by central-difference integration from rest at each ``omega`` [rad/s]."""
-        omega = np.atleast_1d(np.asarray(omega, dtype=float))
-        _validate.positive("omega", omega)
+        """Steady state by central-difference integration from rest at each excitation
+        frequency ``f_hz`` [Hz] (scalar or array); the result's ``omega`` is in rad/s."""
+        f_hz = np.atleast_1d(np.asarray(f_hz, dtype=float))
+        _validate.positive("f_hz (excitation frequency, Hz)", f_hz)
         _validate.integer("steps_per_period", steps_per_period, minimum=16)
+        omega = 2 * np.pi * f_hz
         dt_max = 2.0 / np.sqrt((self.stiffness + self.contact_stiffness + self.normal_stiffness) / self.mass)
         if np.any(2 * np.pi / omega / steps_per_period > 0.5 * dt_max):
-            raise ValueError("steps_per_period too small for the explicit scheme at the lowest omega")
+            lowest = float(f_hz.min())
+            need = int(np.ceil(2 * np.pi / (2 * np.pi * lowest) / (0.5 * dt_max)))
+            raise ValueError(f"steps_per_period must be >= {need} for the explicit scheme at the lowest "
+                             f"frequency {lowest:.6g} Hz (got {steps_per_period})")
         if self.cubic_stiffness != 0:
             raise ValueError("time_response does not integrate the cubic spring (cubic_stiffness must be 0)")
         samples = np.zeros((omega.size, steps_per_period))

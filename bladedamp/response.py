@@ -8,6 +8,7 @@ import numpy as np
 
 from .hbm.continuation import branch_checks
 from .hbm.fourier import HarmonicBasis
+from .io import Saveable
 
 
 def physical_checks(omega, omega_range, dissipation, excitation_work, max_step=None,
@@ -64,8 +65,27 @@ def with_checks(response, failed: dict):
     return dataclasses.replace(response, success=False, message=message, failed_checks=dict(failed))
 
 
+def plot_branch(ax, x, y, stable=None, **kwargs):
+    """Draw a branch ``y`` (n,) over ``x`` (n,): solid where stable (or when ``stable`` is
+    None), dashed in the same colour where unstable, one legend entry; returns the lines."""
+    stable = None if stable is None else np.asarray(stable, dtype=bool)
+    if stable is None or stable.all():
+        return ax.plot(x, y, **kwargs)
+    solid = np.where(stable, y, np.nan)
+    # extend each unstable run by one point on either side so the two styles join
+    join = np.convolve(~stable, [1, 1, 1], mode="same") > 0
+    dashed = np.where(join, y, np.nan)
+    lines = ax.plot(x, solid, **kwargs)
+    kwargs.pop("label", None)
+    kwargs.pop("linestyle", None)
+    kwargs.pop("ls", None)
+    kwargs["color"] = lines[0].get_color()
+    lines += ax.plot(x, dashed, linestyle="--", label="_unstable", **kwargs)
+    return lines
+
+
 @dataclass
-class FrequencyResponse:
+class FrequencyResponse(Saveable):
     """Harmonic balance frequency response of a system with named degrees of freedom.
 
     Attributes
@@ -85,6 +105,13 @@ class FrequencyResponse:
     harmonics_converged : whether the estimate met the tolerance (None: not estimated)
     failed_checks : physical sanity checks the branch failed (name -> what was found); a
         branch that fails one is not ``success``
+    stable : (n,) bool per point, or None when not computed (see
+        :func:`bladedamp.hbm.stability.with_stability`); plots draw unstable parts dashed
+    floquet_exponents : (n, k) resolved Floquet exponents per point [1/s] (Hill's method; width
+        0 when decided by the determinant sign, for friction), or None
+    bifurcations : {"fold": [...], "branch point": [...], "neimark-sacker": [...], ...}: indices
+        i where the kind happens between points i and i + 1
+    stability_method : "hill", "determinant sign" or "" (not computed)
     """
 
     omega: np.ndarray
@@ -99,6 +126,10 @@ class FrequencyResponse:
     harmonic_tolerance: float = float("nan")
     harmonics_converged: bool | None = None
     failed_checks: dict = field(default_factory=dict)
+    stable: np.ndarray | None = None
+    floquet_exponents: np.ndarray | None = None
+    bifurcations: dict = field(default_factory=dict)
+    stability_method: str = ""
 
     def reversed(self):
         """The same branch in the opposite order (a downward sweep as rising frequency): every
@@ -135,20 +166,37 @@ class FrequencyResponse:
         """max_t |x(t)| over a period at every point (all harmonics)."""
         return np.abs(self.time_samples(dof)).max(axis=1)
 
-    def peak(self, dof=0, harmonic: int = 1):
-        """(omega [rad/s], amplitude) of the largest |X_h| on the branch."""
+    def peak(self, dof=0, harmonic: int = 1) -> tuple[float, float]:
+        """(frequency [Hz], amplitude [SI]) of the largest |X_h| of ``dof`` on the branch
+        (nan, nan for an empty branch)."""
+        if not len(self.omega):
+            return float("nan"), float("nan")
         a = self.harmonic_amplitude(dof, harmonic)
         i = int(np.argmax(a))
-        return float(self.omega[i]), float(a[i])
+        return float(self.frequency_hz[i]), float(a[i])
 
-    def plot(self, dof=0, ax=None, harmonic: int = 1, scale: float = 1.0, unit: str = "", **kwargs):
-        """Plot |X_h| of ``dof`` over frequency [Hz]; returns the axes."""
+    @property
+    def peak_amplitude(self) -> float:
+        """Largest first-harmonic amplitude of the first DOF on the branch [SI: m for a
+        displacement] (nan for an empty branch). Every response class has it: the disks' is
+        the largest tip amplitude u_x [m]."""
+        return self.peak()[1]
+
+    @property
+    def peak_frequency_hz(self) -> float:
+        """Excitation frequency of :attr:`peak_amplitude` [Hz] (the resonance)."""
+        return self.peak()[0]
+
+    def plot(self, ax=None, *, dof=0, harmonic: int = 1, scale: float = 1.0, unit: str = "", **kwargs):
+        """Plot |X_h| of ``dof`` over frequency [Hz] into ``ax`` (a new figure if None); returns
+        the axes. Every response class's ``plot`` takes ``ax`` first, options by keyword."""
         import matplotlib.pyplot as plt
 
         if ax is None:
             _, ax = plt.subplots(figsize=(6, 4))
         label = kwargs.pop("label", f"{self.dof_names[self._dof(dof)]}, H={self.basis.harmonics}")
-        ax.plot(self.frequency_hz, scale * self.harmonic_amplitude(dof, harmonic), label=label, **kwargs)
+        plot_branch(ax, self.frequency_hz, scale * self.harmonic_amplitude(dof, harmonic), self.stable,
+                    label=label, **kwargs)
         ax.set_xlabel("excitation frequency [Hz]")
         ax.set_ylabel(f"|{self.dof_names[self._dof(dof)]}| harmonic {harmonic} {unit}".strip())
         ax.grid(True, alpha=0.3)

@@ -20,6 +20,7 @@ import numpy as np
 from numba import njit
 
 from .contact.point import slider_step
+from .io import Saveable
 
 
 @njit(cache=True)
@@ -64,7 +65,7 @@ def _oscillator_steady_state(omega, m, c, k, k3, k_t, mu, n0, k_n, sin_a, cos_a,
 
 
 @dataclass
-class TimeResponse:
+class TimeResponse(Saveable):
     """Steady-state response by time integration, one run per frequency.
 
     Attributes
@@ -93,7 +94,7 @@ class TimeResponse:
         spec = np.fft.rfft(self.samples, axis=1) / self.samples.shape[1]
         return (1 if harmonic == 0 else 2) * np.abs(spec[:, harmonic])
 
-    def plot(self, ax=None, scale: float = 1.0, **kwargs):
+    def plot(self, ax=None, *, scale: float = 1.0, **kwargs):
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -512,7 +513,7 @@ def _highest_frequency(arrays: _AssemblyArrays, x_static: np.ndarray) -> float:
 
 
 @dataclass
-class DiskTimeResponse:
+class DiskTimeResponse(Saveable):
     """Steady state of a bladed disk by time integration of the full assembly, one run per
     excitation frequency (see :func:`disk_time_response`).
 
@@ -576,7 +577,7 @@ class DiskTimeResponse:
         """|W_exc - W_visc - W_friction| / W_exc per frequency (last period)."""
         return np.abs(self.excitation_work - self.viscous_dissipation - self.dissipated_energy) / np.abs(self.excitation_work)
 
-    def plot(self, ax=None, direction: int = 0, blades=None, **kwargs):
+    def plot(self, ax=None, *, direction: int = 0, blades=None, **kwargs):
         """First-harmonic tip amplitude [mm] over frequency [Hz], one marker series per blade
         (``blades``: indices, default all; a tuned disk's blades coincide); points that are not
         periodic are drawn as open markers."""

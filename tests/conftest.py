@@ -93,7 +93,7 @@ def hbm_amplitudes(osc, omegas, harmonics, n_samples=None, return_solutions=Fals
     from bladedamp.hbm.continuation import newton
 
     system = osc.hbm_system(harmonics, n_samples)
-    frf = osc.frequency_response(0.98 * min(omegas), 1.02 * max(omegas), harmonics, n_samples)
+    frf = osc.frequency_response(0.98 * min(omegas) / (2 * np.pi), 1.02 * max(omegas) / (2 * np.pi), harmonics, n_samples)
     assert frf.success, frf.message
     j = system.basis.cos_index(1)
     amps, sols = [], []

@@ -43,7 +43,7 @@ def fe_frequency(modes, name):
     return modes.frequencies_hz[modes.mode_names.index(name)]
 
 
-def peak_tip_amplitude(blade, force):
+def peak_amplitude(blade, force):
     """Finely searched maximum of |u_x,tip| around the 1F resonance."""
     w1 = blade.natural_angular_frequencies[0]
     res = scipy.optimize.minimize_scalar(
@@ -246,7 +246,7 @@ def test_other_n_modes_returns_lowest_by_frequency():
 
 def test_calibration_no_damper_1f_peak_is_1p7_mm():
     blade = reference_blade()
-    amplitude, omega_peak = peak_tip_amplitude(blade, np.array([0.1, 0, 0, 0, 0, 0]))
+    amplitude, omega_peak = peak_amplitude(blade, np.array([0.1, 0, 0, 0, 0, 0]))
     assert amplitude == pytest.approx(1.70e-3, rel=1e-2)
     assert omega_peak / (2 * np.pi) == pytest.approx(95.0, abs=0.01)
 

@@ -1,12 +1,18 @@
 """The main job end to end: `bladedamp reproduce` writes the summary, the report and the figures."""
+import argparse
 import json
 import os
 import pathlib
+import re
+import subprocess
+import sys
+import time
 
 import numpy as np
 import pytest
 
-from bladedamp.cli import main
+import bladedamp
+from bladedamp.cli import build_parser, main
 
 
 @pytest.mark.slow
@@ -60,12 +66,247 @@ def test_montecarlo_command_writes_results_loadable_without_pickle(tmp_path):
 
     assert main(["montecarlo", "--disks", "2", "--scheduler", "serial", "--out", str(tmp_path)]) == 0
     result = MonteCarloResult.load(tmp_path / "montecarlo")
-    assert result.kappa.shape == (2, 16) and np.all(np.isfinite(result.peak_tip))
+    assert result.kappa.shape == (2, 16) and np.all(np.isfinite(result.peak_amplitude))
     # the largest blade of a 2 % mistuned disk at the tuned optimum stays within +-50 % of the tuned peak
     assert np.all((result.amplification > 0.5) & (result.amplification < 1.5)), result.amplification
     assert result.meta["max_step"] == 0.1 and result.meta["tol"] == 1e-6   # the peak-only defaults
 
 
 def test_montecarlo_command_rejects_a_bad_step(tmp_path, capsys):
-    with pytest.raises(ValueError, match="max.step"):
-        main(["montecarlo", "--disks", "1", "--scheduler", "serial", "--max-step", "-1", "--out", str(tmp_path)])
+    assert main(["montecarlo", "--disks", "1", "--scheduler", "serial", "--max-step", "-1", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "--max-step must be in (0.0, 1.0]" in err and len(err.strip().splitlines()) == 1, err
+
+
+# ---------------------------------------------------------------------------------------
+# the commands on a design written by `bladedamp init` (fast settings: a narrow range around
+# the 1F resonance, the paper's one harmonic, a narrow mass range)
+# ---------------------------------------------------------------------------------------
+FAST = {'frequency_range_hz = [90.0, 105.0]': 'frequency_range_hz = [92.0, 99.0]',
+        'harmonics = "auto"': 'harmonics = [1]',
+        'mass_range_g = [0.01, 20.0]': 'mass_range_g = [0.5, 2.0]'}
+
+
+def _edited(path, changes):
+    text = path.read_text()
+    for old, new in changes.items():
+        assert old in text, old
+        text = text.replace(old, new)
+    path.write_text(text)
+    return path
+
+
+@pytest.fixture(scope="module")
+def fast_design(tmp_path_factory):
+    path = tmp_path_factory.mktemp("design") / "design.toml"
+    assert main(["init", str(path)]) == 0
+    return _edited(path, FAST)
+
+
+def _one_error_line(capsys, *needles):
+    err = capsys.readouterr().err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in err, err
+    for needle in needles:
+        assert needle in lines[0], (needle, lines[0])
+    return lines[0]
+
+
+def _outputs(out, *names):
+    for name in names:
+        assert (out / name).stat().st_size > 0, name
+    summary = (out / "summary.md").read_text()
+    assert not re.search(r"\bnan\b", summary, re.IGNORECASE), summary
+    return summary, json.loads((out / "results.json").read_text()) if (out / "results.json").exists() else None
+
+
+def test_init_writes_the_reference_design_and_keeps_an_existing_file(tmp_path, capsys):
+    from bladedamp.design import template
+
+    path = tmp_path / "design.toml"
+    assert main(["init", str(path)]) == 0
+    assert path.read_text() == template()
+    capsys.readouterr()
+    assert main(["init", str(path)]) == 2
+    _one_error_line(capsys, str(path), "exists")
+    assert main(["init", str(path), "--force"]) == 0
+
+
+def test_frf_on_an_init_design_gives_the_reference_response(fast_design, tmp_path):
+    from bladedamp.reference import reference_disk
+
+    out = tmp_path / "frf"
+    assert main(["frf", str(fast_design), "--out", str(out)]) == 0
+    summary, results = _outputs(out, "frf.png", "summary.md", "results.json", "frf_EO1.npz")
+    r = results["responses"]["EO1"]
+    assert r["success"] and r["harmonics"] == [1]
+    # the same numbers as the reference disk computed directly with the file's settings
+    direct = reference_disk().frequency_response(92.0, 99.0, harmonics=(1,), max_step=0.02)
+    assert r["peak_amplitude_mm"] == pytest.approx(1e3 * direct.tip_amplitude[:, 0].max(), rel=1e-12)
+    assert "| EO1 | yes | (1,) |" in summary
+    loaded = bladedamp.load(out / "frf_EO1.npz")
+    assert np.array_equal(loaded.tip_amplitude, direct.tip_amplitude)
+
+
+def test_optimize_on_an_init_design_finds_the_calibrated_optimum(fast_design, tmp_path):
+    out = tmp_path / "opt"
+    assert main(["optimize", str(fast_design), "--out", str(out), "--processes", "1"]) == 0
+    summary, results = _outputs(out, "optimize.png", "summary.md", "results.json")
+    m = results["mass"]
+    # the calibration of the reference (README): ~1 g, ~71 % at EO = 1
+    assert m["optimal_mass_g"] == pytest.approx(1.0, rel=0.05) and m["reduction_pct"] == pytest.approx(71.0, abs=2)
+    assert m["certified_global"] and "Optimal mass" in summary
+
+
+def test_eo_sweep_on_an_init_design(fast_design, tmp_path):
+    out = tmp_path / "eo"
+    assert main(["eo-sweep", str(fast_design), "--engine-orders", "0", "--out", str(out)]) == 0
+    summary, results = _outputs(out, "eo_sweep.png", "summary.md", "results.json", "eo_sweep.npz")
+    # EO = 0: the cylinder rolls with the platforms, no mass damps (the paper)
+    assert results["engine_orders"] == [0] and abs(results["reduction_pct"][0]) < 1.0
+    assert "| 0 | no mass helps |" in summary
+
+
+@pytest.fixture(scope="module")
+def small_design(tmp_path_factory):
+    """The init design with 4 blades (a cheap full assembly; its 1F resonance is near 102 Hz)."""
+    path = tmp_path_factory.mktemp("small") / "design.toml"
+    assert main(["init", str(path)]) == 0
+    return _edited(path, {**FAST, "n_blades = 16": "n_blades = 4",
+                          "frequency_range_hz = [92.0, 99.0]": "frequency_range_hz = [97.0, 106.0]"})
+
+
+def test_frf_mistuned_with_unit_kappa_is_the_tuned_response(small_design, tmp_path):
+    path = tmp_path / "design.toml"
+    path.write_text(small_design.read_text().replace("# kappa = [1.02, 0.98]", "kappa = [1.0, 1.0, 1.0, 1.0]")
+                    .replace("std = 0.02\n", "").replace("seed = 2\n", ""))
+    out = tmp_path / "frf"
+    assert main(["frf", str(path), "--mistuned", "--out", str(out)]) == 0
+    _, results = _outputs(out, "frf.png", "summary.md", "results.json", "frf_mistuned_EO1.npz")
+    tuned, mistuned = results["responses"]["EO1"], results["responses"]["mistuned_EO1"]
+    assert tuned["success"] and mistuned["success"]
+    # the full assembly of identical blades is the cyclic model: same peak (continuation points differ)
+    assert mistuned["peak_amplitude_mm"] == pytest.approx(tuned["peak_amplitude_mm"], rel=2e-3)
+    assert mistuned["peak_frequency_hz"] == pytest.approx(tuned["peak_frequency_hz"], abs=0.05)
+
+
+def test_montecarlo_on_a_small_design(small_design, tmp_path):
+    from bladedamp.studies.mistuning import MonteCarloResult
+
+    path = small_design
+    out = tmp_path / "mc"
+    assert main(["montecarlo", str(path), "--disks", "1", "--scheduler", "serial", "--out", str(out)]) == 0
+    summary, _ = _outputs(out, "montecarlo.png", "summary.md", "montecarlo.npz")
+    result = MonteCarloResult.load(out / "montecarlo.npz")
+    assert result.kappa.shape == (1, 4) and result.meta["seed"] == 2 and result.meta["std"] == 0.02
+    # the damper still works on the mistuned 4-blade disk: every blade's peak stays well below the
+    # undamped blade's 1.7 mm (with 4 blades at EO = 1 the amplification is far from the 16-blade disk's)
+    assert np.isfinite(result.amplification[0]) and result.peak_amplitude.max() < 0.5 * 1.7e-3
+    assert "1 of 1 mistuned disks solved" in summary
+
+
+def test_show_writes_html_or_says_how_to_install(fast_design, tmp_path, capsys, monkeypatch):
+    import importlib.util
+
+    out = tmp_path / "show"
+    if importlib.util.find_spec("meshcat") is not None and importlib.util.find_spec("trimesh") is not None:
+        assert main(["show", str(fast_design), "--out", str(out)]) == 0
+        assert (out / "ods.html").stat().st_size > 10_000
+        _outputs(out, "summary.md")
+    capsys.readouterr()
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "meshcat" else real(name, *a))
+    assert main(["show", str(fast_design), "--out", str(tmp_path / "no_meshcat")]) == 2
+    _one_error_line(capsys, "meshcat", "pip install 'bladedamp[viz]'")
+    assert not (tmp_path / "no_meshcat").exists()          # nothing computed, nothing written
+
+
+@pytest.mark.parametrize("text, needles", [
+    ("[damper]\nmass_g = -1.0\n", ("[damper] mass_g = -1.0", "(0, 1000] g")),
+    ("[damper]\nmas_g = 1.0\n", ("unknown key [damper] mas_g", "did you mean mass_g")),
+    ("[disk]\ngamma_right_deg = 95.0\n", ("[disk] gamma_right_deg = 95.0", "(0, 90) deg")),
+    ("[analysis]\nharmonics = \"many\"\n", ("[analysis] harmonics = \"many\"", "'auto'")),
+    ("[analysis]\nfrequency_range_hz = [99.0]\n", ("[analysis] frequency_range_hz = [99.0]", "list of 2")),
+])
+@pytest.mark.parametrize("command", ["frf", "optimize", "eo-sweep", "montecarlo", "show"])
+def test_a_bad_field_exits_2_with_one_line_naming_file_key_value_and_range(tmp_path, capsys, text, needles, command):
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    assert main([command, str(path), "--out", str(tmp_path / "out")]) == 2
+    _one_error_line(capsys, str(path), *needles)
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("args, needles", [
+    (["frf", "{tmp}/missing.toml"], ("missing.toml", "no such design file")),
+    (["frf", "{design}", "--out", "{tmp}/a_file/out"], ("--out", "cannot write there")),
+    (["frf", "{design}", "--out", "{tmp}/a_file"], ("--out", "is a file")),
+    (["optimize", "{design}", "--gamma-right-deg", "95"], ("--gamma-right-deg 95", "(0, 90)")),
+    (["optimize", "{design}", "--contact-height-mm", "2"], ("--contact-height-mm", "wedge")),
+    (["eo-sweep", "{design}", "--engine-orders", "9"], ("--engine-orders 9", "[0, 8]")),
+    (["montecarlo", "--workers", "0"], ("--workers", "[1, inf)")),
+    (["montecarlo", "{design}", "--mass", "2"], ("--mass",)),
+    (["reproduce", "--processes", "-2"], ("--processes", "[1, inf)")),
+])
+def test_user_errors_exit_2_with_one_line_before_computing(tmp_path, capsys, fast_design, args, needles):
+    (tmp_path / "a_file").write_text("")
+    args = [a.format(tmp=tmp_path, design=fast_design) for a in args]
+    if "--out" not in args:
+        args += ["--out", str(tmp_path / "out")]
+    t0 = time.perf_counter()
+    assert main(args) == 2
+    assert time.perf_counter() - t0 < 10          # nothing was computed
+    _one_error_line(capsys, *needles)
+    assert not (tmp_path / "out").exists()       # and no output folder made for a bad option
+
+
+def test_bad_field_in_a_fresh_process_no_traceback(tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text("[disk]\nn_blades = 1\n")
+    run = subprocess.run([sys.executable, "-m", "bladedamp.cli", "frf", str(path), "--out", str(tmp_path / "o")],
+                         capture_output=True, text=True)
+    assert run.returncode == 2, run.stderr
+    assert run.stderr.strip() == (f"bladedamp frf: error: {path}: [disk] n_blades = 1 is not allowed: "
+                                  "must be an integer in [2, 1000]"), run.stderr
+
+
+def test_help_is_plain_text_with_help_for_every_option():
+    parser = build_parser()
+    subs = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    assert set(subs.choices) == {"init", "frf", "optimize", "eo-sweep", "montecarlo", "show", "reproduce"}
+    for name, p in subs.choices.items():
+        text = p.format_help()
+        assert "``" not in text and ":func:" not in text and ".. " not in text, name
+        assert p.description, name
+        for action in p._actions:
+            assert action.help, (name, action.dest)
+
+
+def test_help_is_fast():
+    """`bladedamp --help` imports nothing heavy (numpy, numba, the models) in the CLI itself."""
+    t0 = time.perf_counter()
+    run = subprocess.run([sys.executable, "-m", "bladedamp.cli", "--help"], capture_output=True, text=True)
+    elapsed = time.perf_counter() - t0
+    print(f"bladedamp --help: {elapsed:.2f} s")
+    assert run.returncode == 0 and "usage: bladedamp" in run.stdout
+    assert elapsed < 1.5, f"bladedamp --help took {elapsed:.2f} s"
+
+
+def test_progress_bar_in_place_on_a_terminal_and_one_line_otherwise():
+    """Issue 13 item 8: tqdm bars in place on a terminal; a redirected run gets one line per
+    finished study, no bar lines."""
+    import io
+
+    from bladedamp.cli import Progress
+
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+
+    log, tty = io.StringIO(), Terminal()
+    for stream in (log, tty):
+        tick = Progress(stream).bar("mass sweep")
+        for done in range(1, 11):
+            tick(done, 10)
+    assert log.getvalue().count("\n") == 1 and "mass sweep done (10)" in log.getvalue()
+    assert "\r" in tty.getvalue() and "10/10" in tty.getvalue() and "mass sweep done (10)" in tty.getvalue()

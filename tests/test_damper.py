@@ -282,7 +282,7 @@ def test_centrifugal_force_eq26():
     assert F0 == pytest.approx(m * R * (2 * np.pi * 50) ** 2, rel=1e-15) and dF0 == 0.0
     # the disk uses the same law with its own m and R
     disk = reference_disk("cylinder", 1e-3, engine_order=2)
-    assert disk.centrifugal_force(w)[0] == pytest.approx(1e-3 * disk.damper_radius * w ** 2 / 4, rel=1e-15)
+    assert disk.centrifugal_force(w / (2 * np.pi))[0] == pytest.approx(1e-3 * disk.damper_radius * w ** 2 / 4, rel=1e-15)
 
 
 def frictionless_loads(F, gl, gr):

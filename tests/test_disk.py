@@ -323,7 +323,7 @@ def test_damper_equilibrium_eq12(kind, harmonics):
         lhs = g.G_D.T @ F[h]
         rhs = (h * r.omega[i]) ** 2 * g.inertia @ U[h]
         if h == 0:
-            F_cg = r.disk.centrifugal_force(r.omega[i])[0]
+            F_cg = r.disk.centrifugal_force(r.frequency_hz[i])[0]
             # static: F_CG radially outwards on the damper, minus the static retention spring
             # (a fraction of k_N on the static damper position, see TunedDisk.hbm_system)
             rhs = np.array([0, 0, F_cg, 0, 0, 0]) - r.disk.hbm_system(harmonics).static_stiffness[nm:, nm:] @ U[0].real
@@ -356,7 +356,7 @@ def test_one_harmonic_mean_normal_load_is_the_frictionless_static_load():
     normal load of each contact is F_CG(Omega) sin(gamma) / sin(2 gamma) at every point."""
     r = frf("cylinder", REFERENCE_MASS["cylinder"])
     gamma = r.disk.gamma_left
-    F = np.array([r.disk.centrifugal_force(w)[0] for w in r.omega])
+    F = np.array([r.disk.centrifugal_force(f)[0] for f in r.frequency_hz])
     expected = F * np.sin(gamma) / np.sin(2 * gamma)
     assert r.point_state[..., 2].max() == 0
     err = np.abs(r.normal_load - expected[:, None]).max() / expected.max()

@@ -101,9 +101,9 @@ def compare_full_to_cyclic(tdisk, harmonics=(1,), n_check=6, f_range=F_RANGE):
 ])
 def test_tuned_full_assembly_equals_cyclic(n, eo, harmonics, opts):
     err, rf, rt = compare_full_to_cyclic(tuned(n, eo, **opts), harmonics)
-    peaks = rf.peak_tip
+    peaks = rf.peak_amplitude
     print(f"\n[tuned full vs cyclic] n={n} EO={eo} H={harmonics}: max rel. difference {err:.2e}; "
-          f"peaks full {1e3 * peaks.min():.6f}-{1e3 * peaks.max():.6f} mm, cyclic {1e3 * rt.peak_tip_amplitude:.6f} mm; "
+          f"peaks full {1e3 * peaks.min():.6f}-{1e3 * peaks.max():.6f} mm, cyclic {1e3 * rt.peak_amplitude:.6f} mm; "
           f"points {len(rf.omega)} vs {len(rt.omega)}")
     assert err < 1e-8, f"tuned full assembly differs from the cyclic solution by {err:.2e} (n={n}, EO={eo}, H={harmonics})"
     assert np.ptp(peaks) < 1e-6 * peaks.max(), f"tuned blades differ: peaks {peaks}"
@@ -146,9 +146,9 @@ def test_per_position_platform_angles_and_gaps_repeat_as_a_sector():
         X = x.reshape(ss.basis.n_coeffs, -1)
         q = (X[j, :2 * nm] - 1j * X[j + 1, :2 * nm]).reshape(2, nm)
         worst = max(worst, np.abs(np.abs((q * tip).sum(axis=1)) - a[i, :2]).max() / a.max())
-    print(f"\n[per-position angles and gaps] full vs two-blade sector {worst:.1e}; peaks {1e3 * rf.peak_tip} mm")
+    print(f"\n[per-position angles and gaps] full vs two-blade sector {worst:.1e}; peaks {1e3 * rf.peak_amplitude} mm")
     assert worst < 1e-7, f"full assembly differs from the two-blade sector by {worst:.2e}"
-    assert abs(rf.peak_tip[0] - rf.peak_tip[1]) > 1e-3 * rf.peak_tip.max()
+    assert abs(rf.peak_amplitude[0] - rf.peak_amplitude[1]) > 1e-3 * rf.peak_amplitude.max()
     assert rf.energy_balance_error().max() < 1e-6
     with pytest.raises(ValueError, match="gamma_right"):
         dataclasses.replace(full, gamma_right=[0.6] * 3)
@@ -157,10 +157,10 @@ def test_per_position_platform_angles_and_gaps_repeat_as_a_sector():
 def test_tuned_16_blade_reference_equals_cyclic():
     """The paper's 16-blade reference disk (cylinder 1 g, EO = 1) written out blade by blade."""
     err, rf, rt = compare_full_to_cyclic(reference_disk("cylinder", 1e-3), n_check=4)
-    print(f"\n[tuned 16] max rel. difference {err:.2e}, peak full {1e3 * rf.peak_tip.max():.6f} mm, "
-          f"cyclic {1e3 * rt.peak_tip_amplitude:.6f} mm")
+    print(f"\n[tuned 16] max rel. difference {err:.2e}, peak full {1e3 * rf.peak_amplitude.max():.6f} mm, "
+          f"cyclic {1e3 * rt.peak_amplitude:.6f} mm")
     assert err < 1e-8, f"16-blade tuned assembly differs from the cyclic solution by {err:.2e}"
-    rel = abs(rf.peak_tip.max() - rt.peak_tip_amplitude) / rt.peak_tip_amplitude
+    rel = abs(rf.peak_amplitude.max() - rt.peak_amplitude) / rt.peak_amplitude
     assert rel < 2e-3, f"peaks differ by {rel:.2e} (different continuation grids only)"
 
 
@@ -226,9 +226,9 @@ def test_alternating_mistuning_is_a_two_blade_sector():
         X = x.reshape(ss.basis.n_coeffs, -1)
         q = (X[j, :8] - 1j * X[j + 1, :8]).reshape(2, 4)
         worst = max(worst, np.abs(np.abs((q * tip).sum(axis=1)) - a[i, :2]).max() / a.max())
-    p = rf.peak_tip
+    p = rf.peak_amplitude
     print(f"\n[alternating] odd blades spread {e_odd:.1e}, even {e_even:.1e}; vs two-blade sector {worst:.1e}; "
-          f"peaks {1e3 * p[0]:.4f} / {1e3 * p[1]:.4f} mm (sector {1e3 * rs.peak_tip[0]:.4f} / {1e3 * rs.peak_tip[1]:.4f})")
+          f"peaks {1e3 * p[0]:.4f} / {1e3 * p[1]:.4f} mm (sector {1e3 * rs.peak_amplitude[0]:.4f} / {1e3 * rs.peak_amplitude[1]:.4f})")
     assert e_odd < 1e-8 and e_even < 1e-8, f"blades 1,3,5 / 2,4,6 differ: {e_odd:.2e} / {e_even:.2e}"
     assert worst < 1e-7, f"full assembly differs from the two-blade sector by {worst:.2e}"
     assert abs(p[0] - p[1]) > 0.01 * p.max(), "the two blade types should respond differently"
@@ -269,7 +269,7 @@ def test_extended_response_equals_a_fresh_one_over_the_wider_range():
     assert wider.success and f[0] == pytest.approx(91.0) and f[-1] == pytest.approx(99.0) and np.all(np.diff(f) > 0)
     assert np.isin(part.omega, wider.omega).all(), "the known part is kept, not recomputed"
     assert wider.energy_balance_error().max() < 1e-6
-    rel = np.abs(wider.peak_tip / fresh.peak_tip - 1).max()
+    rel = np.abs(wider.peak_amplitude / fresh.peak_amplitude - 1).max()
     print(f"\n[extend] {len(part.omega)} -> {len(wider.omega)} points (fresh: {len(fresh.omega)}), peaks differ {rel:.1e}")
     assert rel < 2e-3, f"peaks differ by {rel:.2e}"
     with pytest.raises(ValueError, match="f_end_hz"):
@@ -287,7 +287,7 @@ def test_monte_carlo_settings_keep_the_amplification_of_fine_frfs():
         kappa = mt.random_kappa(16, 0.02, seed=[7, i])
         fast = mt.mistuned_response(disk, kappa, max_step=mt.MONTE_CARLO_MAX_STEP, tol=mt.MONTE_CARLO_TOL)
         fine = mt.mistuned_response(disk, kappa, max_step=0.05, tol=1e-10)
-        worst = max(worst, abs(fast.peak_tip.max() / fine.peak_tip.max() - 1))
+        worst = max(worst, abs(fast.peak_amplitude.max() / fine.peak_amplitude.max() - 1))
     print(f"\n[monte carlo settings] largest peak of 6 disks: worst relative error {worst:.1e}")
     assert worst < 2e-3, f"largest peak differs by {worst:.2e}"
 
@@ -366,11 +366,11 @@ def test_monte_carlo_local_without_dask_and_saved_results(tmp_path):
     without pickle; the amplification of each disk is its largest blade peak over the tuned one."""
     td = tuned(4, 1)
     res = mt.monte_carlo(td, 2, std=0.02, seed=5, f_range_hz=(88.0, 104.0), scheduler="serial")
-    assert res.peak_tip.shape == (2, 4) and res.kappa.shape == (2, 4)
-    assert np.allclose(res.amplification, res.peak_tip.max(axis=1) / res.tuned_peak_tip)
+    assert res.peak_amplitude.shape == (2, 4) and res.kappa.shape == (2, 4)
+    assert np.allclose(res.amplification, res.peak_amplitude.max(axis=1) / res.tuned_peak_amplitude)
     path = res.save(tmp_path / "mc")
     back = mt.MonteCarloResult.load(path)
-    assert np.array_equal(back.peak_tip, res.peak_tip) and back.tuned_peak_tip == res.tuned_peak_tip
+    assert np.array_equal(back.peak_amplitude, res.peak_amplitude) and back.tuned_peak_amplitude == res.tuned_peak_amplitude
     json.loads((tmp_path / "mc.json").read_text())
     lo, hi = res.confidence_interval()
     assert lo <= res.amplification.mean() <= hi
@@ -382,12 +382,12 @@ def test_monte_carlo_on_a_local_dask_cluster_matches_serial():
     pytest.importorskip("distributed")
     td = tuned(4, 1)
     done = []
-    kw = dict(std=0.02, seed=7, f_range_hz=(88.0, 104.0), tuned_peak_tip=1e-4)
+    kw = dict(std=0.02, seed=7, f_range_hz=(88.0, 104.0), tuned_peak_amplitude=1e-4)
     par = mt.monte_carlo(td, 2, n_workers=1, progress=lambda i, n: done.append(i), **kw)
     ser = mt.monte_carlo(td, 2, scheduler="serial", **kw)
-    print(f"\n[dask] peaks {1e3 * par.peak_tip.max(axis=1)} mm, executor {par.meta['executor']}")
+    print(f"\n[dask] peaks {1e3 * par.peak_amplitude.max(axis=1)} mm, executor {par.meta['executor']}")
     assert done == [1, 2]
-    assert np.array_equal(par.kappa, ser.kappa) and np.allclose(par.peak_tip, ser.peak_tip, rtol=1e-12)
+    assert np.array_equal(par.kappa, ser.kappa) and np.allclose(par.peak_amplitude, ser.peak_amplitude, rtol=1e-12)
 
 
 def test_arrangement_optimisation_never_worse_than_the_heuristic():
@@ -395,17 +395,17 @@ def test_arrangement_optimisation_never_worse_than_the_heuristic():
     independent full-assembly FRF of that order, is <= the heuristic's and the given order's."""
     td = tuned(4, 1)
     kappa = np.array([0.97, 0.98, 1.02, 1.03])
-    res = mt.optimise_arrangement(td, kappa, max_evaluations=5, f_range_hz=(88.0, 104.0), tuned_peak_tip=1e-4)
+    res = mt.optimise_arrangement(td, kappa, max_evaluations=5, f_range_hz=(88.0, 104.0), tuned_peak_amplitude=1e-4)
     # independent FRF of the returned order (range widened as the search does: a blade peaks at 104.5 Hz)
     r = mt.mistuned_response(td, kappa[res.order], (88.0, 104.0))
     assert not r.peak_at_range_end.any()
-    check = r.peak_tip.max()
-    print(f"\n[arrangement] given {1e3 * res.given_max_peak_tip:.4f} mm, heuristic "
-          f"{1e3 * res.heuristic_max_peak_tip:.4f} mm (order {res.heuristic_order}), optimised "
-          f"{1e3 * res.max_peak_tip:.4f} mm (order {res.order}), {res.evaluations} FRFs")
+    check = r.peak_amplitude.max()
+    print(f"\n[arrangement] given {1e3 * res.given_max_peak_amplitude:.4f} mm, heuristic "
+          f"{1e3 * res.heuristic_max_peak_amplitude:.4f} mm (order {res.heuristic_order}), optimised "
+          f"{1e3 * res.max_peak_amplitude:.4f} mm (order {res.order}), {res.evaluations} FRFs")
     assert sorted(res.order) == [0, 1, 2, 3]
-    assert res.max_peak_tip <= res.heuristic_max_peak_tip and res.max_peak_tip <= res.given_max_peak_tip
-    assert abs(check - res.max_peak_tip) < 1e-9 * check, f"re-verified peak {check} vs {res.max_peak_tip}"
+    assert res.max_peak_amplitude <= res.heuristic_max_peak_amplitude and res.max_peak_amplitude <= res.given_max_peak_amplitude
+    assert abs(check - res.max_peak_amplitude) < 1e-9 * check, f"re-verified peak {check} vs {res.max_peak_amplitude}"
 
 
 def test_result_plot_and_amplification():
@@ -418,14 +418,14 @@ def test_result_plot_and_amplification():
 
     td = tuned(4, 1)
     r = MistunedDisk.from_tuned(td, [0.98, 1.0, 1.02, 1.01]).frequency_response(88.0, 104.0, harmonics=(1,), max_step=MAX_STEP,
-                                                                                 tuned_peak_tip=1e-4)
+                                                                                 tuned_peak_amplitude=1e-4)
     ax = r.plot()
     assert len(ax.lines) == 4 + 1
-    assert np.allclose(r.amplification(), r.peak_tip / 1e-4)
-    assert np.all(r.peak_tip >= r.tip_amplitude[:, :, 0].max(axis=0))
+    assert np.allclose(r.amplification(), r.peak_amplitude / 1e-4)
+    assert np.all(r.peak_amplitude >= r.tip_amplitude[:, :, 0].max(axis=0))
     plt.close("all")
-    with pytest.raises(ValueError, match="tuned_peak_tip"):
-        dataclasses.replace(r, tuned_peak_tip=None).amplification()
+    with pytest.raises(ValueError, match="tuned_peak_amplitude"):
+        dataclasses.replace(r, tuned_peak_amplitude=None).amplification()
 
 
 @pytest.mark.slow

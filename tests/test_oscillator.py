@@ -11,6 +11,8 @@ from conftest import hbm_amplitudes
 from bladedamp import FrictionOscillator
 from bladedamp.contact import SEPARATED
 
+HZ = 1 / (2 * np.pi)     # the oscillator takes Hz; these tests think in rad/s (sqrt(k/m) = 100 rad/s)
+
 BASE = dict(damping=2.0, normal_load=3.0, forcing=2.0)    # k = k_T = 1e4 N/m, m = 1 kg, mu = 0.3
 
 
@@ -26,10 +28,10 @@ def test_huge_normal_load_is_the_stuck_linear_system(harmonics, angle):
     (Not 1e12 N: the AFT would then extract a 2 N response from 1e12 N samples, below the
     rounding of the normal force.)"""
     osc = FrictionOscillator(damping=2.0, normal_load=1e6, forcing=2.0, contact_angle=angle)
-    frf = osc.frequency_response(60.0, 220.0, harmonics=harmonics)
+    frf = osc.frequency_response(60.0 * HZ, 220.0 * HZ, harmonics=harmonics)
     assert frf.success, frf.message
     amp = frf.harmonic_amplitude()
-    ref = osc.linear_amplitude(frf.omega, stuck=True)
+    ref = osc.linear_amplitude(frf.frequency_hz, stuck=True)
     err = np.max(np.abs(amp / ref - 1))
     print(f"max rel err over {frf.omega.size} points: {err:.2e}")
     assert err < 1e-8, f"max rel err over {frf.omega.size} points: {err:.2e}"
@@ -42,14 +44,15 @@ def test_huge_normal_load_is_the_stuck_linear_system(harmonics, angle):
 
 def test_zero_friction_is_the_system_without_contact():
     osc = FrictionOscillator(damping=2.0, normal_load=3.0, forcing=2.0, friction_coefficient=0.0)
-    frf = osc.frequency_response(40.0, 200.0, harmonics=(1, 3))
+    frf = osc.frequency_response(40.0 * HZ, 200.0 * HZ, harmonics=(1, 3))
     assert frf.success, frf.message
     amp = frf.harmonic_amplitude()
-    err = np.max(np.abs(amp / osc.linear_amplitude(frf.omega, stuck=False) - 1))
+    err = np.max(np.abs(amp / osc.linear_amplitude(frf.frequency_hz, stuck=False) - 1))
     print(f"max rel err over {frf.omega.size} points: {err:.2e}")
     assert err < 1e-8, f"max rel err over {frf.omega.size} points: {err:.2e}"
     # peak at the free natural frequency sqrt(k/m) = 100 rad/s (damped peak 99.98)
-    w_peak, _ = frf.peak()
+    f_peak, _ = frf.peak()
+    w_peak = 2 * np.pi * f_peak
     print(f"peak at {w_peak:.3f} rad/s")
     assert abs(w_peak - np.sqrt(1e4 - 2.0 ** 2 / 2)) < 0.5, f"peak at {w_peak:.3f} rad/s"
 
@@ -68,7 +71,7 @@ REGIMES = {
 @pytest.fixture(scope="module")
 def flat_time_responses():
     osc = FrictionOscillator(**BASE)
-    return osc, {name: osc.time_response(om) for name, om in REGIMES.items()}
+    return osc, {name: osc.time_response(om * HZ) for name, om in REGIMES.items()}
 
 
 @pytest.mark.parametrize("regime", list(REGIMES))
@@ -95,7 +98,7 @@ def test_time_integration_discretisation_error_is_small(flat_time_responses):
     """The reference itself: 2048 vs 8192 steps per period agree to 2e-5."""
     osc, trs = flat_time_responses
     om = REGIMES["gross_slip"][::3]
-    fine = osc.time_response(om, steps_per_period=8192)
+    fine = osc.time_response(om * HZ, steps_per_period=8192)
     err = np.abs(trs["gross_slip"].amplitude[::3] / fine.amplitude - 1)
     print(f"time integration 2048 vs 8192 steps: {err}")
     assert err.max() < 2e-5, f"time integration 2048 vs 8192 steps: {err}"
@@ -106,7 +109,7 @@ def test_hbm_converges_to_time_integration_with_harmonics(flat_time_responses):
     (both converge to the same periodic solution)."""
     osc, trs = flat_time_responses
     om = REGIMES["gross_slip"][[0, 3, 6, 10]]
-    ref = osc.time_response(om, steps_per_period=8192).amplitude
+    ref = osc.time_response(om * HZ, steps_per_period=8192).amplitude
     err = np.abs(hbm_amplitudes(osc, om, (1, 3, 5, 7, 9, 11, 13, 15), n_samples=1024) / ref - 1)
     print(f"errors {err}")
     assert err.max() < 5e-5, f"errors {err}"
@@ -118,7 +121,7 @@ def test_superharmonic_regime_needs_the_higher_harmonics():
     (1,) and (1, 3) at every point."""
     osc = FrictionOscillator(**BASE)
     om = np.array([30.0, 39.5, 40.0, 45.0, 50.0, 60.0])
-    tr = osc.time_response(om)
+    tr = osc.time_response(om * HZ)
     assert tr.converged.all()
     errs = {H: np.abs(hbm_amplitudes(osc, om, H) / tr.amplitude - 1) for H in [(1,), (1, 3), (1, 3, 5, 7)]}
     table = "; ".join(f"H={H}: " + " ".join(f"{e:.1e}" for e in err) for H, err in errs.items())
@@ -136,7 +139,7 @@ def test_inclined_contact_needs_the_static_and_even_harmonics():
     (1,) at every point where (1,) is off by more than 1e-3; (0, ..., 7) within 1e-3."""
     osc = FrictionOscillator(**BASE, contact_angle=0.3)
     om = np.linspace(90.0, 150.0, 13)
-    tr = osc.time_response(om)
+    tr = osc.time_response(om * HZ)
     assert tr.converged.all()
     errs = {}
     for H in [(1,), (0, 1, 2, 3), (0, 1, 2, 3, 4, 5, 6, 7)]:
@@ -163,7 +166,7 @@ def test_inclined_contact_needs_the_static_and_even_harmonics():
 def test_energy_balance_at_every_point(harmonics, angle):
     """Excitation work = viscous + contact dissipation per cycle at every converged point (1e-6)."""
     osc = FrictionOscillator(**BASE, contact_angle=angle)
-    frf = osc.frequency_response(80.0, 160.0, harmonics=harmonics)
+    frf = osc.frequency_response(80.0 * HZ, 160.0 * HZ, harmonics=harmonics)
     assert frf.success, frf.message
     W = osc.energy_balance(frf)
     exc, visc, contact = W.T

@@ -29,11 +29,12 @@ from bladedamp import reference as ref
 SEED = 20261201
 N_DISKS = 160
 N_OSCILLATORS = 160
-# issue 12's target is 0.99; measured 268 of 320 = 0.838 on 2026-12-01 (up from 0.716 before the
-# shared robust start, the hop acceptance and the range clip). Until the target is met this is a
-# regression floor, not the target: the share is printed, and the failing designs with it.
+# issue 12's target is 0.99; measured 271 of 320 = 0.847 on 2026-12-01 (268 = 0.838 before the
+# continuation's det orientation and its turn at non-smooth folds; 0.716 before the shared robust
+# start, the hop acceptance and the range clip). Until the target is met this is a regression
+# floor, not the target: the share is printed, and the failing designs with it.
 SHARE_TARGET = 0.99
-SHARE_REQUIRED = 0.83
+SHARE_REQUIRED = 0.84
 # Harmonics of the oscillators cross-checked by time integration. The one-harmonic HBM is
 # wrong for inclined contacts (the normal load varies: it needs the static term and higher
 # harmonics); switch this to None (the frequency_response default) once that default is chosen
@@ -135,7 +136,7 @@ def run_design(d: dict) -> dict:
             points = r.point_dissipation
         else:
             osc = FrictionOscillator(**d["params"])
-            r = osc.frequency_response(d["omega_start"], d["omega_end"], harmonics=d["harmonics"],
+            r = osc.frequency_response(d["omega_start"] / (2 * np.pi), d["omega_end"] / (2 * np.pi), harmonics=d["harmonics"],
                                        n_samples=d["n_samples"], max_step=d["max_step"], max_points=MAX_POINTS)
             lo, hi = sorted((d["omega_start"], d["omega_end"]))
             e = osc.energy_balance(r) if len(r.omega) else np.zeros((0, 3))
@@ -199,9 +200,9 @@ def test_oscillator_started_below_the_resonance_reaches_the_end():
     did not converge (no point kept); the robust start must find the solution."""
     osc = FrictionOscillator(mass=1, stiffness=1, damping=0.01, contact_stiffness=1, friction_coefficient=1,
                              normal_load=0.1, forcing=0.05)
-    r = osc.frequency_response(0.9, 2.2)
+    r = osc.frequency_response(0.9 / (2 * np.pi), 2.2 / (2 * np.pi))       # 0.9..2.2 rad/s
     assert r.success, r.message
-    assert r.omega[0] == 0.9 and r.omega[-1] == 2.2
+    assert r.omega[0] == pytest.approx(0.9, rel=1e-14) and r.omega[-1] == pytest.approx(2.2, rel=1e-14)
     assert not branch_checks(r.omega, 0.9, 2.2, 0.02)
 
 
@@ -247,13 +248,13 @@ def test_random_oscillator_peak_against_time_integration(design):
     osc = FrictionOscillator(**design["params"])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        r = osc.frequency_response(design["omega_start"], design["omega_end"], harmonics=TIME_CHECK_HARMONICS,
+        r = osc.frequency_response(design["omega_start"] / (2 * np.pi), design["omega_end"] / (2 * np.pi), harmonics=TIME_CHECK_HARMONICS,
                                    n_samples=design["n_samples"], max_step=0.02)
     assert r.success, r.message
     j1 = r.basis.cos_index(1)
     a = np.hypot(r.coefficients[:, j1, 0], r.coefficients[:, j1 + 1, 0])
     k = int(np.argmax(a))
-    td = osc.time_response([r.omega[k]], steps_per_period=2048)
+    td = osc.time_response([r.frequency_hz[k]], steps_per_period=2048)
     assert td.converged[0]
     assert td.amplitude[0] == pytest.approx(a[k], rel=2e-2), (design["params"], r.omega[k])
 

@@ -35,19 +35,19 @@ def _quiet():
 # bad input
 # ---------------------------------------------------------------------------------------
 @pytest.mark.parametrize("call, match", [
-    (lambda: engine_order_sweep("cylinder", []), "engine_orders"),
-    (lambda: engine_order_sweep("cylinder", [9]), "engine_orders"),
-    (lambda: engine_order_sweep("cylinder", [1], mass_bounds=(0.0, 1e-2)), "mass_bounds"),
-    (lambda: engine_order_sweep("cylinder", [1], mass_bounds=(1e-2, 1e-3)), "mass_bounds"),
-    (lambda: engine_order_sweep("cylinder", [1], mass_bounds=(-1e-3, 1e-2)), "mass_bounds"),
-    (lambda: engine_order_sweep("cone", [1]), "kind"),
-    (lambda: engine_order_sweep("cylinder", [0], rotor_speed_eo0=0.0), "rotor_speed_eo0"),
-    (lambda: engine_order_sweep("cylinder", [1], f_range_hz=(105.0, 90.0)), "f_range_hz"),
-    (lambda: platform_angle_study([]), "gamma_right_deg"),
-    (lambda: platform_angle_study([90.0]), "gamma_right_deg"),
-    (lambda: platform_angle_study([35.0], gamma_left_deg=0.0), "gamma_left_deg"),
-    (lambda: platform_angle_study([35.0], fixed_mass=0.0), "fixed_mass"),
-    (lambda: platform_angle_study([35.0], mass_bounds=(1e-3, 1e-3)), "mass_bounds"),
+    (lambda: engine_order_sweep(reference_disk("cylinder"), []), "engine_orders"),
+    (lambda: engine_order_sweep(reference_disk("cylinder"), [9]), "engine_orders"),
+    (lambda: engine_order_sweep(reference_disk("cylinder"), [1], mass_bounds=(0.0, 1e-2)), "mass_bounds"),
+    (lambda: engine_order_sweep(reference_disk("cylinder"), [1], mass_bounds=(1e-2, 1e-3)), "mass_bounds"),
+    (lambda: engine_order_sweep(reference_disk("cylinder"), [1], mass_bounds=(-1e-3, 1e-2)), "mass_bounds"),
+    (lambda: engine_order_sweep(reference_disk(None), [1]), "damper"),
+    (lambda: engine_order_sweep(reference_disk("cylinder"), [0], rotor_speed_eo0=0.0), "rotor_speed_eo0"),
+    (lambda: engine_order_sweep(reference_disk("cylinder"), [1], f_range_hz=(105.0, 90.0)), "f_range_hz"),
+    (lambda: platform_angle_study(reference_disk("cylinder"), []), "gamma_right_deg"),
+    (lambda: platform_angle_study(reference_disk("cylinder"), [90.0]), "gamma_right_deg"),
+    (lambda: platform_angle_study(reference_disk("cylinder"), [35.0], gamma_left_deg=0.0), "gamma_left_deg"),
+    (lambda: platform_angle_study(reference_disk("cylinder"), [35.0], fixed_mass=0.0), "fixed_mass"),
+    (lambda: platform_angle_study(reference_disk("cylinder"), [35.0], mass_bounds=(1e-3, 1e-3)), "mass_bounds"),
     (lambda: contact_state(reference_disk(None)), "damper"),
     (lambda: contact_state(reference_disk("cylinder"), f_range_hz=(0.0, 90.0)), "f_range_hz"),
     (lambda: wedge_liftoff_map(reference_disk("wedge"), f_range_hz=()), "f_range_hz"),
@@ -62,13 +62,13 @@ def test_bad_input_raises_value_error_naming_the_parameter(call, match):
 # ---------------------------------------------------------------------------------------
 def test_eo0_cylinder_rolls_optimum_is_the_undamped_amplitude():
     """EO = 0: the cylinder rolls, no mass reduces the resonance by more than 1 %."""
-    s = engine_order_sweep("cylinder", [0], mass_bounds=(1e-4, 1e-2), xatol=0.1)
+    s = engine_order_sweep(reference_disk("cylinder"), [0], mass_bounds=(1e-4, 1e-2), xatol=0.1)
     assert not s.failures
-    assert abs(s.optimal_peak_tip[0] / s.undamped_peak_tip[0] - 1) < 0.01
+    assert abs(s.optimal_peak_amplitude[0] / s.undamped_peak_amplitude[0] - 1) < 0.01
     assert np.isnan(s.optimal_mass[0])
     # and the rolling is real: already at a single mass the peak is the undamped one within 1 %
     p, _, _ = peak_response(reference_disk("cylinder", 3e-3, engine_order=0, rotor_speed=ROTOR_SPEED_EO0))
-    assert abs(p / s.undamped_peak_tip[0] - 1) < 0.01
+    assert abs(p / s.undamped_peak_amplitude[0] - 1) < 0.01
 
 
 def test_eo0_wedge_damps_where_the_cylinder_rolls():
@@ -81,7 +81,7 @@ def test_eo0_wedge_damps_where_the_cylinder_rolls():
 
 @pytest.mark.slow
 def test_eo0_wedge_optimum_clearly_below_undamped():
-    s = engine_order_sweep("wedge", [0], mass_bounds=(1e-4, 1e-2), xatol=0.1)
+    s = engine_order_sweep(reference_disk("wedge"), [0], mass_bounds=(1e-4, 1e-2), xatol=0.1)
     assert not s.failures
     assert s.reduction[0] > 0.4
     assert np.isfinite(s.optimal_mass[0])
@@ -90,8 +90,8 @@ def test_eo0_wedge_optimum_clearly_below_undamped():
 @pytest.mark.slow
 def test_optimal_mass_is_a_true_minimum():
     """The optimiser's mass gives a lower peak than 0.8 and 1.25 times that mass (EO = 1)."""
-    s = engine_order_sweep("cylinder", [1], mass_bounds=(5e-5, 5e-3), xatol=0.03)
-    m, p = s.optimal_mass[0], s.optimal_peak_tip[0]
+    s = engine_order_sweep(reference_disk("cylinder"), [1], mass_bounds=(5e-5, 5e-3), xatol=0.03)
+    m, p = s.optimal_mass[0], s.optimal_peak_amplitude[0]
     assert np.isfinite(m) and s.reduction[0] > 0.3
     disk = reference_disk("cylinder", m, engine_order=1)
     for factor in (0.8, 1.25):
@@ -144,9 +144,9 @@ def test_light_cylinder_at_eo6_fails_with_a_lower_bound_and_is_not_the_optimum()
     ev = robust_peak(reference_disk("cylinder", 0.1261e-3, engine_order=6))
     undamped, _, _ = peak_response(reference_disk(None, engine_order=6))
     if ev.success:                                  # a better continuation solved it: a true peak
-        assert ev.peak_tip > 0.6 * undamped
+        assert ev.peak_amplitude > 0.6 * undamped
     else:
-        assert np.isnan(ev.peak_tip) and ev.lower_bound > 0.6 * undamped and ev.attempts == 3
+        assert np.isnan(ev.peak_amplitude) and ev.lower_bound > 0.6 * undamped and ev.attempts == 3
         assert "not covered" in ev.message
 
 
@@ -158,11 +158,11 @@ def test_eo7_cylinder_global_optimum_beyond_the_old_local_one():
     disk = reference_disk("cylinder", 1e-2, engine_order=7)
     opt = optimal_mass(disk, bounds=(1e-3, 3e-2), xatol=0.05, grid_per_decade=3)
     assert opt.success, opt.message
-    assert opt.peak_tip < robust_peak(with_mass(disk, 7.1e-3)).peak_tip
+    assert opt.peak_amplitude < robust_peak(with_mass(disk, 7.1e-3)).peak_amplitude
     for factor in (0.8, 1.25):
         ev = robust_peak(with_mass(disk, factor * opt.mass))
-        assert not ev.success or ev.peak_tip > opt.peak_tip
-    assert len(opt.grid_mass) == len(opt.grid_peak_tip) and opt.bracket[0] < opt.mass < opt.bracket[1]
+        assert not ev.success or ev.peak_amplitude > opt.peak_amplitude
+    assert len(opt.grid_mass) == len(opt.grid_peak_amplitude) and opt.bracket[0] < opt.mass < opt.bracket[1]
 
 
 # ---------------------------------------------------------------------------------------
@@ -201,10 +201,10 @@ def test_mirror_symmetry_eo1_exact_as_in_the_paper():
 
 
 def test_platform_angle_study_fixed_mass_symmetric_matches_peak_response():
-    s = platform_angle_study([35.0], optimise=False)
+    s = platform_angle_study(reference_disk("cylinder"), [35.0], optimise=False)
     p, _, _ = peak_response(reference_disk("cylinder", 1e-3))
-    assert s.peak_tip_at_fixed_mass[0] == pytest.approx(p, rel=1e-9)
-    assert s.peak_tip_at_fixed_mass[0] < s.undamped_peak_tip
+    assert s.peak_amplitude_at_fixed_mass[0] == pytest.approx(p, rel=1e-9)
+    assert s.peak_amplitude_at_fixed_mass[0] < s.undamped_peak_amplitude
     assert np.isnan(s.optimal_mass[0])
 
 
@@ -223,7 +223,7 @@ def test_gamma_r_85_left_sticks_right_slides():
     assert abs(cs.F_star[1]) < abs(cs.w_star[1])                        # friction-limited
     assert cs.normal_load[1] < cs.normal_load[0]                        # less normal force at OR
     # normalisation (Eq. 27)
-    assert cs.normal_load == pytest.approx(d.static_normal_loads(2 * np.pi * cs.resonance_hz), rel=1e-9)
+    assert cs.normal_load == pytest.approx(d.static_normal_loads(cs.peak_frequency_hz), rel=1e-9)
     assert cs.w_star == pytest.approx(cs.w_xi * cs.tangential_stiffness / (cs.friction_coefficient * cs.normal_load))
 
 
@@ -276,7 +276,7 @@ def test_liftoff_ratio_two_ways_agree(liftoff_maps):
         assert np.array_equal((lm.min_approach < 0)[clear], (lm.ratio > 1)[clear])
         # the static approach is the disk's own preload (TunedDisk._approach_function)
         approach = disk._approach_function(disk.damper_geometry(), disk.hbm_system().basis)
-        assert lm.static_approach == pytest.approx(approach(2 * np.pi * lm.resonance_hz)[0], rel=1e-8)
+        assert lm.static_approach == pytest.approx(approach(2 * np.pi * lm.peak_frequency_hz)[0], rel=1e-8)
 
 
 def test_liftoff_first_at_the_edges(liftoff_maps):

@@ -103,7 +103,7 @@ def test_oscillator_hbm_matches_time_integration_and_balances_energy():
 
 
 def test_oscillator_stuck_limit_is_linear():
-    d = W.oscillator_comparison(normal_load=1000.0, forcing=2.0, time_omegas=())
+    d = W.oscillator_comparison(normal_load=1000.0, forcing=2.0, time_frequencies_hz=())
     np.testing.assert_allclose(d["hbm"], d["stuck"], rtol=1e-6)
 
 
@@ -125,8 +125,8 @@ def test_disk_frf_matches_continuation_and_warm_starts(cache):
         ref_peak, ref_f, _ = peak_response(bd.reference_disk("cylinder", 1e-3))
     r = W.disk_frf("cylinder", 1.0, cache=cache)
     assert r.method in ("cold", "warm")
-    assert r.peak_tip == pytest.approx(ref_peak, rel=1e-3)
-    assert r.resonance_hz == pytest.approx(ref_f, abs=0.02)
+    assert r.peak_amplitude == pytest.approx(ref_peak, rel=1e-3)
+    assert r.peak_frequency_hz == pytest.approx(ref_f, abs=0.02)
     again = W.disk_frf("cylinder", 1.0, cache=cache)
     assert again is r and cache.stats["memo"] >= 1
     nb = W.disk_frf("cylinder", 1.2, cache=cache)
@@ -135,14 +135,14 @@ def test_disk_frf_matches_continuation_and_warm_starts(cache):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ref12 = peak_response(bd.reference_disk("cylinder", 1.2e-3))[0]
-    assert nb.peak_tip == pytest.approx(ref12, rel=1e-3)
+    assert nb.peak_amplitude == pytest.approx(ref12, rel=1e-3)
 
 
 def test_undamped_frf_is_the_calibrated_peak(cache):
     r = W.undamped_frf(cache=cache)
     assert r.method == "linear"
-    assert r.peak_tip == pytest.approx(1.6996e-3, rel=1e-3)
-    assert r.resonance_hz == pytest.approx(95.0, abs=0.02)
+    assert r.peak_amplitude == pytest.approx(1.6996e-3, rel=1e-3)
+    assert r.peak_frequency_hz == pytest.approx(95.0, abs=0.02)
 
 
 def test_disk_frf_figure_and_reduction(cache):
@@ -150,7 +150,7 @@ def test_disk_frf_figure_and_reduction(cache):
     damped, free = fig.data
     assert damped.reduction(free) == pytest.approx(0.712, abs=0.01)      # calibrated ~71 %
     line = fig.axes[0].get_lines()[1]
-    np.testing.assert_allclose(line.get_ydata(), 1e3 * damped.tip[:, 0])
+    np.testing.assert_allclose(line.get_ydata(), 1e3 * damped.tip_amplitude[:, 0])
     assert "reduction" in fig.axes[0].get_title()
     with pytest.raises(ValueError):
         W.disk_frf("plate", 1.0, cache=cache)
@@ -205,7 +205,7 @@ def test_platform_angle_warm_starts_from_the_nearest_angle(cache):
         import dataclasses
         disk = dataclasses.replace(bd.reference_disk("cylinder", 1e-3), gamma_right=np.radians(45.0))
         ref = peak_response(disk)[0]
-    assert r.peak_tip == pytest.approx(ref, rel=1e-3)
+    assert r.peak_amplitude == pytest.approx(ref, rel=1e-3)
 
 
 # ---------------------------------------------------------------------------------------
@@ -220,13 +220,13 @@ def test_mistuning_explorer_figure_matches_the_study_and_memoises():
     from bladedamp.studies import mistuning as mt
 
     disk = dataclasses.replace(bd.reference_disk("cylinder", 1e-3), n_blades=4)
-    tuned_peak_tip, _, tuned = mt.tuned_peak(disk, mt.auto_range(disk, [1.0], 0.05))
-    ex = W.MistuningExplorer(disk, tuned, tuned_peak_tip, max_step=0.05)
+    tuned_peak_amplitude, _, tuned = mt.tuned_peak(disk, mt.auto_range(disk, [1.0], 0.05))
+    ex = W.MistuningExplorer(disk, tuned, tuned_peak_amplitude, max_step=0.05)
     fig = ex.figure("random", seed=3, std_percent=2.0)
     kappa = mt.random_kappa(4, 0.02, seed=3)
     ref = mt.mistuned_response(disk, kappa, max_step=0.05)
     assert np.array_equal(fig.kappa, kappa)
-    assert np.allclose(fig.amplification, ref.peak_tip / tuned_peak_tip, rtol=1e-12)
+    assert np.allclose(fig.amplification, ref.peak_amplitude / tuned_peak_amplitude, rtol=1e-12)
     plt.close(fig)
     assert ex.response("random", 3, 0.02) is ex.response("random", 3, 0.02 + 1e-9)   # memoised
     fig = ex.figure("alternating", std_percent=2.0)

@@ -38,6 +38,25 @@ def rigid_point_map(xi: np.ndarray, eta: np.ndarray) -> np.ndarray:
     return B
 
 
+def dof_jacobian(point_map: np.ndarray, point_jacobian: np.ndarray) -> np.ndarray:
+    """The Jacobian of a patch's generalised forces from its points' (Eq. 11 differentiated):
+    ``sum_p B_p^T (d f_p / d c_p) B_p`` per pair of harmonic coefficients.
+
+    ``point_map`` B (..., P, 3, 6) maps the 6 control-point DOF to each point's (xi, eta,
+    zeta); ``point_jacobian`` (..., P, C, 3, 3, C) is d f_coef[a, p, i] / d c_p[b, k] (force
+    coefficient a of direction i by displacement coefficient b of direction k); returns
+    (..., C, 6, C, 6). Leading axes (patches, dampers) are batched. One optimised einsum over
+    flattened leading axes (with one BLAS thread, measured on the 2-core box: 0.6 / 6.4 ms
+    for the 2 / 32 patches of a tuned sector / a 16-blade assembly at 7 coefficients, against
+    2.0 / 25 ms for two chained plain einsums)."""
+    lead = point_map.shape[:-3]
+    L = int(np.prod(lead, dtype=int))
+    B = point_map.reshape((L,) + point_map.shape[-3:])
+    J = point_jacobian.reshape((L,) + point_jacobian.shape[-5:])
+    out = np.einsum("lpim,lpaikb,lpkn->lambn", B, J, B, optimize=True)
+    return out.reshape(lead + out.shape[1:])
+
+
 @dataclass
 class PatchEvaluation:
     """Result of one AFT evaluation of a patch.
@@ -162,10 +181,9 @@ class ContactPatch:
         jac = None
         if jacobian:
             # d f_coef[a, p, i] / d c_p[b, k]  (point coefficient blocks are direction-major)
-            # (BLAS matmul and two plain einsums: ~8x faster than one optimised 3-operand einsum)
             P, T = self.n_points, basis.n_samples
             jp = np.matmul(basis.analysis, pts.jacobian.reshape(P, T, 9 * C)).reshape(P, C, 3, 3, C)
-            jac = np.einsum("pamkb,pkn->ambn", np.einsum("pim,paikb->pamkb", B, jp), B).reshape(C * 6, C * 6)
+            jac = dof_jacobian(B, jp).reshape(C * 6, C * 6)
         return PatchEvaluation(force, jac, pts)
 
     def equivalent_stiffness(self, w, basis, approach_offset) -> dict[int, np.ndarray]:

@@ -767,6 +767,12 @@ class PointContactElement:
         return self.tangential_stiffness.size
 
     @property
+    def memoryless(self) -> bool:
+        """Whether the force depends on the present displacement only: frictionless (mu = 0 at
+        every point), so only the normal law acts (see :mod:`bladedamp.hbm.stability`)."""
+        return bool(np.all(self.friction_coefficient == 0))
+
+    @property
     def n_local(self) -> int:
         return 3 * self.n_points
 

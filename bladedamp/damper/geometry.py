@@ -175,6 +175,24 @@ def _polygon_inertia(poly: np.ndarray, mass: float, length: float) -> tuple[np.n
     return np.array([cx, cz]), M
 
 
+# Plausible ranges of a damper's mass and dimensions (a PlausibilityWarning outside, not an
+# error: the physics holds, the numbers most likely have the wrong unit). Underplatform dampers
+# of turbine blades weigh from a fraction of a gram (small compressor / turbocharger blades,
+# the reference wedge optimum 0.28 g) to tens of grams (large low-pressure turbine blades; the
+# EO-8 optimum of the reference disk is 15 g): 1e-5..0.1 kg leaves a decade of margin on both
+# sides, so "1.0" meant as 1 g (1 kg) and "1e-3" meant as 1 mg both warn. Their cross-section
+# and length follow the platform gap and the blade chord: 0.1 mm..100 mm (the reference
+# cylinder has r = 2 mm, l_C = 20 mm); 2.0 meant as 2 mm warns.
+DAMPER_MASS_RANGE = (1.0e-5, 0.1)        # kg
+DAMPER_LENGTH_RANGE = (1.0e-4, 0.1)      # m
+
+
+def _check_plausible_damper(mass: float, lengths: dict) -> None:
+    _validate.plausible("damper mass", mass, *DAMPER_MASS_RANGE, "kg", "underplatform dampers weigh 0.01 g to 100 g")
+    for name, value in lengths.items():
+        _validate.plausible(name, value, *DAMPER_LENGTH_RANGE, "m", "damper dimensions are 0.1 mm to 100 mm")
+
+
 @dataclass
 class CylinderDamper:
     """Cylindrical damper (Fig. 1): curved surfaces, Hertzian line contacts, free to roll.
@@ -196,6 +214,7 @@ class CylinderDamper:
         _validate.nonnegative("damper mass", self.mass)
         _validate.positive("cylinder radius", self.radius)
         _validate.positive("damper length l_C", self.length)
+        _check_plausible_damper(self.mass, {"cylinder radius": self.radius, "damper length l_C": self.length})
 
     kind = "cylinder"
 
@@ -243,6 +262,7 @@ class WedgeDamper:
             raise ValueError("contact_height h_C of a wedge damper must be given, in (0, inf) m")
         _validate.positive("contact_height h_C", self.contact_height)
         _validate.positive("damper length l_C", self.length)
+        _check_plausible_damper(self.mass, {"contact_height h_C": self.contact_height, "damper length l_C": self.length})
 
     def geometry(self, gamma_left: float, gamma_right: float) -> DamperGeometry:
         _check_angles(gamma_left, gamma_right)

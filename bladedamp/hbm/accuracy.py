@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .continuation import newton
+from .linsolve import one_blas_thread
 
 #: default tolerance on the first-harmonic output amplitudes, relative to the peak amplitude
 HARMONIC_TOLERANCE = 0.01
@@ -115,6 +116,7 @@ def lift(model, coefficients: np.ndarray, basis, system, omega: float) -> np.nda
     return X.ravel()
 
 
+@one_blas_thread
 def harmonic_error(model, response, harmonics=None, n_points: int = 5, tol: float = 1e-10) -> HarmonicCheck:
     """Error estimate of ``response`` (computed by ``model``) against the enriched set
     ``harmonics`` (default :func:`enriched` of the response's), see the module docstring."""
@@ -153,12 +155,13 @@ def annotate(response, check: HarmonicCheck, tolerance: float):
         note = (f"harmonic error estimate {100 * check.error:.2g} % exceeds the tolerance "
                 f"{100 * tolerance:.2g} % (harmonics {check.harmonics} against {check.enriched})")
     if note:
-        warnings.warn(note, AccuracyWarning, stacklevel=3)
+        warnings.warn(note, AccuracyWarning, stacklevel=5)   # annotate, converged_response, its BLAS wrapper, the model, the caller
     message = response.message + ("; " + note if note else "")
     return dataclasses.replace(response, harmonic_error=check.error, harmonic_tolerance=tolerance,
                                harmonics_converged=met, message=message)
 
 
+@one_blas_thread
 def converged_response(model, solve, harmonics="auto", tolerance: float = HARMONIC_TOLERANCE,
                        max_harmonic: int = 3, n_points: int = 5):
     """The branch of ``solve(harmonics) -> response`` with its harmonic error estimate.

@@ -75,6 +75,14 @@ def _bordered(J, column, row, column_scale, factor):
     return A
 
 
+def _det_sign(A) -> int:
+    """Sign of det A for a dense matrix (0 if singular, or for a sparse one: not computed)."""
+    if sp.issparse(A) or not isinstance(A, np.ndarray):
+        return 0
+    sign, _ = np.linalg.slogdet(A)
+    return int(sign)
+
+
 class ConvergenceWarning(UserWarning):
     """A Newton or continuation run stopped without converging."""
 
@@ -250,6 +258,36 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         R, J, Rw = fun(x, w)
         return R / residual_scale, _bordered(J, Rw * w_scale, row, x_scale, 1.0 / residual_scale)
 
+    # Orientation of the branch (Allgower & Georg): the sense of the tangent t keeps the sign of
+    # det [dR/dy; t^T], which changes at no fold and no corner of a piecewise-smooth branch.
+    # "t . previous tangent > 0" picks the wrong sense once the branch turns by more than 90
+    # degrees (scaled) between two points: the branch then retraced itself (measured: random
+    # disk 12 ran up to 98.58 Hz and back down its own path to the start, 84.35 Hz), and a
+    # corner the corrector cannot pass (below) may leave at any angle. With t solving
+    # [dR/dy; r^T] t = e (r . t = 1), det [dR/dy; t^T] = det [dR/dy; r^T] |t|^2: the sign comes
+    # from the bordered matrix already factorised (dense only; 0, not used, otherwise).
+    # The sign also changes at a bifurcation off the branch (e.g. symmetry breaking at EO = n/2,
+    # where the mirror-odd damper DOFs are at zero with almost no stiffness, and their noise
+    # flipped it at every step: the branch went back and forth between two points). So a
+    # reversal the sign asks for on a tangent that has hardly turned (within 18 degrees of the
+    # previous one; measured there: 9 degrees, at the folds and corners of random disks 12 and
+    # 102 and oscillator 136: 75-90 degrees) is not taken, and the sign is re-recorded instead.
+    orientation = [0]
+
+    def oriented(t, bordered_matrix, reference, corner=False):
+        """t (solving [dR/dy; r^T] t = e_{n+1}, r = ``reference``) normalised, in the sense of
+        the branch orientation (recorded from the start sense); ``corner``: at a corner the
+        corrector could not pass, where the sign is taken whatever the angle."""
+        t = t / np.linalg.norm(t)
+        sign = _det_sign(bordered_matrix)
+        if sign == 0:
+            return t
+        if orientation[0] == 0 or (sign != orientation[0] and not corner
+                                   and t @ reference > 0.95 * np.linalg.norm(reference)):
+            orientation[0] = sign
+            return t
+        return t * sign * orientation[0]
+
     def tangent_at(y, prev):
         if prev is None:
             prev = np.zeros(n + 1)
@@ -257,9 +295,8 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         else:
             prev = prev / scale()
             prev /= np.linalg.norm(prev)
-        t = factorize(scaled_system(y, prev)[1])(np.append(np.zeros(n), 1.0))
-        t /= np.linalg.norm(t)
-        return t if t @ prev > 0 else -t
+        A = scaled_system(y, prev)[1]
+        return oriented(factorize(A)(np.append(np.zeros(n), 1.0)), A, prev)
 
     def solve_at(w, x_from):
         """Newton at fixed omega = w from the point(s) x_from (tried in turn)."""
@@ -282,49 +319,82 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
             tangent = next_tangent / scale()      # unscaled -> scaled by the current x_scale
             tangent /= np.linalg.norm(tangent)
         accepted = hopped = False
-        while h >= min_step:
-            yp = y + h * tangent
-            yc = yp.copy()
-            ok = False
-            step_norm = np.inf
-            for it in range(1, max_corrector + 1):
-                R, A = scaled_system(yc, tangent)
-                if not np.all(np.isfinite(R)):
+        h_first, cycle, turned = h, (), False
+        while True:
+            while h >= min_step:
+                yp = y + h * tangent
+                yc = yp.copy()
+                ok = False
+                step_norm = np.inf
+                previous_iterate = yc
+                for it in range(1, max_corrector + 1):
+                    R, A = scaled_system(yc, tangent)
+                    if not np.all(np.isfinite(R)):
+                        break
+                    G = np.append(R, tangent @ (yc - yp))
+                    try:
+                        bordered = factorize(A)
+                    except (np.linalg.LinAlgError, RuntimeError):   # singular (RuntimeError: splu)
+                        break
+                    dy = -bordered(G)
+                    previous_iterate, yc = yc, yc + dy
+                    previous_norm, step_norm = step_norm, np.linalg.norm(dy)
+                    # converged: residual at the noise level and the update computed there small
+                    if np.linalg.norm(R) < tol and step_norm < np.sqrt(tol):
+                        ok = True
+                        break
+                    if step_norm >= previous_norm:
+                        # Newton updates that do not contract: the corrector diverges or cycles
+                        # (measured: such runs go on to |omega| of hundreds of Hz); halve the step
+                        break
+                # reject corrector results that jump back along the branch, that end farther from
+                # the predictor than the predictor is from the last point (more than 45 degrees off
+                # the tangent: another branch), or that step farther in omega than max_step allows
+                if ok and (yc - y) @ tangent > 0 and np.linalg.norm(yc - yp) <= h \
+                        and abs(yc[n] - y[n]) * w_scale <= max_dw:
+                    accepted = True
+                    hops = 0
+                    # the next tangent solves [J; tangent] t = e_{n+1}: the matrix just factorised
+                    # at the converged point (to the last update), so it costs one back-substitution
+                    next_tangent = oriented(bordered(np.append(np.zeros(n), 1.0)), A, tangent)
                     break
-                G = np.append(R, tangent @ (yc - yp))
-                try:
-                    bordered = factorize(A)
-                except (np.linalg.LinAlgError, RuntimeError):   # singular (RuntimeError: splu)
-                    break
-                dy = -bordered(G)
-                yc = yc + dy
-                previous_norm, step_norm = step_norm, np.linalg.norm(dy)
-                # converged: residual at the noise level and the update computed there small
-                if np.linalg.norm(R) < tol and step_norm < np.sqrt(tol):
-                    ok = True
-                    break
-                if step_norm >= previous_norm:
-                    # Newton updates that do not contract: the corrector diverges or cycles
-                    # (measured: such runs go on to |omega| of hundreds of Hz); halve the step
-                    break
-            # reject corrector results that jump back along the branch, that end farther from
-            # the predictor than the predictor is from the last point (more than 45 degrees off
-            # the tangent: another branch), or that step farther in omega than max_step allows
-            if ok and (yc - y) @ tangent > 0 and np.linalg.norm(yc - yp) <= h \
-                    and abs(yc[n] - y[n]) * w_scale <= max_dw:
-                accepted = True
-                hops = 0
-                # the next tangent solves [J; tangent] t = e_{n+1}: the matrix just factorised
-                # at the converged point (to the last update), so it costs one back-substitution
-                next_tangent = bordered(np.append(np.zeros(n), 1.0))
-                next_tangent *= np.sign(next_tangent @ tangent) / np.linalg.norm(next_tangent)
+                if not ok:
+                    cycle = (previous_iterate, yc)
+                h /= 2
+            if accepted or turned or orientation[0] == 0:
                 break
-            h /= 2
+            # corner of a piecewise-smooth branch the corrector cannot pass along the tangent of
+            # the piece it leaves: its last iterates (a Newton 2-cycle) lie on the adjacent piece.
+            # Continue along that piece's tangent, oriented as the branch (det rule above): it may
+            # leave the corner at any angle, beyond 90 degrees at a non-smooth fold, where no
+            # point exists on the hyperplane of the old tangent nor at a fixed omega beyond.
+            # Measured on random disk 102 (a 0.042 g cylinder rolling into gross slip at
+            # 94.22 Hz): the adjacent piece turns back by 154 degrees and its corrector
+            # converges quadratically where the old one cycled at every step down to 1e-7.
+            turned, old_tangent = True, tangent
+            for z in cycle:
+                try:
+                    Az = scaled_system(z, tangent)[1]
+                    t_z = factorize(Az)(np.append(np.zeros(n), 1.0))
+                except (np.linalg.LinAlgError, RuntimeError):
+                    continue
+                if _det_sign(Az) == 0 or not np.all(np.isfinite(t_z)):
+                    continue
+                t_z = oriented(t_z, Az, tangent, corner=True)
+                if t_z @ tangent < 0.999:
+                    tangent = t_z
+                    break
+            if tangent is old_tangent:
+                break
+            h = h_first
+        if not accepted and turned:
+            tangent = old_tangent
         if not accepted and h < step and hops < 5:
             # corner of a piecewise-smooth branch (e.g. birth of a slip phase): the corrector
             # cycles between the two pieces at any step size; hop over it at fixed omega
             hops += 1
             w_last = points[-1][n]
+            saved_orientation = orientation[0]      # a rejected hop tangent must not re-orient the branch
             for frac in (1e-3, 1e-2, 1e-1):
                 w_try = w_last + direction * frac * max_dw
                 jump = newton(fun, points[-1][:n], w_try, x_scale, residual_scale, tol=tol, factorize=factorize)
@@ -346,6 +416,7 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
                     continue
                 if hop_tangent @ chord > 0.9 * np.linalg.norm(chord):
                     break
+                orientation[0] = saved_orientation
             else:
                 jump = None
             if jump is not None:

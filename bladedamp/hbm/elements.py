@@ -1,7 +1,13 @@
-"""Simple nonlinear elements for the harmonic balance (AFT with analytic Jacobian)."""
+"""Simple nonlinear elements for the harmonic balance (AFT with analytic Jacobian).
+
+An element may declare ``memoryless = True``: its force at time t depends on its local
+displacement at t only (no hysteresis). Hill's method is exact for such elements; elements
+without the flag (friction) are treated as hysteretic by :mod:`bladedamp.hbm.stability`.
+"""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 from .. import _validate
 
@@ -12,6 +18,7 @@ class CubicSpring:
 
     coefficient: float
     n_local: int = 1
+    memoryless: ClassVar[bool] = True
 
     def __post_init__(self):
         _validate.finite("cubic_stiffness", self.coefficient)

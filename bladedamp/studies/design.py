@@ -4,10 +4,16 @@ the Damper Design", Fig. 7-11, Eq. 26, 27).
 * :func:`engine_order_sweep` -- the optimal damper mass and the resonance amplitude it gives
   for each engine order (Fig. 7, 8);
 * :func:`platform_angle_study` -- the same for asymmetric platforms, gamma_R varied (Fig. 10);
+* :func:`design_map`, :func:`liftoff_onset` -- mass x platform angle grids, the wedge's lift-off
+  over contact height and excitation;
 * :func:`contact_state` -- the normalised first-harmonic xi-motion and xi-force of both
   contacts at resonance (Eq. 27, Fig. 11);
 * :func:`wedge_liftoff_map` -- the ratio of normal vibration amplitude to static approach of
   every patch point at resonance (Fig. 9): r > 1 means the point lifts off once per period.
+
+Every study takes a model, a :class:`~bladedamp.disk.TunedDisk` with a damper (the reference
+disk, ``bladedamp.reference_disk(...)``, or a design's ``load_design(path).disk``), and varies
+only what it studies; the rest of the disk stays as given.
 
 SI units throughout: masses [kg], amplitudes [m], frequencies [Hz] where the name says so,
 angles [deg] where the name says so.
@@ -23,8 +29,9 @@ import numpy as np
 from .. import _validate
 from ..damper.kinetics import seat
 from ..disk import TunedDisk
+from ..io import Saveable
 from .parallel import parallel_map
-from .mass import optimal_mass, peak_response
+from .mass import optimal_mass, peak_response, with_mass
 
 ROLLING_TOLERANCE = 0.01   # an optimum less than 1 % below the undamped peak counts as "no damping"
 
@@ -51,16 +58,16 @@ def _check_disk(disk):
 # 1. engine orders (Fig. 7, 8)
 # ---------------------------------------------------------------------------------------
 @dataclass
-class EngineOrderSweep:
+class EngineOrderSweep(Saveable):
     """Optimal damper mass per engine order.
 
     kind : damper type
     engine_orders : (k,) EO
     optimal_mass : (k,) optimal damper mass [kg]; NaN where no mass lowers the peak by more
         than 1 % (the rolling cylinder at EO = 0) or where the response failed
-    optimal_peak_tip : (k,) peak first-harmonic tip amplitude u_x at the optimum [m] (the
+    optimal_peak_amplitude : (k,) peak first-harmonic tip amplitude u_x at the optimum [m] (the
         undamped peak where no mass helps)
-    undamped_peak_tip : (k,) peak tip amplitude without damper [m]
+    undamped_peak_amplitude : (k,) peak tip amplitude without damper [m]
     reduction : (k,) 1 - optimal / undamped [-]
     failures : {EO: message} of engine orders whose frequency response failed (their entries NaN)
     certified : (k,) bool, the optimum is global over the mass bounds (``MassOptimum.success``:
@@ -71,8 +78,8 @@ class EngineOrderSweep:
     kind: str
     engine_orders: np.ndarray
     optimal_mass: np.ndarray
-    optimal_peak_tip: np.ndarray
-    undamped_peak_tip: np.ndarray
+    optimal_peak_amplitude: np.ndarray
+    undamped_peak_amplitude: np.ndarray
     reduction: np.ndarray
     failures: dict = field(default_factory=dict)
     certified: np.ndarray = None
@@ -85,8 +92,8 @@ class EngineOrderSweep:
         if ax is None:
             _, ax = plt.subplots(figsize=(6, 4))
         kwargs.setdefault("label", f"{self.kind}, optimal mass")
-        ax.plot(self.engine_orders, 1e3 * self.optimal_peak_tip, marker="o", **kwargs)
-        ax.plot(self.engine_orders, 1e3 * self.undamped_peak_tip, color="gray", ls="--", lw=1, label="no damper")
+        ax.plot(self.engine_orders, 1e3 * self.optimal_peak_amplitude, marker="o", **kwargs)
+        ax.plot(self.engine_orders, 1e3 * self.undamped_peak_amplitude, color="gray", ls="--", lw=1, label="no damper")
         ax.set_xlabel("engine order EO")
         ax.set_ylabel("resonance tip amplitude u_x [mm]")
         ax.grid(True, alpha=0.3)
@@ -97,48 +104,48 @@ class EngineOrderSweep:
         return ax
 
 
-def _engine_order_case(case):
-    """Optimal mass of one (kind, EO); the RuntimeError text if the response fails."""
-    from ..reference import reference_disk
+def at_engine_order(disk: TunedDisk, engine_order: int, rotor_speed_eo0: float) -> TunedDisk:
+    """``disk`` at another engine order; at EO = 0 with the rotor speed ``rotor_speed_eo0``
+    [rad/s] unless the disk has its own (the excitation does not fix the speed there)."""
+    speed = disk.rotor_speed if disk.rotor_speed is not None or engine_order != 0 else rotor_speed_eo0
+    return dataclasses.replace(disk, engine_order=int(engine_order), rotor_speed=speed)
 
-    kind, eo, bounds, f_range, xatol, rotor_speed_eo0, disk_kwargs = case
-    kw = dict(disk_kwargs)
-    if eo == 0:
-        kw["rotor_speed"] = rotor_speed_eo0
-    disk = reference_disk(kind, np.sqrt(bounds[0] * bounds[1]), engine_order=eo, **kw)
+
+def _engine_order_case(case):
+    """Optimal mass of one disk at one EO; the RuntimeError text if the response fails."""
+    disk, bounds, f_range, xatol, harmonics = case
     try:
-        return optimal_mass(disk, bounds, f_range, xatol=xatol)
+        return optimal_mass(disk, bounds, f_range, harmonics, xatol=xatol)
     except RuntimeError as exc:
         return str(exc)
 
 
-def engine_order_sweep(kind: str, engine_orders=range(0, 9), mass_bounds=(1e-5, 2e-2),
+def engine_order_sweep(disk: TunedDisk, engine_orders=range(0, 9), mass_bounds=(1e-5, 2e-2),
                        rotor_speed_eo0: float = 2 * np.pi * 95, f_range_hz=(90.0, 105.0), xatol: float = 0.02,
-                       progress=None, processes: int | None = 1, **disk_kwargs) -> EngineOrderSweep:
-    """Re-optimise the damper mass of the reference disk for each engine order (Fig. 7, 8).
+                       harmonics=(1,), progress=None, processes: int | None = 1) -> EngineOrderSweep:
+    """Re-optimise the damper mass of ``disk`` for each engine order (Fig. 7, 8).
 
     Parameters
     ----------
-    kind : "cylinder" or "wedge"
+    disk : TunedDisk with a damper (its mass is the one thing not used: it is optimised)
     engine_orders : EOs in 0..n/2 (non-empty)
     mass_bounds : (low, high) [kg], 0 < low < high
-    rotor_speed_eo0 : rotor speed at EO = 0 [rad/s] (> 0); otherwise Omega_R = Omega_E / EO
-    f_range_hz : (low, high) [Hz] around the 1F resonance; ``peak_response`` widens it when
+    rotor_speed_eo0 : rotor speed at EO = 0 [rad/s] (> 0) if the disk has none; otherwise
+        Omega_R = Omega_E / EO (or the disk's fixed rotor speed)
+    f_range_hz : (low, high) [Hz] around the resonance; ``peak_response`` widens it when
         the peak sits at an end
     xatol : tolerance of the optimiser in log(mass)
+    harmonics : of every peak search (default the paper's (1,))
     progress : optional callable(done, total)
     processes : worker processes over the engine orders (None: every core)
-    disk_kwargs : passed to :func:`bladedamp.reference.reference_disk`
     """
-    from ..reference import N_BLADES
-
-    if kind not in ("cylinder", "wedge"):
-        raise ValueError(f"kind must be 'cylinder' or 'wedge' (got {kind!r})")
+    _check_disk(disk)
+    n_max = disk.n_blades // 2
     eos = np.atleast_1d(np.asarray(list(engine_orders) if not np.isscalar(engine_orders) else [engine_orders]))
     if eos.size == 0:
-        raise ValueError(f"engine_orders must be a non-empty range of integers in [0, {N_BLADES // 2}]")
+        raise ValueError(f"engine_orders must be a non-empty range of integers in [0, {n_max}]")
     for eo in eos:
-        _validate.integer("engine_orders", eo, minimum=0, maximum=N_BLADES // 2)
+        _validate.integer("engine_orders", eo, minimum=0, maximum=n_max)
     bounds = _check_mass_bounds(mass_bounds)
     _validate.positive("rotor_speed_eo0 (rad/s)", rotor_speed_eo0)
     f_range = _check_f_range(f_range_hz)
@@ -147,19 +154,19 @@ def engine_order_sweep(kind: str, engine_orders=range(0, 9), mass_bounds=(1e-5, 
     k = eos.size
     m_opt, p_opt, p_und = np.full(k, np.nan), np.full(k, np.nan), np.full(k, np.nan)
     certified, messages, failures = np.zeros(k, dtype=bool), {}, {}
-    cases = [(kind, int(eo), bounds, f_range, xatol, rotor_speed_eo0, disk_kwargs) for eo in eos]
+    cases = [(at_engine_order(disk, eo, rotor_speed_eo0), bounds, f_range, xatol, tuple(harmonics)) for eo in eos]
     for j, (eo, result) in enumerate(zip(eos, parallel_map(_engine_order_case, cases, processes, progress))):
         if isinstance(result, str):
             failures[int(eo)] = result
             warnings.warn(f"engine order {eo}: {result}", RuntimeWarning, stacklevel=2)
             continue
-        p_und[j] = result.undamped_peak_tip
+        p_und[j] = result.undamped_peak_amplitude
         certified[j], messages[int(eo)] = result.success, result.message
-        if result.peak_tip >= (1 - ROLLING_TOLERANCE) * result.undamped_peak_tip:
-            p_opt[j] = result.undamped_peak_tip          # no mass helps (the rolling cylinder)
+        if result.peak_amplitude >= (1 - ROLLING_TOLERANCE) * result.undamped_peak_amplitude:
+            p_opt[j] = result.undamped_peak_amplitude          # no mass helps (the rolling cylinder)
         else:
-            m_opt[j], p_opt[j] = result.mass, result.peak_tip
-    return EngineOrderSweep(kind, eos.astype(int), m_opt, p_opt, p_und, 1 - p_opt / p_und, failures,
+            m_opt[j], p_opt[j] = result.mass, result.peak_amplitude
+    return EngineOrderSweep(disk.damper.kind, eos.astype(int), m_opt, p_opt, p_und, 1 - p_opt / p_und, failures,
                             certified, messages)
 
 
@@ -196,15 +203,15 @@ def eo_trend(values, tolerance: float, relative: bool = False) -> dict:
 # 2. asymmetric platforms (Fig. 10)
 # ---------------------------------------------------------------------------------------
 @dataclass
-class PlatformAngleStudy:
+class PlatformAngleStudy(Saveable):
     """Optimal damper mass over the right platform angle (gamma_L fixed).
 
     kind : damper type; gamma_left_deg : [deg]; fixed_mass : [kg]
     gamma_right_deg : (k,) [deg]
     optimal_mass : (k,) [kg] (NaN when not optimised)
-    optimal_peak_tip : (k,) peak tip amplitude u_x at the optimal mass [m]
-    peak_tip_at_fixed_mass : (k,) peak tip amplitude at ``fixed_mass`` [m]
-    undamped_peak_tip : peak without damper [m]
+    optimal_peak_amplitude : (k,) peak tip amplitude u_x at the optimal mass [m]
+    peak_amplitude_at_fixed_mass : (k,) peak tip amplitude at ``fixed_mass`` [m]
+    undamped_peak_amplitude : peak without damper [m]
     """
 
     kind: str
@@ -212,9 +219,9 @@ class PlatformAngleStudy:
     fixed_mass: float
     gamma_right_deg: np.ndarray
     optimal_mass: np.ndarray
-    optimal_peak_tip: np.ndarray
-    peak_tip_at_fixed_mass: np.ndarray
-    undamped_peak_tip: float
+    optimal_peak_amplitude: np.ndarray
+    peak_amplitude_at_fixed_mass: np.ndarray
+    undamped_peak_amplitude: float
 
     def plot(self, ax=None, **kwargs):
         """Resonance amplitude [mm] over gamma_R [deg], optimal and fixed mass."""
@@ -222,10 +229,10 @@ class PlatformAngleStudy:
 
         if ax is None:
             _, ax = plt.subplots(figsize=(6, 4))
-        ax.plot(self.gamma_right_deg, 1e3 * self.optimal_peak_tip, marker="o", label="optimal mass", **kwargs)
-        ax.plot(self.gamma_right_deg, 1e3 * self.peak_tip_at_fixed_mass, marker="s",
+        ax.plot(self.gamma_right_deg, 1e3 * self.optimal_peak_amplitude, marker="o", label="optimal mass", **kwargs)
+        ax.plot(self.gamma_right_deg, 1e3 * self.peak_amplitude_at_fixed_mass, marker="s",
                 label=f"m = {1e3 * self.fixed_mass:g} g", **kwargs)
-        ax.axhline(1e3 * self.undamped_peak_tip, color="gray", ls="--", lw=1, label="no damper")
+        ax.axhline(1e3 * self.undamped_peak_amplitude, color="gray", ls="--", lw=1, label="no damper")
         ax.set_xlabel(f"platform angle gamma_R [deg] (gamma_L = {self.gamma_left_deg:g} deg)")
         ax.set_ylabel("resonance tip amplitude u_x [mm]")
         ax.grid(True, alpha=0.3)
@@ -233,63 +240,64 @@ class PlatformAngleStudy:
         return ax
 
 
+def with_platform_angles(disk: TunedDisk, gamma_left_deg: float, gamma_right_deg: float) -> TunedDisk:
+    """``disk`` with other platform angles [deg]."""
+    return dataclasses.replace(disk, gamma_left=np.radians(gamma_left_deg), gamma_right=np.radians(gamma_right_deg))
+
+
 def _platform_angle_case(case):
     """(peak at the fixed mass, optimal mass, optimal peak) of one gamma_R [m, kg, m]."""
-    from ..reference import reference_disk
-
-    kind, gamma_left_deg, g, fixed_mass, bounds, f_range, optimise, xatol, disk_kwargs = case
-    base = reference_disk(kind, fixed_mass, **disk_kwargs)
-    disk = dataclasses.replace(base, gamma_left=np.radians(gamma_left_deg), gamma_right=np.radians(g))
-    p_fix = peak_response(disk, f_range)[0]
+    disk, bounds, f_range, optimise, xatol, harmonics = case
+    p_fix = peak_response(disk, f_range, harmonics)[0]
     if not optimise:
         return p_fix, np.nan, np.nan
-    opt = optimal_mass(disk, bounds, f_range, xatol=xatol)
-    return p_fix, opt.mass, opt.peak_tip
+    opt = optimal_mass(disk, bounds, f_range, harmonics, xatol=xatol)
+    return p_fix, opt.mass, opt.peak_amplitude
 
 
-def platform_angle_study(gamma_right_deg, kind: str = "cylinder", gamma_left_deg: float = 35.0,
-                         fixed_mass: float = 1e-3, mass_bounds=(1e-5, 2e-2), f_range_hz=(90.0, 105.0),
-                         optimise: bool = True, xatol: float = 0.02, progress=None, processes: int | None = 1,
-                         **disk_kwargs) -> PlatformAngleStudy:
-    """Peak tip amplitude over the right platform angle gamma_R (Fig. 10), EO of the reference disk.
+def platform_angle_study(disk: TunedDisk, gamma_right_deg, gamma_left_deg: float | None = None,
+                         fixed_mass: float | None = None, mass_bounds=(1e-5, 2e-2), f_range_hz=(90.0, 105.0),
+                         optimise: bool = True, xatol: float = 0.02, harmonics=(1,), progress=None,
+                         processes: int | None = 1) -> PlatformAngleStudy:
+    """Peak tip amplitude of ``disk`` over the right platform angle gamma_R (Fig. 10).
 
     Parameters
     ----------
+    disk : TunedDisk with a damper
     gamma_right_deg : right platform angles [deg], each in (0, 90) (non-empty)
-    kind : "cylinder" or "wedge"
-    gamma_left_deg : left platform angle [deg] in (0, 90)
-    fixed_mass : damper mass of the comparison at constant mass [kg] (> 0)
+    gamma_left_deg : left platform angle [deg] in (0, 90) (default: the disk's)
+    fixed_mass : damper mass of the comparison at constant mass [kg] (> 0; default: the disk's)
     mass_bounds : (low, high) [kg] of the mass optimisation, 0 < low < high
     optimise : False skips the mass optimisation (optimal_* are NaN)
+    harmonics : of every peak search (default the paper's (1,))
     progress : optional callable(done, total); processes : worker processes (None: every core)
-    disk_kwargs : passed to :func:`bladedamp.reference.reference_disk`
     """
-    from ..reference import reference_disk
-
-    if kind not in ("cylinder", "wedge"):
-        raise ValueError(f"kind must be 'cylinder' or 'wedge' (got {kind!r})")
+    _check_disk(disk)
+    gl = float(np.degrees(disk.gamma_left)) if gamma_left_deg is None else gamma_left_deg
+    fixed_mass = disk.damper.mass if fixed_mass is None else fixed_mass
     gr = np.atleast_1d(np.asarray(gamma_right_deg, dtype=float))
     if gr.size == 0:
         raise ValueError("gamma_right_deg must be a non-empty array of angles in (0, 90) deg")
     _validate.in_range("gamma_right_deg", gr, 0.0, 90.0, closed="neither")
-    _validate.in_range("gamma_left_deg", gamma_left_deg, 0.0, 90.0, closed="neither")
+    _validate.in_range("gamma_left_deg", gl, 0.0, 90.0, closed="neither")
     _validate.positive("fixed_mass (kg)", fixed_mass)
     bounds = _check_mass_bounds(mass_bounds)
     f_range = _check_f_range(f_range_hz)
 
-    undamped, _, _ = peak_response(reference_disk(None, **disk_kwargs), f_range)
-    cases = [(kind, float(gamma_left_deg), float(g), fixed_mass, bounds, f_range, optimise, xatol, disk_kwargs)
-             for g in gr]
+    harmonics = tuple(harmonics)
+    undamped, _, _ = peak_response(dataclasses.replace(disk, damper=None), f_range, harmonics)
+    base = with_mass(disk, fixed_mass)
+    cases = [(with_platform_angles(base, gl, float(g)), bounds, f_range, optimise, xatol, harmonics) for g in gr]
     results = np.array(parallel_map(_platform_angle_case, cases, processes, progress))
     p_fix, m_opt, p_opt = results.T
-    return PlatformAngleStudy(kind, float(gamma_left_deg), float(fixed_mass), gr, m_opt, p_opt, p_fix, undamped)
+    return PlatformAngleStudy(disk.damper.kind, float(gl), float(fixed_mass), gr, m_opt, p_opt, p_fix, undamped)
 
 
 # ---------------------------------------------------------------------------------------
 # 3. contact state at resonance (Eq. 27, Fig. 11)
 # ---------------------------------------------------------------------------------------
 @dataclass
-class ContactState:
+class ContactState(Saveable):
     """Normalised first-harmonic xi-components at resonance, OL then OR (Eq. 27).
 
     w_star : (2,) complex, w_xi,1 c_T / (mu F_N) [-]  (|w*| < 1: the whole contact sticks)
@@ -298,7 +306,7 @@ class ContactState:
     F_xi : (2,) complex first-harmonic xi contact force [N]
     normal_load : (2,) static normal loads F_N [N]; tangential_stiffness : (2,) c_T [N/m]
     friction_coefficient : (2,) mu [-]
-    resonance_hz : frequency of the largest tip amplitude [Hz]; peak_tip : that amplitude [m]
+    peak_frequency_hz : frequency of the largest tip amplitude [Hz]; peak_amplitude : that amplitude [m]
     """
 
     w_star: np.ndarray
@@ -308,8 +316,8 @@ class ContactState:
     normal_load: np.ndarray
     tangential_stiffness: np.ndarray
     friction_coefficient: np.ndarray
-    resonance_hz: float
-    peak_tip: float
+    peak_frequency_hz: float
+    peak_amplitude: float
 
     def plot(self, ax=None, **kwargs):
         """w* and F* of OL and OR as arrows in the complex plane, with the unit circle (Fig. 11)."""
@@ -358,7 +366,7 @@ def contact_state(disk: TunedDisk, f_range_hz=(90.0, 105.0)) -> ContactState:
     patches = disk.damper_geometry().patches
     c_t = np.array([p.tangential_stiffness for p in patches])
     mu = np.array([p.friction_coefficient for p in patches])
-    F_N = np.asarray(disk.static_normal_loads(r.omega[i]), dtype=float)
+    F_N = np.asarray(disk.static_normal_loads(r.frequency_hz[i]), dtype=float)
     return ContactState(w_xi * c_t / (mu * F_N), F_xi / (mu * F_N), w_xi, F_xi, F_N, c_t, mu,
                         float(r.frequency_hz[i]), float(r.tip_amplitude[i, 0]))
 
@@ -367,7 +375,7 @@ def contact_state(disk: TunedDisk, f_range_hz=(90.0, 105.0)) -> ContactState:
 # 4. lift-off map (Fig. 9)
 # ---------------------------------------------------------------------------------------
 @dataclass
-class LiftoffMap:
+class LiftoffMap(Saveable):
     """Normal vibration amplitude over static approach of every patch point, at resonance.
 
     xi_star, eta_star : (P,) normalised coordinates xi / h_C, eta / l_C [-] (same for OL, OR)
@@ -378,7 +386,7 @@ class LiftoffMap:
         (< 0 iff the point lifts off)
     static_approach : (2, P) a_static [m]
     normal_amplitude : (2, P) |w_zeta,1| [m]
-    resonance_hz : [Hz]; peak_tip : [m]; n_samples : time samples per period of the AFT
+    peak_frequency_hz : [Hz]; peak_amplitude : [m]; n_samples : time samples per period of the AFT
     """
 
     xi_star: np.ndarray
@@ -388,8 +396,8 @@ class LiftoffMap:
     min_approach: np.ndarray
     static_approach: np.ndarray
     normal_amplitude: np.ndarray
-    resonance_hz: float
-    peak_tip: float
+    peak_frequency_hz: float
+    peak_amplitude: float
     n_samples: int
 
     @property
@@ -397,7 +405,7 @@ class LiftoffMap:
         """(2, P) bool, r > 1."""
         return self.ratio > 1
 
-    def plot(self, ax=None, contact: int = 0, **kwargs):
+    def plot(self, ax=None, *, contact: int = 0, **kwargs):
         """r over (xi*, eta*) of one contact (0: OL, 1: OR) as a scatter map (Fig. 9)."""
         import matplotlib.pyplot as plt
 
@@ -411,7 +419,7 @@ class LiftoffMap:
         ax.figure.colorbar(sc, ax=ax, label="r = |w_zeta| / w_zeta,static")
         ax.set_xlabel("xi* = xi / h_C")
         ax.set_ylabel("eta* = eta / l_C")
-        ax.set_title(f"{('OL', 'OR')[contact]} at {self.resonance_hz:.2f} Hz")
+        ax.set_title(f"{('OL', 'OR')[contact]} at {self.peak_frequency_hz:.2f} Hz")
         if lift.any():
             ax.legend(fontsize=8)
         return ax
@@ -428,7 +436,7 @@ def wedge_liftoff_map(disk: TunedDisk, f_range_hz=(90.0, 105.0)) -> LiftoffMap:
     r, i = _resonance(disk, f_range_hz)
     basis = r.basis
     geometry = disk.damper_geometry()
-    F_cg = disk.centrifugal_force(r.omega[i])[0]
+    F_cg = disk.centrifugal_force(r.frequency_hz[i])[0]
     _, a_static, _ = seat(geometry, F_cg)                   # (2, P)
     coeffs = r.point_displacement[i][..., 2]                # (C, 2, P) normal displacement
     amplitude = np.abs(basis.to_complex(coeffs)[1])
@@ -444,28 +452,28 @@ def wedge_liftoff_map(disk: TunedDisk, f_range_hz=(90.0, 105.0)) -> LiftoffMap:
 # 5. design search beyond the paper: damper mass x platform angle (x wedge contact height)
 # ---------------------------------------------------------------------------------------
 @dataclass
-class DesignMap:
+class DesignMap(Saveable):
     """Peak tip amplitude over a grid of damper mass and right platform angle.
 
     kind : damper type; contact_height : wedge h_C [m] (None for the cylinder)
-    mass : (m,) [kg]; gamma_right_deg : (g,) [deg]; peak_tip : (g, m) [m]
-    undamped_peak_tip : [m]
+    mass : (m,) [kg]; gamma_right_deg : (g,) [deg]; peak_amplitude : (g, m) [m]
+    undamped_peak_amplitude : [m]
     """
 
     kind: str
     contact_height: float | None
     mass: np.ndarray
     gamma_right_deg: np.ndarray
-    peak_tip: np.ndarray
-    undamped_peak_tip: float
+    peak_amplitude: np.ndarray
+    undamped_peak_amplitude: float
 
     @property
     def optimum(self) -> dict:
         """Best grid point: {'mass_g', 'gamma_right_deg', 'peak_tip_mm', 'reduction_pct'}."""
-        g, m = np.unravel_index(np.nanargmin(self.peak_tip), self.peak_tip.shape)
-        p = self.peak_tip[g, m]
+        g, m = np.unravel_index(np.nanargmin(self.peak_amplitude), self.peak_amplitude.shape)
+        p = self.peak_amplitude[g, m]
         return {"mass_g": 1e3 * float(self.mass[m]), "gamma_right_deg": float(self.gamma_right_deg[g]),
-                "peak_tip_mm": 1e3 * float(p), "reduction_pct": 100 * float(1 - p / self.undamped_peak_tip)}
+                "peak_tip_mm": 1e3 * float(p), "reduction_pct": 100 * float(1 - p / self.undamped_peak_amplitude)}
 
     def plot(self, ax=None, **kwargs):
         """Contours of the peak amplitude [mm] over mass [g] (log) and gamma_R [deg], optimum marked."""
@@ -474,7 +482,7 @@ class DesignMap:
         if ax is None:
             _, ax = plt.subplots(figsize=(6, 4.5))
         M, G = np.meshgrid(1e3 * self.mass, self.gamma_right_deg)
-        cs = ax.contourf(M, G, 1e3 * self.peak_tip, levels=15, cmap="viridis_r", **kwargs)
+        cs = ax.contourf(M, G, 1e3 * self.peak_amplitude, levels=15, cmap="viridis_r", **kwargs)
         plt.colorbar(cs, ax=ax, label="resonance tip amplitude u_x [mm]")
         opt = self.optimum
         ax.plot(opt["mass_g"], opt["gamma_right_deg"], "r*", ms=14, label=f"best {opt['peak_tip_mm']:.3f} mm")
@@ -488,75 +496,107 @@ class DesignMap:
 
 
 def _design_case(case):
-    from ..reference import reference_disk
-
-    kind, mass, gamma_left_deg, g, contact_height, f_range, disk_kwargs = case
-    disk = reference_disk(kind, mass, **disk_kwargs)
-    damper = disk.damper if contact_height is None else dataclasses.replace(disk.damper, contact_height=contact_height)
-    disk = dataclasses.replace(disk, damper=damper, gamma_left=np.radians(gamma_left_deg), gamma_right=np.radians(g))
+    disk, f_range, harmonics = case
     try:
-        return peak_response(disk, f_range)[0]
+        return peak_response(disk, f_range, harmonics)[0]
     except RuntimeError:
         return np.nan
 
 
-def design_map(kind: str, masses, gamma_right_deg, contact_height: float | None = None,
-               gamma_left_deg: float = 35.0, f_range_hz=(90.0, 105.0), progress=None,
-               processes: int | None = 1, **disk_kwargs) -> DesignMap:
-    """Peak tip amplitude over damper mass x right platform angle (and a wedge's contact height).
+def with_contact_height(disk: TunedDisk, contact_height: float) -> TunedDisk:
+    """``disk`` with another wedge contact height h_C [m]."""
+    return dataclasses.replace(disk, damper=dataclasses.replace(disk.damper, contact_height=contact_height))
+
+
+def design_map(disk: TunedDisk, masses, gamma_right_deg, contact_height: float | None = None,
+               gamma_left_deg: float | None = None, f_range_hz=(90.0, 105.0), harmonics=(1,), progress=None,
+               processes: int | None = 1) -> DesignMap:
+    """Peak tip amplitude of ``disk`` over damper mass x right platform angle (and a wedge's
+    contact height).
 
     masses [kg] (> 0, non-empty), gamma_right_deg [deg] in (0, 90) (non-empty), contact_height [m]
-    (wedge only). Grid points whose response fails are NaN (never a number that was not solved).
+    (wedge only; default the disk's), gamma_left_deg [deg] (default the disk's). Grid points
+    whose response fails are NaN (never a number that was not solved).
     """
-    from ..reference import reference_disk
-
-    if kind not in ("cylinder", "wedge"):
-        raise ValueError(f"kind must be 'cylinder' or 'wedge' (got {kind!r})")
+    _check_disk(disk)
     masses = np.atleast_1d(np.asarray(masses, dtype=float))
     gr = np.atleast_1d(np.asarray(gamma_right_deg, dtype=float))
     if masses.size == 0 or gr.size == 0:
         raise ValueError("masses and gamma_right_deg must be non-empty (masses in (0, inf) kg, angles in (0, 90) deg)")
     _validate.positive("masses", masses)
     _validate.in_range("gamma_right_deg", gr, 0.0, 90.0, closed="neither")
+    gl = float(np.degrees(disk.gamma_left)) if gamma_left_deg is None else gamma_left_deg
     if contact_height is not None:
-        if kind != "wedge":
-            raise ValueError("contact_height applies to the wedge only (kind='wedge')")
+        if disk.damper.kind != "wedge":
+            raise ValueError("contact_height applies to a wedge damper only (the disk's is a "
+                             f"{disk.damper.kind})")
         _validate.positive("contact_height h_C", contact_height)
+        disk = with_contact_height(disk, contact_height)
     f_range = _check_f_range(f_range_hz)
-    cases = [(kind, float(m), float(gamma_left_deg), float(g), contact_height, f_range, disk_kwargs)
+    harmonics = tuple(harmonics)
+    cases = [(with_platform_angles(with_mass(disk, float(m)), gl, float(g)), f_range, harmonics)
              for g in gr for m in masses]
     peaks = np.array(parallel_map(_design_case, cases, processes, progress)).reshape(gr.size, masses.size)
-    undamped, _, _ = peak_response(reference_disk(None, **disk_kwargs), f_range)
-    return DesignMap(kind, contact_height, masses, gr, peaks, undamped)
+    undamped, _, _ = peak_response(dataclasses.replace(disk, damper=None), f_range, harmonics)
+    return DesignMap(disk.damper.kind, contact_height, masses, gr, peaks, undamped)
 
 
 def _liftoff_case(case):
-    from ..reference import reference_disk
-
-    mass, contact_height, force, f_range = case
-    disk = reference_disk("wedge", mass, excitation=np.array([force, 0, 0, 0, 0, 0]))
-    disk = dataclasses.replace(disk, damper=dataclasses.replace(disk.damper, contact_height=contact_height))
+    disk, f_range = case
     try:
         return float(wedge_liftoff_map(disk, f_range).ratio.max())
     except RuntimeError:
         return np.nan
 
 
-def liftoff_onset(contact_heights, forces, mass: float = 1e-3, f_range_hz=(90.0, 105.0), progress=None,
+def liftoff_onset(disk: TunedDisk, contact_heights, forces, f_range_hz=(90.0, 105.0), progress=None,
                   processes: int | None = 1) -> dict:
-    """Largest lift-off ratio r of the wedge over contact height x tip excitation F_x.
+    """Largest lift-off ratio r of the wedge damper of ``disk`` over contact height [m] x tip
+    excitation F_x [N] (the other excitation components stay the disk's).
 
-    Returns {'contact_height_mm': [...], 'force_n': [...], 'max_ratio': [[...]] (heights x forces)};
-    r > 1 means some point separates during the cycle.
+    Returns {'contact_height_mm': [...], 'force_n': [...], 'max_ratio': [[...]] (heights x forces),
+    'mass_g'}; r > 1 means some point separates during the cycle.
     """
+    _check_disk(disk)
+    if disk.damper.kind != "wedge":
+        raise ValueError(f"liftoff_onset needs a wedge damper (the disk's is a {disk.damper.kind})")
     hs = np.atleast_1d(np.asarray(contact_heights, dtype=float))
     fs = np.atleast_1d(np.asarray(forces, dtype=float))
     if hs.size == 0 or fs.size == 0:
         raise ValueError("contact_heights (m, > 0) and forces (N, > 0) must be non-empty")
     _validate.positive("contact_heights", hs)
     _validate.positive("forces", fs)
-    _validate.positive("mass", mass)
     f_range = _check_f_range(f_range_hz)
-    cases = [(mass, float(h), float(f), f_range) for h in hs for f in fs]
+
+    def excited(d, force):
+        excitation = d.excitation.copy()
+        excitation[0] = force
+        return dataclasses.replace(d, excitation=excitation)
+
+    cases = [(excited(with_contact_height(disk, float(h)), float(f)), f_range) for h in hs for f in fs]
     r = np.array(parallel_map(_liftoff_case, cases, processes, progress)).reshape(hs.size, fs.size)
-    return {"contact_height_mm": list(1e3 * hs), "force_n": list(fs), "max_ratio": r.tolist(), "mass_g": 1e3 * mass}
+    return {"contact_height_mm": list(1e3 * hs), "force_n": list(fs), "max_ratio": r.tolist(),
+            "mass_g": 1e3 * disk.damper.mass}
+
+
+def tip_dof_amplitude(response, dof: int) -> np.ndarray:
+    """(n,) first-harmonic amplitude of tip DOF ``dof`` (0..5: u_x, u_y, u_z [m], phi_x, phi_y,
+    phi_z [rad]) along a :class:`~bladedamp.disk.DiskResponse`."""
+    disk, basis = response.disk, response.basis
+    nm = disk.blade.n_modes
+    j = basis.cos_index(1)
+    q = response.coefficients[:, j, :nm] - 1j * response.coefficients[:, j + 1, :nm]
+    return np.abs(q @ disk.blade.shape("tip")[dof])
+
+
+def mode_window(disk: TunedDisk, f0_hz: float, dof: int, width=(0.97, 1.06), harmonics=(1,)):
+    """FRF around one mode, ``f0_hz * width`` [Hz] (the paper's one harmonic by default, as its
+    Table 1), and the peak of tip DOF ``dof``: ``(response, peak amplitude [m or rad], peak
+    frequency [Hz])``. Raises RuntimeError if the branch is incomplete."""
+    lo, hi = f0_hz * width[0], f0_hz * width[1]
+    r = disk.frequency_response(lo, hi, harmonics=harmonics, max_step=0.05)
+    if not r.success:
+        raise RuntimeError(f"FRF around {f0_hz} Hz incomplete: {r.message}")
+    a = tip_dof_amplitude(r, dof)
+    i = int(np.argmax(a))
+    return r, float(a[i]), float(r.frequency_hz[i])

@@ -10,6 +10,7 @@ from scipy.optimize import minimize_scalar
 
 from .. import _validate
 from ..disk import TunedDisk
+from ..io import Saveable
 
 
 def with_mass(disk: TunedDisk, mass: float) -> TunedDisk:
@@ -95,11 +96,11 @@ ROBUST_ATTEMPTS = ({"max_step": 0.05}, {"max_step": 0.02})
 
 
 @dataclass
-class PeakEvaluation:
+class PeakEvaluation(Saveable):
     """Peak tip amplitude of one disk found by :func:`robust_peak`.
 
     success : the peak is the interior maximum of a frequency response that covers the range
-    peak_tip : [m] (NaN if not success); resonance_hz : [Hz] (NaN if not success)
+    peak_amplitude : [m] (NaN if not success); peak_frequency_hz : [Hz] (NaN if not success)
     lower_bound : [m] if not success, the largest tip amplitude on the converged parts of the
         branches (the true peak is at least this; NaN when no part converged)
     message : how the peak was obtained, or why every attempt failed
@@ -107,8 +108,8 @@ class PeakEvaluation:
     """
 
     success: bool
-    peak_tip: float
-    resonance_hz: float
+    peak_amplitude: float
+    peak_frequency_hz: float
     lower_bound: float
     message: str
     attempts: int
@@ -186,22 +187,22 @@ def robust_peak(disk: TunedDisk, f_range_hz=(90.0, 105.0), harmonics=(1,), direc
 
 
 @dataclass
-class MassSweep:
+class MassSweep(Saveable):
     """Peak tip amplitude over damper mass.
 
-    mass : (k,) [kg]; peak_tip : (k,) [m]; resonance_hz : (k,) [Hz]; kind : damper type
+    mass : (k,) [kg]; peak_amplitude : (k,) [m]; peak_frequency_hz : (k,) [Hz]; kind : damper type
     """
 
     mass: np.ndarray
-    peak_tip: np.ndarray
-    resonance_hz: np.ndarray
+    peak_amplitude: np.ndarray
+    peak_frequency_hz: np.ndarray
     kind: str
-    undamped_peak_tip: float
+    undamped_peak_amplitude: float
 
     @property
     def reduction(self) -> np.ndarray:
         """1 - peak / undamped peak."""
-        return 1 - self.peak_tip / self.undamped_peak_tip
+        return 1 - self.peak_amplitude / self.undamped_peak_amplitude
 
     def plot(self, ax=None, **kwargs):
         import matplotlib.pyplot as plt
@@ -209,8 +210,8 @@ class MassSweep:
         if ax is None:
             _, ax = plt.subplots(figsize=(6, 4))
         kwargs.setdefault("label", self.kind)
-        ax.semilogx(1e3 * self.mass, 1e3 * self.peak_tip, marker="o", **kwargs)
-        ax.axhline(1e3 * self.undamped_peak_tip, color="gray", ls="--", lw=1)
+        ax.semilogx(1e3 * self.mass, 1e3 * self.peak_amplitude, marker="o", **kwargs)
+        ax.axhline(1e3 * self.undamped_peak_amplitude, color="gray", ls="--", lw=1)
         ax.set_xlabel("damper mass [g]")
         ax.set_ylabel("resonance tip amplitude u_x [mm]")
         ax.grid(True, which="both", alpha=0.3)
@@ -242,21 +243,21 @@ def mass_sweep(disk: TunedDisk, masses, f_range_hz=(90.0, 105.0), harmonics=(1,)
 
 
 @dataclass
-class MassOptimum:
+class MassOptimum(Saveable):
     """Optimal damper mass [kg], its peak tip amplitude [m], the undamped peak [m].
 
     Found by :func:`optimal_mass`: a log grid over the bounds, then a bounded local search in
     the bracket of the best grid point.
 
-    mass, peak_tip : the best mass evaluated and its peak [kg, m]
-    undamped_peak_tip : [m]; evaluations : number of masses evaluated
+    mass, peak_amplitude : the best mass evaluated and its peak [kg, m]
+    undamped_peak_amplitude : [m]; evaluations : number of masses evaluated
     failed_masses : (f,) [kg] masses whose response could not be computed even with the
         retries of :func:`robust_peak` (e.g. a very light cylinder whose continuation stalls
         just below the resonance); never returned as the optimum
     failed_lower_bounds : (f,) [m] the largest tip amplitude on their converged partial
         branches, a lower bound of their true peak (NaN: nothing converged)
     failure_messages : (f,) why each failed
-    grid_mass : (g,) [kg] the bracketing grid; grid_peak_tip : (g,) [m] (NaN where failed)
+    grid_mass : (g,) [kg] the bracketing grid; grid_peak_amplitude : (g,) [m] (NaN where failed)
     bracket : (low, high) [kg] the grid interval of the local search
     success : True when the optimum is certified global on the grid: every failed mass has a
         lower bound above the optimum peak (so it cannot hide a better mass)
@@ -264,21 +265,21 @@ class MassOptimum:
     """
 
     mass: float
-    peak_tip: float
-    undamped_peak_tip: float
+    peak_amplitude: float
+    undamped_peak_amplitude: float
     evaluations: int
     failed_masses: tuple = ()
     failed_lower_bounds: tuple = ()
     failure_messages: tuple = ()
     grid_mass: np.ndarray = None
-    grid_peak_tip: np.ndarray = None
+    grid_peak_amplitude: np.ndarray = None
     bracket: tuple = ()
     success: bool = True
     message: str = ""
 
     @property
     def reduction(self) -> float:
-        return 1 - self.peak_tip / self.undamped_peak_tip
+        return 1 - self.peak_amplitude / self.undamped_peak_amplitude
 
 
 GRID_PER_DECADE = 4   # bracketing grid density; the narrowest valley measured (cylinder, EO 7)
@@ -346,10 +347,10 @@ def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0),
 
     def record(m, ev):
         evaluations[m] = ev
-        return ev.peak_tip if ev.success else np.nan
+        return ev.peak_amplitude if ev.success else np.nan
 
     def best_so_far():
-        return min((ev.peak_tip for ev in evaluations.values() if ev.success), default=np.inf)
+        return min((ev.peak_amplitude for ev in evaluations.values() if ev.success), default=np.inf)
 
     def fun(logm):
         m = float(np.exp(logm))
@@ -368,13 +369,13 @@ def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0),
         for m, ev in zip(retry, parallel_map(_robust_peak_case, cases, processes)):
             ev.attempts += evaluations[m].attempts
             record(m, ev)
-        return [evaluations[m].peak_tip if evaluations[m].success else np.nan for m in masses]
+        return [evaluations[m].peak_amplitude if evaluations[m].success else np.nan for m in masses]
 
     n = max(5, int(np.ceil(grid_per_decade * np.log10(hi / lo))) + 1)
     loggrid = np.linspace(np.log(lo), np.log(hi), n)
     logm, peak, _, (a, b) = bracket_minimum(fun, loggrid, xatol, 10 * undamped, evaluate_grid=evaluate_grid)
     grid_m = np.exp(loggrid)
-    grid_p = np.array([evaluations[float(m)].peak_tip for m in grid_m])
+    grid_p = np.array([evaluations[float(m)].peak_amplitude for m in grid_m])
     failed = sorted(m for m, ev in evaluations.items() if not ev.success)
     bounds_f = tuple(evaluations[m].lower_bound for m in failed)
     msgs = tuple(evaluations[m].message for m in failed)

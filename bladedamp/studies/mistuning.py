@@ -25,6 +25,7 @@ import numpy as np
 
 from .. import _validate
 from ..disk import TunedDisk
+from ..io import Saveable, npz_path
 from ..mistuned import MistunedDisk, MistunedResponse
 
 PAPER_STD = 0.02
@@ -135,7 +136,7 @@ def auto_range(disk: TunedDisk, kappa, margin: float = 0.03) -> tuple[float, flo
 
 
 def mistuned_response(disk: TunedDisk, kappa, f_range_hz=None, harmonics=(1,), max_step: float = 0.05,
-                      tuned_peak_tip: float | None = None, max_widenings: int = 3, n_sector: int | None = None,
+                      tuned_peak_amplitude: float | None = None, max_widenings: int = 3, n_sector: int | None = None,
                       n_samples: int | None = None, tol: float = 1e-10) -> MistunedResponse:
     """Full-assembly response of ``disk`` with blade frequencies times ``kappa``; while some
     blade's largest amplitude is at an end of the range (default :func:`auto_range`), the branch
@@ -152,7 +153,7 @@ def mistuned_response(disk: TunedDisk, kappa, f_range_hz=None, harmonics=(1,), m
         f_range_hz = auto_range(disk, kappa)
     lo, hi = (float(f) for f in f_range_hz)
     # a sweep that turns back and leaves the range by 5 % of its width has left the curve (below)
-    common = dict(harmonics=harmonics, n_samples=n_samples, tuned_peak_tip=tuned_peak_tip, tol=tol, leave_margin=0.05)
+    common = dict(harmonics=harmonics, n_samples=n_samples, tuned_peak_amplitude=tuned_peak_amplitude, tol=tol, leave_margin=0.05)
 
     def sweep(lo, hi):
         # the upward sweep can leave the response curve at a branch point and follow another
@@ -210,27 +211,27 @@ def tuned_peak(disk: TunedDisk, f_range_hz=(88.0, 106.0), harmonics=(1,), max_st
 # the paper's cases
 # ---------------------------------------------------------------------------------------
 @dataclass
-class MistuningCase:
+class MistuningCase(Saveable):
     name: str
     mass: float
     kappa: np.ndarray
     response: MistunedResponse
-    tuned_peak_tip: float
+    tuned_peak_amplitude: float
     tuned_response: object = None
 
     @property
-    def peak_tip(self) -> np.ndarray:
+    def peak_amplitude(self) -> np.ndarray:
         """(16,) peak of every blade [m] (a sector model's blades repeated around the disk)."""
-        return np.resize(self.response.peak_tip, len(self.kappa))
+        return np.resize(self.response.peak_amplitude, len(self.kappa))
 
     @property
-    def peak_hz(self) -> np.ndarray:
+    def peak_frequency_hz(self) -> np.ndarray:
         return np.resize(self.response.peak_frequency_hz, len(self.kappa))
 
     def summary(self) -> dict:
-        return {"kappa": [float(k) for k in self.kappa], "peak_tip_mm": [float(1e3 * p) for p in self.peak_tip],
-                "tuned_peak_tip_mm": float(1e3 * self.tuned_peak_tip), "mass_g": 1e3 * self.mass,
-                "peak_hz": [float(f) for f in self.peak_hz], "model": "full assembly" if self.response.n_sector == len(
+        return {"kappa": [float(k) for k in self.kappa], "peak_tip_mm": [float(1e3 * p) for p in self.peak_amplitude],
+                "tuned_peak_tip_mm": float(1e3 * self.tuned_peak_amplitude), "mass_g": 1e3 * self.mass,
+                "peak_hz": [float(f) for f in self.peak_frequency_hz], "model": "full assembly" if self.response.n_sector == len(
                     self.kappa) else f"cyclic sector of {self.response.n_sector} blades"}
 
 
@@ -273,12 +274,12 @@ def paper_cases(disk_factory=None, progress=None, f_range_hz=None, max_step: flo
         kappa = kappas[name]
         sector = 2 if name == "alternating" else None
         r = mistuned_response(disk, kappa[:sector] if sector else kappa, f_range_hz, max_step=max_step,
-                              tuned_peak_tip=tuned[mass][0], n_sector=sector)
+                              tuned_peak_amplitude=tuned[mass][0], n_sector=sector)
         key = f"{name}_{1e3 * mass:g}g"
         out[key] = MistuningCase(key, mass, kappa, r, tuned[mass][0], tuned[mass][1])
         done += 1
         if progress:
-            progress(done, total, f"{key}: max peak {1e3 * r.peak_tip.max():.4f} mm "
+            progress(done, total, f"{key}: max peak {1e3 * r.peak_amplitude.max():.4f} mm "
                                   f"(tuned {1e3 * tuned[mass][0]:.4f} mm), {len(r.omega)} points")
     return out
 
@@ -376,30 +377,30 @@ def _one_disk(disk, kappa, f_range_hz, settings):
 
 
 @dataclass
-class MonteCarloResult:
+class MonteCarloResult(Saveable):
     """Peaks of N mistuned disks.
 
-    kappa : (N, n) mistuning factors; peak_tip : (N, n) peak u_x of every blade [m] (with the
+    kappa : (N, n) mistuning factors; peak_amplitude : (N, n) peak u_x of every blade [m] (with the
     default Monte Carlo settings, accurate for the largest blade of each disk; see
     :data:`MONTE_CARLO_MAX_STEP` for the measured errors of the others);
-    peak_hz : (N, n); tuned_peak_tip [m]; errors : per disk, '' if it converged.
+    peak_frequency_hz : (N, n); tuned_peak_amplitude [m]; errors : per disk, '' if it converged.
     """
 
     kappa: np.ndarray
-    peak_tip: np.ndarray
-    peak_hz: np.ndarray
-    tuned_peak_tip: float
+    peak_amplitude: np.ndarray
+    peak_frequency_hz: np.ndarray
+    tuned_peak_amplitude: float
     errors: list = field(default_factory=list)
     meta: dict = field(default_factory=dict)
 
     @property
     def amplification(self) -> np.ndarray:
         """(N,) largest blade peak of each disk over the tuned peak."""
-        return self.peak_tip.max(axis=1) / self.tuned_peak_tip
+        return self.peak_amplitude.max(axis=1) / self.tuned_peak_amplitude
 
     @property
     def valid(self) -> np.ndarray:
-        return np.all(np.isfinite(self.peak_tip), axis=1)
+        return np.all(np.isfinite(self.peak_amplitude), axis=1)
 
     def confidence_interval(self, level: float = 0.95) -> tuple[float, float]:
         """Confidence interval of the mean amplification (normal approximation)."""
@@ -423,35 +424,32 @@ class MonteCarloResult:
         return float(np.quantile(a, q)), float(a[max(lo - 1, 0)]), float(a[min(hi, n - 1)])
 
     def summary(self) -> dict:
-        a = self.amplification[self.valid]
-        lo, hi = self.confidence_interval()
-        return {"n_disks": int(len(self.amplification)), "n_failed": int((~self.valid).sum()),
-                "tuned_peak_tip_mm": 1e3 * self.tuned_peak_tip, "amplification_mean": float(a.mean()),
-                "amplification_mean_ci95": [lo, hi], "amplification_std": float(a.std(ddof=1)) if a.size > 1 else 0.0,
-                "amplification_max": float(a.max()), "amplification_min": float(a.min()), **self.meta}
+        """Amplification statistics of the disks that converged (JSON-able). With no disk
+        converged the statistics are None (not NaN) and ``n_failed`` says why."""
+        a = self.amplification[self.valid] if len(self.kappa) else np.zeros(0)
+        lo, hi = self.confidence_interval() if a.size else (None, None)
+        stats = dict(amplification_mean=float(a.mean()), amplification_mean_ci95=[lo, hi],
+                     amplification_std=float(a.std(ddof=1)) if a.size > 1 else 0.0,
+                     amplification_max=float(a.max()), amplification_min=float(a.min())) if a.size else \
+            dict(amplification_mean=None, amplification_mean_ci95=[None, None], amplification_std=None,
+                 amplification_max=None, amplification_min=None)
+        return {"n_disks": int(len(self.kappa)), "n_failed": int((~self.valid).sum()),
+                "tuned_peak_tip_mm": 1e3 * self.tuned_peak_amplitude, **stats, **self.meta}
 
     def save(self, path) -> Path:
-        """``path``.npz (arrays) and ``path``.json (summary, errors); both load without pickle."""
-        path = Path(path)
-        base = path.with_suffix("") if path.suffix in (".npz", ".json") else path
-        base.parent.mkdir(parents=True, exist_ok=True)
-        np.savez(base.with_suffix(".npz"), kappa=self.kappa, peak_tip=self.peak_tip, peak_hz=self.peak_hz,
-                 tuned_peak_tip=np.array(self.tuned_peak_tip))
-        base.with_suffix(".json").write_text(json.dumps({"summary": self.summary(), "errors": list(self.errors),
-                                                         "meta": self.meta}, indent=2))
-        return base.with_suffix(".npz")
+        """``path``.npz: the result, with its errors and meta (:func:`bladedamp.io.save`,
+        loads without pickle: :func:`bladedamp.load` or ``MonteCarloResult.load``), and beside
+        it ``path``.json: the summary and the errors, for a reader. The summary is built before
+        anything is written, so a failure leaves no half-written pair."""
+        from ..io import save
 
-    @classmethod
-    def load(cls, path) -> "MonteCarloResult":
-        path = Path(path)
-        base = path.with_suffix("") if path.suffix in (".npz", ".json") else path
-        with np.load(base.with_suffix(".npz"), allow_pickle=False) as z:
-            arrays = {k: z[k] for k in z.files}
-        info = json.loads(base.with_suffix(".json").read_text()) if base.with_suffix(".json").exists() else {}
-        return cls(arrays["kappa"], arrays["peak_tip"], arrays["peak_hz"], float(arrays["tuned_peak_tip"]),
-                   info.get("errors", []), info.get("meta", {}))
+        npz = npz_path(path)
+        text = json.dumps({"summary": self.summary(), "errors": list(self.errors), "meta": self.meta}, indent=2)
+        save(self, npz)
+        npz.with_suffix(".json").write_text(text)
+        return npz
 
-    def plot(self, ax=None, bins: int = 30):
+    def plot(self, ax=None, *, bins: int = 30):
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -483,7 +481,7 @@ def _without_malloc_trim():
 
 def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f_range_hz=None,
                 harmonics=(1,), max_step: float = MONTE_CARLO_MAX_STEP, scheduler=None, n_workers: int | None = None,
-                progress=None, out=None, tuned_peak_tip: float | None = None, tol: float = MONTE_CARLO_TOL,
+                progress=None, out=None, tuned_peak_amplitude: float | None = None, tol: float = MONTE_CARLO_TOL,
                 n_samples: int | None = None) -> MonteCarloResult:
     """Peak amplification of ``n_disks`` randomly mistuned copies of ``disk`` (full assemblies).
 
@@ -508,8 +506,8 @@ def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f
     if n_workers is not None:
         _validate.integer("n_workers", n_workers, minimum=1)
     t0 = time.perf_counter()
-    if tuned_peak_tip is None:
-        tuned_peak_tip = tuned_peak(disk, f_range_hz or auto_range(disk, [1.0], 0.05), harmonics)[0]
+    if tuned_peak_amplitude is None:
+        tuned_peak_amplitude = tuned_peak(disk, f_range_hz or auto_range(disk, [1.0], 0.05), harmonics)[0]
     results = [None] * n_disks
     used = "serial"
     if scheduler == "serial":
@@ -546,7 +544,7 @@ def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f
                 cluster.close()
     elapsed = time.perf_counter() - t0
     res = MonteCarloResult(kappas, np.array([r[0] for r in results]), np.array([r[1] for r in results]),
-                           float(tuned_peak_tip), [r[2] for r in results],
+                           float(tuned_peak_amplitude), [r[2] for r in results],
                            {"std": std, "seed": int(seed), "f_range_hz": None if f_range_hz is None else list(f_range_hz), "harmonics": list(harmonics),
                             "max_step": max_step, "tol": tol, "n_samples": n_samples, "executor": used,
                             "elapsed_s": elapsed,
@@ -562,16 +560,16 @@ def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f
 # arrangement optimisation
 # ---------------------------------------------------------------------------------------
 @dataclass
-class Arrangement:
+class Arrangement(Saveable):
     """Result of :func:`optimise_arrangement` (orders index the given blade set)."""
 
     kappa: np.ndarray
     order: np.ndarray
-    max_peak_tip: float
+    max_peak_amplitude: float
     heuristic_order: np.ndarray
-    heuristic_max_peak_tip: float
-    given_max_peak_tip: float
-    tuned_peak_tip: float
+    heuristic_max_peak_amplitude: float
+    given_max_peak_amplitude: float
+    tuned_peak_amplitude: float
     evaluations: int
     history: list
     response: MistunedResponse = None
@@ -579,16 +577,16 @@ class Arrangement:
     @property
     def gain_over_given(self) -> float:
         """Relative reduction of the largest peak vs the given (random) order."""
-        return 1 - self.max_peak_tip / self.given_max_peak_tip
+        return 1 - self.max_peak_amplitude / self.given_max_peak_amplitude
 
     @property
     def gain_over_heuristic(self) -> float:
-        return 1 - self.max_peak_tip / self.heuristic_max_peak_tip
+        return 1 - self.max_peak_amplitude / self.heuristic_max_peak_amplitude
 
 
 def optimise_arrangement(disk: TunedDisk, kappa, max_evaluations: int = 30, candidates: int = 3,
                          f_range_hz=None, max_step: float = 0.05, progress=None,
-                         tuned_peak_tip: float | None = None) -> Arrangement:
+                         tuned_peak_amplitude: float | None = None) -> Arrangement:
     """Blade order minimising the largest blade peak of the full assembly.
 
     Search: start from :func:`reorder` (the heuristic); at every step the blade with the largest
@@ -599,17 +597,17 @@ def optimise_arrangement(disk: TunedDisk, kappa, max_evaluations: int = 30, cand
     """
     k = check_kappa(kappa, disk.n_blades)
     max_evaluations = _validate.integer("max_evaluations", max_evaluations, minimum=2)
-    if tuned_peak_tip is None:
-        tuned_peak_tip = tuned_peak(disk, f_range_hz or auto_range(disk, [1.0], 0.05), max_step=max_step)[0]
+    if tuned_peak_amplitude is None:
+        tuned_peak_amplitude = tuned_peak(disk, f_range_hz or auto_range(disk, [1.0], 0.05), max_step=max_step)[0]
     cache = {}
 
     def evaluate(order):
         key = tuple(int(o) for o in order)
         if key not in cache:
-            r = mistuned_response(disk, k[list(key)], f_range_hz, max_step=max_step, tuned_peak_tip=tuned_peak_tip)
+            r = mistuned_response(disk, k[list(key)], f_range_hz, max_step=max_step, tuned_peak_amplitude=tuned_peak_amplitude)
             cache[key] = r
             if progress:
-                progress(len(cache), max_evaluations, f"max peak {1e3 * r.peak_tip.max():.4f} mm")
+                progress(len(cache), max_evaluations, f"max peak {1e3 * r.peak_amplitude.max():.4f} mm")
         return cache[key]
 
     given = np.arange(k.size)
@@ -617,10 +615,10 @@ def optimise_arrangement(disk: TunedDisk, kappa, max_evaluations: int = 30, cand
     heuristic = reorder(k)
     r_best = evaluate(heuristic)
     best = heuristic.copy()
-    history = [float(r_given.peak_tip.max()), float(r_best.peak_tip.max())]
+    history = [float(r_given.peak_amplitude.max()), float(r_best.peak_amplitude.max())]
     n = k.size
     while len(cache) < max_evaluations:
-        p = int(np.argmax(r_best.peak_tip))
+        p = int(np.argmax(r_best.peak_amplitude))
         scores = []
         for j in range(n):
             if j == p:
@@ -636,11 +634,11 @@ def optimise_arrangement(disk: TunedDisk, kappa, max_evaluations: int = 30, cand
             if len(cache) >= max_evaluations:
                 break
             r = evaluate(o)
-            if r.peak_tip.max() < r_best.peak_tip.max() and (improved is None or r.peak_tip.max() < improved[1].peak_tip.max()):
+            if r.peak_amplitude.max() < r_best.peak_amplitude.max() and (improved is None or r.peak_amplitude.max() < improved[1].peak_amplitude.max()):
                 improved = (o, r)
         if improved is None:
             break
         best, r_best = improved
-        history.append(float(r_best.peak_tip.max()))
-    return Arrangement(k, best, float(r_best.peak_tip.max()), heuristic, float(cache[tuple(heuristic)].peak_tip.max()),
-                       float(r_given.peak_tip.max()), float(tuned_peak_tip), len(cache), history, r_best)
+        history.append(float(r_best.peak_amplitude.max()))
+    return Arrangement(k, best, float(r_best.peak_amplitude.max()), heuristic, float(cache[tuple(heuristic)].peak_amplitude.max()),
+                       float(r_given.peak_amplitude.max()), float(tuned_peak_amplitude), len(cache), history, r_best)

@@ -336,7 +336,7 @@ def cycle_data(result, index: int | None = None, frequency_hz: float | None = No
         if basis.has_static:
             a_static = np.zeros((2, patches[0].n_points))
         else:
-            a_static = seat(disk.damper_geometry(), disk.centrifugal_force(result.omega[i])[0])[1]
+            a_static = seat(disk.damper_geometry(), disk.centrifugal_force(result.frequency_hz[i])[0])[1]
         u = basis.to_time(result.point_displacement[i][..., 2])                       # (T, 2, P)
         a = a_static[None] - u
         mean = a.mean(axis=0)

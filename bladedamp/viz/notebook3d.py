@@ -109,7 +109,7 @@ def liftoff_figure(contact_height_mm: float = 2.0, force_n: float = 0.1, mass_g:
     axes[0].set_ylabel("xi* = xi / h_C (across the height)")
     fig.colorbar(sc, ax=axes, label="r = |w_zeta,1| / a_static  (r > 1, red ring: lifts off)")
     fig.suptitle(f"wedge {mass_g:g} g, h_C = {contact_height_mm:g} mm, F_x = {force_n:g} N: "
-                 f"resonance {m.resonance_hz:.2f} Hz, tip {1e3 * m.peak_tip:.3f} mm", fontsize=10)
+                 f"resonance {m.peak_frequency_hz:.2f} Hz, tip {1e3 * m.peak_amplitude:.3f} mm", fontsize=10)
     return fig
 
 
@@ -182,5 +182,5 @@ def tangential_ratio(result, index: int | None = None) -> np.ndarray:
     patches = disk.damper_geometry().patches
     c_t = np.array([p.tangential_stiffness for p in patches])
     mu = np.array([p.friction_coefficient for p in patches])
-    F_N = np.asarray(disk.static_normal_loads(result.omega[i]), dtype=float)
+    F_N = np.asarray(disk.static_normal_loads(result.frequency_hz[i]), dtype=float)
     return w1[[0, 6]] * c_t / (mu * F_N)

@@ -241,37 +241,40 @@ def describing_function_figure(k_t_kn_per_m=10.0, slip_force_n=0.3, normal_varia
 _OSC_CACHE: "OrderedDict[tuple, dict]" = OrderedDict()
 
 
-def oscillator_comparison(normal_load=3.0, forcing=2.0, damping=2.0, harmonics=(1, 3, 5), omega_range=(70.0, 200.0),
-                          time_omegas=(90.0, 110.0, 130.0, 160.0), steps_per_period=512, max_step=0.05) -> dict:
-    """FRF of the :class:`FrictionOscillator` (m = 1 kg, k = k_T = 1e4 N/m, mu = 0.3) by HBM
-    beside time integration at ``time_omegas`` [rad/s], and the linear limits.
+def oscillator_comparison(normal_load=3.0, forcing=2.0, damping=2.0, harmonics=(1, 3, 5), f_range_hz=(11.0, 32.0),
+                          time_frequencies_hz=(14.0, 17.5, 20.5, 25.5), steps_per_period=512, max_step=0.05) -> dict:
+    """FRF of the :class:`FrictionOscillator` (m = 1 kg, k = k_T = 1e4 N/m, mu = 0.3: the free
+    natural frequency is 15.9 Hz) over ``f_range_hz`` [Hz] by HBM beside time integration at
+    ``time_frequencies_hz`` [Hz], and the linear limits.
 
-    Returns a dict: ``osc``, ``frf`` (FrequencyResponse), ``omega`` [rad/s], ``hbm`` (first-harmonic
-    amplitude on the branch) [m], ``time_omega``, ``time_amplitude`` (time integration),
-    ``hbm_at_time`` (HBM interpolated there), ``energy`` (excitation, viscous, contact work per
-    cycle on the branch), ``free``, ``stuck`` (linear amplitudes over ``omega``) and the same on a
-    dense grid ``omega_dense``: ``free_dense``, ``stuck_dense``. Memoised.
+    Returns a dict: ``osc``, ``frf`` (FrequencyResponse), ``frequency_hz`` [Hz], ``hbm``
+    (first-harmonic amplitude on the branch) [m], ``time_frequency_hz``, ``time_amplitude``
+    (time integration), ``hbm_at_time`` (HBM interpolated there), ``energy`` (excitation,
+    viscous, contact work per cycle on the branch), ``free``, ``stuck`` (linear amplitudes over
+    ``frequency_hz``) and the same on a dense grid ``frequency_dense_hz``: ``free_dense``,
+    ``stuck_dense``. Memoised.
     """
-    key = (float(normal_load), float(forcing), float(damping), tuple(harmonics), tuple(omega_range),
-           tuple(time_omegas), int(steps_per_period), float(max_step))
+    key = (float(normal_load), float(forcing), float(damping), tuple(harmonics), tuple(f_range_hz),
+           tuple(time_frequencies_hz), int(steps_per_period), float(max_step))
     if key in _OSC_CACHE:
         return _OSC_CACHE[key]
     osc = FrictionOscillator(damping=damping, normal_load=normal_load, forcing=forcing)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        frf = osc.frequency_response(*omega_range, harmonics=harmonics, max_step=max_step)
+        frf = osc.frequency_response(*f_range_hz, harmonics=harmonics, max_step=max_step)
     amp = frf.harmonic_amplitude(0, 1)
-    tw = np.asarray(time_omegas, dtype=float)
-    tr = osc.time_response(tw, steps_per_period=steps_per_period) if tw.size else None
-    order = np.argsort(frf.omega)
-    out = dict(osc=osc, frf=frf, omega=frf.omega, hbm=amp, time_omega=tw,
+    tf = np.asarray(time_frequencies_hz, dtype=float)
+    tr = osc.time_response(tf, steps_per_period=steps_per_period) if tf.size else None
+    f = frf.frequency_hz
+    order = np.argsort(f)
+    out = dict(osc=osc, frf=frf, frequency_hz=f, hbm=amp, time_frequency_hz=tf,
                time_amplitude=tr.amplitude if tr is not None else np.zeros(0),
                time_converged=tr.converged if tr is not None else np.zeros(0, bool),
-               hbm_at_time=np.interp(tw, frf.omega[order], amp[order]),
-               energy=osc.energy_balance(frf), free=osc.linear_amplitude(frf.omega, stuck=False),
-               stuck=osc.linear_amplitude(frf.omega, stuck=True))
-    dense = np.linspace(*omega_range, 600)
-    out.update(omega_dense=dense, free_dense=osc.linear_amplitude(dense, stuck=False),
+               hbm_at_time=np.interp(tf, f[order], amp[order]),
+               energy=osc.energy_balance(frf), free=osc.linear_amplitude(f, stuck=False),
+               stuck=osc.linear_amplitude(f, stuck=True))
+    dense = np.linspace(*f_range_hz, 600)
+    out.update(frequency_dense_hz=dense, free_dense=osc.linear_amplitude(dense, stuck=False),
                stuck_dense=osc.linear_amplitude(dense, stuck=True))
     _OSC_CACHE[key] = out
     while len(_OSC_CACHE) > 32:
@@ -284,13 +287,14 @@ def oscillator_figure(normal_load=3.0, forcing=2.0, damping=2.0, **kwargs):
     limits. ``fig.data`` holds the :func:`oscillator_comparison` result."""
     d = oscillator_comparison(normal_load, forcing, damping, **kwargs)
     fig, ax = _figure(figsize=(7, 4))
-    ax.semilogy(d["omega_dense"], 1e3 * d["free_dense"], color="gray", ls="--", lw=1, label="linear, no contact (k)")
-    ax.semilogy(d["omega_dense"], 1e3 * d["stuck_dense"], color="gray", ls=":", lw=1,
+    ax.semilogy(d["frequency_dense_hz"], 1e3 * d["free_dense"], color="gray", ls="--", lw=1,
+                label="linear, no contact (k)")
+    ax.semilogy(d["frequency_dense_hz"], 1e3 * d["stuck_dense"], color="gray", ls=":", lw=1,
                 label="linear, stuck (k + k_T)")
-    ax.semilogy(d["omega"], 1e3 * d["hbm"], "C0-", label=f"HBM, harmonics {tuple(d['frf'].basis.harmonics)}")
-    if d["time_omega"].size:
-        ax.semilogy(d["time_omega"], 1e3 * d["time_amplitude"], "C3o", label="time integration")
-    ax.set_xlabel("excitation frequency Omega [rad/s]")
+    ax.semilogy(d["frequency_hz"], 1e3 * d["hbm"], "C0-", label=f"HBM, harmonics {tuple(d['frf'].basis.harmonics)}")
+    if d["time_frequency_hz"].size:
+        ax.semilogy(d["time_frequency_hz"], 1e3 * d["time_amplitude"], "C3o", label="time integration")
+    ax.set_xlabel("excitation frequency [Hz]")
     ax.set_ylabel("first-harmonic amplitude |x_1| [mm]")
     ax.set_title(f"friction oscillator: mu N = {d['osc'].slip_force:.3g} N, F = {forcing:.3g} N", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
@@ -307,17 +311,17 @@ def oscillator_figure(normal_load=3.0, forcing=2.0, damping=2.0, **kwargs):
 class DiskFRF:
     """A frequency response of the reference disk on a frequency grid.
 
-    frequency_hz : (n,) [Hz]; tip : (n, 3) first-harmonic tip amplitude u_x, u_y, u_z [m];
-    x : (n, N) harmonic balance unknowns; peak_tip [m] and resonance_hz [Hz] of u_x (refined);
+    frequency_hz : (n,) [Hz]; tip_amplitude : (n, 3) first-harmonic tip amplitude u_x, u_y, u_z [m];
+    x : (n, N) harmonic balance unknowns; peak_amplitude [m] and peak_frequency_hz [Hz] of u_x (refined);
     peak_x : unknowns at the refined peak; method : "linear", "warm", "cold" or "continuation";
     seconds : compute time [s]; disk : the TunedDisk; system : its HarmonicBalanceSystem.
     """
 
     frequency_hz: np.ndarray
-    tip: np.ndarray
+    tip_amplitude: np.ndarray
     x: np.ndarray
-    peak_tip: float
-    resonance_hz: float
+    peak_amplitude: float
+    peak_frequency_hz: float
     peak_x: np.ndarray
     method: str
     seconds: float
@@ -326,7 +330,7 @@ class DiskFRF:
 
     def reduction(self, undamped: "DiskFRF") -> float:
         """1 - peak / undamped peak."""
-        return 1.0 - self.peak_tip / undamped.peak_tip
+        return 1.0 - self.peak_amplitude / undamped.peak_amplitude
 
 
 def _tip(disk, system, X) -> np.ndarray:
@@ -435,7 +439,7 @@ class DiskFRFCache:
         lo, hi = self.f_range_hz
         for _ in range(3):
             r = self._solve_range(fam, mass, disk, system, lo, hi, t0)
-            i = int(np.argmax(r.tip[:, 0]))
+            i = int(np.argmax(r.tip_amplitude[:, 0]))
             width = hi - lo
             if 0 < i < len(r.frequency_hz) - 1:
                 return r
@@ -502,9 +506,9 @@ class DiskFRFCache:
         tip_b = _tip(disk, system, xb)
         i = int(np.argmax(tip_b[:, 0]))
         out = self._finish(disk, system, fs, X, "continuation", t0, solve)
-        if tip_b[i, 0] > out.peak_tip:
-            out.peak_tip, out.resonance_hz, out.peak_x = float(tip_b[i, 0]), float(fb[i]), xb[i]
-        out.frequency_hz, out.tip, out.x = fb, tip_b, xb
+        if tip_b[i, 0] > out.peak_amplitude:
+            out.peak_amplitude, out.peak_frequency_hz, out.peak_x = float(tip_b[i, 0]), float(fb[i]), xb[i]
+        out.frequency_hz, out.tip_amplitude, out.x = fb, tip_b, xb
         return out
 
     def _finish(self, disk, system, fs, X, method, t0, solve) -> DiskFRF:
@@ -561,14 +565,14 @@ def disk_frf_figure(mass_g=1.0, kind="cylinder", engine_order=1, gamma_right_deg
     damped = disk_frf(kind, mass_g, engine_order, gamma_right_deg, cache=cache)
     free = undamped_frf(engine_order, cache=cache)
     fig, ax = _figure(figsize=(7, 4))
-    ax.plot(free.frequency_hz, 1e3 * free.tip[:, 0], "k--", lw=1, label="no damper")
-    ax.plot(damped.frequency_hz, 1e3 * damped.tip[:, 0], "C0-", label=f"{kind} {mass_g:.3g} g")
-    ax.plot([damped.resonance_hz], [1e3 * damped.peak_tip], "C3o")
+    ax.plot(free.frequency_hz, 1e3 * free.tip_amplitude[:, 0], "k--", lw=1, label="no damper")
+    ax.plot(damped.frequency_hz, 1e3 * damped.tip_amplitude[:, 0], "C0-", label=f"{kind} {mass_g:.3g} g")
+    ax.plot([damped.peak_frequency_hz], [1e3 * damped.peak_amplitude], "C3o")
     ax.set_xlabel("excitation frequency [Hz]")
     ax.set_ylabel("tip amplitude u_x [mm]")
     ax.set_xlim(damped.frequency_hz[0], damped.frequency_hz[-1])
-    ax.set_title(f"EO = {engine_order}, gamma_R = {gamma_right_deg:g} deg: peak {1e3 * damped.peak_tip:.3f} mm at "
-                 f"{damped.resonance_hz:.2f} Hz, reduction {100 * damped.reduction(free):.1f} % "
+    ax.set_title(f"EO = {engine_order}, gamma_R = {gamma_right_deg:g} deg: peak {1e3 * damped.peak_amplitude:.3f} mm at "
+                 f"{damped.peak_frequency_hz:.2f} Hz, reduction {100 * damped.reduction(free):.1f} % "
                  f"({damped.method}, {damped.seconds:.2f} s)", fontsize=9)
     ax.grid(True, alpha=0.3)
     ax.legend()
@@ -580,16 +584,16 @@ def disk_frf_figure(mass_g=1.0, kind="cylinder", engine_order=1, gamma_right_deg
 def mass_sweep_peaks(kind, masses_g, engine_order=1, gamma_right_deg=35.0, cache=None) -> dict:
     """Peak tip amplitude [m] and reduction over damper masses [g], warm-started mass after mass.
 
-    Returns a dict ``mass_g``, ``peak_tip``, ``resonance_hz``, ``undamped_peak_tip``, ``reduction``,
+    Returns a dict ``mass_g``, ``peak_amplitude``, ``peak_frequency_hz``, ``undamped_peak_amplitude``, ``reduction``,
     and the best grid point ``best_mass_g``, ``best_reduction``."""
     masses_g = np.atleast_1d(np.asarray(masses_g, dtype=float))
     rs = [disk_frf(kind, m, engine_order, gamma_right_deg, cache=cache) for m in masses_g]
     free = undamped_frf(engine_order, cache=cache)
-    peaks = np.array([r.peak_tip for r in rs])
-    red = 1 - peaks / free.peak_tip
+    peaks = np.array([r.peak_amplitude for r in rs])
+    red = 1 - peaks / free.peak_amplitude
     j = int(np.argmax(red))
-    return dict(mass_g=masses_g, peak_tip=peaks, resonance_hz=np.array([r.resonance_hz for r in rs]),
-                undamped_peak_tip=free.peak_tip, reduction=red, best_mass_g=float(masses_g[j]),
+    return dict(mass_g=masses_g, peak_amplitude=peaks, peak_frequency_hz=np.array([r.peak_frequency_hz for r in rs]),
+                undamped_peak_amplitude=free.peak_amplitude, reduction=red, best_mass_g=float(masses_g[j]),
                 best_reduction=float(red[j]))
 
 
@@ -599,18 +603,18 @@ def mass_study_figure(mass_g=1.0, kind="cylinder", sweeps=None, engine_order=1, 
     damped = disk_frf(kind, mass_g, engine_order, cache=cache)
     free = undamped_frf(engine_order, cache=cache)
     fig, (ax, ax2) = _figure(1, 2, figsize=(11, 4))
-    ax.plot(free.frequency_hz, 1e3 * free.tip[:, 0], "k--", lw=1, label="no damper")
-    ax.plot(damped.frequency_hz, 1e3 * damped.tip[:, 0], label=f"{kind} {mass_g:.3g} g")
+    ax.plot(free.frequency_hz, 1e3 * free.tip_amplitude[:, 0], "k--", lw=1, label="no damper")
+    ax.plot(damped.frequency_hz, 1e3 * damped.tip_amplitude[:, 0], label=f"{kind} {mass_g:.3g} g")
     ax.set_xlim(damped.frequency_hz[0], damped.frequency_hz[-1])
     ax.set_xlabel("excitation frequency [Hz]")
     ax.set_ylabel("tip amplitude u_x [mm]")
-    ax.set_title(f"peak {1e3 * damped.peak_tip:.3f} mm, reduction {100 * damped.reduction(free):.1f} %", fontsize=9)
+    ax.set_title(f"peak {1e3 * damped.peak_amplitude:.3f} mm, reduction {100 * damped.reduction(free):.1f} %", fontsize=9)
     ax.grid(True, alpha=0.3)
     ax.legend()
     for k, sw in (sweeps or {}).items():
-        ax2.semilogx(sw["mass_g"], 1e3 * sw["peak_tip"], "o-", label=k)
-    ax2.axhline(1e3 * free.peak_tip, color="gray", ls="--", lw=1, label="no damper")
-    ax2.plot([mass_g], [1e3 * damped.peak_tip], "k*", ms=14, label="this mass")
+        ax2.semilogx(sw["mass_g"], 1e3 * sw["peak_amplitude"], "o-", label=k)
+    ax2.axhline(1e3 * free.peak_amplitude, color="gray", ls="--", lw=1, label="no damper")
+    ax2.plot([mass_g], [1e3 * damped.peak_amplitude], "k*", ms=14, label="this mass")
     ax2.set_xlabel("damper mass [g]")
     ax2.set_ylabel("resonance tip amplitude u_x [mm]")
     ax2.grid(True, which="both", alpha=0.3)
@@ -635,7 +639,7 @@ def contact_state_at_peak(frf: DiskFRF):
     disk, system = frf.disk, frf.system
     if not disk.has_damper:
         raise ValueError("contact_state_at_peak needs a damped response")
-    omega = 2 * np.pi * frf.resonance_hz
+    omega = 2 * np.pi * frf.peak_frequency_hz
     branch = Branch(np.array([omega]), frf.peak_x[None, :], np.zeros(1, dtype=int), True, "peak")
     r = DiskResponse.from_branch(disk, system, branch)
     basis = r.basis
@@ -645,9 +649,9 @@ def contact_state_at_peak(frf: DiskFRF):
     patches = disk.damper_geometry().patches
     c_t = np.array([p.tangential_stiffness for p in patches])
     mu = np.array([p.friction_coefficient for p in patches])
-    F_N = np.asarray(disk.static_normal_loads(omega), dtype=float)
+    F_N = np.asarray(disk.static_normal_loads(frf.peak_frequency_hz), dtype=float)
     state = ContactState(w_xi * c_t / (mu * F_N), F_xi / (mu * F_N), w_xi, F_xi, F_N, c_t, mu,
-                         float(frf.resonance_hz), float(frf.peak_tip))
+                         float(frf.peak_frequency_hz), float(frf.peak_amplitude))
     state.point_state = r.point_state[0]     # (2, P, 3) stick / slip / separated share per point
     return state
 
@@ -660,12 +664,12 @@ def platform_angle_figure(gamma_right_deg=35.0, kind="cylinder", mass_g=1.0, cac
     free = undamped_frf(1, cache=cache)
     state = contact_state_at_peak(damped)
     fig, (ax, ax2) = _figure(1, 2, figsize=(11, 4.5), gridspec_kw={"width_ratios": [1.4, 1]})
-    ax.plot(free.frequency_hz, 1e3 * free.tip[:, 0], "k--", lw=1, label="no damper")
-    ax.plot(damped.frequency_hz, 1e3 * damped.tip[:, 0], label=f"{kind} {mass_g:.3g} g, gamma_R = {gamma_right_deg:g} deg")
+    ax.plot(free.frequency_hz, 1e3 * free.tip_amplitude[:, 0], "k--", lw=1, label="no damper")
+    ax.plot(damped.frequency_hz, 1e3 * damped.tip_amplitude[:, 0], label=f"{kind} {mass_g:.3g} g, gamma_R = {gamma_right_deg:g} deg")
     ax.set_xlim(damped.frequency_hz[0], damped.frequency_hz[-1])
     ax.set_xlabel("excitation frequency [Hz]")
     ax.set_ylabel("tip amplitude u_x [mm]")
-    ax.set_title(f"peak {1e3 * damped.peak_tip:.3f} mm, reduction {100 * damped.reduction(free):.1f} %; "
+    ax.set_title(f"peak {1e3 * damped.peak_amplitude:.3f} mm, reduction {100 * damped.reduction(free):.1f} %; "
                  f"N_OL = {state.normal_load[0]:.3g} N, N_OR = {state.normal_load[1]:.3g} N", fontsize=9)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
@@ -683,15 +687,15 @@ class MistuningExplorer:
     """Mistuned responses of one disk by pattern, memoised, and the slider figure of notebook 05.
 
     ``disk`` : the tuned reference (its damper at every position); ``tuned_response`` : its
-    DiskResponse (drawn for comparison) and ``tuned_peak_tip`` [m] (amplification factors);
+    DiskResponse (drawn for comparison) and ``tuned_peak_amplitude`` [m] (amplification factors);
     ``max_step`` : continuation step of each FRF. The alternating pattern is solved as its exact
     two-blade cyclic sector (see :func:`bladedamp.studies.mistuning.mistuned_response`).
     """
 
-    def __init__(self, disk, tuned_response, tuned_peak_tip: float, max_step: float = 0.05):
+    def __init__(self, disk, tuned_response, tuned_peak_amplitude: float, max_step: float = 0.05):
         self.disk = disk
         self.tuned_response = tuned_response
-        self.tuned_peak_tip = float(tuned_peak_tip)
+        self.tuned_peak_amplitude = float(tuned_peak_amplitude)
         self.max_step = max_step
         self._responses = {}
 
@@ -709,7 +713,7 @@ class MistuningExplorer:
             k = self.kappa(pattern, seed, std)
             sector = 2 if pattern == "alternating" else None
             self._responses[key] = mistuned_response(self.disk, k[:2] if sector else k, max_step=self.max_step,
-                                                     tuned_peak_tip=self.tuned_peak_tip, n_sector=sector)
+                                                     tuned_peak_amplitude=self.tuned_peak_amplitude, n_sector=sector)
         return self._responses[key]
 
     def figure(self, pattern="random", seed=0, std_percent=2.0):

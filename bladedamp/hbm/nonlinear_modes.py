@@ -1,0 +1,663 @@
+"""Nonlinear modes by the extended periodic motion concept (EPMC, Krack 2015).
+
+A damped nonlinear mode is the periodic motion of the *autonomous* system with an artificial
+negative modal damping term that makes up for the dissipation of the friction contacts and the
+viscous damping over a period::
+
+    M x'' + (D - 2 zeta omega M) x' + K x + f_nl(x) = f_static
+
+(the excitation's dynamic part is dropped; a static load, the damper's centrifugal preload
+F_CG with a static harmonic, is kept). The unknowns are the harmonic coefficients of x,
+omega and zeta, at a prescribed modal amplitude ``a``: with a harmonic basis (see
+:mod:`bladedamp.hbm.fourier`), x = x_0 + a * phi (the static harmonic x_0 is not scaled by a).
+Two equations close the problem:
+
+* amplitude: phi_1^H M phi_1 = 1 (first harmonic, complex X = a_1 - i b_1): for a linear system
+  ``a`` is the modal coordinate of the mass-normalised mode;
+* phase: the sine coefficient of the first harmonic of a reference DOF is zero (default: the
+  DOF of the largest mass-weighted amplitude of the stuck linear mode).
+
+The residual is :meth:`HarmonicBalanceSystem.residual` plus the dynamic excitation (so it is
+zero) minus 2 zeta omega^2 (d/dtau (x) M) x, with every derivative analytic: dR/dx from the
+system, dR/domega from the system plus the excitation's and the EPMC term's, dR/dzeta =
+-2 omega^2 (d/dtau (x) M) x. Newton (the system's linear solver on the bordered, column-scaled
+Jacobian) at each amplitude, sequential continuation in log(a) with a secant predictor and
+step halving, from the stuck linear mode (the generalised eigenproblem of the first-harmonic
+block of the Jacobian at the static state; for a preload that follows omega it is iterated in
+omega to a fixed point).
+
+Energy: dotting the residual with x' over a period gives exactly
+2 zeta omega oint x'^T M x' dt = dissipated energy per cycle (viscous + contacts), for any
+harmonic truncation (``NonlinearModeResponse.dissipated_energy`` holds the right-hand side).
+
+Single-nonlinear-mode synthesis of the forced response (Krack 2014/2015): for a first-harmonic
+force F, (omega(a)^2 - Omega^2 + 2 i zeta(a) omega(a) Omega) a = phi_1^H F; its largest
+amplitude (the resonance) solves 2 zeta omega^2 sqrt(1 - zeta^2) a = |phi_1^H F| at
+Omega = omega sqrt(1 - 2 zeta^2) (:meth:`NonlinearModeResponse.forced_peak`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg
+
+from .. import _validate
+from ..io import Saveable
+from .fourier import HarmonicBasis
+
+
+# ----- the EPMC residual ------------------------------------------------------------------
+class EPMCProblem:
+    """The EPMC residual of one model's harmonic balance system, in the unknowns
+    u = (x_static, phi_dynamic) (C*n), omega, zeta at a given modal amplitude."""
+
+    def __init__(self, system, reference_dof: int):
+        self.system = system
+        basis = system.basis
+        self.basis = basis
+        self.C, self.n = basis.n_coeffs, system.n_dof
+        self.N = self.C * self.n
+        mass = system.mass.toarray() if hasattr(system.mass, "toarray") else np.atleast_2d(np.asarray(system.mass, float))
+        self.M = mass
+        # (d/dtau (x) M): x' = omega * E_M-less derivative; the EPMC term is -2 zeta omega^2 E x
+        self.E = np.kron(basis.derivative, mass)
+        static = np.zeros(self.N, dtype=bool)
+        if basis.has_static:
+            j0 = basis.cos_index(0)
+            static[j0 * self.n:(j0 + 1) * self.n] = True
+        self.static = static
+        j1 = basis.cos_index(1)
+        self.i_cos = slice(j1 * self.n, (j1 + 1) * self.n)
+        self.i_sin = slice((j1 + 1) * self.n, (j1 + 2) * self.n)
+        self.phase_index = (j1 + 1) * self.n + reference_dof
+        self.reference_dof = reference_dof
+        self.last_worst = -1          # unknown of the largest update of the last Newton iteration
+
+    def describe(self, index: int, dof_names) -> str:
+        """Name of unknown ``index``: 'omega', 'zeta' or '<harmonic term> of <dof>'."""
+        if index == self.N:
+            return "omega"
+        if index == self.N + 1:
+            return "zeta"
+        j, d = divmod(index, self.n)
+        h = int(self.basis.order[j])
+        term = "static term" if h == 0 else f"{'cos' if self.basis.cos_index(h) == j else 'sin'} {h}"
+        return f"the {term} of {dof_names[d] if d < len(dof_names) else d}"
+
+    def scaling(self, a: float) -> np.ndarray:
+        """x = S u: 1 on the static rows, a on the dynamic ones."""
+        return np.where(self.static, 1.0, a)
+
+    def state(self, u: np.ndarray, a: float) -> np.ndarray:
+        return self.scaling(a) * u
+
+    def dynamic_excitation(self, omega: float):
+        f, df = self.system.excitation(omega)
+        f, df = np.array(f, dtype=float), np.array(df, dtype=float)
+        f[self.static] = 0.0
+        df[self.static] = 0.0
+        return f, df
+
+    def residual(self, y: np.ndarray, a: float, jacobian: bool = True):
+        """R (N + 2,) and dR/dy (N + 2, N + 2) for y = (u, omega, zeta)."""
+        N = self.N
+        u, omega, zeta = y[:N], float(y[N]), float(y[N + 1])
+        S = self.scaling(a)
+        x = S * u
+        R, J, Rw = self.system.residual(x, omega, jacobian)
+        f, df = self.dynamic_excitation(omega)
+        Ex = self.E @ x
+        R = R + f - 2 * zeta * omega ** 2 * Ex
+        phi_c, phi_s = u[self.i_cos], u[self.i_sin]
+        norm = phi_c @ self.M @ phi_c + phi_s @ self.M @ phi_s
+        out = np.concatenate([R, [u[self.phase_index], norm - 1.0]])
+        if not jacobian:
+            return out, None
+        J = J.toarray() if hasattr(J, "toarray") else np.asarray(J)
+        Jfull = np.zeros((N + 2, N + 2))
+        Jfull[:N, :N] = (J - 2 * zeta * omega ** 2 * self.E) * S[None, :]
+        Jfull[:N, N] = Rw + df - 4 * zeta * omega * Ex
+        Jfull[:N, N + 1] = -2 * omega ** 2 * Ex
+        Jfull[N, self.phase_index] = 1.0
+        Jfull[N + 1, self.i_cos] = 2 * self.M @ phi_c
+        Jfull[N + 1, self.i_sin] = 2 * self.M @ phi_s
+        return out, Jfull
+
+
+def _newton(problem: EPMCProblem, y0, a, y_scale, r_scale, tol=1e-10, max_iter=25):
+    """Newton on the EPMC residual with a backtracking line search on the scaled residual norm
+    (the AFT's friction forces are piecewise smooth: a full step can 2-cycle across a kink, a
+    stick-slip switch of a time sample; halving the step breaks the cycle). Converged when the
+    scaled residual is below ``tol`` and the scaled update below sqrt(tol); that update is applied.
+    Returns (y, converged, iterations)."""
+    N = problem.N
+
+    def scaled(y):
+        R, J = problem.residual(y, a)
+        if not (np.all(np.isfinite(R)) and np.all(np.isfinite(J))):
+            return None, None, np.inf
+        rs = R.copy()
+        rs[:N] /= r_scale
+        return rs, J, float(np.linalg.norm(rs))
+
+    y = np.array(y0, dtype=float)
+    rs, J, norm = scaled(y)
+    if rs is None:
+        return y, False, 0
+    for it in range(1, max_iter + 1):
+        Js = J * y_scale[None, :]
+        Js[:N] /= r_scale
+        try:
+            dz = -np.linalg.solve(Js, rs)
+        except np.linalg.LinAlgError:
+            return y, False, it
+        if not np.all(np.isfinite(dz)):
+            return y, False, it
+        problem.last_worst = int(np.argmax(np.abs(dz)))
+        if np.linalg.norm(rs, np.inf) < tol and np.linalg.norm(dz, np.inf) < np.sqrt(tol):
+            y = y + dz * y_scale
+            return y, bool(y[N] > 0), it
+        lam = 1.0
+        while True:
+            trial = y + lam * dz * y_scale
+            rs_t, J_t, norm_t = scaled(trial) if trial[N] > 0 else (None, None, np.inf)
+            if norm_t <= (1 - 1e-4 * lam) * norm or lam < 1 / 16:
+                break
+            lam /= 2
+        if rs_t is None:
+            return y, False, it
+        y, rs, J, norm = trial, rs_t, J_t, norm_t
+    return y, False, max_iter
+
+
+# ----- the linear stuck mode ----------------------------------------------------------------
+def _static_equilibrium(model, system, omega, tol=1e-12):
+    """The static state (no dynamic motion): the model's (``static_state``), refined by Newton
+    on the static harmonic when the basis has one (the damper seated under F_CG with the
+    harmonic balance's own contact law and retention spring)."""
+    x = np.array(model.static_state(system, omega), dtype=float) if hasattr(model, "static_state") \
+        else np.zeros(system.n_unknowns)
+    basis = system.basis
+    if not basis.has_static:
+        return x
+    n = system.n_dof
+    j0 = basis.cos_index(0)
+    rows = slice(j0 * n, (j0 + 1) * n)
+    x0 = x.copy()
+    for _ in range(50):
+        R, J, _ = system.residual(x, omega)
+        J = J.toarray() if hasattr(J, "toarray") else np.asarray(J)
+        r = R[rows]
+        try:
+            dx = -np.linalg.solve(J[rows, rows], r)
+        except np.linalg.LinAlgError:
+            return x0
+        x[rows] += dx
+        if np.linalg.norm(dx) <= tol * max(np.linalg.norm(x[rows]), 1e-300):
+            return x
+    return x0
+
+
+def linear_stuck_mode(model, system, mode: int = 0, omega_guess: float | None = None, max_iter: int = 30):
+    """The linear mode ``mode`` of the stuck (zero-amplitude) linearisation.
+
+    Returns (omega [rad/s], zeta, phi (n,) complex mass-normalised first-harmonic shape, x_static
+    (C*n,), number of modes). The stiffness is the first-harmonic block of dR/dx at the static
+    state without the inertia and viscous parts; a preload that depends on omega (F_CG(Omega_E))
+    is followed to the fixed point omega = omega_mode(omega). zeta = Re(phi^H D phi) / (2 omega)."""
+    basis = system.basis
+    n = system.n_dof
+    M = np.atleast_2d(np.asarray(system.mass.toarray() if hasattr(system.mass, "toarray") else system.mass, float))
+    D = np.atleast_2d(np.asarray(system.damping.toarray() if hasattr(system.damping, "toarray") else system.damping, float))
+    K = np.atleast_2d(np.asarray(system.stiffness.toarray() if hasattr(system.stiffness, "toarray") else system.stiffness, float))
+    j1 = basis.cos_index(1)
+    ca, cb = slice(j1 * n, (j1 + 1) * n), slice((j1 + 1) * n, (j1 + 2) * n)
+    if omega_guess is None:
+        w2 = scipy.linalg.eigvals(K, M)
+        w2 = np.sort(np.real(w2[np.isfinite(w2) & (np.real(w2) > 0)]))
+        omega_guess = float(np.sqrt(w2[min(mode, len(w2) - 1)])) if len(w2) else 1.0
+    omega = omega_guess
+    for _ in range(max_iter):
+        xs = _static_equilibrium(model, system, omega)
+        _, J, _ = system.residual(xs, omega)
+        J = J.toarray() if hasattr(J, "toarray") else np.asarray(J)
+        A, _ = system._dynamic_stiffness(omega)
+        A = A.toarray() if hasattr(A, "toarray") else np.asarray(A)
+        Jnl = J - A
+        K1 = K + Jnl[ca, ca] + 1j * Jnl[ca, cb]
+        K1 = 0.5 * (K1 + K1.conj().T)              # Hermitian to rounding (stuck contacts: symmetric)
+        lam, vec = scipy.linalg.eig(K1, M)
+        ok = np.isfinite(lam) & (np.real(lam) > 0)
+        lam, vec = lam[ok], vec[:, ok]
+        order = np.argsort(np.real(lam))
+        if mode >= len(order):
+            raise ValueError(f"mode must be an integer in [0, {len(order) - 1}] (the stuck system's "
+                             f"modes of positive frequency; got {mode})")
+        k = order[mode]
+        new = float(np.sqrt(np.real(lam[k])))
+        phi = vec[:, k]
+        converged = abs(new - omega) <= 1e-13 * new
+        omega = new
+        if converged:
+            break
+    w_all = np.sqrt(np.real(lam[order]))
+    gap = np.min(np.abs(np.delete(w_all, mode) - omega)) / omega if len(w_all) > 1 else np.inf
+    if gap < 1e-6:
+        raise ValueError(f"mode {mode} ({omega / (2 * np.pi):.6g} Hz) is a repeated mode of the stuck system "
+                         f"(another within {gap:.1e} relative): one phase condition does not fix its shape; "
+                         "for a tuned assembly use the TunedDisk (cyclic symmetry: one nodal diameter, "
+                         "the engine order) or mistune it")
+    phi = phi / np.sqrt(np.real(phi.conj() @ M @ phi))
+    zeta = float(np.real(phi.conj() @ D @ phi)) / (2 * omega)
+    return omega, zeta, phi, xs, len(order)
+
+
+# ----- the result -------------------------------------------------------------------------
+@dataclass
+class NonlinearModeResponse(Saveable):
+    """A damped nonlinear mode (EPMC) over modal amplitude.
+
+    Attributes (n amplitudes, C coefficients, n_dof degrees of freedom)
+    ----------
+    modal_amplitude : (n,) modal amplitude a [sqrt(kg) m for a mass-normalised shape]
+    frequency_hz : (n,) natural frequency omega(a) / 2 pi [Hz]
+    damping_ratio : (n,) modal damping ratio zeta(a) [-]
+    coefficients : (n, C, n_dof) mode shape harmonics phi(a) (x = x_0 + a phi; the static
+        harmonic's row holds x_0 itself, not scaled by a) [SI per modal amplitude]
+    basis : HarmonicBasis
+    dof_names : names of the degrees of freedom
+    success : whether every requested amplitude converged
+    message : why it stopped
+    iterations : (n,) Newton iterations per point
+    dissipated_energy : (n,) energy dissipated per cycle (viscous + contacts) [J]
+    output_amplitude : (n, k) the model's first-harmonic output amplitudes at each point
+        (``model.output_amplitudes``: the oscillator's |x|, the disk's tip u_x, u_y, u_z) [m]
+    excitation : (n_dof,) complex first-harmonic excitation of the model at the first point's
+        frequency (X = a_1 - i b_1), the default force of :meth:`forced_peak` [N]
+    linear_frequency_hz, linear_damping_ratio : the stuck linear mode's (the start) [Hz], [-]
+    reference_dof : the DOF whose first-harmonic sine coefficient is zero (phase)
+    mode : the mode number (0: the first of the stuck system)
+    gaps : [(a_lo, a_hi), ...] amplitude intervals the continuation jumped over: Newton did not
+        converge at any point close to a non-smooth point there (both ends are solutions)
+    """
+
+    modal_amplitude: np.ndarray
+    frequency_hz: np.ndarray
+    damping_ratio: np.ndarray
+    coefficients: np.ndarray
+    basis: HarmonicBasis
+    dof_names: tuple = ()
+    success: bool = True
+    message: str = ""
+    iterations: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    dissipated_energy: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    output_amplitude: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    excitation: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=complex))
+    linear_frequency_hz: float = float("nan")
+    linear_damping_ratio: float = float("nan")
+    reference_dof: int = 0
+    mode: int = 0
+    gaps: list = field(default_factory=list)
+
+    @property
+    def omega(self) -> np.ndarray:
+        """Natural angular frequency omega(a) [rad/s]."""
+        return 2 * np.pi * np.asarray(self.frequency_hz)
+
+    def shape(self, harmonic: int = 1) -> np.ndarray:
+        """(n, n_dof) complex harmonic ``harmonic`` of phi (X = a_h - i b_h)."""
+        j = self.basis.cos_index(harmonic)
+        c = np.asarray(self.coefficients)
+        return c[:, j] + 0j if harmonic == 0 else c[:, j] - 1j * c[:, j + 1]
+
+    def forced_peak(self, force=None, scale: float = 1.0) -> dict:
+        """Resonance of the forced response by single-nonlinear-mode synthesis.
+
+        ``force``: (n_dof,) first-harmonic force amplitude (real: a cosine load; complex X = a - i b),
+        default the model's own ``excitation``; ``scale`` multiplies it (excitation levels).
+        The peak amplitude solves 2 zeta(a) omega(a)^2 sqrt(1 - zeta^2) a = |phi_1(a)^H F|
+        (the largest a on the computed range; a, omega, zeta and phi interpolated monotonically in
+        log a), at the excitation frequency Omega = omega sqrt(1 - 2 zeta^2).
+
+        Returns {"modal_amplitude", "frequency_hz", "output_amplitude" (k,) [m],
+        "damping_ratio", "found" (bool), "message"}; nan values when the peak is beyond the
+        computed range (the message says which end)."""
+        from scipy.interpolate import PchipInterpolator
+        from scipy.optimize import brentq
+
+        F = self.excitation if force is None else np.asarray(force)
+        F = np.asarray(F, dtype=complex).ravel() * float(_validate.finite("scale", scale))
+        n_dof = self.coefficients.shape[2]
+        if F.shape != (n_dof,):
+            raise ValueError(f"force must have shape ({n_dof},) (one first-harmonic amplitude per DOF; got {F.shape})")
+        a = np.asarray(self.modal_amplitude, dtype=float)
+        nan = {"modal_amplitude": np.nan, "frequency_hz": np.nan, "damping_ratio": np.nan,
+               "output_amplitude": np.full(np.shape(self.output_amplitude)[1:], np.nan), "found": False}
+        if a.size < 2:
+            return {**nan, "message": "need at least two amplitudes"}
+        phi1 = self.shape(1)
+        modal_force = np.abs(phi1.conj() @ F)           # |phi_1^H F| at every point
+        w, z = self.omega, np.asarray(self.damping_ratio)
+        h = 2 * z * w ** 2 * np.sqrt(np.clip(1 - z ** 2, 0, None)) * a - modal_force
+        la = np.log(a)
+        if h[0] > 0:
+            return {**nan, "message": f"the peak lies below the smallest amplitude {a[0]:.4g}"}
+        above = np.flatnonzero(h > 0)
+        if not above.size or above[-1] < np.flatnonzero(h <= 0)[-1]:
+            return {**nan, "message": f"the peak lies above the largest amplitude {a[-1]:.4g}"}
+        last_below = np.flatnonzero(h <= 0)[-1]
+        i = last_below
+        fz, fw = PchipInterpolator(la, z), PchipInterpolator(la, w)
+        fphi_r, fphi_i = PchipInterpolator(la, phi1.real, axis=0), PchipInterpolator(la, phi1.imag, axis=0)
+
+        def hfun(s):
+            zz, ww = float(fz(s)), float(fw(s))
+            p = fphi_r(s) + 1j * fphi_i(s)
+            return 2 * zz * ww ** 2 * np.sqrt(max(1 - zz ** 2, 0.0)) * np.exp(s) - abs(p.conj() @ F)
+
+        s = brentq(hfun, la[i], la[i + 1], xtol=1e-13, rtol=1e-13)
+        ap, zp, wp = float(np.exp(s)), float(fz(s)), float(fw(s))
+        out = np.asarray(self.output_amplitude, dtype=float)
+        if out.size:
+            out_amp = np.array([np.exp(PchipInterpolator(la, np.log(np.maximum(out[:, k] / a, 1e-300)))(s))
+                                for k in range(out.shape[1])]) * ap
+        else:
+            out_amp = np.zeros(0)
+        return {"modal_amplitude": ap, "frequency_hz": wp * np.sqrt(max(1 - 2 * zp ** 2, 0.0)) / (2 * np.pi),
+                "damping_ratio": zp, "output_amplitude": out_amp, "found": True, "message": "peak found"}
+
+    def plot(self, ax=None, *, label: str | None = None, **kwargs):
+        """Frequency [Hz] (top) and damping ratio [%] (bottom) over the modal amplitude (log x).
+        ``ax``: a pair of axes (a new figure if None); returns the pair."""
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            _, ax = plt.subplots(2, 1, sharex=True, figsize=(6, 5))
+        ax_f, ax_z = ax
+        label = label or f"mode {self.mode}, H={self.basis.harmonics}"
+        ax_f.semilogx(self.modal_amplitude, self.frequency_hz, label=label, **kwargs)
+        ax_z.semilogx(self.modal_amplitude, 100 * np.asarray(self.damping_ratio), label=label, **kwargs)
+        ax_f.set_ylabel("natural frequency [Hz]")
+        ax_z.set_ylabel("damping ratio [%]")
+        ax_z.set_xlabel("modal amplitude a")
+        for a_ in (ax_f, ax_z):
+            a_.grid(True, which="both", alpha=0.3)
+        ax_f.legend()
+        if not self.success:
+            ax_f.set_title(f"incomplete: {self.message}", fontsize=8)
+        return ax
+
+
+# ----- the driver --------------------------------------------------------------------------
+def _local_force_norm(system, x, omega) -> float:
+    """Norm of every element's local forces at ``x`` (e.g. the contacts' normal preload): the
+    level of the rounding in the residual's element forces."""
+    C = system.basis.n_coeffs
+    total = 0.0
+    for c in system.couplings:
+        local = (c.matrix @ x).reshape(C, c.element.n_local)
+        force, _, _ = c.element.harmonic_forces(local, system.basis, omega, False)
+        total += float(np.linalg.norm(force))
+    return total
+
+
+def _default_amplitudes(problem: EPMCProblem, x_static, phi_u, omega, n_points=60):
+    """Modal amplitudes from fully stuck to gross slip: along the stuck linear mode, the
+    nonlinear forces' relative deviation from their stuck linearisation g(a) is scanned on a log
+    grid (1e-12..1e6, 4 per decade); onset: the first a with g > 1e-6 where the rounding of the
+    element forces (1e2 eps times their norm, e.g. the normal preload) is below 1e-9 of the
+    linear force, gross slip: the first a with g within 0.5 % of its value at 1e6. Returns ``n_points`` log-spaced from
+    onset / 10 to 10 x gross slip."""
+    system = problem.system
+    _, J, _ = system.residual(x_static, omega)
+    A, _ = system._dynamic_stiffness(omega)
+    J = J.toarray() if hasattr(J, "toarray") else np.asarray(J)
+    A = A.toarray() if hasattr(A, "toarray") else np.asarray(A)
+    Jnl = J - A
+    f = system.excitation(omega)[0]
+
+    def nonlinear_force(x):
+        R, _, _ = system.residual(x, omega, False)
+        return R - A @ x + f
+
+    f0 = nonlinear_force(x_static)
+    dyn = np.where(problem.static, 0.0, phi_u)
+    lin = Jnl @ dyn
+    if np.linalg.norm(lin) == 0:
+        raise ValueError("the mode has no amplitude-dependent element to follow (no contact or nonlinear "
+                         "force along it); pass amplitudes explicitly")
+    grid = np.logspace(-12, 6, 73)
+    g = np.array([np.linalg.norm(nonlinear_force(x_static + a * dyn) - f0 - a * lin) / (a * np.linalg.norm(lin))
+                  for a in grid])
+    noise = 1e2 * np.finfo(float).eps * (_local_force_norm(system, x_static, omega) + np.linalg.norm(f0)) \
+        / (grid * np.linalg.norm(lin))
+    onset = np.flatnonzero((g > 1e-6) & (noise < 1e-9))
+    if not onset.size:
+        raise ValueError("the nonlinear forces stay linear along the mode for modal amplitudes 1e-12..1e6; "
+                         "pass amplitudes explicitly")
+    a_on = grid[onset[0]]
+    # gross slip: g within 0.5 % of its large-amplitude limit (1 for a contact whose every force
+    # saturates; below 1 when the normal springs stay linear along the mode, e.g. the wedge: 0.51)
+    gross = np.flatnonzero((np.abs(g - g[-1]) <= 5e-3 * g[-1]) & (grid > a_on))
+    a_gross = grid[gross[0]] if gross.size else grid[-1]
+    return np.logspace(np.log10(a_on) - 1, np.log10(max(a_gross, 10 * a_on)) + 1, n_points)
+
+
+def nonlinear_mode(model, mode: int = 0, amplitudes=None, harmonics=(1,), n_samples=None,
+                   reference_dof: int | None = None, tol: float = 1e-10, max_log_step: float = 0.25,
+                   n_points: int = 60) -> NonlinearModeResponse:
+    """Damped nonlinear mode ``mode`` of ``model`` by EPMC (see the module docstring).
+
+    Parameters
+    ----------
+    model : anything with ``hbm_system(harmonics, n_samples)``; validated for the
+        FrictionOscillator and the TunedDisk (one sector by cyclic symmetry, the engine order as
+        nodal diameter, both damper types). A MistunedDisk runs through the same code but is not
+        validated (dense Jacobian of the whole assembly: slow; a tuned assembly's double modes
+        are refused)
+    mode : mode number of the stuck linear system (0: the lowest frequency)
+    amplitudes : modal amplitudes a (> 0; computed in ascending order); default ``n_points``
+        log-spaced from fully stuck to gross slip, derived from the model along its stuck mode
+    harmonics : harmonic set, must contain 1 (the normalisation's harmonic); 0 adds the static term
+    reference_dof : DOF of the phase condition (default: the largest mass-weighted amplitude of
+        the stuck mode)
+    tol : Newton tolerance (scaled residual; scaled update sqrt(tol))
+    max_log_step : largest continuation step in log10(a) [decades], (0, 2]
+
+    Continuation starts at the stuck linear mode at min(amplitudes[0], onset / 10) and steps in
+    log(a) (secant predictor, step halving down to 1e-3 decades on failure, then a jump of up to
+    0.3 decades over a non-smooth point, recorded in ``gaps``). A failure stops it: the result
+    holds the converged amplitudes, ``success`` False, and the message says where and which
+    unknown did not settle.
+    """
+    if not hasattr(model, "hbm_system"):
+        raise TypeError(f"model must provide hbm_system(harmonics, n_samples) (got {type(model).__qualname__})")
+    mode = _validate.integer("mode", mode, minimum=0)
+    try:
+        harmonics = tuple(int(h) for h in (harmonics if np.ndim(harmonics) else (harmonics,)))
+    except (TypeError, ValueError):
+        raise ValueError(f"harmonics must be a tuple of integers >= 0 containing 1 (got {harmonics!r})") from None
+    if 1 not in harmonics:
+        raise ValueError(f"harmonics must contain 1, the harmonic of the amplitude and phase normalisation "
+                         f"(got {harmonics!r})")
+    _validate.in_range("tol", tol, 0.0, 1e-3, closed="right")
+    _validate.in_range("max_log_step (decades)", max_log_step, 0.0, 2.0, closed="right")
+    n_points = _validate.integer("n_points", n_points, minimum=2)
+    if amplitudes is not None:
+        amps = np.atleast_1d(np.asarray(amplitudes, dtype=float))
+        if amps.ndim != 1 or amps.size == 0:
+            raise ValueError(f"amplitudes must be a non-empty 1-D array of modal amplitudes in (0, inf) (got shape {amps.shape})")
+        _validate.positive("amplitudes (modal amplitudes)", amps)
+        amps = np.unique(amps)
+
+    system = model.hbm_system(harmonics, n_samples)
+    basis = system.basis
+    C, n = basis.n_coeffs, system.n_dof
+    omega_lin, zeta_lin, phi, x_static, n_modes = linear_stuck_mode(model, system, mode)
+    M = np.atleast_2d(np.asarray(system.mass.toarray() if hasattr(system.mass, "toarray") else system.mass, float))
+    if reference_dof is None:
+        weight = np.abs(phi) * np.sqrt(np.clip(np.diag(M), 0, None))
+        reference_dof = int(np.argmax(weight))
+    reference_dof = _validate.integer("reference_dof", reference_dof, minimum=0, maximum=n - 1)
+    if abs(phi[reference_dof]) < 1e-12 * np.abs(phi).max():
+        raise ValueError(f"reference_dof {reference_dof} does not move in mode {mode}; choose a DOF in [0, {n - 1}] "
+                         "that does (default: the largest)")
+    phi = phi * np.exp(-1j * np.angle(phi[reference_dof]))
+    problem = EPMCProblem(system, reference_dof)
+    j1 = basis.cos_index(1)
+    u0 = np.array(x_static, dtype=float)
+    U = u0.reshape(C, n)
+    U[j1] = phi.real
+    U[j1 + 1] = -phi.imag
+    u0[problem.phase_index] = 0.0
+
+    if amplitudes is None:
+        amps = _default_amplitudes(problem, x_static, u0, omega_lin, n_points)
+
+    # scales of the unknowns: per DOF, the stuck shape (floored), the static state, omega, zeta
+    dof_scale = np.abs(phi)
+    dof_scale = np.maximum(dof_scale, 1e-6 * dof_scale.max())
+    y_scale_base = np.tile(dof_scale, C)
+    static_scale = np.abs(x_static)
+    zeta_scale = max(abs(zeta_lin), 1e-3)
+    r_base = omega_lin ** 2 * np.linalg.norm(np.tile(M @ dof_scale, C))
+    f_static = system.excitation(omega_lin)[0][problem.static]
+    # residual scale: the linear forces of the mode, the static load, and a floor of 1e-4 of the
+    # element forces (the contacts' preload: their rounding would stall Newton at tiny amplitudes)
+    f_static_norm = (np.linalg.norm(f_static) if f_static.size else 0.0) \
+        + 1e-4 * _local_force_norm(system, x_static, omega_lin)
+
+    def scales(a):
+        ys = y_scale_base.copy()
+        if problem.static.any():
+            ys[problem.static] = np.maximum(static_scale[problem.static],
+                                            1e-3 * max(static_scale.max(), a * dof_scale.max()) + 1e-300)
+        return np.concatenate([ys, [omega_lin, zeta_scale]]), a * r_base + f_static_norm
+
+    y_prev = np.concatenate([u0, [omega_lin, zeta_lin]])
+    la_prev = None
+    y_prev2, la_prev2 = None, None
+    # internal start in the stuck limit
+    if amplitudes is None:
+        a_start = amps[0]
+    else:
+        try:
+            a_start = min(amps[0], _default_amplitudes(problem, x_static, u0, omega_lin, 2)[0])
+        except ValueError:        # nothing nonlinear along the mode: start where asked
+            a_start = amps[0]
+    y, ok, it = _newton(problem, y_prev, a_start, *scales(a_start), tol=tol)
+    if not ok:
+        return _result(model, system, problem, [], [], [], False,
+                       f"no EPMC solution at the start amplitude {a_start:.4g} from the stuck linear mode "
+                       f"({omega_lin / (2 * np.pi):.6g} Hz)", omega_lin, zeta_lin, mode)
+    y_prev, la_prev, it_prev = y, np.log10(a_start), it
+
+    keep_a, keep_y, keep_it = [], [], []
+    message = f"all {amps.size} amplitudes converged"
+    success = True
+    gaps = []
+    step = max_log_step
+    for target in amps:
+        lt = np.log10(target)
+        while True:
+            if la_prev >= lt - 1e-14:
+                if abs(la_prev - lt) <= 1e-14:
+                    y_t, it_t = y_prev, it_prev
+                    break
+            s = min(step, lt - la_prev)
+            la_new = la_prev + s
+            if abs(la_new - lt) < 1e-12:
+                la_new = lt
+            if y_prev2 is not None and la_prev != la_prev2:
+                guess = y_prev + (y_prev - y_prev2) * (la_new - la_prev) / (la_prev - la_prev2)
+            else:
+                guess = y_prev
+            a_new = 10.0 ** la_new
+            y, ok, it = _newton(problem, guess, a_new, *scales(a_new), tol=tol)
+            if not ok and y_prev2 is not None:
+                y, ok, it = _newton(problem, y_prev, a_new, *scales(a_new), tol=tol)
+            if ok:
+                y_prev2, la_prev2 = y_prev, la_prev
+                y_prev, la_prev, it_prev = y, la_new, it
+                step = min(max_log_step, 1.5 * step)
+                if la_new == lt:
+                    y_t, it_t = y, it
+                    break
+            else:
+                step /= 2
+                if step < 1e-3:
+                    # a non-smooth point (a time sample switching stick / slip, the static damper
+                    # position jumping): Newton 2-cycles at any step onto it; jump over it
+                    jumped = False
+                    for jump in (0.01, 0.03, 0.1, 0.3):
+                        la_j = min(la_prev + jump, lt)
+                        a_j = 10.0 ** la_j
+                        for start in (guess, y_prev):
+                            y, ok, it = _newton(problem, start, a_j, *scales(a_j), tol=tol)
+                            if ok:
+                                break
+                        if ok:
+                            gaps.append((float(10.0 ** la_prev), float(a_j)))
+                            y_prev2, la_prev2 = None, None
+                            y_prev, la_prev, it_prev = y, la_j, it
+                            step = min(max_log_step, 0.05)
+                            jumped = True
+                            break
+                        if la_j == lt:
+                            break
+                    if jumped:
+                        if la_prev == lt:
+                            y_t, it_t = y_prev, it_prev
+                            break
+                        continue
+                    success = False
+                    names = tuple(getattr(model, "dof_names", ()))
+                    worst = problem.describe(problem.last_worst, names) if problem.last_worst >= 0 else "?"
+                    message = (f"Newton failed at modal amplitude {a_new:.6g} (step below 1e-3 decades, "
+                               f"no jump of up to 0.3 decades converged; largest last update: {worst}"
+                               + ("; the mean damper rotation is held only by the weak static retention "
+                                  "spring of TunedDisk.hbm_system once the contacts slip, and does not settle"
+                                  if "static" in worst and "phi" in worst else "")
+                               + f"); {len(keep_a)} of {amps.size} amplitudes converged")
+                    break
+        if not success:
+            break
+        keep_a.append(target)
+        keep_y.append(y_t)
+        keep_it.append(it_t)
+    if gaps:
+        message += ("; passed " + ", ".join(f"{lo:.5g}..{hi:.5g}" for lo, hi in gaps)
+                    + " by a jump (non-smooth point: Newton 2-cycles onto it)")
+    result = _result(model, system, problem, keep_a, keep_y, keep_it, success, message,
+                     omega_lin, zeta_lin, mode)
+    result.gaps = gaps
+    return result
+
+
+def _result(model, system, problem, amps, ys, its, success, message, omega_lin, zeta_lin, mode):
+    basis = system.basis
+    C, n, N = basis.n_coeffs, system.n_dof, problem.N
+    amps = np.asarray(amps, dtype=float)
+    ys = np.asarray(ys, dtype=float).reshape(len(amps), N + 2)
+    coeffs = ys[:, :N].reshape(-1, C, n)
+    omega = ys[:, N]
+    zeta = ys[:, N + 1]
+    energy = np.zeros(len(amps))
+    outputs = []
+    for i, (a, y) in enumerate(zip(amps, ys)):
+        x = problem.state(y[:N], a)
+        energy[i] = system.viscous_dissipation(x, omega[i]) + sum(system.element_dissipation(x, omega[i]))
+        if hasattr(model, "output_amplitudes"):
+            outputs.append(np.asarray(model.output_amplitudes(x.reshape(1, C, n), basis))[0])
+    outputs = np.array(outputs) if outputs else np.zeros((len(amps), 0))
+    w_ex = omega[0] if len(omega) else omega_lin
+    f = np.asarray(system.excitation(w_ex)[0], dtype=float).reshape(C, n)
+    j1 = basis.cos_index(1)
+    excitation = f[j1] - 1j * f[j1 + 1]
+    names = tuple(getattr(model, "dof_names", ())) or tuple(f"x{d}" for d in range(n))
+    if len(names) != n:
+        names = tuple(f"x{d}" for d in range(n))
+    return NonlinearModeResponse(amps, omega / (2 * np.pi), zeta, coeffs, basis, names, bool(success), message,
+                                 np.asarray(its, dtype=int), energy, outputs, excitation,
+                                 omega_lin / (2 * np.pi), zeta_lin, int(problem.reference_dof), int(mode))

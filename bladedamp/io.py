@@ -1,0 +1,247 @@
+"""Save and load every result object: one ``.npz`` file, no pickle.
+
+Every response and study result (:class:`~bladedamp.response.FrequencyResponse`,
+:class:`~bladedamp.disk.DiskResponse`, :class:`~bladedamp.mistuned.MistunedResponse`, the
+time-domain responses, the study results of :mod:`bladedamp.studies`) has ``.save(path)``
+(from :class:`Saveable`), and :func:`load` reads any of them back::
+
+    frf.save("results/frf")                 # writes results/frf.npz
+    frf = bladedamp.load("results/frf.npz")
+
+File layout (readable with ``np.load(path, allow_pickle=False)`` and any npz reader):
+
+* each array field of the dataclass is one npz entry under its field name (an object array of
+  strings as a unicode array, turned back into an object array on loading); a nested result
+  (e.g. the ``response`` of a :class:`~bladedamp.studies.mistuning.MistuningCase`) has its
+  arrays under ``<field>/<name>``, a list of arrays under ``<field>/<index>``;
+* the entry ``__bladedamp__`` is a 0-d unicode array holding JSON: the format version, the
+  class (``module:qualname``, on which :func:`load` dispatches), every scalar, string, tuple,
+  list and dict field (dicts as key-value pairs, so integer keys stay integers; complex
+  numbers as [re, im]; NaN as JSON's NaN), and the
+  :class:`~bladedamp.hbm.fourier.HarmonicBasis` by its harmonics and n_samples.
+
+The model is not saved: a ``disk`` (TunedDisk or MistunedDisk) or ``system`` field is
+stored as absent, and a loaded result has ``disk=None`` (``system=None``). Rebuilding a disk
+would need its blade, damper and contact objects written out as well, which is what the design
+file does; so the file keeps a short description of the model (class, damper kind and mass,
+engine order, blades) under ``models`` -> ``disk`` in the JSON for the reader, and every named property and
+``.plot()`` of a loaded result works without the model (3D views need it: compute again).
+"""
+from __future__ import annotations
+
+import dataclasses
+import importlib
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+FORMAT_VERSION = 1
+META_KEY = "__bladedamp__"
+#: fields that hold a model, not data: stored as absent, loaded as None (see the module docstring)
+MODEL_FIELDS = ("disk", "system")
+
+
+class Saveable:
+    """Mixin of every result dataclass: ``.save(path)`` and ``Class.load(path)``."""
+
+    def save(self, path) -> Path:
+        """Write this result to ``path`` (``.npz`` appended if missing); returns the file's path.
+        Loadable with :func:`bladedamp.load` and ``np.load(path, allow_pickle=False)``."""
+        return save(self, path)
+
+    @classmethod
+    def load(cls, path):
+        """Read a result saved by :meth:`save`; raises TypeError if the file holds another class."""
+        result = load(path)
+        if not isinstance(result, cls):
+            raise TypeError(f"{path} holds a {type(result).__qualname__}, not a {cls.__qualname__}")
+        return result
+
+
+def npz_path(path) -> Path:
+    """``path`` with the suffix ``.npz`` (added when it has another or none, ``.json`` replaced)."""
+    path = Path(path)
+    if path.suffix == ".npz":
+        return path
+    if path.suffix == ".json":
+        return path.with_suffix(".npz")
+    return path.with_name(path.name + ".npz")
+
+
+# ----- JSON values ----------------------------------------------------------------------
+def _encode(value, where: str):
+    """A JSON-able form of a scalar / string / container value (see :func:`_decode`)."""
+    from .hbm.fourier import HarmonicBasis
+
+    if value is None or isinstance(value, (bool, str)):
+        return value
+    if isinstance(value, np.bool_):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return float(value)
+    if isinstance(value, (complex, np.complexfloating)):
+        return {"__complex__": [float(value.real), float(value.imag)]}
+    if isinstance(value, HarmonicBasis):
+        return {"__basis__": {"harmonics": [int(h) for h in value.harmonics], "n_samples": int(value.n_samples)}}
+    if isinstance(value, np.ndarray):
+        if value.dtype.kind == "c":
+            return {"__array__": np.stack([value.real, value.imag], axis=-1).tolist(), "dtype": str(value.dtype)}
+        if value.dtype.kind == "O":
+            value = np.asarray(value.tolist())
+        return {"__array__": value.tolist(), "dtype": str(value.dtype)}
+    if isinstance(value, tuple):
+        return {"__tuple__": [_encode(v, f"{where}[{i}]") for i, v in enumerate(value)]}
+    if isinstance(value, list):
+        return [_encode(v, f"{where}[{i}]") for i, v in enumerate(value)]
+    if isinstance(value, dict):
+        return {"__dict__": [[_encode(k, where), _encode(v, f"{where}[{k!r}]")] for k, v in value.items()]}
+    raise TypeError(f"cannot save {where}: a {type(value).__module__}.{type(value).__qualname__} "
+                    "(results hold arrays, numbers, strings, tuples, lists, dicts and results)")
+
+
+def _decode(value):
+    from .hbm.fourier import HarmonicBasis
+
+    if isinstance(value, list):
+        return [_decode(v) for v in value]
+    if not isinstance(value, dict):
+        return value
+    if "__complex__" in value:
+        re, im = value["__complex__"]
+        return complex(re, im)
+    if "__basis__" in value:
+        b = value["__basis__"]
+        return HarmonicBasis(tuple(b["harmonics"]), b["n_samples"])
+    if "__array__" in value:
+        dtype = np.dtype(value["dtype"])
+        if dtype.kind == "c":
+            a = np.asarray(value["__array__"], dtype=float)
+            return (a[..., 0] + 1j * a[..., 1]).astype(dtype)
+        return np.asarray(value["__array__"], dtype=dtype)
+    if "__tuple__" in value:
+        return tuple(_decode(v) for v in value["__tuple__"])
+    if "__dict__" in value:
+        return {_hashable(_decode(k)): _decode(v) for k, v in value["__dict__"]}
+    raise ValueError(f"unknown JSON value {value!r} in a saved result")
+
+
+def _hashable(key):
+    return tuple(key) if isinstance(key, list) else key
+
+
+# ----- dataclasses to entries -------------------------------------------------------------
+def _model_summary(model) -> dict:
+    """A short description of a model for the reader of a file (not enough to rebuild it)."""
+    out = {"class": f"{type(model).__module__}:{type(model).__qualname__}"}
+    damper = getattr(model, "damper", None)
+    if damper is not None and not isinstance(damper, (list, tuple)):
+        out.update(damper=getattr(damper, "kind", None), damper_mass_kg=float(getattr(damper, "mass", math.nan)))
+    for name in ("engine_order", "n_blades", "n_sector"):
+        value = getattr(model, name, None)
+        if isinstance(value, (int, float, np.integer, np.floating)):
+            out[name] = value.item() if isinstance(value, np.generic) else value
+    return out
+
+
+def _flatten(result, prefix: str, arrays: dict) -> dict:
+    """The JSON description of ``result`` (a dataclass); its arrays go into ``arrays``."""
+    if not dataclasses.is_dataclass(result) or isinstance(result, type):
+        raise TypeError(f"save takes a result dataclass (got {type(result).__qualname__})")
+    cls = type(result)
+    meta = {"class": f"{cls.__module__}:{cls.__qualname__}", "fields": {}, "arrays": [], "object_arrays": [],
+            "array_lists": {}, "results": {}, "absent": [], "models": {}}
+    for f in dataclasses.fields(result):
+        value = getattr(result, f.name)
+        key = f"{prefix}{f.name}"
+        where = f"{cls.__qualname__}.{f.name}"
+        if f.name in MODEL_FIELDS and value is not None and not isinstance(value, (np.ndarray, str, int, float)):
+            meta["absent"].append(f.name)
+            if f.name == "disk":
+                meta["models"][f.name] = _model_summary(value)
+        elif isinstance(value, np.ndarray):
+            if value.dtype.kind == "O":                  # e.g. per-point status strings: stored as unicode
+                meta["object_arrays"].append(f.name)
+                value = np.asarray(value.tolist())
+                if value.dtype.kind not in "UbifcS":
+                    raise TypeError(f"cannot save {where}: an object array of {value.dtype} values")
+            arrays[key] = value
+            meta["arrays"].append(f.name)
+        elif isinstance(value, list) and value and all(isinstance(v, np.ndarray) for v in value):
+            for i, v in enumerate(value):
+                arrays[f"{key}/{i}"] = v
+            meta["array_lists"][f.name] = len(value)
+        elif dataclasses.is_dataclass(value) and not isinstance(value, type):
+            meta["results"][f.name] = _flatten(value, f"{key}/", arrays)
+        else:
+            meta["fields"][f.name] = _encode(value, where)
+    return meta
+
+
+def _rebuild(meta: dict, prefix: str, arrays):
+    cls = _resolve(meta["class"])
+    kwargs = {name: _decode(v) for name, v in meta["fields"].items()}
+    for name in meta["arrays"]:
+        kwargs[name] = np.asarray(arrays[f"{prefix}{name}"])
+        if name in meta.get("object_arrays", ()):
+            kwargs[name] = kwargs[name].astype(object)
+    for name, n in meta["array_lists"].items():
+        kwargs[name] = [np.asarray(arrays[f"{prefix}{name}/{i}"]) for i in range(n)]
+    for name, sub in meta["results"].items():
+        kwargs[name] = _rebuild(sub, f"{prefix}{name}/", arrays)
+    for name in meta["absent"]:
+        kwargs[name] = None
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    init = {k: v for k, v in kwargs.items() if k in fields and fields[k].init}
+    obj = cls(**init)
+    for k, v in kwargs.items():
+        if k in fields and not fields[k].init:
+            object.__setattr__(obj, k, v)
+    return obj
+
+
+def _resolve(name: str):
+    module, _, qualname = name.partition(":")
+    if not (module == "bladedamp" or module.startswith("bladedamp.")):
+        raise ValueError(f"a saved result's class must come from bladedamp (got {name!r})")
+    obj = importlib.import_module(module)
+    for part in qualname.split("."):
+        obj = getattr(obj, part)
+    if not (isinstance(obj, type) and dataclasses.is_dataclass(obj)):
+        raise ValueError(f"{name!r} is not a result class")
+    return obj
+
+
+# ----- the public functions ---------------------------------------------------------------
+def save(result, path) -> Path:
+    """Write ``result`` (any response or study result) to ``path`` (``.npz`` appended if
+    missing; the folder is created); returns the file's path. See the module docstring for
+    the layout; the model (``disk``) is not saved."""
+    path = npz_path(path)
+    arrays: dict[str, np.ndarray] = {}
+    meta = _flatten(result, "", arrays)
+    meta = {"format": FORMAT_VERSION, "library": "bladedamp", **meta}
+    text = json.dumps(meta, allow_nan=True)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    np.savez(path, **arrays, **{META_KEY: np.array(text)})
+    return path
+
+
+def load(path):
+    """Read a result written by ``.save(path)`` / :func:`save` (``.npz``; ``path`` without the
+    suffix works too); returns an object of the class stored in the file, with ``disk=None``.
+    Raises FileNotFoundError naming the file, ValueError for a file that is not a saved result."""
+    path = npz_path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"no saved result at {path}")
+    with np.load(path, allow_pickle=False) as z:
+        if META_KEY not in z.files:
+            raise ValueError(f"{path} is not a saved bladedamp result (no {META_KEY} entry)")
+        meta = json.loads(str(z[META_KEY][()]))
+        if meta.get("format", 0) > FORMAT_VERSION:
+            raise ValueError(f"{path} has format {meta.get('format')}; this bladedamp reads up to {FORMAT_VERSION}")
+        arrays = {k: z[k] for k in z.files if k != META_KEY}
+    return _rebuild(meta, "", arrays)

@@ -1,0 +1,136 @@
+"""One API (issue 13, item 2): Hz at every public frequency argument, the oscillator included;
+``bladedamp.frequency_response`` for every model; one set of result names; one ``plot``
+signature; implausible masses and lengths warned about."""
+import dataclasses
+import inspect
+import warnings
+
+import numpy as np
+import pytest
+
+import bladedamp as bd
+from bladedamp._validate import PlausibilityWarning
+from bladedamp.mistuned import MistunedDisk, MistunedResponse
+from bladedamp.studies import design as sd
+from bladedamp.studies import mass as sm
+from bladedamp.studies import mistuning as mt
+from bladedamp.timedomain import DiskTimeResponse, TimeResponse
+
+F0 = 95.0                       # Hz: the reference disk's damped 1F resonance (95.3 Hz) and the oscillator's
+
+
+def stiff_oscillator():
+    """An oscillator whose contact never slips (mu N0 huge), tuned to F0 with the contact stuck:
+    k + k_T = m (2 pi F0)^2."""
+    k = (2 * np.pi * F0) ** 2
+    return bd.FrictionOscillator(mass=1.0, stiffness=0.5 * k, contact_stiffness=0.5 * k, damping=20.0,
+                                 normal_load=1e6, forcing=1.0)
+
+
+def test_the_oscillator_and_the_disk_read_the_same_frequency_unit():
+    """Both given the range 90-100 [Hz] by the same call: both peaks near 95 Hz. Read as rad/s
+    (the oscillator's old unit) the oscillator's range would hold no resonance at all."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        osc = bd.frequency_response(stiff_oscillator(), (90.0, 100.0), harmonics=(1,))
+        disk = bd.frequency_response(bd.reference_disk("cylinder", 1e-3), (90.0, 100.0), harmonics=(1,), max_step=0.05)
+    assert osc.success and disk.success, (osc.message, disk.message)
+    assert osc.frequency_hz.min() == pytest.approx(90.0) and osc.frequency_hz.max() == pytest.approx(100.0)
+    assert abs(osc.peak_frequency_hz - F0) < 0.2, osc.peak_frequency_hz
+    assert abs(disk.peak_frequency_hz - F0) < 1.0, disk.peak_frequency_hz
+    # interior peaks, not the range's end: both resonances are inside 90-100 Hz
+    assert osc.peak_amplitude > 2 * osc.harmonic_amplitude()[[0, -1]].max()
+    np.testing.assert_allclose(osc.omega, 2 * np.pi * osc.frequency_hz)       # omega: the only rad/s
+
+
+def test_oscillator_time_response_and_linear_amplitude_take_hz():
+    osc = stiff_oscillator()
+    f = np.linspace(80.0, 110.0, 301)
+    assert f[np.argmax(osc.linear_amplitude(f, stuck=True))] == pytest.approx(F0, abs=0.1)
+    tr = osc.time_response([F0], steps_per_period=512, min_periods=5, max_periods=60, tol=1e-3)
+    np.testing.assert_allclose(tr.omega, [2 * np.pi * F0])
+    np.testing.assert_allclose(tr.frequency_hz, [F0])
+
+
+def test_public_frequency_arguments_are_named_in_hz():
+    for method in (bd.FrictionOscillator.frequency_response, bd.TunedDisk.frequency_response,
+                   MistunedDisk.frequency_response):
+        assert list(inspect.signature(method).parameters)[1:3] == ["f_start_hz", "f_end_hz"], method
+    for method in (bd.FrictionOscillator.time_response, bd.TunedDisk.time_response, MistunedDisk.time_response):
+        assert list(inspect.signature(method).parameters)[1] == "f_hz", method
+    assert list(inspect.signature(bd.FrictionOscillator.linear_amplitude).parameters)[1] == "f_hz"
+    assert list(inspect.signature(bd.frequency_response).parameters)[:2] == ["model", "f_range_hz"]
+
+
+def test_frequency_response_of_anything_else_is_a_type_error_naming_it():
+    with pytest.raises(TypeError, match="got bladedamp.blade.ModalBlade"):
+        bd.frequency_response(bd.reference_blade(), (90.0, 100.0))
+    with pytest.raises(TypeError, match="got builtins.str"):
+        bd.frequency_response("cylinder", (90.0, 100.0))
+    with pytest.raises(ValueError, match="f_range_hz"):
+        bd.frequency_response(stiff_oscillator(), 95.0)
+
+
+RESPONSES = [bd.FrequencyResponse, bd.DiskResponse, MistunedResponse]
+OLD_NAMES = ("peak_tip", "peak_tip_amplitude", "resonance_hz", "resonance_frequency_hz", "peak_hz",
+             "tuned_peak_tip", "undamped_peak_tip", "optimal_peak_tip", "grid_peak_tip", "max_peak_tip")
+RESULTS = RESPONSES + [TimeResponse, DiskTimeResponse, sm.PeakEvaluation, sm.MassSweep, sm.MassOptimum,
+                       sd.EngineOrderSweep, sd.PlatformAngleStudy, sd.ContactState, sd.LiftoffMap, sd.DesignMap,
+                       mt.MistuningCase, mt.MonteCarloResult, mt.Arrangement]
+
+
+@pytest.mark.parametrize("cls", RESPONSES, ids=lambda c: c.__name__)
+def test_every_response_names_its_peak_the_same_way(cls):
+    assert isinstance(inspect.getattr_static(cls, "peak_amplitude"), property)
+    assert isinstance(inspect.getattr_static(cls, "peak_frequency_hz"), property)
+
+
+@pytest.mark.parametrize("cls", RESULTS, ids=lambda c: c.__name__)
+def test_no_result_keeps_an_old_name(cls):
+    names = {f.name for f in dataclasses.fields(cls)} | set(dir(cls))
+    assert not any(old in names for old in OLD_NAMES), sorted(names & set(OLD_NAMES))
+
+
+@pytest.mark.parametrize("cls", [c for c in RESULTS if hasattr(c, "plot")], ids=lambda c: c.__name__)
+def test_one_plot_signature_ax_first_then_keywords(cls):
+    params = list(inspect.signature(cls.plot).parameters.values())[1:]
+    assert params[0].name == "ax" and params[0].default is None, cls
+    assert all(p.kind in (p.KEYWORD_ONLY, p.VAR_KEYWORD) for p in params[1:]), [(p.name, p.kind) for p in params]
+
+
+def test_mistuned_peaks_are_per_blade_arrays_under_the_same_names():
+    td = dataclasses.replace(bd.reference_disk("cylinder", 1e-3), n_blades=4)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = MistunedDisk.from_tuned(td, [1.01, 0.99, 1.02, 1.0]).frequency_response(92.0, 99.0, harmonics=(1,),
+                                                                                   max_step=0.1)
+    assert r.peak_amplitude.shape == (4,) and r.peak_frequency_hz.shape == (4,)
+    assert np.all((r.peak_frequency_hz > 92.0) & (r.peak_frequency_hz < 99.0))
+    np.testing.assert_allclose(r.peak_amplitude.max(), r.tip_amplitude[:, :, 0].max(), rtol=1e-2)
+
+
+# ----- plausible masses and lengths --------------------------------------------------------
+def test_a_one_kilogram_damper_warns_naming_parameter_value_unit_and_range():
+    with pytest.warns(PlausibilityWarning, match=r"damper mass = 1.0 kg is outside the plausible range 1e-05-0.1 kg"):
+        bd.reference_disk("cylinder", mass=1.0)
+
+
+@pytest.mark.parametrize("make, name", [
+    (lambda: bd.CylinderDamper(1e-3, radius=2.0), "cylinder radius = 2.0 m"),
+    (lambda: bd.WedgeDamper(1e-3, contact_height=2.0), "contact_height h_C = 2.0 m"),
+    (lambda: bd.WedgeDamper(1e-3, length=1e-6), "damper length l_C = 1e-06 m"),
+    (lambda: bd.CylinderDamper(1e-7), "damper mass = 1e-07 kg"),
+    (lambda: dataclasses.replace(bd.reference_disk("cylinder", 1e-3), damper_radius=26.1), "damper_radius R = 26.1 m"),
+])
+def test_implausible_damper_numbers_warn(make, name):
+    with pytest.warns(PlausibilityWarning, match=name.replace("(", r"\(").replace(")", r"\)")):
+        make()
+
+
+def test_plausible_designs_and_no_damper_do_not_warn():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", PlausibilityWarning)
+        bd.reference_disk("cylinder", 1e-3)
+        bd.reference_disk("wedge", 0.28e-3)
+        bd.reference_disk("cylinder", 15e-3)
+        bd.CylinderDamper(0.0)                  # mass 0: no damper

@@ -1,0 +1,228 @@
+"""Design files (bladedamp.design): the template is the reference disk, every field is
+validated with a one-line message naming the file, key, value and allowed range, unknown keys
+are errors, and partial files take the reference values for what they leave out."""
+from __future__ import annotations
+
+import tomllib
+
+import numpy as np
+import pytest
+
+import bladedamp
+from bladedamp.design import (Boolean, Choice, DesignError, Either, List, Number, Text, fields, load_design,
+                              reference_design, template, write_template)
+from bladedamp.reference import reference_disk
+
+
+def _write(tmp_path, text: str, name: str = "design.toml"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def _same_disk(a, b):
+    """Every model parameter of two TunedDisks is equal (the blade's shapes exactly)."""
+    for name in ("n_blades", "engine_order", "gamma_left", "gamma_right", "damper_radius", "rotor_speed",
+                 "damper_inertia"):
+        assert getattr(a, name) == getattr(b, name), name
+    assert np.array_equal(a.excitation, b.excitation)
+    assert a.damper == b.damper
+    assert np.array_equal(a.blade.natural_frequencies_hz, b.blade.natural_frequencies_hz)
+    assert np.array_equal(a.blade.damping_ratios, b.blade.damping_ratios)
+    assert a.blade.mode_names == b.blade.mode_names
+    assert set(a.blade.mode_shapes) == set(b.blade.mode_shapes)
+    for point in b.blade.mode_shapes:
+        assert np.array_equal(a.blade.mode_shapes[point], b.blade.mode_shapes[point]), point
+        assert np.array_equal(a.blade.points[point], b.blade.points[point]), point
+
+
+# ---------------------------------------------------------------------------------------
+# the template is the reference design
+# ---------------------------------------------------------------------------------------
+def test_template_round_trip_is_the_reference_disk(tmp_path):
+    path = write_template(tmp_path / "design.toml")
+    design = bladedamp.load_design(path)             # exported from the package
+    _same_disk(design.disk, reference_disk())
+    assert design.engine_orders == (1,)
+    assert design.analysis.f_range_hz == (90.0, 105.0) and design.analysis.harmonics == "auto"
+    assert design.mistuning.std == 0.02 and design.mistuning.kappa is None
+    _same_disk(reference_design().disk, reference_disk())
+
+
+def test_template_same_frf_as_the_reference_disk(tmp_path):
+    design = load_design(write_template(tmp_path / "design.toml"))
+    a = design.disk.frequency_response(94.0, 97.0, harmonics=(1,), max_step=0.05)
+    b = reference_disk().frequency_response(94.0, 97.0, harmonics=(1,), max_step=0.05)
+    assert a.success and np.array_equal(a.tip_amplitude, b.tip_amplitude)
+
+
+def test_template_comments_every_key_with_its_allowed_range_from_the_one_table():
+    text = template()
+    values = tomllib.loads(text)
+    lines = text.splitlines()
+    for f in fields():
+        table = values
+        for part in f.table.split("."):
+            table = table[part]
+        if f.value is None:                       # optional: shown commented out
+            assert f"# {f.key} = " in text, f.key
+            assert f.key not in table
+        else:
+            assert f.key in table, f.key
+        i = next(k for k, line in enumerate(lines) if line.startswith((f"{f.key} = ", f"# {f.key} = ")))
+        comment = " ".join(line.lstrip("# ").strip() for line in lines[max(i - 4, 0):i] if line.startswith("#"))
+        assert f"Allowed: {f.allowed}." in comment, (f.key, comment)
+        assert f.reason in comment, f.key
+        if f.unit != "-":
+            assert f"Unit: {f.unit}." in comment, f.key
+
+
+def test_init_refuses_to_overwrite(tmp_path):
+    path = write_template(tmp_path / "design.toml")
+    with pytest.raises(DesignError, match="exists"):
+        write_template(path)
+    write_template(path, overwrite=True)
+
+
+# ---------------------------------------------------------------------------------------
+# every field is validated
+# ---------------------------------------------------------------------------------------
+def _wrong_type(check):
+    """A TOML value that ``check`` refuses."""
+    return "[1]" if isinstance(check, Text) else '"nonsense"'
+
+
+def _out_of_range(check):
+    """A number just outside a Number's range (or None when it has none on that side)."""
+    if isinstance(check, Number):
+        return check.high + 1 if check.high < 1e6 else check.low - 1
+    return None
+
+
+@pytest.mark.parametrize("field", fields(), ids=lambda f: f"{f.table}.{f.key}")
+def test_every_field_rejects_a_wrong_value_naming_file_key_value_and_range(tmp_path, field):
+    bad = [_wrong_type(field.check)]
+    if _out_of_range(field.check) is not None:
+        bad.append(repr(_out_of_range(field.check)))
+    for value in bad:
+        path = _write(tmp_path, f"[{field.table}]\n{field.key} = {value}\n")
+        with pytest.raises(DesignError) as err:
+            load_design(path)
+        msg = str(err.value)
+        assert "\n" not in msg
+        assert str(path) in msg and f"[{field.table}] {field.key} = " in msg, msg
+        assert field.allowed in msg, msg
+
+
+def test_every_check_describes_what_it_allows():
+    for f in fields():
+        assert isinstance(f.check, (Number, Choice, Boolean, Text, List, Either))
+        assert f.allowed and "None" not in f.allowed, f.key
+
+
+@pytest.mark.parametrize("text, match", [
+    ("[damper]\nmas_g = 1.0\n", r"unknown key \[damper\] mas_g \(did you mean mass_g\?\)"),
+    ("[dampr]\nmass_g = 1.0\n", r"unknown table or key 'dampr' \(did you mean damper\?\)"),
+    ("n_blades = 16\n", "unknown table or key 'n_blades'"),
+    ("damper = 3\n", r"damper must be a table \[damper\]"),
+    ("[disk]\nengine_order = 9\n", r"\[disk\] engine_order = 9 .* \[0, 8\]"),
+    ("[disk]\nengine_order = [2, 1]\n", r"\[disk\] engine_order = \[2, 1\] .* strictly increasing"),
+    ("[disk]\nexcitation_n_nm = [0.1, 0.0]\n", r"\[disk\] excitation_n_nm = \[0.1, 0.0\] .* list of 6"),
+    ("[analysis]\nharmonics = [0, 2]\n", r"harmonics = \[0, 2\] .* containing 1"),
+    ("[analysis]\nfrequency_range_hz = [105.0, 90.0]\n", r"frequency_range_hz = \[105.0, 90.0\] .* increasing"),
+    ("[blade]\nnatural_frequencies_hz = [95.0, 423.0]\n", r"natural_frequencies_hz = .* 4 numbers"),
+    ("[blade.beam]\nplatform_contact_z_offset_mm = 70.0\n", r"\[0, shank_length_mm = 60\] mm"),
+    ("[mistuning]\nkappa = [1.0, 1.01]\n", r"kappa = \[1.0, 1.01\] .* 16 numbers"),
+    ("[mistuning]\nstd = 0.01\nkappa = " + str([1.0] * 16) + "\n", "kappa replaces std and seed"),
+    ("[damper]\nmass_g = true\n", r"mass_g = true is not allowed: must be a number in \(0, 1000\] g"),
+    ("[damper\nmass_g = 1\n", "not valid TOML"),
+])
+def test_bad_files_one_line_naming_the_problem(tmp_path, text, match):
+    path = _write(tmp_path, text)
+    with pytest.raises(DesignError, match=match) as err:
+        load_design(path)
+    assert "\n" not in str(err.value) and str(path) in str(err.value)
+
+
+def test_missing_file_says_how_to_write_one(tmp_path):
+    with pytest.raises(DesignError, match="no such design file .*bladedamp init"):
+        load_design(tmp_path / "nothing.toml")
+
+
+# ---------------------------------------------------------------------------------------
+# partial designs take the reference values; the models follow the keys
+# ---------------------------------------------------------------------------------------
+def test_a_partial_file_is_the_reference_with_its_changes(tmp_path):
+    design = load_design(_write(tmp_path, "[damper]\nmass_g = 2.5\n"))
+    _same_disk(design.disk, reference_disk("cylinder", 2.5e-3))
+    assert design.mistuning is None                  # no [mistuning] table: a tuned design
+    with pytest.raises(DesignError, match="mistuning"):
+        design.mistuned_disk()
+
+
+def test_wedge_angles_speed_and_engine_orders_in_si(tmp_path):
+    text = ("[damper]\nkind = \"wedge\"\nmass_g = 0.3\ncontact_height_mm = 3.0\nfriction_coefficient = 0.5\n"
+            "[disk]\nengine_order = [0, 2, 4]\ngamma_left_deg = 30.0\ngamma_right_deg = 60.0\n"
+            "damper_radius_mm = 100.0\nrotor_speed_eo0_rpm = 3000.0\n"
+            "[analysis]\nharmonics = [0, 1, 3]\nmass_range_g = [0.1, 5.0]\n")
+    design = load_design(_write(tmp_path, text))
+    d = design.disk
+    assert d.damper.kind == "wedge" and d.damper.contact_height == pytest.approx(3e-3)
+    assert d.damper.mass == pytest.approx(3e-4) and d.damper.contact.friction_coefficient == 0.5
+    assert d.gamma_left == pytest.approx(np.radians(30)) and d.gamma_right == pytest.approx(np.radians(60))
+    assert d.damper_radius == pytest.approx(0.1)
+    assert design.engine_orders == (0, 2, 4) and d.engine_order == 0
+    assert d.rotor_speed == pytest.approx(3000 * 2 * np.pi / 60)      # EO = 0 needs a speed
+    eo2 = design.disk_at(2)
+    assert eo2.engine_order == 2 and eo2.rotor_speed is None          # 'auto': Omega_E / EO
+    assert design.analysis.harmonics == (0, 1, 3) and design.analysis.study_harmonics == (0, 1, 3)
+    assert design.analysis.mass_bounds == pytest.approx((1e-4, 5e-3))
+
+
+def test_no_damper_and_a_fixed_rotor_speed(tmp_path):
+    design = load_design(_write(tmp_path, "[damper]\nkind = \"none\"\n[disk]\nrotor_speed_rpm = 6000.0\n"))
+    assert not design.disk.has_damper
+    assert design.disk.rotor_speed == pytest.approx(200 * np.pi)
+
+
+def test_beam_overrides_change_the_blade(tmp_path):
+    text = ("[blade]\nnatural_frequencies_hz = \"model\"\ndamping_ratio = [0.001, 0.002, 0.003, 0.004]\n"
+            "[blade.beam]\nairfoil_length_mm = 120.0\nshank_length_mm = 60.0\n")
+    blade = load_design(_write(tmp_path, text)).disk.blade
+    # a shorter airfoil stiffens the blade: its own (FE) 1F frequency rises above the reference's 95 Hz
+    assert blade.natural_frequencies_hz[0] > 100.0
+    assert np.array_equal(blade.damping_ratios, [0.001, 0.002, 0.003, 0.004])
+    assert blade.points["tip"][2] == pytest.approx(0.18)
+
+
+def test_explicit_kappa_gives_the_mistuned_assembly(tmp_path):
+    kappa = [1.0 + 0.01 * (-1) ** k for k in range(4)]
+    design = load_design(_write(tmp_path, f"[disk]\nn_blades = 4\n[mistuning]\nkappa = {kappa}\n"))
+    m = design.mistuned_disk()
+    f1 = design.disk.blade.natural_frequencies_hz
+    assert len(m.blades) == 4
+    for b, k in zip(m.blades, kappa):
+        assert np.allclose(b.natural_frequencies_hz, k * f1)
+
+
+def test_random_mistuning_from_std_and_seed(tmp_path):
+    from bladedamp.studies.mistuning import random_kappa
+
+    design = load_design(_write(tmp_path, "[mistuning]\nstd = 0.03\nseed = 7\n"))
+    assert np.array_equal(design.kappa, random_kappa(16, 0.03, 7))
+
+
+def test_modal_file_blade(tmp_path):
+    from bladedamp.blade import ModalBlade
+
+    if not hasattr(ModalBlade, "save") or not hasattr(ModalBlade, "from_file"):
+        pytest.skip("ModalBlade.save / from_file not in this version")
+    ref = reference_disk()
+    ref.blade.save(tmp_path / "blade.npz")
+    design = load_design(_write(tmp_path, "[blade]\nmodal_file = \"blade.npz\"\n"))   # relative to the file
+    _same_disk(design.disk, ref)
+    # the beam keys do not apply to a file's blade: an error, not silently ignored
+    with pytest.raises(DesignError, match=r"\[blade.beam\] airfoil_length_mm applies to the beam model only"):
+        load_design(_write(tmp_path, "[blade]\nmodal_file = \"blade.npz\"\n[blade.beam]\nairfoil_length_mm = 1.0\n"))
+    with pytest.raises(DesignError, match="modal_file"):
+        load_design(_write(tmp_path, "[blade]\nmodal_file = \"missing.npz\"\n"))

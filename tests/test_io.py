@@ -1,0 +1,279 @@
+"""Results persist: every response and study result saves to one .npz (no pickle) and loads back
+equal, field by field, with its named properties and .plot() working (issue 13, item 5).
+
+The responses are computed (small and fast: an oscillator, a one-harmonic sector, a 4-blade
+mistuned ring); the study results, whose computation takes minutes, are built from arrays of
+the shapes the studies return, with the awkward values a real run produces (NaN, complex,
+integer-keyed dicts, tuples, lists of arrays of different lengths, string arrays).
+"""
+import dataclasses
+import json
+import warnings
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+import bladedamp as bd  # noqa: E402
+from bladedamp import io  # noqa: E402
+from bladedamp.mistuned import MistunedDisk, MistunedResponse  # noqa: E402
+from bladedamp.studies import design as sd  # noqa: E402
+from bladedamp.studies import mass as sm  # noqa: E402
+from bladedamp.studies import mistuning as mt  # noqa: E402
+from bladedamp.timedomain import DiskTimeResponse, TimeResponse  # noqa: E402
+
+
+def assert_same(a, b, where="result"):
+    """Field-by-field equality of two results (NaN equal to NaN); models (disk) are not saved."""
+    assert type(a) is type(b), where
+    for f in dataclasses.fields(a):
+        x, y = getattr(a, f.name), getattr(b, f.name)
+        w = f"{where}.{f.name}"
+        if f.name in io.MODEL_FIELDS:
+            assert y is None, w
+        elif dataclasses.is_dataclass(x):
+            assert_same(x, y, w)
+        elif isinstance(x, np.ndarray):
+            assert isinstance(y, np.ndarray) and x.shape == y.shape and x.dtype == y.dtype, w
+            if x.dtype.kind in "fc":
+                np.testing.assert_array_equal(x, y, err_msg=w)
+            else:
+                assert np.array_equal(x, y), w
+        elif isinstance(x, list) and x and isinstance(x[0], np.ndarray):
+            assert len(x) == len(y), w
+            for i, (u, v) in enumerate(zip(x, y)):
+                np.testing.assert_array_equal(u, v, err_msg=f"{w}[{i}]")
+        elif isinstance(x, float) and np.isnan(x):
+            assert isinstance(y, float) and np.isnan(y), w
+        elif isinstance(x, bd.HarmonicBasis):
+            assert x.harmonics == y.harmonics and x.n_samples == y.n_samples, w
+        else:
+            assert same_value(x, y), (w, x, y)
+
+
+def same_value(x, y) -> bool:
+    """Equality of plain values, types included, NaN equal to NaN (inside tuples, lists, dicts)."""
+    if type(x) is not type(y):
+        return False
+    if isinstance(x, (tuple, list)):
+        return len(x) == len(y) and all(same_value(u, v) for u, v in zip(x, y))
+    if isinstance(x, dict):
+        return list(x) == list(y) and all(same_value(x[k], y[k]) for k in x)
+    if isinstance(x, float) and np.isnan(x):
+        return np.isnan(y)
+    return x == y
+
+
+def round_trip(result, tmp_path, name="r"):
+    path = result.save(tmp_path / name)
+    assert path.suffix == ".npz" and path.exists()
+    with np.load(path, allow_pickle=False) as z:          # any npz reader, no pickle
+        meta = json.loads(str(z[io.META_KEY][()]))
+    assert meta["class"].endswith(type(result).__qualname__)
+    back = bd.load(path)
+    assert_same(result, back)
+    assert type(result).load(path) is not None            # Class.load checks the class
+    return back
+
+
+# ----- responses (computed) --------------------------------------------------------------
+@pytest.fixture(scope="module")
+def oscillator_frf():
+    osc = bd.FrictionOscillator(damping=2.0, normal_load=3.0, forcing=2.0)
+    return osc, osc.frequency_response(14.0, 25.0, harmonics=(1, 3))
+
+
+@pytest.fixture(scope="module")
+def disk_frf():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return bd.reference_disk("cylinder", 1e-3).frequency_response(93.0, 97.0, harmonics=(1,), max_step=0.1)
+
+
+@pytest.fixture(scope="module")
+def mistuned_frf():
+    td = dataclasses.replace(bd.reference_disk("cylinder", 1e-3), n_blades=4)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return MistunedDisk.from_tuned(td, [1.01, 0.99, 1.02, 1.0]).frequency_response(
+            92.0, 99.0, harmonics=(1,), max_step=0.1, tuned_peak_amplitude=5e-4)
+
+
+def test_frequency_response_round_trip(oscillator_frf, tmp_path):
+    _, r = oscillator_frf
+    back = round_trip(r, tmp_path)
+    assert back.peak_amplitude == r.peak_amplitude and back.peak_frequency_hz == r.peak_frequency_hz
+    np.testing.assert_array_equal(back.time_samples(), r.time_samples())     # the basis is rebuilt
+    assert back.plot().get_lines()
+
+
+def test_disk_response_round_trip_without_the_model(disk_frf, tmp_path):
+    back = round_trip(disk_frf, tmp_path)
+    assert back.disk is None and back.peak_amplitude == disk_frf.peak_amplitude
+    assert back.peak_frequency_hz == disk_frf.peak_frequency_hz
+    np.testing.assert_array_equal(back.energy_balance_error(), disk_frf.energy_balance_error())
+    ax = back.plot()
+    np.testing.assert_array_equal(ax.get_lines()[0].get_ydata(), 1e3 * disk_frf.tip_amplitude[:, 0])
+    with np.load(tmp_path / "r.npz", allow_pickle=False) as z:
+        model = json.loads(str(z[io.META_KEY][()]))["models"]["disk"]
+    assert model["damper"] == "cylinder" and model["damper_mass_kg"] == 1e-3    # described, not rebuilt
+
+
+def test_mistuned_response_round_trip(mistuned_frf, tmp_path):
+    back = round_trip(mistuned_frf, tmp_path)
+    np.testing.assert_array_equal(back.peak_amplitude, mistuned_frf.peak_amplitude)
+    np.testing.assert_array_equal(back.amplification(), mistuned_frf.amplification())
+    assert back.plot().get_lines()
+
+
+def test_time_responses_round_trip(tmp_path):
+    tr = bd.FrictionOscillator(damping=2.0, normal_load=3.0, forcing=2.0).time_response([15.0, 17.0],
+                                                                                        steps_per_period=256)
+    back = round_trip(tr, tmp_path, "osc")
+    assert back.plot().get_lines()
+    n, s, S, nd = 3, 4, 8, 2
+    rng = np.random.default_rng(0)
+    dtr = DiskTimeResponse(
+        omega=2 * np.pi * np.array([94.0, 95.0, 96.0]), tip_amplitude=rng.random((n, s, 3)),
+        tip_harmonic=rng.random((n, s, 3)) + 1j * rng.random((n, s, 3)), tip_samples=rng.random((n, s, 3, S)),
+        dissipated_energy=rng.random(n), damper_dissipation=rng.random((n, nd)), excitation_work=rng.random(n),
+        viscous_dissipation=rng.random(n), periods=np.array([20, 31, 4000]), periodic=np.array([True, True, False]),
+        status=np.array(["periodic", "periodic", "drifting"], dtype=object),          # as disk_time_response
+        message=np.array(["", "", "damper 1 rolls"], dtype=object),
+        settling=np.array([1e-7, 1e-8, np.nan]), damper_mean=rng.random((n, nd, 6)),
+        damper_drift=rng.random((n, nd, 6)), point_state=rng.random((n, 5, 3)), steps_per_period=S,
+        time_step=np.full(n, 1e-5), static_state=rng.random((n, 10)),
+        tip_history=[rng.random((k, s, 3)) + 0j for k in (20, 31, 4000)],
+        damper_history=[rng.random((k, nd, 6)) for k in (20, 31, 4000)])
+    back = round_trip(dtr, tmp_path, "disk")
+    assert back.n_blades == s and back.plot().get_lines()
+
+
+# ----- study results (built) -------------------------------------------------------------
+def study_results(disk_frf, mistuned_frf):
+    nan = float("nan")
+    masses = np.array([1e-4, 1e-3, 1e-2])
+    return {
+        "PeakEvaluation": sm.PeakEvaluation(False, nan, nan, 3e-4, "continuation stalled", 3),
+        "MassSweep": sm.MassSweep(masses, np.array([1e-3, 5e-4, nan]), np.array([95.0, 95.3, nan]), "cylinder", 1.7e-3),
+        "MassOptimum": sm.MassOptimum(1e-3, 4.9e-4, 1.7e-3, 12, (2e-5,), (nan,), ("stalled at 94 Hz",), masses,
+                                      np.array([1e-3, 5e-4, 9e-4]), (1e-4, 1e-2), False, "one mass failed"),
+        "EngineOrderSweep": sd.EngineOrderSweep("cylinder", np.arange(3), np.array([nan, 1e-3, 2e-3]),
+                                                np.array([1.7e-3, 5e-4, 3e-4]), np.full(3, 1.7e-3),
+                                                np.array([0.0, 0.7, 0.8]), {0: "rolls"},
+                                                np.array([False, True, True]), {1: "grid", 2: "grid"}),
+        "PlatformAngleStudy": sd.PlatformAngleStudy("wedge", 35.0, 1e-3, np.array([25.0, 35.0, 45.0]),
+                                                    np.array([3e-4, 2.8e-4, nan]), np.array([3e-4, 3.2e-4, 4e-4]),
+                                                    np.array([4e-4, 5e-4, 6e-4]), 1.7e-3),
+        "ContactState": sd.ContactState(np.array([0.7 + 0.1j, 3.3 - 1j]), np.array([0.5j, 1 + 0j]),
+                                        np.array([1e-6 + 2e-7j, 3e-6j]), np.array([0.1 + 0j, 0.2 - 0.1j]),
+                                        np.array([5.0, 6.0]), np.array([2e7, 2e7]), np.array([0.3, 0.3]), 95.3, 4.9e-4),
+        "LiftoffMap": sd.LiftoffMap(np.linspace(0, 1, 6), np.linspace(-0.5, 0.5, 6), np.linspace(0.5, 1.5, 12).reshape(2, 6),
+                                    np.ones((2, 6)), np.full((2, 6), -1e-8), np.full((2, 6), 1e-7),
+                                    np.full((2, 6), 2e-7), 95.1, 3e-4, 64),
+        "DesignMap": sd.DesignMap("wedge", 2e-3, masses, np.array([30.0, 40.0]), np.array([[3e-4, 2e-4, nan], [4e-4, 3e-4, 5e-4]]),
+                                  1.7e-3),
+        "MistuningCase": mt.MistuningCase("random_1g", 1e-3, np.array([1.01, 0.99, 1.02, 1.0]), mistuned_frf, 5e-4,
+                                          disk_frf),
+        "MonteCarloResult": mt.MonteCarloResult(np.zeros((2, 4)), np.full((2, 4), 5e-4), np.full((2, 4), 95.0), 5e-4,
+                                                ["", ""], {"seed": 1, "f_range_hz": [90.0, 100.0], "disk": {"n_blades": 4}}),
+        "Arrangement": mt.Arrangement(np.array([1.01, 0.99, 1.02, 1.0]), np.array([2, 0, 3, 1]), 5.1e-4,
+                                      np.array([0, 2, 1, 3]), 5.3e-4, 5.6e-4, 5e-4, 17, [5.6e-4, 5.1e-4], mistuned_frf),
+    }
+
+
+@pytest.mark.parametrize("name", ["PeakEvaluation", "MassSweep", "MassOptimum", "EngineOrderSweep", "PlatformAngleStudy",
+                                  "ContactState", "LiftoffMap", "DesignMap", "MistuningCase", "MonteCarloResult",
+                                  "Arrangement"])
+def test_study_result_round_trip(name, disk_frf, mistuned_frf, tmp_path):
+    result = study_results(disk_frf, mistuned_frf)[name]
+    back = round_trip(result, tmp_path)
+    if hasattr(back, "plot"):
+        back.plot()
+        plt.close("all")
+    for prop in ("reduction", "optimum", "lifts_off", "amplification", "gain_over_given", "gain_over_heuristic", "peak_amplitude", "peak_frequency_hz"):
+        if hasattr(type(back), prop):
+            a, b = getattr(result, prop), getattr(back, prop)
+            assert np.array_equal(np.asarray(a, dtype=object) if isinstance(a, dict) else a,
+                                  np.asarray(b, dtype=object) if isinstance(b, dict) else b, equal_nan=not isinstance(a, dict)), prop
+
+
+def test_integer_keys_and_tuples_survive(disk_frf, mistuned_frf, tmp_path):
+    back = round_trip(study_results(disk_frf, mistuned_frf)["EngineOrderSweep"], tmp_path)
+    assert back.failures == {0: "rolls"} and list(back.messages) == [1, 2]
+    opt = round_trip(study_results(disk_frf, mistuned_frf)["MassOptimum"], tmp_path, "opt")
+    assert opt.bracket == (1e-4, 1e-2) and isinstance(opt.failure_messages, tuple)
+
+
+# ----- Monte Carlo with failed disks (issue 13: save failed after writing the .npz, load lost the errors)
+def test_monte_carlo_where_every_disk_failed_saves_and_loads_its_errors(tmp_path, monkeypatch):
+    def fails(disk, kappa, f_range_hz, **settings):
+        raise RuntimeError(f"continuation stalled (kappa[0] = {kappa[0]:.4f})")
+
+    monkeypatch.setattr(mt, "mistuned_response", fails)
+    td = dataclasses.replace(bd.reference_disk("cylinder", 1e-3), n_blades=4)
+    res = mt.monte_carlo(td, 3, seed=2, f_range_hz=(90.0, 100.0), scheduler="serial", tuned_peak_amplitude=5e-4)
+    assert not res.valid.any() and all(e.startswith("continuation stalled") for e in res.errors)
+    path = res.save(tmp_path / "mc")
+    back = mt.MonteCarloResult.load(path)
+    assert back.errors == res.errors and len(back.errors) == 3
+    assert np.isnan(back.peak_amplitude).all() and back.meta == json.loads(json.dumps(res.meta))
+    summary = json.loads((tmp_path / "mc.json").read_text())          # strict JSON: no NaN
+    assert summary["summary"]["n_failed"] == 3 and summary["summary"]["amplification_mean"] is None
+    assert summary["errors"] == res.errors
+
+
+def test_monte_carlo_where_some_disks_failed(tmp_path, monkeypatch):
+    real = mt.mistuned_response
+    calls = []
+
+    def second_fails(disk, kappa, f_range_hz, **settings):
+        calls.append(1)
+        if len(calls) == 2:
+            raise RuntimeError("no start point")
+        return real(disk, kappa, f_range_hz, **settings)
+
+    monkeypatch.setattr(mt, "mistuned_response", second_fails)
+    td = dataclasses.replace(bd.reference_disk("cylinder", 1e-3), n_blades=4)
+    res = mt.monte_carlo(td, 2, seed=2, f_range_hz=(90.0, 100.0), scheduler="serial", tuned_peak_amplitude=5e-4)
+    back = bd.load(res.save(tmp_path / "mc"))
+    assert back.errors == ["", "no start point"] and back.valid.tolist() == [True, False]
+    np.testing.assert_array_equal(back.amplification, res.amplification)
+
+
+# ----- the file ------------------------------------------------------------------------
+def test_load_rejects_what_is_not_a_result(tmp_path, oscillator_frf):
+    np.savez(tmp_path / "plain.npz", x=np.zeros(3))
+    with pytest.raises(ValueError, match="not a saved bladedamp result"):
+        bd.load(tmp_path / "plain.npz")
+    with pytest.raises(FileNotFoundError, match="missing"):
+        bd.load(tmp_path / "missing.npz")
+    path = oscillator_frf[1].save(tmp_path / "frf")
+    with pytest.raises(TypeError, match="not a MassSweep"):
+        sm.MassSweep.load(path)
+    with pytest.raises(TypeError, match="cannot save HarmonicBalanceSystem.excitation: a builtins.function"):
+        bd.save(oscillator_frf[0].hbm_system(), tmp_path / "system")       # names the field it cannot store
+    with pytest.raises(TypeError, match="result dataclass"):
+        bd.save({"peak": 1.0}, tmp_path / "dict")
+
+
+def test_load_dispatches_on_the_stored_class_only_inside_bladedamp(tmp_path, oscillator_frf):
+    path = oscillator_frf[1].save(tmp_path / "frf")
+    with np.load(path, allow_pickle=False) as z:
+        arrays = {k: z[k] for k in z.files}
+    meta = json.loads(str(arrays[io.META_KEY][()]))
+    meta["class"] = "os:system"
+    arrays[io.META_KEY] = np.array(json.dumps(meta))
+    np.savez(tmp_path / "evil.npz", **arrays)
+    with pytest.raises(ValueError, match="must come from bladedamp"):
+        bd.load(tmp_path / "evil.npz")
+
+
+def test_every_result_class_is_saveable():
+    classes = [bd.FrequencyResponse, bd.DiskResponse, MistunedResponse, TimeResponse, DiskTimeResponse,
+               sm.MassSweep, sm.MassOptimum, sd.EngineOrderSweep, sd.PlatformAngleStudy, sd.ContactState,
+               sd.LiftoffMap, sd.DesignMap, mt.MistuningCase, mt.MonteCarloResult, mt.Arrangement]
+    assert all(issubclass(c, io.Saveable) for c in classes)
