@@ -19,7 +19,8 @@ _LAZY = {
     "ContactProperties": "damper", "CylinderDamper": "damper", "WedgeDamper": "damper",
     "TunedDisk": "disk", "DiskResponse": "disk",
     "MistunedDisk": "mistuned", "MistunedResponse": "mistuned",
-    "HarmonicBasis": "hbm",
+    "HarmonicBasis": "hbm", "HarmonicBalanceSystem": "hbm", "Coupling": "hbm",
+    "TimeDomainElement": "hbm", "CubicSpring": "hbm", "GapSpring": "hbm", "with_element": "hbm",
     "FrictionOscillator": "oscillator",
     "reference_disk": "reference",
     "FrequencyResponse": "response",
@@ -71,5 +72,10 @@ def frequency_response(model, f_range_hz, harmonics="auto", stability: bool = Fa
     if stability:
         from .hbm.stability import with_stability
 
+        extra = options.get("extra_couplings")
+        if extra is not None:
+            from .disk import WithCouplings
+
+            model = WithCouplings(model, extra)
         response = with_stability(model, response)
     return response

@@ -361,7 +361,7 @@ class TunedDisk:
 
     def frequency_response(self, f_start_hz: float, f_end_hz: float, harmonics="auto", n_samples=None,
                            max_step: float = 0.02, harmonic_tolerance: float = HARMONIC_TOLERANCE,
-                           max_harmonic: int = 7, **continuation_options) -> "DiskResponse":
+                           max_harmonic: int = 7, extra_couplings=None, **continuation_options) -> "DiskResponse":
         """Forced response from ``f_start_hz`` to ``f_end_hz`` [Hz] by continuation.
 
         ``harmonics``: ``"auto"`` (default) chooses the harmonic set whose first-harmonic tip
@@ -376,6 +376,10 @@ class TunedDisk:
         ``max_step`` is the largest arc-length step in scaled units (the frequency range is 1;
         smaller: more points). The result is ``success`` only if the branch reached the end and
         passed :func:`bladedamp.response.physical_checks`.
+        ``extra_couplings``: your own nonlinear elements, a callable ``basis -> sequence of
+        Coupling`` (called for every harmonic set, the solved ones and the enriched one of the
+        error estimate; ``self.point_map(basis, "tip")`` gives a blade point's map), added to
+        the sector with :meth:`HarmonicBalanceSystem.add` (README, "Your own nonlinear element").
         """
         _validate.positive("f_start_hz", f_start_hz)
         _validate.positive("f_end_hz", f_end_hz)
@@ -383,8 +387,10 @@ class TunedDisk:
             raise ValueError("f_end_hz must differ from f_start_hz")
         w0, w1 = 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz
 
+        model = self if extra_couplings is None else WithCouplings(self, extra_couplings)
+
         def solve(H):
-            system = self.hbm_system(H, n_samples)
+            system = model.hbm_system(H, n_samples)
             scales = self._scales(system, w0, w1)
             x0 = self._start_solution(system, w0, scales)
             branch = continuation(system.residual, x0, w0, w1, x_scale=scales,
@@ -395,7 +401,16 @@ class TunedDisk:
             return with_checks(response, physical_checks(branch.omega, (w0, w1), dissipation,
                                                          response.excitation_work, max_step, system.basis.n_samples))
 
-        return converged_response(self, solve, harmonics, harmonic_tolerance, max_harmonic)
+        return converged_response(model, solve, harmonics, harmonic_tolerance, max_harmonic)
+
+    def point_map(self, basis: HarmonicBasis, point: str = "tip", directions=(0,)) -> np.ndarray:
+        """Real-form map (C*k, C*n_dof) from the unknowns of :meth:`hbm_system` (``basis``'s
+        harmonics) to the motion of the reference blade's ``point`` in the k ``directions``
+        (0, 1, 2: x, y, z translation [m]; 3, 4, 5: rotations [rad], blade frame), through the
+        blade's mode shapes (the damper's DOFs do not enter). The map of a
+        :class:`~bladedamp.hbm.system.Coupling` from the sector to an element at that point."""
+        nm = self.blade.n_modes
+        return blade_point_map(self.blade, basis, point, directions, nm + (6 if self.has_damper else 0), slice(0, nm))
 
     # ----- the protocol of bladedamp.hbm.accuracy ----------------------------------------
     def output_amplitudes(self, coefficients: np.ndarray, basis: HarmonicBasis) -> np.ndarray:
@@ -474,6 +489,44 @@ class TunedDisk:
         from .timedomain import disk_time_response
 
         return disk_time_response(MistunedDisk.from_tuned(self), f_hz, **options)
+
+
+def blade_point_map(blade, basis, point, directions, n_dof, modes):
+    """Real-form map (C*k, C*n_dof) of ``basis`` to ``blade``'s ``point`` in ``directions`` (0..5), from
+    its modal DOFs ``modes`` (a slice of the n_dof unknowns per coefficient)."""
+    try:
+        directions = tuple(int(d) for d in np.atleast_1d(directions))
+    except (TypeError, ValueError):
+        raise ValueError(f"directions must be integers in 0..5 (x, y, z, rx, ry, rz), got {directions!r}") from None
+    if not directions or any(d < 0 or d > 5 for d in directions):
+        raise ValueError(f"directions must be integers in 0..5 (x, y, z, rx, ry, rz), got {directions!r}")
+    out = np.zeros((len(directions), n_dof))
+    out[:, modes] = blade.shape(point)[list(directions)]      # ValueError naming the points
+    return basis.real_form(lambda h: out)
+
+
+class WithCouplings:
+    """``model`` (a :class:`TunedDisk`) whose :meth:`hbm_system` has the extra couplings
+    ``extra(basis)`` (a callable ``basis -> sequence of Coupling``); every other attribute is the
+    model's. What ``frequency_response(..., extra_couplings=extra)`` solves, for the functions
+    that rebuild a response's system from its model (``harmonic_error``, ``with_stability``)."""
+
+    def __init__(self, model, extra):
+        if not callable(extra):
+            raise TypeError("extra_couplings must be a callable basis -> sequence of Coupling (it is called "
+                            f"for every harmonic set), got {type(extra).__name__}")
+        self._model, self._extra = model, extra
+
+    def __getattr__(self, name):
+        return getattr(self._model, name)
+
+    def hbm_system(self, harmonics=(1,), n_samples=None, **options):
+        system = self._model.hbm_system(harmonics, n_samples, **options)
+        for c in self._extra(system.basis):
+            if not isinstance(c, Coupling):
+                raise TypeError(f"extra_couplings(basis) must give Coupling objects, got {type(c).__name__}")
+            system = system.add(c.element, c.matrix, c.name)
+        return system
 
 
 @dataclass

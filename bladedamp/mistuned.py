@@ -642,6 +642,15 @@ class MistunedDisk:
         tips = np.stack([b.shape("tip")[:3] for b in self.blades])            # (s, 3, nm)
         return np.abs(np.einsum("pkm,kim->pki", q1, tips)).reshape(len(coefficients), -1)
 
+    def point_map(self, basis, point: str = "tip", directions=(0,), blade: int = 0) -> np.ndarray:
+        """Real-form map (C*k, C*n_dof) from the unknowns of :meth:`hbm_system` to the motion of
+        blade ``blade``'s ``point`` in the k ``directions`` (0..5: x, y, z [m], rx, ry, rz [rad]),
+        as :meth:`TunedDisk.point_map`; add an element with ``system.add(element, map, name)``."""
+        from .disk import blade_point_map
+
+        blade = _validate.integer("blade", blade, minimum=0, maximum=self.n_sector - 1)
+        return blade_point_map(self.blades[blade], basis, point, directions, self.n_dof, self.blade_slice(blade))
+
     def unknown_scales(self, system: HarmonicBalanceSystem, omega_start: float, omega_end: float) -> np.ndarray:
         """Scale of each unknown of ``system`` over omega_start..omega_end [rad/s] (:meth:`scales`)."""
         return self.scales(system, omega_start, omega_end)

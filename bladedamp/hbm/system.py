@@ -22,7 +22,9 @@ from .linsolve import factorize as lu_factorize
 
 
 class NonlinearElement(Protocol):
-    """What an element provides to the harmonic balance."""
+    """What an element provides to the harmonic balance (the contract, with units, shapes and the
+    sign convention, is in :mod:`bladedamp.hbm.elements`; subclass
+    :class:`~bladedamp.hbm.elements.TimeDomainElement` to give only the force in time)."""
 
     n_local: int
 
@@ -34,7 +36,11 @@ class NonlinearElement(Protocol):
 
 @dataclass
 class Coupling:
-    """An element and the real-form map ``matrix`` (C*n_local, C*n_dof) from the structure to it."""
+    """An element and the real-form map ``matrix`` (C*n_local, C*n_dof) from the structure to it.
+
+    ``matrix @ x`` (x the structure's harmonic coefficients, harmonic-major) are the element's
+    local coefficients, and ``matrix.T`` carries its restoring forces back. ``name`` labels it.
+    """
 
     element: NonlinearElement
     matrix: np.ndarray
@@ -116,6 +122,17 @@ class HarmonicBalanceSystem:
             return splu(A.tocsc()).solve(f)
         return np.linalg.lstsq(A, f, rcond=None)[0]
 
+    def add(self, element: NonlinearElement, matrix, name: str = "") -> "HarmonicBalanceSystem":
+        """A new system with one more nonlinear element: ``element`` seen through the real-form
+        map ``matrix`` (C*n_local, C*n_dof, e.g. ``TunedDisk.point_map``); this system is left
+        as it is. The new system is a plain :class:`HarmonicBalanceSystem` (the generic
+        residual): a model's specialised assembly (the mistuned disk's) knows only its own
+        elements, so it is not carried over; the residual is the same to rounding.
+
+        Raises ValueError if the map's shape does not fit ``element.n_local`` and this system.
+        """
+        return with_element(self, element, matrix, name)
+
     def factorize(self, A):
         """The linear solver for this system's Newton and arc-length steps: ``A`` (dR/dx, or it
         bordered by one row and column) -> ``solve(b)``. Dense or sparse LU here; assemblies
@@ -171,3 +188,23 @@ class HarmonicBalanceSystem:
             force, _, _ = c.element.harmonic_forces(local, self.basis, omega, False)
             out.append(float(np.sum(self.basis.work_per_cycle(force, local))))
         return out
+
+
+def with_element(system: HarmonicBalanceSystem, element: NonlinearElement, matrix, name: str = "") -> HarmonicBalanceSystem:
+    """``system`` with ``element`` added through the real-form map ``matrix`` (see
+    :meth:`HarmonicBalanceSystem.add`); ``system`` itself is not changed."""
+    n_local = getattr(element, "n_local", None)
+    if not callable(getattr(element, "harmonic_forces", None)) or not isinstance(n_local, (int, np.integer)) \
+            or n_local < 1:
+        raise TypeError(f"element must have an integer n_local >= 1 and a method harmonic_forces "
+                        f"(see bladedamp.hbm.elements; got {type(element).__name__})")
+    C = system.basis.n_coeffs
+    shape = (C * int(n_local), system.n_unknowns)
+    if not sp.issparse(matrix):
+        matrix = np.asarray(matrix, dtype=float)
+    if matrix.shape != shape:
+        raise ValueError(f"matrix of element {name or type(element).__name__!r} must be (C*n_local, C*n_dof) = "
+                         f"{shape} for this system (C = {C} coefficients, n_local = {n_local}, "
+                         f"n_dof = {system.n_dof}); got {matrix.shape}")
+    return HarmonicBalanceSystem(system.basis, system.mass, system.damping, system.stiffness, system.excitation,
+                                 list(system.couplings) + [Coupling(element, matrix, name)], system.static_stiffness)
