@@ -3,7 +3,7 @@
 Data flows one way: geometry and parameters -> model -> harmonic balance residual ->
 continuation solver -> result objects -> plots, reports and 3D views.
 """
-import importlib
+from .lazy import lazy_attributes
 
 from . import _numba_cache
 
@@ -31,16 +31,7 @@ _LAZY = {
 __all__ = sorted(_LAZY) + ["frequency_response"]
 
 
-def __getattr__(name):
-    if name in _LAZY:
-        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'bladedamp' has no attribute {name!r}")
-
-
-def __dir__():
-    return sorted(set(globals()) | set(_LAZY))
+__getattr__, __dir__ = lazy_attributes(__name__, _LAZY, globals())
 
 
 def frequency_response(model, f_range_hz, harmonics="auto", stability: bool = False, **options):

@@ -5,7 +5,7 @@ arc-length continuation (continuation).
 The public names below are imported on first use (PEP 562), so that importing a light submodule
 (``bladedamp.hbm.fourier``) does not load the solver (scipy.sparse, numba).
 """
-import importlib
+from ..lazy import lazy_attributes
 
 _LAZY = {
     "HarmonicBasis": "fourier",
@@ -16,13 +16,4 @@ _LAZY = {
 __all__ = sorted(_LAZY)
 
 
-def __getattr__(name):
-    if name in _LAZY:
-        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'bladedamp.hbm' has no attribute {name!r}")
-
-
-def __dir__():
-    return sorted(set(globals()) | set(_LAZY))
+__getattr__, __dir__ = lazy_attributes(__name__, _LAZY, globals())
