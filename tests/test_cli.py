@@ -48,6 +48,10 @@ def test_reproduce_writes_summary_report_and_figures(tmp_path):
     lift = summary["wedge_liftoff"]
     assert np.array(lift["r"]).shape == (2, len(lift["xi_star"]))
     report = (tmp_path / "report.md").read_text()
+    # issue 13 item 10: no number a user has to decode
+    import re
+    assert not re.search(r"\bnan\b|(?<![\d.])-0\.0+\b(?!\.)|\d[eE][+-]0\d", report), \
+        [line for line in report.splitlines() if re.search(r"\bnan\b|-0\.0|[eE][+-]0\d", line)]
     assert "## Design studies" in report
     assert "| 1F |" in report and "verdict" in report
     for name in ("fig4_frf_four_modes.png", "fig5_mass_variation.png", "fig6_mass_optimisation.png",
