@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .studies.design import tip_dof_amplitude  # noqa: F401 (the figures of Table 1 use it)
+from .studies.design import tip_dof_amplitude
 
 # the paper's numbers that the reproduce report compares with
 PAPER = {

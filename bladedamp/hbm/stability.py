@@ -265,6 +265,12 @@ def floquet_exponents(system, x: np.ndarray, omega: float, tolerance: float = ST
     modes near resonance cross the imaginary axis; the exponents of far modes are not computed.
     """
     _, J, _ = system.residual(x, omega, True)
+    return _floquet_from_jacobian(system, J, omega, tolerance, n_near, method)
+
+
+def _floquet_from_jacobian(system, J, omega, tolerance, n_near, method) -> FloquetResult:
+    """:func:`floquet_exponents` from the Jacobian dR/dx at the point (computed once per point
+    by :func:`branch_stability`, which also needs it for the bordered determinant)."""
     sign = determinant_sign(J)
     if method not in ("auto", "hill", "determinant sign"):
         raise ValueError(f"method must be 'auto', 'hill' or 'determinant sign' (got {method!r})")
@@ -357,7 +363,12 @@ def branch_stability(system, coefficients: np.ndarray, omega: np.ndarray, x_scal
     t0 = time.perf_counter()
     omega = np.asarray(omega, dtype=float)
     X = np.asarray(coefficients).reshape(len(omega), -1)
-    results = [floquet_exponents(system, X[i], float(omega[i]), tolerance, method=method) for i in range(len(omega))]
+    tangents, scale, w_scale = _secant_tangents(X, omega, x_scale)
+    results, bordered = [], np.zeros(len(omega), dtype=int)
+    for i, w in enumerate(omega):          # one Jacobian per point serves both determinants
+        _, J, Jw = system.residual(X[i], float(w), True)
+        results.append(_floquet_from_jacobian(system, J, float(w), tolerance, None, method))
+        bordered[i] = _bordered_sign(J, Jw, tangents[i], scale, w_scale)
     width = max((r.exponents.size for r in results), default=0)
     exps = np.full((len(omega), width), np.nan + 0j)
     for i, r in enumerate(results):
@@ -369,34 +380,35 @@ def branch_stability(system, coefficients: np.ndarray, omega: np.ndarray, x_scal
     for i in changes:
         r = results[i] if not results[i].stable else results[i + 1]
         kinds.append({"real": "fold", "complex": "neimark-sacker"}.get(r.unstable_kind(), r.unstable_kind()))
-    bordered = _bordered_signs(system, X, omega, x_scale)
     branch_points = np.flatnonzero(bordered[1:] * bordered[:-1] < 0)
     method = results[0].method if results else "hill"
     return BranchStability(stable, exps, max_real, changes, tuple(kinds), branch_points, method,
                            time.perf_counter() - t0)
 
 
-def _bordered_signs(system, X, omega, x_scale) -> np.ndarray:
-    """Sign of det [[dR/dx, dR/domega], [t_x, t_omega]] at every point, with the secant tangent
+def _secant_tangents(X, omega, x_scale):
+    """``(tangents (n, N + 1), scale (N,), w_scale)``: the unit secant tangent at every point
     (central where possible) in scaled unknowns (x / x_scale, omega / range)."""
     n = len(omega)
-    if n < 2:
-        return np.zeros(n, dtype=int)
     scale = np.broadcast_to(np.asarray(x_scale, dtype=float), X.shape[1:])
     w_scale = max(float(np.ptp(omega)), 1e-300)
     Y = np.column_stack([X / scale, omega / w_scale])
-    signs = np.zeros(n, dtype=int)
-    for i in range(n):
-        t = Y[min(i + 1, n - 1)] - Y[max(i - 1, 0)]
-        t /= max(np.linalg.norm(t), 1e-300)
-        _, J, Jw = system.residual(X[i], float(omega[i]), True)
-        if sp.issparse(J):
-            A = sp.bmat([[sp.csc_matrix(J) @ sp.diags(scale), sp.csc_matrix(Jw[:, None] * w_scale)],
-                         [sp.csr_matrix(t[None, :-1]), sp.csr_matrix([[t[-1]]])]], format="csc")
-        else:
-            A = np.block([[np.asarray(J) * scale[None, :], (Jw * w_scale)[:, None]], [t[None, :]]])
-        signs[i] = determinant_sign(A)
-    return signs
+    T = Y[np.minimum(np.arange(n) + 1, n - 1)] - Y[np.maximum(np.arange(n) - 1, 0)]
+    T /= np.maximum(np.linalg.norm(T, axis=1, keepdims=True), 1e-300)
+    return T, scale, w_scale
+
+
+def _bordered_sign(J, Jw, t, scale, w_scale) -> int:
+    """Sign of det [[dR/dx, dR/domega], [t_x, t_omega]] in the scaled unknowns of ``t``
+    (0 for a single-point branch, whose tangent is zero)."""
+    if not np.any(t):
+        return 0
+    if sp.issparse(J):
+        A = sp.bmat([[sp.csc_matrix(J) @ sp.diags(scale), sp.csc_matrix(Jw[:, None] * w_scale)],
+                     [sp.csr_matrix(t[None, :-1]), sp.csr_matrix([[t[-1]]])]], format="csc")
+    else:
+        A = np.block([[np.asarray(J) * scale[None, :], (Jw * w_scale)[:, None]], [t[None, :]]])
+    return determinant_sign(A)
 
 
 def with_stability(model, response, method: str = "auto"):
