@@ -36,7 +36,7 @@ from .hbm.continuation import continuation
 from .hbm.start import robust_start
 from .hbm.fourier import HarmonicBasis
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import FrequencyResponse, physical_checks, with_checks, plot_branch
+from .response import REFINE_SAMPLES_FACTOR, FrequencyResponse, physical_checks, with_checks, plot_branch
 
 DAMPER_DOFS = ("uD_x", "uD_y", "uD_z", "phiD_x", "phiD_y", "phiD_z")
 
@@ -396,10 +396,18 @@ class TunedDisk:
             branch = continuation(system.residual, x0, w0, w1, x_scale=scales,
                                   max_step=max_step, **continuation_options)
             response = DiskResponse.from_branch(self, system, branch)
-            dissipation = response.point_dissipation.sum(axis=-1) if self.has_damper and len(branch.omega) \
-                else np.zeros((len(branch.omega), 0))
-            return with_checks(response, physical_checks(branch.omega, (w0, w1), dissipation,
-                                                         response.excitation_work, max_step, system.basis.n_samples))
+            T = system.basis.n_samples
+
+            def points_dissipation(r):       # every contact point's dissipation, (n, 2 P)
+                return r.point_dissipation.reshape(len(r.omega), -1) if self.has_damper and len(r.omega) \
+                    else np.zeros((len(r.omega), 0))
+
+            def refine(indices):
+                fine = model.hbm_system(system.basis.harmonics, REFINE_SAMPLES_FACTOR * T)
+                return points_dissipation(DiskResponse.from_branch(self, fine, branch.take(indices)))
+
+            return with_checks(response, physical_checks(branch.omega, (w0, w1), points_dissipation(response),
+                                                         response.excitation_work, max_step, T, refine))
 
         return converged_response(model, solve, harmonics, harmonic_tolerance, max_harmonic)
 

@@ -24,7 +24,7 @@ from .hbm.start import robust_start
 from .hbm.elements import CubicSpring
 from .hbm.fourier import HarmonicBasis
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import FrequencyResponse, physical_checks, with_checks
+from .response import REFINE_SAMPLES_FACTOR, FrequencyResponse, physical_checks, with_checks
 from .timedomain import TimeResponse, _oscillator_steady_state
 
 
@@ -143,9 +143,15 @@ class FrictionOscillator:
             response = FrequencyResponse(branch.omega, branch.x.reshape(-1, C, 1), system.basis, ("x",),
                                          branch.success, branch.message, branch.iterations, branch.turning_points)
             energy = self.energy_balance(response) if len(branch.omega) else np.zeros((0, 3))
+            T = system.basis.n_samples
+
+            def refine(indices):
+                fine = self.hbm_system(system.basis.harmonics, REFINE_SAMPLES_FACTOR * T)
+                return np.array([fine.element_dissipation(branch.x[i], branch.omega[i]) for i in indices])
+
             return with_checks(response, physical_checks(branch.omega, (omega_start, omega_end), energy[:, 2:],
                                                          energy[:, 0], continuation_options.get("max_step") or 0.02,
-                                                         system.basis.n_samples))
+                                                         T, refine))
 
         return converged_response(self, solve, harmonics, harmonic_tolerance, max_harmonic)
 

@@ -23,18 +23,20 @@ import pytest
 from bladedamp import FrictionOscillator
 from bladedamp.blade import reference_blade
 from bladedamp.damper.geometry import ContactProperties, CylinderDamper, WedgeDamper
-from bladedamp.disk import TunedDisk
+from bladedamp.disk import DiskResponse, TunedDisk
+from bladedamp.hbm.continuation import Branch
 from bladedamp import reference as ref
 
 SEED = 20261201
 N_DISKS = 160
 N_OSCILLATORS = 160
-# issue 12's target is 0.99; measured 271 of 320 = 0.847 on 2026-12-01 (268 = 0.838 before the
-# continuation's det orientation and its turn at non-smooth folds; 0.716 before the shared robust
-# start, the hop acceptance and the range clip). Until the target is met this is a regression
-# floor, not the target: the share is printed, and the failing designs with it.
+# issue 12's target is 0.99; measured 276 of 320 = 0.862 on 2026-12-01, third session (271 = 0.847
+# before the corner fallbacks of the continuation and the refined dissipation check; 268 = 0.838
+# before the continuation's det orientation and its turn at non-smooth folds; 0.716 before the
+# shared robust start, the hop acceptance and the range clip). Until the target is met this is a
+# regression floor, not the target: the share is printed, and the failing designs with it.
 SHARE_TARGET = 0.99
-SHARE_REQUIRED = 0.84
+SHARE_REQUIRED = 0.86
 # Harmonics of the oscillators cross-checked by time integration. The one-harmonic HBM is
 # wrong for inclined contacts (the normal load varies: it needs the static term and higher
 # harmonics); switch this to None (the frequency_response default) once that default is chosen
@@ -122,6 +124,25 @@ def branch_checks(omega, lo, hi, max_step) -> list[str]:
     return bad
 
 
+FINE_FACTOR = 16   # the re-evaluation of a suspect negative dissipation: 16 x the AFT samples
+
+
+def resolved_dissipation(d, r, indices):
+    """(k, m) dissipation at the points ``indices`` of response ``r`` of design ``d``, re-evaluated
+    from the same harmonic coefficients with FINE_FACTOR x the AFT samples per period: every contact
+    point of a disk's dampers, the contact of an oscillator. The suite's own check, written
+    independently of the product's (bladedamp.response.physical_checks)."""
+    H, fine_samples = r.basis.harmonics, FINE_FACTOR * r.basis.n_samples
+    if d["kind"][0] == "disk":
+        disk = make_disk(d)
+        fine = disk.hbm_system(H, fine_samples)
+        branch = Branch(r.omega[indices], r.coefficients[indices].reshape(len(indices), -1),
+                        np.zeros(len(indices), dtype=int), True, "")
+        return DiskResponse.from_branch(disk, fine, branch).point_dissipation.reshape(len(indices), -1)
+    fine = FrictionOscillator(**d["params"]).hbm_system(H, fine_samples)
+    return np.array([fine.element_dissipation(r.coefficients[i].ravel(), r.omega[i]) for i in indices])
+
+
 def run_design(d: dict) -> dict:
     """Run one design; returns success, message, the violated checks and the time taken."""
     t0 = time.perf_counter()
@@ -131,24 +152,29 @@ def run_design(d: dict) -> dict:
             r = make_disk(d).frequency_response(d["f_start"], d["f_end"], harmonics=d["harmonics"],
                                                 max_step=d["max_step"], max_points=MAX_POINTS)
             lo, hi = sorted((2 * np.pi * d["f_start"], 2 * np.pi * d["f_end"]))
-            diss = r.dissipated_energy
             work = np.abs(r.excitation_work)
-            points = r.point_dissipation
+            points = np.zeros((len(r.omega), 0)) if r.point_dissipation is None \
+                else r.point_dissipation.reshape(len(r.omega), -1)
         else:
             osc = FrictionOscillator(**d["params"])
             r = osc.frequency_response(d["omega_start"] / (2 * np.pi), d["omega_end"] / (2 * np.pi), harmonics=d["harmonics"],
                                        n_samples=d["n_samples"], max_step=d["max_step"], max_points=MAX_POINTS)
             lo, hi = sorted((d["omega_start"], d["omega_end"]))
             e = osc.energy_balance(r) if len(r.omega) else np.zeros((0, 3))
-            diss, work, points = e[:, 2], np.abs(e[:, 0]), None
-    bad = branch_checks(r.omega, lo, hi, d["max_step"])
-    # a friction contact cannot give energy back over a period: non-negative to rounding, 1e-9 of
-    # the largest excitation work on the branch (as bladedamp.response.physical_checks)
-    floor = -1e-9 * work.max() if len(r.omega) else 0.0
-    if len(r.omega) and np.any(diss < floor):
-        bad.append(f"negative dissipation {diss.min() / work.max():.3g} of the excitation work")
-    if points is not None and len(r.omega) and np.any(points < floor):
-        bad.append(f"negative point dissipation {points.min() / work.max():.3g} of the excitation work")
+            work, points = np.abs(e[:, 0]), e[:, 2:]
+        bad = branch_checks(r.omega, lo, hi, d["max_step"])
+        # a friction contact cannot give energy back over a period, whatever the harmonic
+        # truncation (bladedamp.response.physical_checks has the argument): a value below
+        # rounding (1e-9 of the excitation work) is the AFT's sampling error, re-evaluated with
+        # FINE_FACTOR x the samples, and fails if still below 1e-6 of the excitation work there
+        if len(r.omega):
+            relative = points.min(axis=1, initial=0.0) / work
+            suspect = np.flatnonzero(relative < -1e-9)
+            if suspect.size:
+                relative[suspect] = resolved_dissipation(d, r, suspect).min(axis=1, initial=0.0) / work[suspect]
+            if np.any(relative < -1e-6):
+                bad.append(f"negative dissipation {relative.min():.3g} of the excitation work "
+                           f"(with {FINE_FACTOR} x the AFT samples)")
     omega_end = 2 * np.pi * d["f_end"] if d["kind"][0] == "disk" else d["omega_end"]
     reached = bool(len(r.omega)) and abs(r.omega[-1] - omega_end) <= 1e-9 * abs(omega_end)
     return dict(kind=d["kind"], success=bool(r.success), reached=reached, message=r.message, bad=bad,

@@ -83,6 +83,13 @@ def _det_sign(A) -> int:
     return int(sign)
 
 
+# returns of a branch to its own earlier points after which it is taken to be in a loop: a
+# corner may send the corrector back over a few points before it passes (measured: the 1 g
+# cylinder on the beam blade's own frequencies, (0, ..., 5), came back to a point 9 steps
+# earlier at 95.39 Hz and then reached the end), a loop returns at every step
+MAX_REVISITS = 200
+
+
 class ConvergenceWarning(UserWarning):
     """A Newton or continuation run stopped without converging."""
 
@@ -140,6 +147,11 @@ class Branch:
     message: str
     turning_points: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))  # indices of folds
     checks: dict = field(default_factory=dict)   # name -> bool, see branch_checks
+
+    def take(self, indices) -> "Branch":
+        """The points ``indices`` of this branch (for re-evaluating them, e.g. with a finer AFT)."""
+        indices = np.asarray(indices, dtype=int)
+        return Branch(self.omega[indices], self.x[indices], self.iterations[indices], self.success, self.message)
 
 
 def branch_checks(omega, omega_start, omega_end, max_step) -> dict:
@@ -298,6 +310,134 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         A = scaled_system(y, prev)[1]
         return oriented(factorize(A)(np.append(np.zeros(n), 1.0)), A, prev)
 
+    def corner_tangent(y, yc, h):
+        """The oriented tangent at ``yc`` if ``yc`` (a converged corrector point more than 45
+        degrees off the predictor's tangent) lies past a corner on the piece of the branch that
+        leaves ``y``, else None.
+
+        At a corner of a piecewise-smooth branch (a stick-slip transition, a contact opening)
+        the corrector converges on the adjacent piece at a distance proportional to the step:
+        no step, however short, passes the 45-degree test. Measured on random disk 6 (a 0.094 g
+        wedge at slip onset, 94.996 Hz): the chord was 3.6 / 4.5 / 8.0 times the step at
+        h = 1e-2 / 1e-3 / 1e-4 and the branch turned by 75-83 degrees there. The point is
+        accepted when the chord from ``y`` runs along the branch through ``yc`` (within 25
+        degrees of its tangent, which excludes a jump to another branch crossing the
+        hyperplane) and stays short (at most 10 steps and 2 max_step)."""
+        chord = yc - y
+        length = np.linalg.norm(chord)
+        if not (0 < length <= min(10 * h, 2 * max_step)):
+            return None
+        chord = chord / length
+        try:
+            Az = scaled_system(yc, chord)[1]
+            t_z = factorize(Az)(np.append(np.zeros(n), 1.0))
+        except (np.linalg.LinAlgError, RuntimeError):
+            return None
+        if not np.all(np.isfinite(t_z)):
+            return None
+        if _det_sign(Az) == 0:              # sparse: no orientation, the chord gives the sense
+            t_z = np.sign(t_z @ chord) * t_z / np.linalg.norm(t_z)
+        else:
+            t_z = oriented(t_z, Az, chord, corner=True)
+        return t_z if t_z @ chord > 0.9 else None
+
+    def sphere_solution(y, v, radius):
+        """Newton on R = 0, |y_c - y| = radius from y + radius v (scaled); (point, iterations) or None."""
+        yc = y + radius * v
+        for it in range(1, max_corrector + 1):
+            R, A = scaled_system(yc, v)
+            if not np.all(np.isfinite(R)):
+                return None
+            d = yc - y
+            A[n] = 2 * d
+            G = np.append(R, (d @ d - radius ** 2) / radius)
+            A[n] /= radius
+            try:
+                dy = -factorize(A)(G)
+            except (np.linalg.LinAlgError, RuntimeError):
+                return None
+            yc = yc + dy
+            if np.linalg.norm(R) < tol and np.linalg.norm(dy) < np.sqrt(tol):
+                return yc, it
+        return None
+
+    def corner_escape(y, tangent, cycles, h_first):
+        """The branch's next point past a sharp corner or a non-smooth fold at ``y``, found on a
+        sphere around ``y``: (point, next tangent (scaled), iterations) or None.
+
+        Where the branch turns by more than 90 degrees at a corner, the hyperplane corrector
+        finds no point near its predictor at any step (the residual there is proportional to
+        the step: measured on random disk 51, a 7 g cylinder at 94.18 Hz, a Newton 2-cycle at
+        every step from 1e-2 to 1e-7), and the tangents of its 2-cycle iterates at the smallest
+        steps are those of the point itself. On a sphere of radius r around ``y`` the branch has
+        two points, the one it came from (direction -tangent) and the one it leaves by (there:
+        111 degrees off the tangent, omega turning back). Newton on the sphere from the
+        directions of the cycles' tangents (both senses, largest steps first) finds it; the
+        one leaving (not within 60 degrees of -tangent) and turning least is taken, and the
+        orientation is re-recorded on the new piece (a dense problem only)."""
+        if sp.issparse(scaled_system(y, tangent)[1]):
+            return None
+        directions = [tangent]
+        for _, iterates in cycles[:4]:
+            for z in iterates:
+                try:
+                    Az = scaled_system(z, tangent)[1]
+                    t_z = factorize(Az)(np.append(np.zeros(n), 1.0))
+                except (np.linalg.LinAlgError, RuntimeError):
+                    continue
+                if np.all(np.isfinite(t_z)):
+                    t_z = t_z / np.linalg.norm(t_z)
+                    directions += [t_z, -t_z]
+                chord = z - y
+                if np.linalg.norm(chord) > 0:
+                    directions.append(chord / np.linalg.norm(chord))
+        best = None
+        r0 = max(h_first, min(step, 1e-3))
+        for radius in (r0, 0.1 * r0, 0.01 * r0):
+            for v in directions:
+                found = sphere_solution(y, v, radius)
+                if found is None:
+                    continue
+                yc, it = found
+                d = (yc - y) / np.linalg.norm(yc - y)
+                if d @ tangent < -0.5 or abs(yc[n] - y[n]) * w_scale > max_dw:
+                    continue          # the piece it came from, or too long a step
+                if best is None or d @ tangent > best[1] @ tangent:
+                    best = (yc, d, it)
+            if best is not None:
+                break
+        if best is None:
+            return None
+        yc, d, it = best
+        try:
+            A = scaled_system(yc, d)[1]
+            t = factorize(A)(np.append(np.zeros(n), 1.0))
+        except (np.linalg.LinAlgError, RuntimeError):
+            return None
+        t = t / np.linalg.norm(t)
+        if t @ d < 0:
+            t = -t
+        orientation[0] = _det_sign(A) * (1 if t @ d >= 0 else -1) or orientation[0]
+        return yc, t, it
+
+    def retraced(points, new, h):
+        """Index of an earlier point (not among the last 5) that ``new`` comes back to, within
+        1 % of the step ``h`` (scaled), or None. An FRF branch never passes through one of its
+        own points again: measured on random disk 51 (a 7 g cylinder, (0, 1, 2, 3)), past a
+        non-smooth fold at 94.18 Hz the branch went back and forth between 94.28 and 94.30 Hz
+        at full steps, coming back to within 1e-5..5e-7 of earlier points, until the 2000-point
+        cap; stopping at the first return says so at once."""
+        if len(points) < 6:
+            return None
+        radius = 1e-2 * h
+        w = np.fromiter((p[n] for p in points[:-5]), float, len(points) - 5)
+        near = np.flatnonzero(np.abs(w - new[n]) < radius * w_scale)   # |d omega| bounds the distance
+        if near.size == 0:
+            return None
+        d = np.linalg.norm((np.array([points[j] for j in near]) - new) / scale(), axis=1)
+        k = int(np.argmin(d))
+        return int(near[k]) if d[k] < radius else None
+
     def solve_at(w, x_from):
         """Newton at fixed omega = w from the point(s) x_from (tried in turn)."""
         for x in x_from:
@@ -309,6 +449,7 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
     message, success = "", False
     h = step
     hops = 0  # consecutive fixed-omega hops over corners
+    revisits = 0  # returns to an earlier point (see retraced)
     end_retries = 0  # steps past omega_end whose landing on omega_end failed
     next_tangent = None  # from the last corrector's factorisation (scaled, then unscaled)
     while len(points) < max_points:
@@ -320,6 +461,8 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
             tangent /= np.linalg.norm(tangent)
         accepted = hopped = False
         h_first, cycle, turned = h, (), False
+        cycles = []   # (h, iterates) of every corrector that did not converge, largest h first
+        corner = None  # (point, iterations, h): the first converged corrector rejected as off the tangent
         while True:
             while h >= min_step:
                 yp = y + h * tangent
@@ -350,16 +493,21 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
                 # reject corrector results that jump back along the branch, that end farther from
                 # the predictor than the predictor is from the last point (more than 45 degrees off
                 # the tangent: another branch), or that step farther in omega than max_step allows
-                if ok and (yc - y) @ tangent > 0 and np.linalg.norm(yc - yp) <= h \
-                        and abs(yc[n] - y[n]) * w_scale <= max_dw:
+                forward = ok and (yc - y) @ tangent > 0 and abs(yc[n] - y[n]) * w_scale <= max_dw
+                if forward and np.linalg.norm(yc - yp) <= h:
                     accepted = True
                     hops = 0
                     # the next tangent solves [J; tangent] t = e_{n+1}: the matrix just factorised
                     # at the converged point (to the last update), so it costs one back-substitution
                     next_tangent = oriented(bordered(np.append(np.zeros(n), 1.0)), A, tangent)
                     break
+                if forward and corner is None:
+                    corner = (yc, it, h)     # a last resort, see corner_tangent
                 if not ok:
                     cycle = (previous_iterate, yc)
+                    cycles.append((h, cycle))
+                elif len(cycles) < 4:
+                    cycles.append((h, (yc,)))      # converged, rejected: its chord is a direction to try
                 h /= 2
             if accepted or turned or orientation[0] == 0:
                 break
@@ -426,6 +574,18 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
                 tangent = next_tangent = None
                 if hop_tangent is not None:
                     tangent = hop_tangent     # go on along the new piece (scaled; unscaled below)
+        if not accepted and corner is not None:
+            # the old paths (shorter steps, the turn at a 2-cycle, the hop) all failed: a point
+            # past a corner, if the chord to it runs along its own branch
+            t_corner = corner_tangent(y, corner[0], corner[2])
+            if t_corner is not None:
+                (yc, it, _), next_tangent = corner, t_corner
+                accepted, hops = True, 0
+        if not accepted and orientation[0] != 0:
+            escaped = corner_escape(y, tangent, cycles, h_first)
+            if escaped is not None:
+                yc, next_tangent, it = escaped
+                accepted, hops = True, 0
         if not accepted:
             w_stop = points[-1][n]
             message = f"continuation did not converge after omega = {w_stop:.6g} rad/s " \
@@ -470,8 +630,18 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         tangent_prev = None if tangent is None else tangent * scale()
         next_tangent = None if next_tangent is None else next_tangent * scale()
         h = max(h, step) if hopped else h
+        revisited = retraced(points, new, h)
         points.append(new)
         its.append(it)
+        if revisited is not None:
+            revisits += 1
+            if revisits >= MAX_REVISITS:
+                message = f"continuation retraced its own path at omega = {new[n]:.6g} rad/s " \
+                          f"({new[n] / (2 * np.pi):.6g} Hz; {revisits} returns to earlier points, the last to point " \
+                          f"{revisited} of {len(points)}: a loop or a back-and-forth between corners it cannot " \
+                          f"leave); branch kept up to there"
+                warnings.warn(message, ConvergenceWarning, stacklevel=2)
+                break
         x_scale = np.maximum(x_scale, np.abs(points[-1][:n]))
         if it <= target_iterations - 1:
             h = min(h * 1.5, max_step)
