@@ -380,6 +380,24 @@ class ModalBlade:
         return cls(natural_frequencies_hz=freqs, damping_ratios=damping_ratios,
                    mode_shapes=shapes, points=points, mode_names=names)
 
+    @classmethod
+    def from_solid(cls, geometry=None, element_size: float | None = None, n_modes: int = 4,
+                   **options) -> "ModalBlade":
+        """Build from a solid (3D, quadratic tetrahedra) FE model of the parametric blade.
+
+        ``geometry``: None (the reference blade), a :class:`BeamBladeGeometry` (its solid, with
+        geometry.py's platform and contact faces) or a :class:`bladedamp.solid.SolidBladeGeometry`;
+        ``element_size`` [m] gmsh's element size (None: :data:`bladedamp.solid.DEFAULT_ELEMENT_SIZE`,
+        6 mm, about 29 000 DOF for the reference blade); ``n_modes`` = 4 gives ("1F", "2F", "1T", "1E").
+        The same named points as :meth:`from_beam`, each a least-squares rigid-body fit of the
+        FE displacement (OL, OR over their platform contact face); the raw contact-face
+        displacements are kept in ``contact_faces``. ``options``: see
+        :func:`bladedamp.solid.solid_blade`. Needs the ``fe`` extra (gmsh, scikit-fem).
+        Returns a :class:`bladedamp.solid.SolidModalBlade` (a ModalBlade).
+        """
+        from . import solid   # gmsh / scikit-fem are imported only here
+        return solid.solid_blade(geometry, element_size, n_modes, **options)
+
     # -- files and FE matrices ---------------------------------------------------------
     @classmethod
     def from_file(cls, path) -> "ModalBlade":

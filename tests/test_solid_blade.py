@@ -1,0 +1,381 @@
+"""Validation of the solid finite-element blade (bladedamp.solid, ModalBlade.from_solid).
+
+Checks that could fail: the FE solution itself (mass normalisation, orthogonality, eigen
+residual, exact mass of the meshed volume), the plain cantilever plate against closed-form
+beam theory (nu = 0: the Euler-Bernoulli limit to 0.3 %; nu = 0.3: between the beam and the
+plate bounds), the reference solid against the beam model (shapes at the named points, 2F;
+1F is 3.4 % above the beam for physical reasons, see test_1F_within_3_percent_of_beam), the
+rigid-platform limit of the contact-face fit, and a tuned-disk FRF with the solid blade.
+
+Fast tests use coarse meshes (the reference solid at 9 mm, 14 400 DOF, 4 s; the plain plate at
+12 mm, 5 500 DOF, 1 s); the mesh-convergence table, the converged comparisons with the beam and
+the FRF are ``slow``.
+"""
+from __future__ import annotations
+
+import dataclasses
+import sys
+
+import numpy as np
+import pytest
+
+pytest.importorskip("gmsh", reason="the solid blade needs the fe extra: pip install 'bladedamp[fe]'")
+pytest.importorskip("skfem", reason="the solid blade needs the fe extra: pip install 'bladedamp[fe]'")
+
+import bladedamp as bd  # noqa: E402
+from bladedamp import solid  # noqa: E402
+from bladedamp.blade import REQUIRED_POINTS  # noqa: E402
+from bladedamp.reference import reference_blade_geometry  # noqa: E402
+
+COARSE = 9e-3          # [m] reference solid: 14 400 DOF, 1F 0.4 % above the 3 mm value
+PLATE = 12e-3          # [m] plain plate (no platform): 5 500 DOF, 1F within 0.02 % of nu = 0 theory
+CONVERGENCE_SIZES = (9e-3, 6e-3, 4.5e-3)   # [m] 14 400, 28 800, 54 100 DOF
+
+
+@pytest.fixture(scope="module")
+def beam():
+    """The beam model of the reference geometry with its own FE frequencies (no Table 1)."""
+    return bd.ModalBlade.from_beam(reference_blade_geometry())
+
+
+@pytest.fixture(scope="module")
+def coarse_modes():
+    return solid.solid_modes(None, COARSE)
+
+
+@pytest.fixture(scope="module")
+def coarse_blade(coarse_modes):
+    return solid.solid_blade(modes=coarse_modes)
+
+
+def _plate(nu, size=PLATE):
+    """The reference section as a plain clamped plate over the whole span (no platform)."""
+    g = dataclasses.replace(reference_blade_geometry(), poisson_ratio=nu)
+    return g, solid.solid_modes(solid.SolidBladeGeometry(beam=g, platform=False), size, 6)
+
+
+def _by_name(modes):
+    return dict(zip(modes.mode_names, modes.frequencies_hz))
+
+
+# --------------------------------------------------------------------------------------
+# the extra, the fit, the geometry
+# --------------------------------------------------------------------------------------
+def test_missing_fe_extra_gives_one_line_hint(monkeypatch):
+    monkeypatch.setitem(sys.modules, "gmsh", None)      # import gmsh -> ImportError
+    with pytest.raises(ImportError) as err:
+        bd.ModalBlade.from_solid()
+    assert str(err.value) == "the solid blade needs the fe extra: pip install 'bladedamp[fe]'"
+
+
+def test_rigid_fit_recovers_a_rigid_motion_exactly():
+    rng = np.random.default_rng(3)
+    x = rng.normal(size=(40, 3)) * 1e-2
+    w = rng.uniform(0.5, 1.5, 40)
+    ref = np.array([0.01, -0.02, 0.05])
+    q = rng.normal(size=(6, 2))
+    u = q[:3][None] + np.cross(q[3:].T[None], (x - ref)[:, None, :]).transpose(0, 2, 1)   # (40, 3, 2)
+    motion, residual, N = solid.rigid_fit(x, w, u, ref)
+    np.testing.assert_allclose(motion, q, rtol=1e-10, atol=1e-12)
+    assert residual.max() < 1e-12
+    # a deformation (u_x = x^2) is not rigid: the residual says so
+    _, residual, _ = solid.rigid_fit(x, w, (x[:, 0] ** 2)[:, None, None] * np.array([1.0, 0, 0])[None, :, None], ref)
+    assert residual[0] > 0.1
+
+
+def test_platform_section_is_the_3d_views():
+    geometry = pytest.importorskip("bladedamp.geometry")   # needs trimesh
+    sg = solid.SolidBladeGeometry()
+    g = sg.beam
+    pts = g.points()
+    view = geometry._platform_section(np.array([pts["OL"], pts["OR"]]), sg.gamma_left, sg.gamma_right,
+                                      1.25 * g.platform_half_width, sg.platform_top, 2.5e-3, 0.3e-3)
+    np.testing.assert_allclose(sg.platform_polygon(), view, rtol=0, atol=1e-15)
+    mesh = geometry.blade_mesh(g)
+    np.testing.assert_allclose(mesh.platform.bounds[:, 1], [-sg.platform_length / 2, sg.platform_length / 2])
+
+
+def test_mass_is_the_meshed_volume(coarse_modes):
+    """rho x the exact volume of the geometry (planar faces: linear tetrahedra fill it exactly)."""
+    sg = coarse_modes.geometry
+    g = sg.beam
+    poly = sg.platform_polygon()
+    area = 0.5 * abs(np.dot(poly[:, 0], np.roll(poly[:, 1], -1)) - np.dot(poly[:, 1], np.roll(poly[:, 0], -1)))
+    body = g.shank_thickness_x * g.shank_chord_y * g.total_length          # one section (reference)
+    overlap = g.shank_thickness_x * g.shank_chord_y * (sg.platform_top - poly[0, 1])
+    volume = body + area * sg.platform_length - overlap
+    assert coarse_modes.mass == pytest.approx(g.density * volume, rel=1e-9)
+    # the beam: 0.3265 kg body + 40.6 g plate; the solid's platform prism has 48.2 g
+    assert coarse_modes.mass - g.density * body == pytest.approx(0.0482, rel=0.01)
+
+
+# --------------------------------------------------------------------------------------
+# the FE solution
+# --------------------------------------------------------------------------------------
+def test_modes_are_mass_normalised_orthogonal_eigenvectors(coarse_modes):
+    m = coarse_modes
+    V, K, M = m.vectors, m.stiffness, m.mass_matrix
+    np.testing.assert_allclose(V.T @ (M @ V), np.eye(V.shape[1]), rtol=0, atol=1e-10)
+    lam = (2 * np.pi * m.frequencies_hz) ** 2
+    KV = V.T @ (K @ V)
+    np.testing.assert_allclose(KV, np.diag(lam), rtol=0, atol=1e-9 * lam.max())
+    free = m.free_dofs
+    residual = np.linalg.norm((K @ V - (M @ V) * lam)[free], axis=0) / np.linalg.norm((K @ V)[free], axis=0)
+    assert residual.max() < 1e-6
+    clamped = np.setdiff1d(np.arange(m.n_dofs), free)
+    assert clamped.size > 0 and np.all(V[clamped] == 0.0)
+    assert np.all(np.diff(m.frequencies_hz) > 0)
+
+
+def test_paper_modes_are_the_lowest_four_and_beam_like(coarse_modes):
+    m = coarse_modes
+    assert m.mode_names[:4] == ("1F", "2F", "1T", "1E")
+    assert m.tip_residual[:4].max() < 0.01              # the tip face moves rigidly
+    # each family dominates its own mode's tip motion
+    for j, fam in enumerate("FFTE"):
+        assert m.family_fractions[j, solid.FAMILIES.index(fam)] > 0.95
+
+
+def test_plain_plate_against_closed_form_beam_theory():
+    """The reference section as a plain cantilever over the 0.2 m span (no platform).
+
+    nu = 0: the solid is Euler-Bernoulli's beam in flatwise bending (no anticlastic plate effect),
+    so 1F and 2F agree with the closed form to 0.3 %. Edgewise (1E, chord 45.5 mm, L / chord 4.4)
+    the solid is 3 % below: shear deformation and rotary inertia (Timoshenko), which the beam
+    leaves out. 1T is 5-6 % above St. Venant: the clamped root holds the section's warping.
+    nu = 0.3: the wide section cannot curve anticlastically near the clamp, so 1F lies between the
+    beam (E) and the plate (E / (1 - nu^2), +4.9 % frequency) values.
+    """
+    g0, plate0 = _plate(0.0)
+    cf = solid.cantilever_frequencies_hz(g0)
+    f = _by_name(plate0)
+    assert f["1F"] / cf["1F"] == pytest.approx(1.0, abs=3e-3)
+    assert f["2F"] / cf["2F"] == pytest.approx(1.0, abs=3e-3)
+    assert 0.95 < f["1E"] / cf["1E"] < 1.0
+    assert 1.0 < f["1T"] / cf["1T"] < 1.10
+    g3, plate3 = _plate(0.3)
+    cf3, f3 = solid.cantilever_frequencies_hz(g3), _by_name(plate3)
+    assert 1.005 < f3["1F"] / cf3["1F"] < 1.0 / np.sqrt(1 - 0.3**2)
+
+
+# --------------------------------------------------------------------------------------
+# the ModalBlade
+# --------------------------------------------------------------------------------------
+def test_from_solid_has_the_beam_blades_points_and_shapes(coarse_blade, beam):
+    sb = coarse_blade
+    assert isinstance(sb, bd.ModalBlade) and isinstance(sb, solid.SolidModalBlade)
+    assert sb.mode_names == ("1F", "2F", "1T", "1E") == beam.mode_names
+    assert set(sb.points) == set(beam.points) and set(REQUIRED_POINTS) <= set(sb.points)
+    for p in sb.points:
+        np.testing.assert_array_equal(sb.points[p], beam.points[p])
+        assert sb.shape(p).shape == (6, 4)
+    # 1F and 2F shapes agree with the beam's at the tip and at the contact control points
+    for p, dof in (("tip", 0), ("tip", 4), ("OL", 0), ("OL", 2), ("OL", 4), ("OR", 0), ("OR", 2)):
+        np.testing.assert_allclose(sb.shape(p)[dof, :2], beam.shape(p)[dof, :2], rtol=0.05)
+    assert sb.shape("tip")[0, 0] == pytest.approx(beam.shape("tip")[0, 0], rel=0.02)
+    # the platform is mirror-symmetric in x: OR is OL mirrored (u_x, phi_y even in 1F)
+    np.testing.assert_allclose(sb.shape("OR")[[0, 4], 0], sb.shape("OL")[[0, 4], 0], rtol=1e-3)
+    np.testing.assert_allclose(sb.shape("OR")[2, 0], -sb.shape("OL")[2, 0], rtol=1e-3)
+    assert sb.solid_info["n_free"] < sb.solid_info["n_dofs"] and sb.solid_info["element_size"] == COARSE
+
+
+def test_contact_faces_hold_the_raw_displacements(coarse_blade):
+    sb = coarse_blade
+    for side in ("OL", "OR"):
+        face = sb.contact_faces[side]
+        n_p = solid.DEFAULT_FACE_SAMPLES[0] * solid.DEFAULT_FACE_SAMPLES[1]
+        assert face.points.shape == (n_p, 3) and face.shapes.shape == (n_p, 3, 4)
+        np.testing.assert_allclose((face.points - face.centre) @ face.frame[2], 0.0, atol=1e-12)   # on the face
+        np.testing.assert_allclose(face.rigid_motion, sb.shape(side), rtol=0, atol=1e-12)
+        np.testing.assert_allclose(face.rigid_residual, sb.fit_residuals[side])
+        # the reference platform is nearly rigid: the fit misses < 2 % of the face motion, and the
+        # raw samples differ from the fitted rigid motion by < 3 % of their largest value
+        assert face.rigid_residual.max() < 0.02
+        miss = np.abs(face.shapes - face.rigid_shapes()).max(axis=(0, 1)) / np.abs(face.shapes).max(axis=(0, 1))
+        assert miss.max() < 0.03
+    # mistuning and saving keep working on the subclass
+    scaled = sb.scaled(1.02)
+    assert isinstance(scaled, solid.SolidModalBlade) and scaled.contact_faces is sb.contact_faces
+    np.testing.assert_allclose(scaled.natural_frequencies_hz, 1.02 * sb.natural_frequencies_hz)
+
+
+def test_saved_solid_blade_reads_back(coarse_blade, tmp_path):
+    back = bd.ModalBlade.from_file(coarse_blade.save(tmp_path / "solid.npz"))
+    for p in coarse_blade.points:
+        np.testing.assert_array_equal(back.shape(p), coarse_blade.shape(p))
+    np.testing.assert_array_equal(back.natural_frequencies_hz, coarse_blade.natural_frequencies_hz)
+
+
+def test_mirrored_mesh_gives_exactly_symmetric_modes(coarse_blade):
+    """The default mesh is a quarter mirrored twice: the modes have the geometry's symmetries to
+    rounding. OR is OL mirrored in x, and what the y-mirror forbids at OL in the bending and torsion
+    modes (u_y, phi_x, phi_z in 1F / 2F; u_x, u_z, phi_y in 1T) vanishes. An unsymmetric mesh leaves
+    about 1e-5 of them, on which the tuned disk's continuation with a static harmonic crawls
+    (see bladedamp.solid.mesh_blade)."""
+    ol, or_ = coarse_blade.shape("OL"), coarse_blade.shape("OR")
+    scale = np.abs(ol).max(axis=0)                      # (4,) per mode
+    # x-mirror, 1F / 2F (u_x even in x): u_x and phi_y of OR are OL's, u_z the opposite
+    np.testing.assert_allclose(or_[[0, 4], :2], ol[[0, 4], :2], rtol=0, atol=1e-9 * scale.max())
+    np.testing.assert_allclose(or_[2, :2], -ol[2, :2], rtol=0, atol=1e-9 * scale.max())
+    # y-mirror: forbidden components at OL (on the plane y = 0)
+    assert np.abs(ol[[1, 3, 5], :2]).max() < 1e-9 * scale[:2].min()
+    assert np.abs(ol[[0, 2, 4], 2]).max() < 1e-9 * scale[2]
+    unsym = solid.solid_blade(None, COARSE, symmetric=False).shape("OL")
+    assert 1e-9 < np.abs(unsym[[1, 3, 5], 0]).max() / np.abs(unsym[:, 0]).max() < 1e-3
+
+
+def test_rigid_platform_limit():
+    """A platform 1000 times stiffer than steel moves rigidly: the OL / OR fit reproduces the raw
+    face displacements to 1e-4 (steel: up to 1e-2, the platform bends a little in 1T)."""
+    stiff = solid.solid_blade(solid.SolidBladeGeometry(platform_youngs_modulus=210e12), COARSE)
+    steel = solid.solid_blade(None, COARSE)
+    for side in ("OL", "OR"):
+        face = stiff.contact_faces[side]
+        assert face.rigid_residual.max() < 1e-4
+        miss = np.abs(face.shapes - face.rigid_shapes()).max(axis=(0, 1)) / np.abs(face.shapes).max(axis=(0, 1))
+        assert miss.max() < 1e-4
+        assert np.all(steel.contact_faces[side].rigid_residual > 30 * face.rigid_residual)
+    # 1F hardly changes (the platform sits near the root, 98.6 -> 99.5 Hz); 1T rises (the rigid
+    # block holds the section's twist and warping over its height, 858 -> 917 Hz)
+    assert stiff.natural_frequencies_hz[0] / steel.natural_frequencies_hz[0] == pytest.approx(1.0, abs=0.015)
+    assert stiff.natural_frequencies_hz[2] > 1.03 * steel.natural_frequencies_hz[2]
+
+
+def test_points_off_the_tip_and_interpolation():
+    """A point at mid-span gets the rigid fit over the cross-section there, as the beam attaches it
+    to its node; the interpolation (probes) reproduces the FE vector at the mesh's vertices."""
+    from bladedamp.blade import beam_modes
+    g = dataclasses.replace(reference_blade_geometry(), excitation_point=np.array([0.0, 0.0, 0.15]))
+    sb = solid.solid_blade(g, PLATE)
+    bm = beam_modes(g)
+    exc_beam = bm.point_shapes(g.points()["excitation"], int(np.argmin(np.abs(bm.node_z - 0.15))))
+    idx = [bm.mode_names.index(n) for n in ("1F", "2F")]
+    for dof in (0, 4):     # u_x and phi_y of 1F, 2F
+        np.testing.assert_allclose(sb.shape("excitation")[dof, :2], exc_beam[dof, idx], rtol=0.05)
+    # the section moves rigidly in 1F; in 2F z = 0.15 m is near the displacement node (0.157 m),
+    # where the section's anticlastic curvature is 5 % of its small motion
+    assert sb.fit_residuals["excitation"][0] < 1e-3 and sb.fit_residuals["excitation"][1] < 0.1
+    m = solid.solid_modes(None, PLATE, 4)
+    basis = m._fe["basis_k"]
+    vertices = np.arange(0, m.mesh.vertices.shape[1], 97)
+    values = m.displacements_at(m.mesh.vertices[:, vertices].T)                      # (P, 3, 4)
+    expected = np.stack([m.vectors[basis.nodal_dofs[c, vertices]] for c in range(3)], axis=1)
+    np.testing.assert_allclose(values, expected, rtol=0, atol=1e-9 * np.abs(m.vectors).max())
+
+
+def test_twisted_blade_and_root_block():
+    """Geometry variants: a 30 deg twist couples flatwise and edgewise (the tip moves in y in 1F)
+    at an unchanged mass (0.1 %); geometry.py's root block below the clamp adds flexibility
+    (1F and 1E drop)."""
+    plain = solid.solid_blade(None, PLATE)
+    twisted = solid.solid_blade(solid.SolidBladeGeometry(twist=np.radians(30.0)), PLATE)
+    assert twisted.solid_info["mass"] == pytest.approx(plain.solid_info["mass"], rel=1e-3)
+    tip_plain, tip_twisted = plain.shape("tip")[:, 0], twisted.shape("tip")[:, 0]
+    assert abs(tip_plain[1]) < 1e-9 * tip_plain[0] and abs(tip_twisted[1]) > 0.01 * tip_twisted[0]
+    rooted = solid.solid_blade(solid.SolidBladeGeometry(root_height=10e-3), PLATE)
+    assert rooted.natural_frequencies_hz[0] < 0.99 * plain.natural_frequencies_hz[0]
+    assert rooted.natural_frequencies_hz[3] < 0.97 * plain.natural_frequencies_hz[3]
+
+
+# --------------------------------------------------------------------------------------
+# slow: mesh convergence against the beam model and closed form, FRF
+# --------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def convergence():
+    return [solid.solid_modes(None, h) for h in CONVERGENCE_SIZES]
+
+
+@pytest.mark.slow
+def test_mesh_convergence_table(convergence, beam, capsys):
+    cf = solid.cantilever_frequencies_hz()
+    names = ("1F", "2F", "1T", "1E")
+    rows = [f"{'element size':>14} {'DOF':>7} " + " ".join(f"{n:>9}" for n in names) + "   [Hz]"]
+    for m in convergence:
+        f = _by_name(m)
+        rows.append(f"{1e3 * m.mesh.element_size:11.2f} mm {m.n_dofs:7d} " + " ".join(f"{f[n]:9.2f}" for n in names))
+    rows.append(f"{'beam model':>22} " + " ".join(f"{v:9.2f}" for v in beam.natural_frequencies_hz))
+    rows.append(f"{'closed form (no platf.)':>22} " + " ".join(f"{cf[n]:9.2f}" for n in names))
+    with capsys.disabled():
+        print("\nsolid reference blade, mesh convergence (quadratic tetrahedra):\n" + "\n".join(rows))
+    fine, finer = _by_name(convergence[-2]), _by_name(convergence[-1])
+    coarse = _by_name(convergence[0])
+    # converged from above (a compatible FE model is too stiff): the last refinement changes the
+    # bending modes by < 0.2 %, 1T and 1E by < 0.5 % (measured 0.10 / 0.09 / 0.29 / 0.09 %: the
+    # warping gradients of torsion at the clamp and the platform converge slowest)
+    for n, tol in zip(names, (2e-3, 2e-3, 5e-3, 5e-3)):
+        assert coarse[n] >= fine[n] >= finer[n]
+        assert fine[n] / finer[n] - 1 < tol
+    beam_f = dict(zip(beam.mode_names, beam.natural_frequencies_hz))
+    assert finer["2F"] / beam_f["2F"] == pytest.approx(1.0, abs=0.03)
+    # edgewise: shear and rotary inertia (the beam is Euler-Bernoulli) put the solid below
+    assert 0.95 < finer["1E"] / beam_f["1E"] < 1.0
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="modelling difference, not FE error: the converged solid 1F is 3.4 % "
+                   "above the beam model (plate effect of the wide section +1.5 %, the platform's finite height "
+                   "stiffening the shank +1.5 %, against the beam's lumped platform mass -0.5 %); see the docstring")
+def test_1F_within_3_percent_of_beam(convergence, beam):
+    """Converged solid 1F against the beam model's 94.99 Hz: 98.21 Hz at 4.5 mm (54 000 DOF), 98.14 Hz
+    at 3 mm (103 000 DOF): +3.4 %.
+
+    Not an FE error (the plain plate with nu = 0 matches Euler-Bernoulli to 0.02 %, and the solid
+    converges from above to 0.1 %), but physics the beam does not have:
+
+    * the plate effect: with nu = 0.3 the 45.5 mm wide section cannot curve anticlastically near the
+      clamp, so it bends stiffer than E I (the plain plate: 96.84 Hz against 95.46 Hz closed form,
+      +1.45 %; with nu = 0 95.43 Hz);
+    * the platform: in the beam a rigid lumped plate on one node, mass only (95.46 -> 94.99 Hz,
+      -0.5 %); in the solid a 5.4 mm high 30 x 50 mm block that also stiffens the shank over its
+      height at 30 % span, where the 1F curvature is high (plain plate 96.84 -> 98.3 Hz with it, +1.5 %).
+
+    With nu = 0 the solid with its platform is 1.0 % above the beam
+    (test_1F_without_the_plate_effect_is_within_3_percent_of_beam). The solid's 1T (851 Hz) is 14 %
+    above the beam's 743 Hz for the same two reasons in torsion: the clamp and the platform block hold
+    the section's warping (the beam is St. Venant, and its platform adds rotary inertia only).
+    """
+    f = _by_name(convergence[-1])
+    assert f["1F"] / beam.natural_frequencies_hz[0] == pytest.approx(1.0, abs=0.03)
+
+
+@pytest.mark.slow
+def test_1F_without_the_plate_effect_is_within_3_percent_of_beam(beam):
+    """nu = 0 (the beam's uniaxial stress): the solid with its platform is within 3 % of the beam
+    with the same nu (the rest is the platform's finite height, +1.0 %)."""
+    g = dataclasses.replace(reference_blade_geometry(), poisson_ratio=0.0)
+    f = _by_name(solid.solid_modes(g, solid.DEFAULT_ELEMENT_SIZE))
+    beam0 = bd.ModalBlade.from_beam(g)
+    ratio = f["1F"] / beam0.natural_frequencies_hz[0]
+    assert 1.0 < ratio < 1.03
+
+
+@pytest.mark.slow
+def test_tuned_disk_frf_with_the_solid_blade(beam, capsys):
+    """The reference disk (1 g cylinder, EO = 1) with the solid blade instead of the beam: the FRF
+    runs over 1F. With each model's own FE frequencies the peak moves with 1F (measured, harmonics
+    (0, 1, 2, 3): solid 0.4674 mm at 98.688 Hz, beam 0.4890 mm at 95.317 Hz: +3.5 % as 1F);
+    with the paper's Table 1 frequencies substituted in both (the shapes differ only) the peaks
+    agree to 0.5 % in frequency and 5 % in amplitude (solid 0.4773 mm at 95.342 Hz, beam
+    0.4899 mm at 95.327 Hz: -2.6 %; the solid's platform moves 1.8 % more at OL per tip motion
+    in 1F, so the damper works harder)."""
+    from bladedamp.reference import TABLE1_DAMPING_RATIOS, TABLE1_FREQUENCIES_HZ
+    ref = bd.reference_disk("cylinder", 1e-3)
+    solid_fe = bd.ModalBlade.from_solid(damping_ratios=TABLE1_DAMPING_RATIOS)
+    solid_t1 = solid.solid_blade(None, natural_frequencies_hz=TABLE1_FREQUENCIES_HZ,
+                                 damping_ratios=TABLE1_DAMPING_RATIOS)
+    beam_fe = dataclasses.replace(beam, damping_ratios=np.asarray(TABLE1_DAMPING_RATIOS))
+    runs = {}
+    for name, blade, rng in (("beam, FE", beam_fe, (90.0, 105.0)), ("solid, FE", solid_fe, (92.0, 108.0)),
+                             ("beam, Table 1", ref.blade, (90.0, 105.0)),
+                             ("solid, Table 1", solid_t1, (90.0, 105.0))):
+        frf = bd.frequency_response(dataclasses.replace(ref, blade=blade), rng, harmonics=(0, 1, 2, 3))
+        assert frf.success, frf.message
+        runs[name] = frf
+    with capsys.disabled():
+        print("\ntuned reference disk, 1 g cylinder, harmonics (0, 1, 2, 3):")
+        for name, frf in runs.items():
+            print(f"  {name:15s} peak {1e3 * frf.peak_amplitude:.4f} mm at {frf.peak_frequency_hz:.3f} Hz")
+    f_ratio = solid_fe.natural_frequencies_hz[0] / beam_fe.natural_frequencies_hz[0]
+    assert runs["solid, FE"].peak_frequency_hz / runs["beam, FE"].peak_frequency_hz == pytest.approx(f_ratio, abs=5e-3)
+    assert runs["solid, Table 1"].peak_frequency_hz == pytest.approx(runs["beam, Table 1"].peak_frequency_hz, rel=5e-3)
+    assert runs["solid, Table 1"].peak_amplitude == pytest.approx(runs["beam, Table 1"].peak_amplitude, rel=0.05)
