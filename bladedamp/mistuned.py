@@ -28,15 +28,18 @@ another ``n_samples`` a tuned full assembly differs from the cyclic solution by 
 discretisation error (measured: ~1e-3 relative with 6 blades, EO = 1, 64 samples).
 
 The Jacobian is sparse (each damper couples two neighbours): the structural matrices and
-the contact map are scipy.sparse matrices and the continuation factorises with
-``scipy.sparse.linalg.splu``. The contact points of all dampers are evaluated in one call of
-the point-contact kernel when the dampers share their normal law (always for frequency or
-mass mistuning), otherwise damper by damper.
+the contact map are scipy.sparse matrices (the Jacobian itself dense up to
+``AssemblySystem.dense_limit`` unknowns). The continuation factorises it, and its bordered
+form, with :class:`~bladedamp.hbm.linsolve.BlockRing`: the damper coordinates condensed, then
+block LU around the ring of blades, O(n) in the blades (``AssemblySystem.linear_solver``;
+"condensation" is the former dense-condensation / sparse-LU path). The contact points of all
+dampers are evaluated in one call of the point-contact kernel when the dampers share their
+normal law (always for frequency or mass mistuning), otherwise damper by damper.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Sequence
+from typing import ClassVar, Sequence
 
 import numpy as np
 import scipy.sparse as sp
@@ -51,11 +54,11 @@ from .disk import DAMPER_DOFS, DamperContacts, TunedDisk
 from .hbm.accuracy import HARMONIC_TOLERANCE, converged_response
 from .hbm.continuation import Branch, continuation
 from .hbm.start import robust_start
-from .hbm.linsolve import BlockCondensation, solve, one_blas_thread
+from .hbm.linsolve import BlockCondensation, BlockRing, one_blas_thread
 from .hbm.linsolve import factorize as lu_factorize
 from .hbm.fourier import HarmonicBasis
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import FrequencyResponse, physical_checks, with_checks
+from .response import REFINE_SAMPLES_FACTOR, FrequencyResponse, physical_checks, with_checks
 
 
 def sparse_real_form(basis: HarmonicBasis, per_harmonic) -> sp.csr_matrix:
@@ -306,10 +309,60 @@ class AssemblySystem(HarmonicBalanceSystem):
                 return None
         return BlockCondensation(interior, coupled, self.n_unknowns)
 
+    #: the linear solver of :meth:`factorize`: "auto" (the ring from :attr:`ring_min_blades`
+    #: blades on, else "condensation"), "ring" (:class:`~bladedamp.hbm.linsolve.BlockRing`,
+    #: O(n) in the blades), "condensation" (damper coordinates condensed, dense LU of the
+    #: blades' Schur complement, for dense Jacobians; sparse LU for sparse ones), "lu"
+    linear_solver = "auto"
+    #: blades from which "auto" takes the ring: every ring. Measured (benchmarks/README.md,
+    #: bench_mistuned_scaling.py): no crossover to resolve, factorise + solve of the bordered
+    #: Jacobian 0.7-2.2x the condensation's speed at 2-16 blades (within the noise of the
+    #: loaded machine), the linear solver's time per FRF point 0.9-1.6x less at 16 blades, 3x at
+    #: 64, 17-22x at 128; and the ring gives det A's sign (``solve.sign``), the condensation not
+    ring_min_blades = 2
+    _ring = None
+    _ring_blades = 0
+    _solvers = ("auto", "ring", "condensation", "lu")
+
+    def use_ring(self, n_blades: int, n_modes: int, positions) -> bool:
+        """Set up :class:`~bladedamp.hbm.linsolve.BlockRing` for a ring of ``n_blades`` blades of
+        ``n_modes`` modal coordinates each (unknowns harmonic-major, blades first, then the
+        dampers) whose d-th damper sits between blade ``positions[d]`` and the next; True if the
+        contact map has that pattern (each damper couples exactly those two blades)."""
+        self._ring, self._ring_blades = None, 0
+        N, C = self.n_dof, self.basis.n_coeffs
+        nd = len(positions)
+        if n_blades < 2 or N != n_blades * n_modes + 6 * nd or (nd and self._condensation is None):
+            return False
+        groups = (np.arange(C)[None, :, None] * N + np.arange(n_blades)[:, None, None] * n_modes
+                  + np.arange(n_modes)[None, None, :]).reshape(n_blades, C * n_modes)
+        links = np.asarray(positions, dtype=np.intp)
+        interior = None
+        if nd:
+            cond = self._condensation
+            interior = cond.interior
+            for d, k in enumerate(links):
+                pair = np.concatenate([groups[k], groups[(k + 1) % n_blades]])
+                if cond.coupled[d].size != pair.size or not np.array_equal(np.sort(cond.coupled[d]), np.sort(pair)):
+                    return False
+        try:
+            self._ring = BlockRing(groups, interior, links, self.n_unknowns)
+        except ValueError:                   # the unknowns are not blades and dampers only
+            return False
+        self._ring_blades = n_blades
+        return True
+
     def factorize(self, A):
-        """Condensation of the damper coordinates (:class:`~bladedamp.hbm.linsolve.BlockCondensation`)
-        for dense Jacobians, else LU."""
-        if self._condensation is not None and not sp.issparse(A):
+        """The linear solver of the continuation (:attr:`linear_solver`): the ring
+        (:class:`~bladedamp.hbm.linsolve.BlockRing`, dense or sparse A) when set up by
+        :meth:`use_ring` and chosen; else the condensation of the damper coordinates
+        (:class:`~bladedamp.hbm.linsolve.BlockCondensation`) for dense Jacobians, or LU."""
+        solver = self.linear_solver
+        if solver not in self._solvers:
+            raise ValueError(f"linear_solver must be one of {self._solvers} (got {solver!r})")
+        if self._ring is not None and (solver == "ring" or (solver == "auto" and self._ring_blades >= self.ring_min_blades)):
+            return self._ring(A)
+        if solver != "lu" and self._condensation is not None and not sp.issparse(A):
             return self._condensation(A)
         return lu_factorize(A)
 
@@ -386,6 +439,9 @@ class MistunedDisk:
     rotor_speed: float | None = None
     damper_inertia: bool = True
     initial_gaps: object = None
+    #: linear solver of the continuation (:attr:`AssemblySystem.linear_solver`); set it on an
+    #: instance (``disk.linear_solver = "condensation"``) to change that disk's solver
+    linear_solver: ClassVar[str] = "auto"
 
     def __post_init__(self):
         if isinstance(self.blades, ModalBlade) or len(self.blades) == 0:
@@ -485,8 +541,14 @@ class MistunedDisk:
         p = self.n_blades // np.gcd(self.n_blades, self.engine_order) if self.engine_order else 1
         return int(-(-default // p) * p)
 
-    def hbm_system(self, harmonics=(1,), n_samples=None, static_retention: float = 1e-4) -> HarmonicBalanceSystem:
-        """The sparse harmonic balance of the model (see TunedDisk.hbm_system for ``static_retention``)."""
+    def hbm_system(self, harmonics=(1,), n_samples=None, static_retention: float = 1e-4,
+                   linear_solver: str | None = None) -> HarmonicBalanceSystem:
+        """The sparse harmonic balance of the model (see TunedDisk.hbm_system for ``static_retention``).
+
+        ``linear_solver``: the system's ``factorize`` (:attr:`AssemblySystem.linear_solver`:
+        "auto", "ring", "condensation" or "lu"); default :attr:`linear_solver` of the disk."""
+        if linear_solver is not None and linear_solver not in AssemblySystem._solvers:
+            raise ValueError(f"linear_solver must be one of {AssemblySystem._solvers} (got {linear_solver!r})")
         if n_samples is None:
             n_samples = self.default_samples(harmonics)
         basis = HarmonicBasis(tuple(harmonics), n_samples)
@@ -551,8 +613,11 @@ class MistunedDisk:
                     df[basis.cos_index(0), z] = dF
             return f.ravel(), df.ravel()
 
-        return AssemblySystem(basis, mass.tocsr(), damp.tocsr(), stiff.tocsr(), excitation, couplings,
-                              None if static is None else static.tocsr())
+        system = AssemblySystem(basis, mass.tocsr(), damp.tocsr(), stiff.tocsr(), excitation, couplings,
+                                None if static is None else static.tocsr())
+        system.use_ring(s, nm, active)
+        system.linear_solver = self.linear_solver if linear_solver is None else linear_solver
+        return system
 
     def static_state(self, system: HarmonicBalanceSystem, omega: float) -> np.ndarray:
         """Rest, or with a static harmonic every damper seated frictionlessly under F_CG."""
@@ -569,7 +634,7 @@ class MistunedDisk:
         """Stuck linear solution (one Newton step from the static state; see TunedDisk._initial_guess)."""
         x = self.static_state(system, omega)
         R, J, _ = system.residual(x, omega)
-        return x - solve(J, R)
+        return x - system.factorize(J)(R)
 
     def start_solution(self, system: HarmonicBalanceSystem, omega: float, scales) -> np.ndarray:
         """Solution at the first frequency (:func:`bladedamp.hbm.start.robust_start`, as the tuned
@@ -629,8 +694,14 @@ class MistunedDisk:
             branch = continuation(system.residual, x0, w0, w1, x_scale=scales,
                                   factorize=system.factorize, max_step=max_step, **continuation_options)
             response = MistunedResponse.from_branch(self, system, branch, tuned_peak_amplitude)
+            T = system.basis.n_samples
+
+            def refine(indices):
+                fine = self.hbm_system(system.basis.harmonics, REFINE_SAMPLES_FACTOR * T)
+                return MistunedResponse.from_branch(self, fine, branch.take(indices)).damper_dissipation
+
             return with_checks(response, physical_checks(branch.omega, (w0, w1), response.damper_dissipation,
-                                                         response.excitation_work, max_step, system.basis.n_samples))
+                                                         response.excitation_work, max_step, T, refine))
 
         return converged_response(self, solve, harmonics, harmonic_tolerance, max_harmonic)
 

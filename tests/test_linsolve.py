@@ -77,7 +77,7 @@ def test_condensation_on_mistuned_jacobians(kind, harmonics):
     condensation of the damper coordinates equals the LU solution to 1e-10 relative."""
     disk = reference_disk(kind, 1e-3)
     md = MistunedDisk.from_tuned(disk, mt.random_kappa(16, 0.02, seed=[0, 1]))
-    system = md.hbm_system(harmonics)
+    system = md.hbm_system(harmonics, linear_solver="condensation")   # the ring: tests/test_ring_solver.py
     w = 2 * np.pi * 95.0
     x = md.initial_guess(system, w)
     x = x * (1 + 0.3 * np.random.default_rng(0).standard_normal(x.size))   # some slip and lift-off

@@ -75,8 +75,13 @@ def _bordered(J, column, row, column_scale, factor):
     return A
 
 
-def _det_sign(A) -> int:
-    """Sign of det A for a dense matrix (0 if singular, or for a sparse one: not computed)."""
+def _det_sign(A, solve=None) -> int:
+    """Sign of det A: from the factorisation ``solve`` if it carries one (``solve.sign``, e.g.
+    :class:`~bladedamp.hbm.linsolve.BlockRing`'s, at no extra cost), else by slogdet for a
+    dense matrix, else 0 (not computed: a sparse matrix without a signed factorisation)."""
+    sign = getattr(solve, "sign", None)
+    if sign is not None:
+        return int(sign)
     if sp.issparse(A) or not isinstance(A, np.ndarray):
         return 0
     sign, _ = np.linalg.slogdet(A)
@@ -286,12 +291,11 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
     # 102 and oscillator 136: 75-90 degrees) is not taken, and the sign is re-recorded instead.
     orientation = [0]
 
-    def oriented(t, bordered_matrix, reference, corner=False):
+    def oriented(t, sign, reference, corner=False):
         """t (solving [dR/dy; r^T] t = e_{n+1}, r = ``reference``) normalised, in the sense of
         the branch orientation (recorded from the start sense); ``corner``: at a corner the
         corrector could not pass, where the sign is taken whatever the angle."""
         t = t / np.linalg.norm(t)
-        sign = _det_sign(bordered_matrix)
         if sign == 0:
             return t
         if orientation[0] == 0 or (sign != orientation[0] and not corner
@@ -308,7 +312,8 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
             prev = prev / scale()
             prev /= np.linalg.norm(prev)
         A = scaled_system(y, prev)[1]
-        return oriented(factorize(A)(np.append(np.zeros(n), 1.0)), A, prev)
+        solve = factorize(A)
+        return oriented(solve(np.append(np.zeros(n), 1.0)), _det_sign(A, solve), prev)
 
     def corner_tangent(y, yc, h):
         """The oriented tangent at ``yc`` if ``yc`` (a converged corrector point more than 45
@@ -330,15 +335,17 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         chord = chord / length
         try:
             Az = scaled_system(yc, chord)[1]
-            t_z = factorize(Az)(np.append(np.zeros(n), 1.0))
+            solve_z = factorize(Az)
+            t_z = solve_z(np.append(np.zeros(n), 1.0))
         except (np.linalg.LinAlgError, RuntimeError):
             return None
         if not np.all(np.isfinite(t_z)):
             return None
-        if _det_sign(Az) == 0:              # sparse: no orientation, the chord gives the sense
+        sign = _det_sign(Az, solve_z)
+        if sign == 0:                       # sparse: no orientation, the chord gives the sense
             t_z = np.sign(t_z @ chord) * t_z / np.linalg.norm(t_z)
         else:
-            t_z = oriented(t_z, Az, chord, corner=True)
+            t_z = oriented(t_z, sign, chord, corner=True)
         return t_z if t_z @ chord > 0.9 else None
 
     def sphere_solution(y, v, radius):
@@ -411,13 +418,14 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         yc, d, it = best
         try:
             A = scaled_system(yc, d)[1]
-            t = factorize(A)(np.append(np.zeros(n), 1.0))
+            solve = factorize(A)
+            t = solve(np.append(np.zeros(n), 1.0))
         except (np.linalg.LinAlgError, RuntimeError):
             return None
         t = t / np.linalg.norm(t)
         if t @ d < 0:
             t = -t
-        orientation[0] = _det_sign(A) * (1 if t @ d >= 0 else -1) or orientation[0]
+        orientation[0] = _det_sign(A, solve) * (1 if t @ d >= 0 else -1) or orientation[0]
         return yc, t, it
 
     def retraced(points, new, h):
@@ -499,7 +507,7 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
                     hops = 0
                     # the next tangent solves [J; tangent] t = e_{n+1}: the matrix just factorised
                     # at the converged point (to the last update), so it costs one back-substitution
-                    next_tangent = oriented(bordered(np.append(np.zeros(n), 1.0)), A, tangent)
+                    next_tangent = oriented(bordered(np.append(np.zeros(n), 1.0)), _det_sign(A, bordered), tangent)
                     break
                 if forward and corner is None:
                     corner = (yc, it, h)     # a last resort, see corner_tangent
@@ -523,12 +531,14 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
             for z in cycle:
                 try:
                     Az = scaled_system(z, tangent)[1]
-                    t_z = factorize(Az)(np.append(np.zeros(n), 1.0))
+                    solve_z = factorize(Az)
+                    t_z = solve_z(np.append(np.zeros(n), 1.0))
                 except (np.linalg.LinAlgError, RuntimeError):
                     continue
-                if _det_sign(Az) == 0 or not np.all(np.isfinite(t_z)):
+                sign = _det_sign(Az, solve_z)
+                if sign == 0 or not np.all(np.isfinite(t_z)):
                     continue
-                t_z = oriented(t_z, Az, tangent, corner=True)
+                t_z = oriented(t_z, sign, tangent, corner=True)
                 if t_z @ tangent < 0.999:
                     tangent = t_z
                     break
