@@ -195,9 +195,15 @@ class FrictionOscillator:
 
     # ----- time integration -----------------------------------------------------------
     def time_response(self, f_hz, steps_per_period: int = 2048, max_periods: int = 5000,
-                      min_periods: int = 20, tol: float = 1e-9) -> TimeResponse:
-        """Steady state by central-difference integration from rest at each excitation
-        frequency ``f_hz`` [Hz] (scalar or array); the result's ``omega`` is in rad/s."""
+                      min_periods: int = 20, tol: float = 1e-9, initial_displacement: float = 0.0,
+                      initial_velocity: float = 0.0) -> TimeResponse:
+        """Steady state by central-difference integration at each excitation frequency ``f_hz``
+        [Hz] (scalar or array), from ``initial_displacement`` [m] and ``initial_velocity`` [m/s]
+        (default rest; started elsewhere, e.g. on an HBM solution, it shows which steady state
+        that start leads to where several coexist); the result's ``omega`` is in rad/s.
+        The cubic spring is integrated too: its stiffness 3 k3 x^2 grows with the amplitude, so
+        the step bound checked here (from the linear stiffnesses) does not cover it; a run that
+        blows up returns ``converged`` False."""
         f_hz = np.atleast_1d(np.asarray(f_hz, dtype=float))
         _validate.positive("f_hz (excitation frequency, Hz)", f_hz)
         _validate.integer("steps_per_period", steps_per_period, minimum=16)
@@ -208,8 +214,8 @@ class FrictionOscillator:
             need = int(np.ceil(2 * np.pi / (2 * np.pi * lowest) / (0.5 * dt_max)))
             raise ValueError(f"steps_per_period must be >= {need} for the explicit scheme at the lowest "
                              f"frequency {lowest:.6g} Hz (got {steps_per_period})")
-        if self.cubic_stiffness != 0:
-            raise ValueError("time_response does not integrate the cubic spring (cubic_stiffness must be 0)")
+        _validate.finite("initial_displacement", initial_displacement)
+        _validate.finite("initial_velocity", initial_velocity)
         samples = np.zeros((omega.size, steps_per_period))
         periods = np.zeros(omega.size, dtype=int)
         converged = np.zeros(omega.size, dtype=bool)
@@ -218,6 +224,8 @@ class FrictionOscillator:
             periods[i], converged[i] = _oscillator_steady_state(
                 w, self.mass, self.damping, self.stiffness, self.cubic_stiffness, self.contact_stiffness,
                 self.friction_coefficient, self.normal_load, self.normal_stiffness, sin_a, cos_a,
-                self.forcing, steps_per_period, max_periods, min_periods, tol, samples[i])
+                self.forcing, steps_per_period, max_periods, min_periods, tol, samples[i],
+                float(initial_displacement), float(initial_velocity))
+            converged[i] &= bool(np.all(np.isfinite(samples[i])))
         spec = np.fft.rfft(samples, axis=1) / steps_per_period
         return TimeResponse(omega, 2 * np.abs(spec[:, 1]), np.abs(samples).max(axis=1), samples, periods, converged)

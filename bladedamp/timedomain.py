@@ -25,12 +25,13 @@ from .io import Saveable
 
 @njit(cache=True)
 def _oscillator_steady_state(omega, m, c, k, k3, k_t, mu, n0, k_n, sin_a, cos_a, force,
-                             steps, max_periods, min_periods, tol, last_period):
-    """Integrate one frequency from rest; returns (periods used, converged) and fills last_period."""
+                             steps, max_periods, min_periods, tol, last_period, x0=0.0, v0=0.0):
+    """Integrate one frequency from x0 [m], v0 [m/s] (default rest; the slider relaxed at 0);
+    returns (periods used, converged) and fills last_period."""
     dt = 2 * np.pi / omega / steps
     a_lhs = m / dt ** 2 + c / (2 * dt)
-    x_prev = 0.0
-    x = 0.0
+    x_prev = x0 - v0 * dt
+    x = x0
     s0 = 0.0
     s1 = 0.0
     amp_old = -1.0

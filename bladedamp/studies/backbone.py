@@ -1,0 +1,241 @@
+"""Damper design by nonlinear modes: the optimal damper mass at many excitation levels from
+one EPMC backbone per mass (issue 14, item 4).
+
+For each damper mass the damped nonlinear mode (EPMC, :func:`bladedamp.nonlinear_mode`) is
+computed once; the resonance peak at any excitation level then follows by single-nonlinear-mode
+synthesis (:meth:`NonlinearModeResponse.forced_peak`), which costs a root search on the
+backbone and no harmonic balance. The optimum over mass is found as in
+:func:`bladedamp.studies.mass.optimal_mass`: a log grid over the bracket (every mode shared by
+all levels), then per level a bounded Brent search in log(mass) in the grid interval around
+the best grid point (the modes of the refinement are cached and shared as well).
+
+The synthesis assumes one resonant mode, well separated (the 1F family of the tuned disk at one
+engine order), and a first-harmonic excitation; its peaks are within about 1 % of the
+one-harmonic FRF peaks of the reference disk (tests/test_backbone_design.py compares the
+optima with :func:`~bladedamp.studies.mass.optimal_mass`).
+"""
+from __future__ import annotations
+
+import dataclasses
+import time
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from .. import _validate
+from ..io import Saveable
+from .mass import GRID_PER_DECADE, peak_response, with_mass
+
+
+@dataclass
+class BackboneDesign(Saveable):
+    """Optimal damper mass over excitation levels, by nonlinear modes.
+
+    Attributes (k masses evaluated, l excitation levels)
+    ----------
+    kind : damper type
+    mass : (k,) every damper mass whose nonlinear mode was computed, ascending [kg]
+    excitation_levels : (l,) excitation levels: the norm of the disk's force vector (F_x for the
+        reference disk) [N]
+    peak_amplitude : (k, l) predicted resonance tip amplitude (first harmonic, ``direction``) [m];
+        NaN where the mode failed or the peak lies outside its computed amplitude range
+    peak_frequency_hz : (k, l) frequency of that resonance [Hz]
+    optimal_mass : (l,) the mass of the lowest peak per level [kg]
+    optimal_peak_amplitude : (l,) its peak [m]
+    undamped_peak_amplitude : (l,) the peak without damper (linear: proportional to the level) [m]
+    bracket : (l, 2) the grid interval of each level's refinement [kg]
+    grid_mass : (g,) the log grid of the first stage [kg]
+    failed_masses : masses whose nonlinear mode did not converge (never the optimum) [kg]
+    at_bound : (l,) True where the optimum is a bound of the search (widen the bracket)
+    elapsed_s : wall time of the study [s]
+    message : what was done
+    """
+
+    kind: str
+    mass: np.ndarray
+    excitation_levels: np.ndarray
+    peak_amplitude: np.ndarray
+    peak_frequency_hz: np.ndarray
+    optimal_mass: np.ndarray
+    optimal_peak_amplitude: np.ndarray
+    undamped_peak_amplitude: np.ndarray
+    bracket: np.ndarray
+    grid_mass: np.ndarray
+    failed_masses: tuple = ()
+    at_bound: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    elapsed_s: float = float("nan")
+    message: str = ""
+
+    @property
+    def reduction(self) -> np.ndarray:
+        """(k, l) 1 - peak / undamped peak."""
+        return 1 - self.peak_amplitude / self.undamped_peak_amplitude[None, :]
+
+    @property
+    def optimal_reduction(self) -> np.ndarray:
+        """(l,) 1 - optimal peak / undamped peak."""
+        return 1 - self.optimal_peak_amplitude / self.undamped_peak_amplitude
+
+    def plot(self, axes=None):
+        """Amplitude reduction [%] over mass [g] per level (left) and the optimal mass [g] over
+        the level [N] (right). ``axes``: a pair of axes (a new figure if None); returns the pair."""
+        import matplotlib.pyplot as plt
+
+        if axes is None:
+            _, axes = plt.subplots(1, 2, figsize=(11, 4))
+        ax, ax2 = axes
+        for j, level in enumerate(self.excitation_levels):
+            line, = ax.semilogx(1e3 * self.mass, 100 * self.reduction[:, j], ".-", label=f"F = {level:.3g} N")
+            ax.plot(1e3 * self.optimal_mass[j], 100 * self.optimal_reduction[j], "o", color=line.get_color())
+        ax.set_xlabel("damper mass [g]")
+        ax.set_ylabel("reduction of the resonance tip amplitude [%]")
+        ax.set_title(f"{self.kind}: peak by single nonlinear mode synthesis", fontsize=9)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+        ax2.loglog(self.excitation_levels, 1e3 * self.optimal_mass, "o-")
+        ax2.set_xlabel("excitation level [N]")
+        ax2.set_ylabel("optimal damper mass [g]")
+        ax2.grid(True, which="both", alpha=0.3)
+        return axes
+
+
+def synthesised_peak(mode, scale: float = 1.0, direction: int = 0):
+    """(tip amplitude [m], frequency [Hz]) of the resonance of ``mode`` under ``scale`` times its
+    own excitation, by single-nonlinear-mode synthesis: the largest root of
+    2 zeta omega^2 sqrt(1 - zeta^2) a = |phi_1^H F| (see
+    :meth:`~bladedamp.hbm.nonlinear_modes.NonlinearModeResponse.forced_peak`), with zeta, omega,
+    |phi_1^H F| and log(tip / a) interpolated by cubic splines in log a. The splines (error of
+    order h^4) make the peak a smooth function of the damper mass, which the optimisation in a flat
+    valley needs: the monotone (pchip) interpolation of ``forced_peak`` is only of order h^3 and its
+    error jumps by up to 1 % as the amplitude grid moves with the mass. NaN outside the range."""
+    from scipy.interpolate import CubicSpline
+    from scipy.optimize import brentq
+
+    a = np.asarray(mode.modal_amplitude, dtype=float)
+    out = np.asarray(mode.output_amplitude, dtype=float)
+    if a.size < 4 or out.ndim != 2 or out.shape[1] <= direction:
+        return np.nan, np.nan
+    s = np.log(a)
+    z, w = np.asarray(mode.damping_ratio, dtype=float), mode.omega
+    g = np.abs(mode.shape(1).conj() @ mode.excitation)
+    h = 2 * z * w ** 2 * np.sqrt(np.clip(1 - z ** 2, 0, None)) * a - scale * g
+    below = np.flatnonzero(h <= 0)
+    if h[0] > 0 or not below.size or below[-1] == a.size - 1:
+        return np.nan, np.nan
+    i = below[-1]
+    fz, fw, fg = CubicSpline(s, z), CubicSpline(s, w), CubicSpline(s, g)
+    fo = CubicSpline(s, np.log(np.maximum(out[:, direction], 1e-300) / a))
+
+    def hfun(x):
+        zz, ww = float(fz(x)), float(fw(x))
+        return 2 * zz * ww ** 2 * np.sqrt(max(1 - zz ** 2, 0.0)) * np.exp(x) - scale * float(fg(x))
+
+    x = brentq(hfun, s[i], s[i + 1], xtol=1e-14, rtol=1e-14)
+    zp, wp = float(fz(x)), float(fw(x))
+    return float(np.exp(fo(x) + x)), wp * np.sqrt(max(1 - 2 * zp ** 2, 0.0)) / (2 * np.pi)
+
+
+def _force_scale(disk) -> float:
+    level = float(np.linalg.norm(disk.excitation[:3]))
+    if level == 0:
+        raise ValueError("the disk has no excitation force (excitation[:3] is zero): nothing to scale")
+    return level
+
+
+def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid_per_decade: float = GRID_PER_DECADE,
+                             xatol: float = 5e-3, direction: int = 0, harmonics=(1,), n_points: int = 60,
+                             tol: float = 1e-9, f_range_hz=(90.0, 105.0)) -> BackboneDesign:
+    """Damper mass minimising the resonance tip amplitude at each of ``excitation_levels`` [N].
+
+    ``disk`` : a TunedDisk with a damper (its mass is replaced), or the damper kind ("cylinder",
+    "wedge") for the reference disk; ``excitation_levels`` : force levels [N] (> 0): the disk's
+    excitation vector scaled to that norm (F_x of the reference disk); ``bracket`` : (low, high)
+    masses [kg]; ``grid_per_decade`` : density of the log grid (at least 5 points);
+    ``xatol`` : tolerance of the Brent search in log(mass) (5e-3: 0.5 % in mass);
+    ``direction`` : tip DOF of the amplitude (0..2: u_x, u_y, u_z); ``harmonics``, ``n_points``,
+    ``tol`` : of :func:`bladedamp.nonlinear_mode`; ``f_range_hz`` : range of the undamped peak's FRF.
+    """
+    from ..hbm.nonlinear_modes import nonlinear_mode
+    from ..reference import reference_disk
+
+    t0 = time.perf_counter()
+    if isinstance(disk, str):
+        disk = reference_disk(disk)
+    if getattr(disk, "damper", None) is None:
+        raise ValueError("the disk must have a damper (its mass is the design variable)")
+    levels = np.atleast_1d(np.asarray(excitation_levels, dtype=float))
+    if levels.ndim != 1 or levels.size == 0:
+        raise ValueError(f"excitation_levels must be a non-empty 1-D array of forces in (0, inf) N (got {excitation_levels!r})")
+    _validate.positive("excitation_levels", levels)
+    lo, hi = _validate.interval("bracket", bracket, "kg")
+    _validate.positive("bracket", np.array([lo, hi]))
+    _validate.positive("xatol", xatol)
+    _validate.positive("grid_per_decade", grid_per_decade)
+    direction = _validate.integer("direction", direction, minimum=0, maximum=2)
+    ref = _force_scale(disk)
+    scales = levels / ref
+
+    modes, peaks, freqs = {}, {}, {}
+
+    def evaluate(m: float):
+        """Peaks (l,) [m] of mass m (cached)."""
+        m = float(m)
+        if m not in peaks:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                r = nonlinear_mode(with_mass(disk, m), harmonics=harmonics, n_points=n_points, tol=tol)
+            modes[m] = r
+            p = np.full(levels.size, np.nan)
+            f = np.full(levels.size, np.nan)
+            if len(r.modal_amplitude) >= 4:
+                for j, s in enumerate(scales):
+                    p[j], f[j] = synthesised_peak(r, s, direction)
+            peaks[m], freqs[m] = p, f
+        return peaks[m]
+
+    n = max(5, int(np.ceil(grid_per_decade * np.log10(hi / lo))) + 1)
+    loggrid = np.linspace(np.log(lo), np.log(hi), n)
+    grid = np.exp(loggrid)
+    grid_vals = np.array([evaluate(m) for m in grid])              # (n, l)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        undamped1, _, _ = peak_response(dataclasses.replace(disk, damper=None), f_range_hz, harmonics, direction=direction)
+    undamped = undamped1 * scales
+
+    best_m = np.full(levels.size, np.nan)
+    best_p = np.full(levels.size, np.nan)
+    brackets = np.full((levels.size, 2), np.nan)
+    at_bound = np.zeros(levels.size, dtype=bool)
+    for j in range(levels.size):
+        col = grid_vals[:, j]
+        if not np.any(np.isfinite(col)):
+            continue
+        i = int(np.nanargmin(col))
+        a, b = loggrid[max(i - 1, 0)], loggrid[min(i + 1, n - 1)]
+        brackets[j] = np.exp([a, b])
+        fail = 10 * undamped[j]
+
+        def objective(logm, j=j, fail=fail):
+            v = evaluate(np.exp(logm))[j]
+            return v if np.isfinite(v) else fail
+
+        minimize_scalar(objective, bounds=(a, b), method="bounded", options={"xatol": xatol})
+        ok = [(m, v[j]) for m, v in peaks.items() if np.isfinite(v[j])]
+        m_best, p_best = min(ok, key=lambda mv: mv[1])
+        best_m[j], best_p[j] = m_best, p_best
+        at_bound[j] = m_best in (grid[0], grid[-1])
+
+    masses = np.array(sorted(peaks))
+    failed = tuple(m for m in masses if not len(modes[m].modal_amplitude) >= 2 or not modes[m].success)
+    text = (f"{len(masses)} nonlinear modes ({n}-point log grid {1e3 * lo:.4g}-{1e3 * hi:.4g} g and a bounded "
+            f"search per level, xatol {xatol:g} in log mass), {levels.size} excitation level(s)")
+    if failed:
+        text += f"; no mode for {', '.join(f'{1e3 * m:.4g}' for m in failed)} g"
+    if at_bound.any():
+        text += f"; optimum at a bound of the bracket for level(s) {', '.join(f'{x:.3g}' for x in levels[at_bound])} N"
+    return BackboneDesign(disk.damper.kind, masses, levels, np.array([peaks[m] for m in masses]),
+                          np.array([freqs[m] for m in masses]), best_m, best_p, undamped, brackets, grid,
+                          failed, at_bound, time.perf_counter() - t0, text)
