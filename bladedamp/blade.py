@@ -876,6 +876,29 @@ def _tip_sign(tip: np.ndarray, shapes: dict) -> np.ndarray:
 # --------------------------------------------------------------------------------------
 # Beam blade geometry and FE model
 # --------------------------------------------------------------------------------------
+def platform_section(centres, gamma_left: float, gamma_right: float, edge: float, top: float,
+                     face_inner_length: float, min_edge_thickness: float) -> np.ndarray:
+    """(6, 2) (x, z) section of the platform prism [m], of the 3D view
+    (:func:`bladedamp.geometry.blade_mesh`) and the solid FE blade (:mod:`bladedamp.solid`):
+    ``l_in, r_in, r_out, r_top, l_top, l_out``: top at z = top, edges at x = -/+ edge, undersides
+    through the contact centres inclined by gamma_L (OL, -x side) and gamma_R (OR, +x side), a
+    flat bottom between them. The undersides run from
+    ``*_in`` (``face_inner_length`` toward the axis from the contact centre) to ``*_out`` (at the
+    edge x = -/+ edge, or where they come within ``min_edge_thickness`` of the top z = top)."""
+    sides = []
+    for side, (centre, gamma) in enumerate(zip(centres, (gamma_left, gamma_right))):
+        sign = -1.0 if side == 0 else 1.0                      # OL face on -x, OR face on +x
+        c = np.array([centre[0], centre[2]])
+        t = np.array([sign * np.cos(gamma), np.sin(gamma)])    # along the face, outward and up
+        s_edge = (edge - sign * c[0]) / np.cos(gamma)
+        s_top = (top - min_edge_thickness - c[1]) / np.sin(gamma)
+        s_out = max(min(s_edge, s_top), 1e-6)
+        inner, outer = c - face_inner_length * t, c + s_out * t
+        sides.append((inner, outer, np.array([outer[0], top])))
+    (l_in, l_out, l_top), (r_in, r_out, r_top) = sides
+    return np.array([l_in, r_in, r_out, r_top, l_top, l_out])
+
+
 @dataclass(eq=False)
 class BeamBladeGeometry:
     """Simplified blade of the paper's Fig. 4: clamped root, shank, platform, airfoil.

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import trimesh
 
-from .blade import BeamBladeGeometry, reference_blade_geometry
+from .blade import BeamBladeGeometry, platform_section, reference_blade_geometry
 from .damper.geometry import CylinderDamper, DamperGeometry, WedgeDamper
 
 __all__ = ["prism", "BladeMesh", "blade_mesh", "cylinder_mesh", "wedge_mesh", "damper_mesh", "SectorLayout",
@@ -173,24 +173,6 @@ def _prism_z(section_xy, z0: float, z1: float) -> trimesh.Trimesh:
     return mesh
 
 
-def _platform_section(centres, gamma_left, gamma_right, edge, top, face_in, min_edge_thickness):
-    """(x, z) section of the platform: top at z = top, edges at x = -/+ edge (or where the inclined
-    underside comes within ``min_edge_thickness`` of the top), undersides through the contact
-    centres inclined by gamma_L (OL, -x side) and gamma_R (OR, +x side); flat bottom between them."""
-    sides = []
-    for side, (centre, gamma) in enumerate(zip(centres, (gamma_left, gamma_right))):
-        sign = -1.0 if side == 0 else 1.0                      # OL face on -x, OR face on +x
-        c = np.array([centre[0], centre[2]])
-        t = np.array([sign * np.cos(gamma), np.sin(gamma)])    # along the face, outward and up
-        s_edge = (edge - sign * c[0]) / np.cos(gamma)
-        s_top = (top - min_edge_thickness - c[1]) / np.sin(gamma)
-        s_out = max(min(s_edge, s_top), 1e-6)
-        inner, outer = c - face_in * t, c + s_out * t
-        sides.append((inner, outer, np.array([outer[0], top])))
-    (l_in, l_out, l_top), (r_in, r_out, r_top) = sides
-    return np.array([l_in, r_in, r_out, r_top, l_top, l_out])
-
-
 def blade_mesh(geometry: BeamBladeGeometry | None = None, gamma_left: float = np.radians(35.0),
                gamma_right: float = np.radians(35.0), contact_centres=None, *, platform_edge: float | None = None,
                platform_length: float | None = None, face_inner_length: float = 2.5e-3, root_height: float = 10e-3,
@@ -220,7 +202,7 @@ def blade_mesh(geometry: BeamBladeGeometry | None = None, gamma_left: float = np
     length = 1.1 * max(g.airfoil_chord_y, g.shank_chord_y) if platform_length is None else float(platform_length)
     z_p = g.shank_length
     top = z_p + max(g.platform_contact_z_offset, 1e-3)
-    section = _platform_section(centres, gamma_left, gamma_right, edge, top, face_inner_length, 0.3e-3)
+    section = platform_section(centres, gamma_left, gamma_right, edge, top, face_inner_length, 0.3e-3)
     platform = prism(section, -length / 2, length / 2)
 
     tx, cy = g.shank_thickness_x, g.shank_chord_y

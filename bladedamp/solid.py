@@ -75,11 +75,11 @@ import scipy.sparse
 import scipy.sparse.linalg
 
 from . import _validate as check
-from .blade import SHIFT_INVERT_SIGMA, BeamBladeGeometry, ModalBlade, PAPER_MODE_ORDER
+from .blade import SHIFT_INVERT_SIGMA, BeamBladeGeometry, ModalBlade, PAPER_MODE_ORDER, platform_section
 
 __all__ = ["FE_HINT", "SolidBladeGeometry", "SolidMesh", "SolidModes", "ContactFaceModes", "SolidModalBlade",
            "mesh_blade", "solid_modes", "solid_blade", "rigid_fit", "classify_tip_motion",
-           "platform_section", "cantilever_frequencies_hz"]
+           "cantilever_frequencies_hz"]
 
 FE_HINT = "the solid blade needs the fe extra: pip install 'bladedamp[fe]'"
 
@@ -119,25 +119,6 @@ def _require_fe():
 # --------------------------------------------------------------------------------------
 # geometry
 # --------------------------------------------------------------------------------------
-def platform_section(centres, gamma_left: float, gamma_right: float, edge: float, top: float,
-                     face_inner_length: float, min_edge_thickness: float) -> np.ndarray:
-    """(6, 2) (x, z) section of the platform prism [m], the same polygon as
-    :func:`bladedamp.geometry.blade_mesh` (whose ``_platform_section`` needs trimesh; a test
-    checks the two agree): ``l_in, r_in, r_out, r_top, l_top, l_out``. The undersides run from
-    ``*_in`` (``face_inner_length`` toward the axis from the contact centre) to ``*_out`` (at the
-    edge x = -/+ edge, or where they come within ``min_edge_thickness`` of the top z = top)."""
-    sides = []
-    for side, (centre, gamma) in enumerate(zip(centres, (gamma_left, gamma_right))):
-        sign = -1.0 if side == 0 else 1.0                      # OL face on -x, OR face on +x
-        c = np.array([centre[0], centre[2]])
-        t = np.array([sign * np.cos(gamma), np.sin(gamma)])    # along the face, outward and up
-        s_edge = (edge - sign * c[0]) / np.cos(gamma)
-        s_top = (top - min_edge_thickness - c[1]) / np.sin(gamma)
-        s_out = max(min(s_edge, s_top), 1e-6)
-        inner, outer = c - face_inner_length * t, c + s_out * t
-        sides.append((inner, outer, np.array([outer[0], top])))
-    (l_in, l_out, l_top), (r_in, r_out, r_top) = sides
-    return np.array([l_in, r_in, r_out, r_top, l_top, l_out])
 
 
 @dataclass(eq=False)

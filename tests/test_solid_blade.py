@@ -85,11 +85,12 @@ def test_rigid_fit_recovers_a_rigid_motion_exactly():
 
 def test_platform_section_is_the_3d_views():
     geometry = pytest.importorskip("bladedamp.geometry")   # needs trimesh
+    from bladedamp.blade import platform_section
     sg = solid.SolidBladeGeometry()
     g = sg.beam
     pts = g.points()
-    view = geometry._platform_section(np.array([pts["OL"], pts["OR"]]), sg.gamma_left, sg.gamma_right,
-                                      1.25 * g.platform_half_width, sg.platform_top, 2.5e-3, 0.3e-3)
+    view = platform_section(np.array([pts["OL"], pts["OR"]]), sg.gamma_left, sg.gamma_right,
+                            1.25 * g.platform_half_width, sg.platform_top, 2.5e-3, 0.3e-3)   # the view's parameters
     np.testing.assert_allclose(sg.platform_polygon(), view, rtol=0, atol=1e-15)
     mesh = geometry.blade_mesh(g)
     np.testing.assert_allclose(mesh.platform.bounds[:, 1], [-sg.platform_length / 2, sg.platform_length / 2])

@@ -304,6 +304,17 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
             return t
         return t * sign * orientation[0]
 
+    def bordered_tangent(y, row):
+        """(t, sign of det) solving [dR/dy; row^T] t = e_{n+1} at y (scaled, unnormalised), the
+        bordered matrix factorised once; None if it is singular or t is not finite."""
+        try:
+            A = scaled_system(y, row)[1]
+            solve = factorize(A)
+            t = solve(np.append(np.zeros(n), 1.0))
+        except (np.linalg.LinAlgError, RuntimeError):   # singular (RuntimeError: splu)
+            return None
+        return (t, _det_sign(A, solve)) if np.all(np.isfinite(t)) else None
+
     def tangent_at(y, prev):
         if prev is None:
             prev = np.zeros(n + 1)
@@ -312,7 +323,7 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
             prev = prev / scale()
             prev /= np.linalg.norm(prev)
         A = scaled_system(y, prev)[1]
-        solve = factorize(A)
+        solve = factorize(A)        # a singular matrix raises here, as the callers expect
         return oriented(solve(np.append(np.zeros(n), 1.0)), _det_sign(A, solve), prev)
 
     def corner_tangent(y, yc, h):
@@ -333,15 +344,10 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         if not (0 < length <= min(10 * h, 2 * max_step)):
             return None
         chord = chord / length
-        try:
-            Az = scaled_system(yc, chord)[1]
-            solve_z = factorize(Az)
-            t_z = solve_z(np.append(np.zeros(n), 1.0))
-        except (np.linalg.LinAlgError, RuntimeError):
+        found = bordered_tangent(yc, chord)
+        if found is None:
             return None
-        if not np.all(np.isfinite(t_z)):
-            return None
-        sign = _det_sign(Az, solve_z)
+        t_z, sign = found
         if sign == 0:                       # sparse: no orientation, the chord gives the sense
             t_z = np.sign(t_z @ chord) * t_z / np.linalg.norm(t_z)
         else:
@@ -387,14 +393,11 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         directions = [tangent]
         for _, iterates in cycles[:4]:
             for z in iterates:
-                try:
-                    Az = scaled_system(z, tangent)[1]
-                    t_z = factorize(Az)(np.append(np.zeros(n), 1.0))
-                except (np.linalg.LinAlgError, RuntimeError):
+                found = bordered_tangent(z, tangent)
+                if found is None:
                     continue
-                if np.all(np.isfinite(t_z)):
-                    t_z = t_z / np.linalg.norm(t_z)
-                    directions += [t_z, -t_z]
+                t_z = found[0] / np.linalg.norm(found[0])
+                directions += [t_z, -t_z]
                 chord = z - y
                 if np.linalg.norm(chord) > 0:
                     directions.append(chord / np.linalg.norm(chord))
@@ -416,17 +419,12 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         if best is None:
             return None
         yc, d, it = best
-        try:
-            A = scaled_system(yc, d)[1]
-            solve = factorize(A)
-            t = solve(np.append(np.zeros(n), 1.0))
-        except (np.linalg.LinAlgError, RuntimeError):
+        found = bordered_tangent(yc, d)
+        if found is None:
             return None
-        t = t / np.linalg.norm(t)
-        if t @ d < 0:
-            t = -t
-        orientation[0] = _det_sign(A, solve) * (1 if t @ d >= 0 else -1) or orientation[0]
-        return yc, t, it
+        t, sign = found                 # d . t = 1 > 0: t points along d
+        orientation[0] = sign or orientation[0]
+        return yc, t / np.linalg.norm(t), it
 
     def retraced(points, new, h):
         """Index of an earlier point (not among the last 5) that ``new`` comes back to, within
@@ -529,16 +527,10 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
             # converges quadratically where the old one cycled at every step down to 1e-7.
             turned, old_tangent = True, tangent
             for z in cycle:
-                try:
-                    Az = scaled_system(z, tangent)[1]
-                    solve_z = factorize(Az)
-                    t_z = solve_z(np.append(np.zeros(n), 1.0))
-                except (np.linalg.LinAlgError, RuntimeError):
+                found = bordered_tangent(z, tangent)
+                if found is None or found[1] == 0:
                     continue
-                sign = _det_sign(Az, solve_z)
-                if sign == 0 or not np.all(np.isfinite(t_z)):
-                    continue
-                t_z = oriented(t_z, sign, tangent, corner=True)
+                t_z = oriented(found[0], found[1], tangent, corner=True)
                 if t_z @ tangent < 0.999:
                     tangent = t_z
                     break
