@@ -213,3 +213,26 @@ def test_contact_dissipation_equals_slider_plastic_work(angle):
     print(msg)
     assert worst[-1] < 1e-4, msg
     assert np.all(np.diff(worst) < 0), msg
+
+
+def test_time_response_with_a_cubic_spring_matches_the_hbm_off_the_fold():
+    """The time integration includes the cubic spring: a hardening friction oscillator (notebook
+    06's) below its left fold, where one solution exists, settles on the HBM amplitude (odd
+    harmonics 1, 3, 5) to 1 %, and started on it stays there."""
+    import warnings
+    W0 = 2 * np.pi
+    osc = FrictionOscillator(mass=1.0, stiffness=W0 ** 2, damping=0.1, contact_stiffness=0.5 * W0 ** 2,
+                             friction_coefficient=0.1, normal_load=0.5, forcing=1.0, cubic_stiffness=20.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        frf = osc.frequency_response(0.8, 0.95, harmonics=(1, 3, 5), max_step=0.05)
+    assert frf.success, frf.message
+    k = len(frf.omega) // 2
+    a_hbm = frf.harmonic_amplitude(0, 1)[k]
+    td = osc.time_response([frf.frequency_hz[k]], steps_per_period=1000, max_periods=400)
+    assert td.converged[0] and td.amplitude[0] == pytest.approx(a_hbm, rel=1e-2)
+    x = frf.time_samples(0)[k]
+    v = frf.omega[k] * (frf.coefficients[k, :, 0] @ frf.basis.derivative.T @ frf.basis.synthesis.T)
+    started = osc.time_response([frf.frequency_hz[k]], steps_per_period=1000, max_periods=400,
+                                initial_displacement=x[0], initial_velocity=v[0])
+    assert started.converged[0] and started.amplitude[0] == pytest.approx(a_hbm, rel=1e-2)
