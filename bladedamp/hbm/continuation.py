@@ -269,10 +269,13 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
     def scale():
         return np.append(x_scale, w_scale)
 
+    sparse_jacobian = [False]     # whether fun's dR/dx is sparse (recorded by scaled_system)
+
     def scaled_system(y, row):
         """Scaled residual and the bordered scaled Jacobian [[dR/dy, dR/dw]; row]."""
         x, w = y[:n] * x_scale, y[n] * w_scale
         R, J, Rw = fun(x, w)
+        sparse_jacobian[0] = sp.issparse(J)
         return R / residual_scale, _bordered(J, Rw * w_scale, row, x_scale, 1.0 / residual_scale)
 
     # Orientation of the branch (Allgower & Georg): the sense of the tangent t keeps the sign of
@@ -362,9 +365,8 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
             if not np.all(np.isfinite(R)):
                 return None
             d = yc - y
-            A[n] = 2 * d
+            A[n] = 2 * d / radius            # the row of (|d|^2 - radius^2) / radius
             G = np.append(R, (d @ d - radius ** 2) / radius)
-            A[n] /= radius
             try:
                 dy = -factorize(A)(G)
             except (np.linalg.LinAlgError, RuntimeError):
@@ -388,7 +390,7 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         directions of the cycles' tangents (both senses, largest steps first) finds it; the
         one leaving (not within 60 degrees of -tangent) and turning least is taken, and the
         orientation is re-recorded on the new piece (a dense problem only)."""
-        if sp.issparse(scaled_system(y, tangent)[1]):
+        if sparse_jacobian[0]:     # the sphere corrector below writes a dense row
             return None
         directions = [tangent]
         for _, iterates in cycles[:4]:
@@ -432,7 +434,8 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         own points again: measured on random disk 51 (a 7 g cylinder, (0, 1, 2, 3)), past a
         non-smooth fold at 94.18 Hz the branch went back and forth between 94.28 and 94.30 Hz
         at full steps, coming back to within 1e-5..5e-7 of earlier points, until the 2000-point
-        cap; stopping at the first return says so at once."""
+        cap. The caller stops after MAX_REVISITS returns (a corner may send a branch back over a
+        few points before it passes)."""
         if len(points) < 6:
             return None
         radius = 1e-2 * h
