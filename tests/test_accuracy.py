@@ -143,7 +143,7 @@ def test_negative_dissipation_is_aft_sampling_error():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         r = osc.frequency_response(d["omega_start"] / (2 * np.pi), d["omega_end"] / (2 * np.pi),
-                                   harmonics=d["harmonics"], n_samples=d["n_samples"], max_step=0.05)
+                                   harmonics=d["harmonics"], n_samples=256, max_step=0.05)
     e = osc.energy_balance(r)
     k = int(np.argmin(e[:, 2] / np.abs(e[:, 0])))
     rel = [osc.hbm_system(r.basis.harmonics, T).element_dissipation(r.coefficients[k].ravel(), r.omega[k])[0]
@@ -152,13 +152,34 @@ def test_negative_dissipation_is_aft_sampling_error():
     assert abs(rel[1]) < abs(rel[0]) / 100 and abs(rel[2]) < abs(rel[1]) / 10     # ... and it converges to 0
 
 
+def test_automatic_aft_sampling_grows_the_samples_until_the_branch_passes():
+    """bladedamp.response.sampled_response on random oscillator 12 (inclined contact lifting off,
+    (0, 1, 2, 3)): with 256 AFT samples, the automatic first choice for an inclined contact, its
+    contact gives energy back beyond the sampling floor (confirmed with 16 x the samples), so
+    the default grows them to 1024, where every check passes; a given n_samples is kept."""
+    import sys
+    sys.path.insert(0, str(__import__("pathlib").Path(__file__).parent))
+    from test_random_designs import oscillator_design
+
+    d = oscillator_design(12)
+    osc = FrictionOscillator(**d["params"])
+    f0, f1 = d["omega_start"] / (2 * np.pi), d["omega_end"] / (2 * np.pi)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fixed = osc.frequency_response(f0, f1, harmonics=d["harmonics"], n_samples=256, max_step=0.05)
+        auto = osc.frequency_response(f0, f1, harmonics=d["harmonics"], max_step=0.05)
+    assert fixed.basis.n_samples == 256 and "dissipation" in fixed.failed_checks and not fixed.success
+    assert auto.success and auto.basis.n_samples == 1024 and not auto.failed_checks, auto.message
+    assert "AFT samples per period raised to 1024 (the branch failed with 256)" in auto.message
+
+
 def test_negative_dissipation_of_a_disk_is_not_success():
     """The issue's disk (EO 8, 74.86 deg platforms, a 0.058 g cylinder separated about half the
     cycle): with one harmonic and 64 AFT samples the contacts give energy back (-1.7 % of the
     excitation work) while the energy balance holds to rounding. That is the AFT's sampling of
     the lift-off (at the worst point, the same coefficients: -3.4 % / -0.15 % / +8e-5 / -2.6e-6 /
-    -1.7e-7 at 64 / 256 / 1024 / 4096 / 16384 samples), too coarse for this design: the result
-    must not be success."""
+    -1.7e-7 at 64 / 256 / 1024 / 4096 / 16384 samples), too coarse for this design, and still
+    with the automatic sampling's one step to 256: the result must not be success."""
     from bladedamp import ContactProperties, CylinderDamper, TunedDisk, reference_blade
 
     disk = TunedDisk(reference_blade(), CylinderDamper(5.815e-05, 0.002, 0.02,
@@ -170,6 +191,7 @@ def test_negative_dissipation_of_a_disk_is_not_success():
         r = disk.frequency_response(85.0, 123.2, harmonics=(1,), max_step=0.05)
     assert np.max(r.energy_balance_error()) < 1e-8         # the energy balance cannot see it
     assert "dissipation" in r.failed_checks and not r.success, r.message
+    assert r.basis.n_samples == 256 and "raised to 256 (the branch failed with 64)" in r.message
 
 
 @pytest.mark.slow

@@ -75,14 +75,54 @@ NEWTON_STEP_MAX = 1e-6
 
 
 @njit(cache=True)
-def _slider_pass(ut, normal, kt, mu, s0, s1, f_out, state_out):
+def touchdown_seats(approach, seat, seat_rate):
+    """Where a separated point closes between two samples, for the slider's seat.
+
+    approach (T,) samples of the normal approach a (contact where a > 0, periodic). Writes
+    seat[t] = theta = -a_t / (a_{t+1} - a_t) in [0, 1) and seat_rate[t] = 1 / (a_{t+1} - a_t)
+    [1/m] at every separated sample t followed by a closed one (the linear interpolation of
+    the approach crosses zero at t + theta), zero elsewhere.
+
+    A separated slider follows the displacement and is seated where the contact closes: at
+    u_t + theta (u_{t+1} - u_t), not at the last separated sample u_t. Seating it at the
+    sample makes an error of order (dt du/dt) k_T in the tangential force over the whole
+    following stick phase, and so of order dt in the forces' harmonics. Measured on random
+    oscillator 95 (inclined contact, separated 72 % of the period), the largest error of the
+    contact force's harmonics at 256 / 1024 / 4096 samples (against 65536), of the largest
+    one: 3.5e-3 / 1.0e-3 / 2.2e-4 seated at the sample (first order), 6.5e-4 / 4.0e-5 / 3.1e-6
+    seated here; and no spurious slip at touchdown. The closing instant is interpolated
+    linearly in the approach, a smooth function of time, so the seat is exact to second order. With the static term
+    (theta, the approach) depend on the normal coefficients: d theta / d a_t = -(1 - theta) /
+    da, d theta / d a_{t+1} = -theta / da, da = a_{t+1} - a_t, and a = offset - u_zeta, so
+    d theta / d c_zeta = ((1 - theta) E_t + theta E_{t+1}) * seat_rate (E the synthesis rows).
+    """
+    T = approach.shape[0]
+    for t in range(T):
+        a0 = approach[t]
+        a1 = approach[(t + 1) % T]
+        if a0 <= 0.0 < a1:
+            seat[t] = -a0 / (a1 - a0)
+            seat_rate[t] = 1.0 / (a1 - a0)
+        else:
+            seat[t] = 0.0
+            seat_rate[t] = 0.0
+
+
+@njit(cache=True)
+def _slider_pass(ut, normal, seat, kt, mu, s0, s1, f_out, state_out):
     """One period of the slider without derivatives: (s0, s1 at the end, moved, slip work);
-    writes f_out[:, 0:2] and state_out."""
+    writes f_out[:, 0:2] and state_out. ``seat`` (T,): see :func:`touchdown_seats`."""
     moved = False
     work = 0.0
-    for t in range(ut.shape[0]):
+    T = ut.shape[0]
+    for t in range(T):
         n = normal[t]
         f0, f1, n_s0, n_s1, st = slider_step(ut[t, 0], ut[t, 1], s0, s1, kt, mu * n, n > 0.0)
+        if st == SEPARATED and seat[t] != 0.0:
+            # the contact closes before the next sample: seat the slider where it closes
+            t1 = (t + 1) % T
+            n_s0 += seat[t] * (ut[t1, 0] - ut[t, 0])
+            n_s1 += seat[t] * (ut[t1, 1] - ut[t, 1])
         f_out[t, 0] = f0
         f_out[t, 1] = f1
         state_out[t] = st
@@ -95,8 +135,8 @@ def _slider_pass(ut, normal, kt, mu, s0, s1, f_out, state_out):
 
 
 @njit(cache=True)
-def _derivative_pass(ut, normal, dnormal, synthesis, kt, mu, s0, s1, f_out, df_out, state_out, ds,
-                     transfer, track):
+def _derivative_pass(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s0, s1, f_out, df_out,
+                     state_out, ds, transfer, track):
     """One period of the slider carrying its derivative ds (2, 3C) (updated in place) and
     writing df_out (see :func:`_point_return_map`); returns (s0, s1, moved, slip work, gw0, gw1).
 
@@ -127,6 +167,12 @@ def _derivative_pass(ut, normal, dnormal, synthesis, kt, mu, s0, s1, f_out, df_o
         sp1 = s1
         n = normal[t]
         f0, f1, n_s0, n_s1, st = slider_step(u0, u1, s0, s1, kt, mu * n, n > 0.0)
+        theta = seat[t] if st == SEPARATED else 0.0
+        t1 = (t + 1) % T
+        if theta != 0.0:
+            # seated where the contact closes, u + theta (u_next - u) (see touchdown_seats)
+            n_s0 += theta * (ut[t1, 0] - u0)
+            n_s1 += theta * (ut[t1, 1] - u1)
         f_out[t, 0] = f0
         f_out[t, 1] = f1
         state_out[t] = st
@@ -136,17 +182,22 @@ def _derivative_pass(ut, normal, dnormal, synthesis, kt, mu, s0, s1, f_out, df_o
         s0 = n_s0
         s1 = n_s1
         if st == SEPARATED:
-            # no force; the slider follows the displacement
+            # no force; the slider follows the displacement, at the closing instant before a
+            # touchdown: d s = E_theta (own block) + (u_next - u) d theta, d theta / d c_zeta =
+            # E_theta * seat_rate, E_theta = (1 - theta) E_t + theta E_next
             for j in range(n3):
                 df_out[t, 0, j] = 0.0
                 df_out[t, 1, j] = 0.0
+            r0 = (ut[t1, 0] - u0) * seat_rate[t]
+            r1 = (ut[t1, 1] - u1) * seat_rate[t]
             for j in range(C):
-                ds0[j] = synthesis[t, j]
+                E = synthesis[t, j] + theta * (synthesis[t1, j] - synthesis[t, j])
+                ds0[j] = E
                 ds1[j] = 0.0
                 ds0[C + j] = 0.0
-                ds1[C + j] = synthesis[t, j]
-                ds0[2 * C + j] = 0.0
-                ds1[2 * C + j] = 0.0
+                ds1[C + j] = E
+                ds0[2 * C + j] = r0 * E
+                ds1[2 * C + j] = r1 * E
             if track:
                 m00 = 0.0
                 m01 = 0.0
@@ -267,7 +318,7 @@ def _slip_scale(normal, kt, mu):
 
 
 @njit(cache=True)
-def _iterate_passes(ut, normal, dnormal, synthesis, kt, mu, s0, s1, static_index, max_passes, tol,
+def _iterate_passes(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s0, s1, static_index, max_passes, tol,
                     want_jac, f_out, df_out, state_out, ds, ds_begin):
     """Repeat the period until the slider position repeats (and, with the Jacobian, its
     derivative too: ``abs(ds - ds_begin) <= tol``), at most ``max_passes`` times.
@@ -287,10 +338,10 @@ def _iterate_passes(ut, normal, dnormal, synthesis, kt, mu, s0, s1, static_index
                 ds_begin[0, j] = ds[0, j]
                 ds_begin[1, j] = ds[1, j]
             # (no transfer tracking: ds_begin only stands in for the unused transfer array)
-            s0, s1, moved, work, _, _ = _derivative_pass(ut, normal, dnormal, synthesis, kt, mu, s0, s1, f_out,
+            s0, s1, moved, work, _, _ = _derivative_pass(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s0, s1, f_out,
                                                          df_out, state_out, ds, ds_begin, False)
         else:
-            s0, s1, moved, work = _slider_pass(ut, normal, kt, mu, s0, s1, f_out, state_out)
+            s0, s1, moved, work = _slider_pass(ut, normal, seat, kt, mu, s0, s1, f_out, state_out)
         if not moved:
             break  # no slip, no separation: this period is already periodic
         if it >= 1 and abs(s0 - b0) <= tol * scale and abs(s1 - b1) <= tol * scale:
@@ -309,7 +360,7 @@ def _iterate_passes(ut, normal, dnormal, synthesis, kt, mu, s0, s1, static_index
 
 
 @njit(cache=True)
-def _point_return_map(ut, normal, dnormal, synthesis, kt, mu, s0, s1, static_index, max_passes, tol,
+def _point_return_map(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s0, s1, static_index, max_passes, tol,
                       want_jac, f_out, df_out, state_out, ds, ds_begin, transfer, closed_form):
     """Periodic return map of one point (see :func:`_return_map`).
 
@@ -354,7 +405,7 @@ def _point_return_map(ut, normal, dnormal, synthesis, kt, mu, s0, s1, static_ind
     * |det(I - Phi)| < SINGULAR_DET (a barely attracting periodic state; see there).
     """
     if not (want_jac and closed_form):
-        work, passes = _iterate_passes(ut, normal, dnormal, synthesis, kt, mu, s0, s1, static_index, max_passes,
+        work, passes = _iterate_passes(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s0, s1, static_index, max_passes,
                                        tol, want_jac, f_out, df_out, state_out, ds, ds_begin)
         return work, (0 if want_jac else passes), (passes if want_jac else 0)
     T = ut.shape[0]
@@ -371,7 +422,7 @@ def _point_return_map(ut, normal, dnormal, synthesis, kt, mu, s0, s1, static_ind
         b0 = s0
         b1 = s1
         passes += 1
-        s0, s1, moved, work = _slider_pass(ut, normal, kt, mu, s0, s1, f_out, state_out)
+        s0, s1, moved, work = _slider_pass(ut, normal, seat, kt, mu, s0, s1, f_out, state_out)
         if not moved:
             break
         if it >= 1 and abs(s0 - b0) <= tol * scale and abs(s1 - b1) <= tol * scale:
@@ -387,9 +438,9 @@ def _point_return_map(ut, normal, dnormal, synthesis, kt, mu, s0, s1, static_ind
             s0 = start0
             s1 = start1
             for it in range(passes - 1):
-                s0, s1, moved, work, _, _ = _derivative_pass(ut, normal, dnormal, synthesis, kt, mu, s0, s1, f_out,
+                s0, s1, moved, work, _, _ = _derivative_pass(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s0, s1, f_out,
                                                              df_out, state_out, ds, transfer, False)
-            s0, s1, moved, work = _slider_pass(ut, normal, kt, mu, s0, s1, f_out, state_out)
+            s0, s1, moved, work = _slider_pass(ut, normal, seat, kt, mu, s0, s1, f_out, state_out)
         ds0 = ds[0]
         ds1 = ds[1]
         for t in range(T):
@@ -405,14 +456,14 @@ def _point_return_map(ut, normal, dnormal, synthesis, kt, mu, s0, s1, static_ind
     if not periodic:
         # the slider position did not repeat within max_passes: no periodic state to
         # linearise about; the derivative of the passes made, as before
-        work, jp = _iterate_passes(ut, normal, dnormal, synthesis, kt, mu, start0, start1, static_index,
+        work, jp = _iterate_passes(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, start0, start1, static_index,
                                    max_passes, tol, True, f_out, df_out, state_out, ds, ds_begin)
         return work, passes, jp
     # one more pass, with the derivative from ds_begin = 0 and the transfers M_t
     ds[:, :] = 0.0
     b0 = s0
     b1 = s1
-    s0, s1, moved, work, gw0, gw1 = _derivative_pass(ut, normal, dnormal, synthesis, kt, mu, b0, b1, f_out,
+    s0, s1, moved, work, gw0, gw1 = _derivative_pass(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, b0, b1, f_out,
                                                      df_out, state_out, ds, transfer, True)
     a = 1.0 - transfer[T - 1, 0]           # I - Phi = [[a, b], [c, d]]
     b = -transfer[T - 1, 1]
@@ -420,7 +471,7 @@ def _point_return_map(ut, normal, dnormal, synthesis, kt, mu, s0, s1, static_ind
     d = 1.0 - transfer[T - 1, 3]
     det = a * d - b * c
     if abs(det) < SINGULAR_DET:
-        work, jp = _iterate_passes(ut, normal, dnormal, synthesis, kt, mu, start0, start1, static_index,
+        work, jp = _iterate_passes(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, start0, start1, static_index,
                                    max_passes, tol, True, f_out, df_out, state_out, ds, ds_begin)
         return work, passes, 1 + jp
     ia = a / det                           # (I - Phi)^{-1} = [[id_, -ib], [-ic, ia]]
@@ -461,12 +512,12 @@ def _point_return_map(ut, normal, dnormal, synthesis, kt, mu, s0, s1, static_ind
 
 
 @njit(cache=True)
-def _return_map(ut, normal, dnormal, synthesis, k_t, mu, s_start, static_index,
+def _return_map(ut, normal, dnormal, seat, seat_rate, synthesis, k_t, mu, s_start, static_index,
                 max_passes, tol, want_jac, f_out, df_out, state_out, slip_work, passes, closed_form):
     """Tangential forces of P points over T samples (see module docstring).
 
     ut (P,T,2) tangential displacement samples; normal (P,T) normal load N >= 0;
-    dnormal (P,T) dN/du_zeta; synthesis (T,C); k_t, mu (P,); s_start (P,2) initial slider;
+    dnormal (P,T) dN/du_zeta; seat, seat_rate (P,T) (see :func:`touchdown_seats`); synthesis (T,C); k_t, mu (P,); s_start (P,2) initial slider;
     static_index: coefficient index of the mean (slider seated at the mean) or -1;
     closed_form: periodic slider derivative in closed form (see :func:`_point_return_map`).
     Outputs: f_out (P,T,2), df_out (P,T,2,3C) (d force / d point coefficients, blocks
@@ -480,7 +531,8 @@ def _return_map(ut, normal, dnormal, synthesis, k_t, mu, s_start, static_index,
     transfer = np.zeros((T, 4))
     for p in range(P):
         dfp = df_out[p] if want_jac else df_out[0]
-        w, n_plain, n_jac = _point_return_map(ut[p], normal[p], dnormal[p], synthesis, k_t[p], mu[p],
+        w, n_plain, n_jac = _point_return_map(ut[p], normal[p], dnormal[p], seat[p], seat_rate[p], synthesis,
+                                              k_t[p], mu[p],
                                               s_start[p, 0], s_start[p, 1], static_index, max_passes, tol,
                                               want_jac, f_out[p], dfp, state_out[p], ds, ds_begin, transfer,
                                               closed_form)
@@ -533,6 +585,9 @@ def damper_contact_forces(B, local, synthesis, analysis, k_t, mu, weight, approa
     uz = np.empty(T)
     normal = np.empty(T)
     dnormal = np.empty(T)
+    approach = np.empty(T)
+    seat = np.empty(T)
+    seat_rate = np.empty(T)
     f_t = np.empty((T, 2))
     df = np.zeros((T, 2, n3p))       # d f_tangential / d c of the last pass; padding stays 0
     df_flat = df.reshape((T, 2 * n3p))
@@ -583,6 +638,7 @@ def damper_contact_forces(B, local, synthesis, analysis, k_t, mu, weight, approa
                 off = approach_offset[g]
                 for t in range(T):
                     app = off - uz[t]
+                    approach[t] = app
                     if app > 0.0:
                         if law_kind == LAW_LINEAR:
                             kw = k_law * w
@@ -596,13 +652,14 @@ def damper_contact_forces(B, local, synthesis, analysis, k_t, mu, weight, approa
                     else:
                         normal[t] = 0.0
                         dnormal[t] = 0.0
+                touchdown_seats(approach, seat, seat_rate)
                 if static_index >= 0:
                     s0 = c[static_index, 0]
                     s1 = c[static_index, 1]
                 else:
                     s0 = 0.0
                     s1 = 0.0
-                _point_return_map(ut, normal, dnormal, synthesis, k_t[g], mu[g], s0, s1, static_index,
+                _point_return_map(ut, normal, dnormal, seat, seat_rate, synthesis, k_t[g], mu[g], s0, s1, static_index,
                                   max_passes, tol, want_jac, f_t, df, state, ds, ds_begin, transfer, closed_form)
                 # force coefficients of the point (normal force -N), projected with B^T
                 for a in range(C):
@@ -721,13 +778,16 @@ def point_contact_forces(coeffs, basis, tangential_stiffness, friction_coefficie
     else:
         static_index = -1
         s_start = np.zeros((P, 2))
+    seat, seat_rate = np.zeros((P, T)), np.zeros((P, T))
+    for p in range(P):
+        touchdown_seats(np.ascontiguousarray(approach[p]), seat[p], seat_rate[p])
     f_t = np.empty((P, T, 2))
     df = np.zeros((P, T, 3, 3 * C)) if jacobian else np.zeros((1, 1, 2, 1))
     state = np.empty((P, T), dtype=np.int8)
     slip_work = np.zeros(P)
     passes = np.zeros((P, 2), dtype=np.int64)
     _return_map(np.ascontiguousarray(disp[:, :, :2]), np.ascontiguousarray(normal),
-                np.ascontiguousarray(dnormal), basis.synthesis, k_t, mu, s_start, static_index,
+                np.ascontiguousarray(dnormal), seat, seat_rate, basis.synthesis, k_t, mu, s_start, static_index,
                 max_passes, tol, jacobian, f_t, df, state, slip_work, passes, closed_form)
     force = np.empty((P, T, 3))
     force[:, :, :2] = f_t

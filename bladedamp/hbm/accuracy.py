@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .continuation import newton
+from .fourier import HarmonicBasis
 from .linsolve import one_blas_thread
 
 #: default tolerance on the first-harmonic output amplitudes, relative to the peak amplitude
@@ -126,7 +127,9 @@ def harmonic_error(model, response, harmonics=None, n_points: int = 5, tol: floa
     idx = check_points(amp.max(axis=1) if amp.size else np.zeros(0), response.turning_points, n_points)
     errors = np.full(idx.size, np.nan)
     if idx.size:
-        system = model.hbm_system(target)
+        # the enriched set with at least the response's AFT samples (the sampling is not the
+        # question here: with fewer, a sampling error would pass for a harmonic one)
+        system = model.hbm_system(target, max(HarmonicBasis(target).n_samples, basis.n_samples))
         w = response.omega
         scales = model.unknown_scales(system, float(w.min()), float(w.max()))
         peak = max(float(amp.max()), 1e-300)
