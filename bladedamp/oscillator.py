@@ -156,6 +156,7 @@ class FrictionOscillator:
             system = self.hbm_system(H, n_samples)
             x0 = self._start_solution(system, omega_start, scale)
             branch = continuation(system.residual, x0, omega_start, omega_end, x_scale=scale,
+                                  start_at_end=lambda: self._start_solution(system, omega_end, scale),
                                   **continuation_options)
             C = system.basis.n_coeffs
             response = FrequencyResponse(branch.omega, branch.x.reshape(-1, C, 1), system.basis, ("x",),

@@ -104,22 +104,25 @@ def sampled_response(solve, n_samples, first: int, most: int):
     keeps no point; the message says how the samples were chosen."""
     if n_samples is not None:
         return solve(n_samples)
-    n, tried, response = int(first), [], None
+    n, tried, response, empty = int(first), [], None, None
     while True:
         finer = solve(n)
         if response is not None and not len(finer.omega):
-            break                                     # the coarser branch is kept
+            empty = n                                 # the coarser branch is kept
+            break
         response = finer
         if response.success or n * SAMPLES_GROWTH > most:
             break
         tried.append(n)
         n *= SAMPLES_GROWTH
-    if tried:
-        n_used = response.basis.n_samples
-        note = (f"; AFT samples per period raised to {n_used} (the branch failed with "
-                f"{', '.join(str(t) for t in tried if t != n_used)})")
-        response = dataclasses.replace(response, message=response.message + note)
-    return response
+    n_used = response.basis.n_samples
+    failed_with = [str(t) for t in tried if t != n_used]
+    note = ""
+    if failed_with:
+        note += f"; AFT samples per period raised to {n_used} (the branch failed with {', '.join(failed_with)})"
+    if empty is not None:
+        note += f"; with {empty} AFT samples per period the branch kept no point"
+    return dataclasses.replace(response, message=response.message + note) if note else response
 
 
 def with_checks(response, failed: dict):

@@ -34,6 +34,47 @@ def test_a_branch_that_turns_back_stops_at_the_start_of_the_range():
     assert len(b.turning_points) == 1
 
 
+def s_curve(c=10.0):
+    """R(x, omega) = x^3 - 3 x - (omega - c): folds at x = -1 (omega = c + 2) and x = 1
+    (omega = c - 2); three solutions for |omega - c| < 2, one outside."""
+    def fun(x, omega, jacobian=True):
+        return (np.array([x[0] ** 3 - 3 * x[0] - (omega - c)]), np.array([[3 * x[0] ** 2 - 3.0]]),
+                np.array([-1.0]))
+    return fun
+
+
+def root(omega, near, c=10.0):
+    """The solution of s_curve nearest ``near`` (Newton)."""
+    x = near
+    for _ in range(50):
+        x -= (x ** 3 - 3 * x - (omega - c)) / (3 * x ** 2 - 3)
+    return np.array([x])
+
+
+def test_a_branch_that_turns_back_is_computed_from_the_end_of_the_range():
+    """From the middle solution at omega = 9 the branch folds at 12 and comes back to 9 on the
+    lower one (a second solution there): it fails. With ``start_at_end`` the branch from the
+    unique solution at 13 down to 9 (the upper one) is returned instead, ordered 9 -> 13, and
+    its message says what the branch from the start did; a guess at the end that leads nowhere
+    keeps the failed branch and its warning."""
+    fun, w0, w1 = s_curve(), 9.0, 13.0
+    options = dict(x_scale=2.0, residual_scale=1.0, max_step=0.05)
+    with pytest.warns(ConvergenceWarning, match="turned back"):
+        forward = continuation(fun, root(w0, 0.0), w0, w1, **options)
+    assert not forward.success and forward.x.min() < -1.0        # it went over the fold at x = -1
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ConvergenceWarning)        # nothing to warn about
+        b = continuation(fun, root(w0, 0.0), w0, w1, start_at_end=lambda: root(w1, 2.0), **options)
+    assert b.success and all(b.checks.values())
+    assert "computed from its end" in b.message and "turned back (fold at omega = 12" in b.message
+    assert b.omega[0] == w0 and b.omega[-1] == w1 and np.all(np.diff(b.omega) > 0)
+    assert np.all(b.x[:, 0] > 1.0)                                # the upper solution throughout
+    assert np.allclose(b.x[:, 0] ** 3 - 3 * b.x[:, 0], b.omega - 10.0, atol=1e-9)
+    with pytest.warns(ConvergenceWarning, match="turned back"):
+        kept = continuation(fun, root(w0, 0.0), w0, w1, start_at_end=lambda: np.array([np.nan]), **options)
+    assert not kept.success and np.array_equal(kept.omega, forward.omega)
+
+
 def test_the_turn_back_stops_whatever_the_leave_margin():
     """mistuned studies pass leave_margin=0.05: the branch still stops at the boundary."""
     fun = circle()

@@ -30,13 +30,16 @@ from bladedamp import reference as ref
 SEED = 20261201
 N_DISKS = 160
 N_OSCILLATORS = 160
-# issue 12's target is 0.99; measured 277 of 320 = 0.866 on 2026-12-01, third session (271 = 0.847
-# before the corner fallbacks of the continuation and the refined dissipation check; 268 = 0.838
-# before the continuation's det orientation and its turn at non-smooth folds; 0.716 before the
-# shared robust start, the hop acceptance and the range clip). Until the target is met this is a
-# regression floor, not the target: the share is printed, and the failing designs with it.
+# issue 12's target is 0.99; measured 296 of 320 = 0.925 on 2026-12-01, fourth session (disks
+# 138 of 160, oscillators 158 of 160: the interpolated touchdown seat, the automatic AFT sampling
+# and the branch from the end of the range where the one from the start fails); 277 = 0.866 in
+# the third (271 = 0.847 before the corner fallbacks of the continuation and the refined
+# dissipation check; 268 = 0.838 before the continuation's det orientation and its turn at
+# non-smooth folds; 0.716 before the shared robust start, the hop acceptance and the range
+# clip). Until the target is met this is a regression floor, not the target: the share is
+# printed, and the failing designs with it.
 SHARE_TARGET = 0.99
-SHARE_REQUIRED = 0.86
+SHARE_REQUIRED = 0.92
 # Harmonics of the oscillators cross-checked by time integration. The one-harmonic HBM is
 # wrong for inclined contacts (the normal load varies: it needs the static term and higher
 # harmonics); switch this to None (the frequency_response default) once that default is chosen

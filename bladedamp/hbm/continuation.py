@@ -153,6 +153,13 @@ class Branch:
     turning_points: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))  # indices of folds
     checks: dict = field(default_factory=dict)   # name -> bool, see branch_checks
 
+    def reversed(self, message: str) -> "Branch":
+        """This branch in the opposite order (a branch computed from the end of its range,
+        returned from the start), with ``message``; its turning points renumbered."""
+        n = len(self.omega)
+        return Branch(self.omega[::-1].copy(), self.x[::-1].copy(), self.iterations[::-1].copy(), self.success,
+                      message, np.sort(n - 1 - np.asarray(self.turning_points, dtype=int)), dict(self.checks))
+
     def take(self, indices) -> "Branch":
         """The points ``indices`` of this branch (for re-evaluating them, e.g. with a finer AFT)."""
         indices = np.asarray(indices, dtype=int)
@@ -190,7 +197,8 @@ def _validate_options(step, max_step, min_step, max_points, tol, max_corrector, 
 
 def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=None,
                  step=None, max_step=None, min_step=None, max_points=5000, tol=1e-10,
-                 max_corrector=12, target_iterations=5, factorize=lu_factorize, leave_margin=0.0):
+                 max_corrector=12, target_iterations=5, factorize=lu_factorize, leave_margin=0.0,
+                 start_at_end=None):
     """Pseudo-arclength continuation of R(x, omega) = 0 from ``omega_start`` to ``omega_end``.
 
     Every branch it returns keeps the contract of :func:`branch_checks` (``Branch.checks``):
@@ -218,6 +226,20 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
     leave_margin : kept for compatibility (>= 0), without effect: a branch that turns back now
         always stops at ``omega_start`` (it used to run on until it passed ``omega_start`` by
         this fraction of the range's width, keeping points outside the range)
+    start_at_end : callable () -> initial guess at ``omega_end``, or None. If the branch from
+        ``omega_start`` fails (it stalls, retraces itself or turns back to the start), the branch
+        from ``omega_end`` down to ``omega_start`` is computed from that guess; if it reaches the
+        start with every check passing it is returned, ordered from ``omega_start`` to
+        ``omega_end``, its message saying what the branch from the start did (where that one
+        turned back there is a second solution at the same frequencies). Otherwise the branch
+        from the start is returned, with its warnings.
+
+    The steps are the methods of :class:`ArcLengthContinuation`, in the order they are tried
+    from each point: the predictor-corrector along the tangent with shorter steps
+    (``step_along``), the turn at a Newton 2-cycle (``turn_at_cycle``), the hop at fixed omega
+    (``hop``), the point past a corner (``past_corner``), the sphere around the point
+    (``corner_escape``); then the landing at either end of the range (``land_at_start``,
+    ``land_at_end``) and the retrace guard (``retraced``).
     """
     _validate.finite("omega_start", omega_start)
     _validate.finite("omega_end", omega_end)
@@ -231,105 +253,291 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
     x0 = np.asarray(x0, dtype=float)
     if not np.all(np.isfinite(x0)):
         raise ValueError("x0 (initial guess) must be finite")
-    direction = np.sign(omega_end - omega_start)
-    w_scale = abs(omega_end - omega_start)
-    if x_scale is None:
-        x_scale = max(np.abs(x0).max(), 1e-300)
-    x_scale = np.broadcast_to(np.asarray(x_scale, dtype=float), x0.shape).copy()
-    if residual_scale is None:
-        residual_scale = max(np.linalg.norm(fun(np.zeros_like(x0), omega_start)[0]), 1e-300)
-    n = x0.size
-    max_dw = max_step * w_scale          # the longest step in omega (item 2 of issue 12)
+    options = (step, max_step, min_step, max_points, tol, max_corrector, target_iterations, factorize)
+    if start_at_end is None:
+        return ArcLengthContinuation(fun, x0, omega_start, omega_end, x_scale, residual_scale, *options).run()
+    with warnings.catch_warnings(record=True) as forward_warnings:
+        warnings.simplefilter("always", ConvergenceWarning)
+        forward = ArcLengthContinuation(fun, x0, omega_start, omega_end, x_scale, residual_scale, *options).run()
+    if not forward.success:
+        with warnings.catch_warnings(record=True):
+            warnings.simplefilter("always", ConvergenceWarning)
+            x_end = np.asarray(start_at_end(), dtype=float)
+            backward = ArcLengthContinuation(fun, x_end, omega_end, omega_start, x_scale, residual_scale,
+                                             *options).run() if np.all(np.isfinite(x_end)) else None
+        if backward is not None and backward.success:
+            return backward.reversed(f"reached the end of the frequency range, computed from its end down to its "
+                                     f"start (from the start, the {forward.message})")
+    for w in forward_warnings:
+        _warn(w.message, 2)
+    return forward
 
-    def finish(points, its, success, message):
-        Y = np.array(points) if points else np.zeros((0, n + 1))
-        checks = branch_checks(Y[:, n], omega_start, omega_end, max_step)
-        if success and not all(checks.values()):
-            success = False
-            message += "; branch checks failed: " + ", ".join(k for k, v in checks.items() if not v)
-            warnings.warn(message, ConvergenceWarning, stacklevel=3)
-        # turning points: where omega stops growing along the branch and turns back
-        d = np.sign(np.diff(Y[:, n]))
-        turning = np.flatnonzero(d[1:] * d[:-1] < 0) + 1
-        return Branch(Y[:, n], Y[:, :n], np.array(its, dtype=int), success, message, turning, checks)
 
-    first = newton(fun, x0, omega_start, x_scale, residual_scale, tol=tol, factorize=factorize)
-    if not first.converged:
-        msg = f"Newton did not converge at the start, omega = {omega_start:.6g} rad/s " \
-              f"(scaled residual {first.residual_norm:.3g})"
-        warnings.warn(msg, ConvergenceWarning, stacklevel=2)
-        return finish([], [], False, msg)
+def _warn(message, depth):
+    """A ConvergenceWarning shown at the caller of :func:`continuation` (``depth`` frames up)."""
+    warnings.warn(message, ConvergenceWarning, stacklevel=depth + 1)
 
-    # unknowns are scaled by x_scale, which grows to the largest |x| met on the branch, so
-    # the arc length weighs every unknown by its own size (a step is a fraction of it)
-    points = [np.append(first.x, omega_start)]
-    its = [first.iterations]
-    tangent_prev = None  # in unscaled units
 
-    def scale():
-        return np.append(x_scale, w_scale)
+@dataclass
+class _Attempt:
+    """What the predictor-corrector found from one point (see :meth:`ArcLengthContinuation.step_along`)."""
 
-    sparse_jacobian = [False]     # whether fun's dR/dx is sparse (recorded by scaled_system)
+    tangent: np.ndarray            # the (scaled, unit) tangent of the last try
+    h: float                       # the step reached
+    h_first: float                 # the step it started from
+    accepted: bool = False
+    point: np.ndarray | None = None          # the accepted point (scaled)
+    iterations: int = 0
+    next_tangent: np.ndarray | None = None   # the tangent there, if known (scaled)
+    hopped: bool = False
+    # (h, iterates) of every corrector that did not converge, largest h first; a converged one
+    # rejected as off the tangent adds (h, (point,)) while fewer than 4 are recorded
+    cycles: list = field(default_factory=list)
+    corner: tuple | None = None    # (point, iterations, h): the first converged corrector rejected as off the tangent
 
-    def scaled_system(y, row):
+
+class ArcLengthContinuation:
+    """One run of :func:`continuation` (which validates the options and calls :meth:`run`), its
+    steps as methods. Unknowns are scaled by ``x_scale`` (which grows to the largest |x| met on
+    the branch, so the arc length weighs every unknown by its own size) and omega by the
+    range's width: ``y = (x / x_scale, omega / w_scale)``."""
+
+    def __init__(self, fun, x0, omega_start, omega_end, x_scale, residual_scale, step, max_step, min_step,
+                 max_points, tol, max_corrector, target_iterations, factorize):
+        self.fun, self.factorize = fun, factorize
+        self.omega_start, self.omega_end = omega_start, omega_end
+        self.step, self.max_step, self.min_step, self.max_points = step, max_step, min_step, max_points
+        self.tol, self.max_corrector, self.target_iterations = tol, max_corrector, target_iterations
+        self.x0 = x0
+        self.direction = np.sign(omega_end - omega_start)
+        self.w_scale = abs(omega_end - omega_start)
+        if x_scale is None:
+            x_scale = max(np.abs(x0).max(), 1e-300)
+        self.x_scale = np.broadcast_to(np.asarray(x_scale, dtype=float), x0.shape).copy()
+        if residual_scale is None:
+            residual_scale = max(np.linalg.norm(fun(np.zeros_like(x0), omega_start)[0]), 1e-300)
+        self.residual_scale = residual_scale
+        self.n = x0.size
+        self.max_dw = max_step * self.w_scale          # the longest step in omega (item 2 of issue 12)
+        self.points, self.its = [], []
+        # Orientation of the branch (Allgower & Georg): the sense of the tangent t keeps the sign of
+        # det [dR/dy; t^T], which changes at no fold and no corner of a piecewise-smooth branch.
+        # "t . previous tangent > 0" picks the wrong sense once the branch turns by more than 90
+        # degrees (scaled) between two points: the branch then retraced itself (measured: random
+        # disk 12 ran up to 98.58 Hz and back down its own path to the start, 84.35 Hz), and a
+        # corner the corrector cannot pass (below) may leave at any angle. With t solving
+        # [dR/dy; r^T] t = e (r . t = 1), det [dR/dy; t^T] = det [dR/dy; r^T] |t|^2: the sign comes
+        # from the bordered matrix already factorised (dense only; 0, not used, otherwise).
+        # The sign also changes at a bifurcation off the branch (e.g. symmetry breaking at EO = n/2,
+        # where the mirror-odd damper DOFs are at zero with almost no stiffness, and their noise
+        # flipped it at every step: the branch went back and forth between two points). So a
+        # reversal the sign asks for on a tangent that has hardly turned (within 18 degrees of the
+        # previous one; measured there: 9 degrees, at the folds and corners of random disks 12 and
+        # 102 and oscillator 136: 75-90 degrees) is not taken, and the sign is re-recorded instead.
+        self.orientation = 0
+
+    # ----- the scaled problem ------------------------------------------------------------
+    def scale(self):
+        return np.append(self.x_scale, self.w_scale)
+
+    def scaled_system(self, y, row):
         """Scaled residual and the bordered scaled Jacobian [[dR/dy, dR/dw]; row]."""
-        x, w = y[:n] * x_scale, y[n] * w_scale
-        R, J, Rw = fun(x, w)
-        sparse_jacobian[0] = sp.issparse(J)
-        return R / residual_scale, _bordered(J, Rw * w_scale, row, x_scale, 1.0 / residual_scale)
+        n = self.n
+        x, w = y[:n] * self.x_scale, y[n] * self.w_scale
+        R, J, Rw = self.fun(x, w)
+        return R / self.residual_scale, _bordered(J, Rw * self.w_scale, row, self.x_scale, 1.0 / self.residual_scale)
 
-    # Orientation of the branch (Allgower & Georg): the sense of the tangent t keeps the sign of
-    # det [dR/dy; t^T], which changes at no fold and no corner of a piecewise-smooth branch.
-    # "t . previous tangent > 0" picks the wrong sense once the branch turns by more than 90
-    # degrees (scaled) between two points: the branch then retraced itself (measured: random
-    # disk 12 ran up to 98.58 Hz and back down its own path to the start, 84.35 Hz), and a
-    # corner the corrector cannot pass (below) may leave at any angle. With t solving
-    # [dR/dy; r^T] t = e (r . t = 1), det [dR/dy; t^T] = det [dR/dy; r^T] |t|^2: the sign comes
-    # from the bordered matrix already factorised (dense only; 0, not used, otherwise).
-    # The sign also changes at a bifurcation off the branch (e.g. symmetry breaking at EO = n/2,
-    # where the mirror-odd damper DOFs are at zero with almost no stiffness, and their noise
-    # flipped it at every step: the branch went back and forth between two points). So a
-    # reversal the sign asks for on a tangent that has hardly turned (within 18 degrees of the
-    # previous one; measured there: 9 degrees, at the folds and corners of random disks 12 and
-    # 102 and oscillator 136: 75-90 degrees) is not taken, and the sign is re-recorded instead.
-    orientation = [0]
+    def solve_at(self, w, x_from):
+        """Newton at fixed omega = w from the point(s) x_from (tried in turn)."""
+        for x in x_from:
+            r = newton(self.fun, x, w, self.x_scale, self.residual_scale, tol=self.tol, factorize=self.factorize)
+            if r.converged:
+                return r
+        return None
 
-    def oriented(t, sign, reference, corner=False):
+    # ----- tangents ----------------------------------------------------------------------
+    def oriented(self, t, sign, reference, corner=False):
         """t (solving [dR/dy; r^T] t = e_{n+1}, r = ``reference``) normalised, in the sense of
         the branch orientation (recorded from the start sense); ``corner``: at a corner the
         corrector could not pass, where the sign is taken whatever the angle."""
         t = t / np.linalg.norm(t)
         if sign == 0:
             return t
-        if orientation[0] == 0 or (sign != orientation[0] and not corner
-                                   and t @ reference > 0.95 * np.linalg.norm(reference)):
-            orientation[0] = sign
+        if self.orientation == 0 or (sign != self.orientation and not corner
+                                     and t @ reference > 0.95 * np.linalg.norm(reference)):
+            self.orientation = sign
             return t
-        return t * sign * orientation[0]
+        return t * sign * self.orientation
 
-    def bordered_tangent(y, row):
+    def bordered_tangent(self, y, row):
         """(t, sign of det) solving [dR/dy; row^T] t = e_{n+1} at y (scaled, unnormalised), the
         bordered matrix factorised once; None if it is singular or t is not finite."""
         try:
-            A = scaled_system(y, row)[1]
-            solve = factorize(A)
-            t = solve(np.append(np.zeros(n), 1.0))
+            A = self.scaled_system(y, row)[1]
+            solve = self.factorize(A)
+            t = solve(np.append(np.zeros(self.n), 1.0))
         except (np.linalg.LinAlgError, RuntimeError):   # singular (RuntimeError: splu)
             return None
         return (t, _det_sign(A, solve)) if np.all(np.isfinite(t)) else None
 
-    def tangent_at(y, prev):
+    def tangent_at(self, y, prev):
+        """The oriented unit tangent at y (scaled); ``prev``: the previous tangent (unscaled) or None."""
+        n = self.n
         if prev is None:
             prev = np.zeros(n + 1)
-            prev[n] = direction
+            prev[n] = self.direction
         else:
-            prev = prev / scale()
+            prev = prev / self.scale()
             prev /= np.linalg.norm(prev)
-        A = scaled_system(y, prev)[1]
-        solve = factorize(A)        # a singular matrix raises here, as the callers expect
-        return oriented(solve(np.append(np.zeros(n), 1.0)), _det_sign(A, solve), prev)
+        A = self.scaled_system(y, prev)[1]
+        solve = self.factorize(A)        # a singular matrix raises here, as the callers expect
+        return self.oriented(solve(np.append(np.zeros(n), 1.0)), _det_sign(A, solve), prev)
 
-    def corner_tangent(y, yc, h):
+    # ----- the predictor-corrector -------------------------------------------------------
+    def corrector(self, y, tangent, h):
+        """Newton on the hyperplane through the predictor y + h tangent, normal to the tangent.
+        Returns (converged, point, iterations, bordered solve, bordered matrix, previous iterate)."""
+        yp = y + h * tangent
+        yc = yp.copy()
+        ok = False
+        step_norm = np.inf
+        previous_iterate = yc
+        bordered = A = None
+        for it in range(1, self.max_corrector + 1):
+            R, A = self.scaled_system(yc, tangent)
+            if not np.all(np.isfinite(R)):
+                break
+            G = np.append(R, tangent @ (yc - yp))
+            try:
+                bordered = self.factorize(A)
+            except (np.linalg.LinAlgError, RuntimeError):   # singular (RuntimeError: splu)
+                break
+            dy = -bordered(G)
+            previous_iterate, yc = yc, yc + dy
+            previous_norm, step_norm = step_norm, np.linalg.norm(dy)
+            # converged: residual at the noise level and the update computed there small
+            if np.linalg.norm(R) < self.tol and step_norm < np.sqrt(self.tol):
+                ok = True
+                break
+            if step_norm >= previous_norm:
+                # Newton updates that do not contract: the corrector diverges or cycles
+                # (measured: such runs go on to |omega| of hundreds of Hz); halve the step
+                break
+        return ok, yc, it, bordered, A, previous_iterate
+
+    def step_along(self, y, tangent, h):
+        """Steps from y along ``tangent``, halved down to min_step, then once more along the
+        tangent of the adjacent piece where the corrector ended in a Newton 2-cycle
+        (:meth:`turn_at_cycle`). Returns an :class:`_Attempt`."""
+        n = self.n
+        attempt = _Attempt(tangent, h, h)
+        cycle, turned, old_tangent = (), False, tangent
+        while True:
+            while h >= self.min_step:
+                ok, yc, it, bordered, A, previous_iterate = self.corrector(y, tangent, h)
+                # reject corrector results that jump back along the branch, that end farther from
+                # the predictor than the predictor is from the last point (more than 45 degrees off
+                # the tangent: another branch), or that step farther in omega than max_step allows
+                forward = ok and (yc - y) @ tangent > 0 and abs(yc[n] - y[n]) * self.w_scale <= self.max_dw
+                if forward and np.linalg.norm(yc - (y + h * tangent)) <= h:
+                    attempt.accepted, attempt.point, attempt.iterations = True, yc, it
+                    # the next tangent solves [J; tangent] t = e_{n+1}: the matrix just factorised
+                    # at the converged point (to the last update), so it costs one back-substitution
+                    attempt.next_tangent = self.oriented(bordered(np.append(np.zeros(n), 1.0)),
+                                                         _det_sign(A, bordered), tangent)
+                    break
+                if forward and attempt.corner is None:
+                    attempt.corner = (yc, it, h)     # a last resort, see past_corner
+                if not ok:
+                    cycle = (previous_iterate, yc)
+                    attempt.cycles.append((h, cycle))
+                elif len(attempt.cycles) < 4:
+                    attempt.cycles.append((h, (yc,)))      # converged, rejected: its chord is a direction to try
+                h /= 2
+            if attempt.accepted or turned or self.orientation == 0:
+                break
+            turned, old_tangent = True, tangent
+            tangent = self.turn_at_cycle(tangent, cycle)
+            if tangent is old_tangent:
+                break
+            h = attempt.h_first
+        attempt.h = h
+        attempt.tangent = tangent if attempt.accepted or not turned else old_tangent
+        return attempt
+
+    def turn_at_cycle(self, tangent, cycle):
+        """The tangent of the piece the corrector's last 2-cycle ``cycle`` lies on (oriented as
+        the branch), or ``tangent`` itself if none differs from it.
+
+        Corner of a piecewise-smooth branch the corrector cannot pass along the tangent of the
+        piece it leaves: its last iterates (a Newton 2-cycle) lie on the adjacent piece.
+        Continue along that piece's tangent, oriented as the branch (det rule, see __init__):
+        it may leave the corner at any angle, beyond 90 degrees at a non-smooth fold, where no
+        point exists on the hyperplane of the old tangent nor at a fixed omega beyond.
+        Measured on random disk 102 (a 0.042 g cylinder rolling into gross slip at 94.22 Hz):
+        the adjacent piece turns back by 154 degrees and its corrector converges quadratically
+        where the old one cycled at every step down to 1e-7."""
+        for z in cycle:
+            found = self.bordered_tangent(z, tangent)
+            if found is None or found[1] == 0:
+                continue
+            t_z = self.oriented(found[0], found[1], tangent, corner=True)
+            if t_z @ tangent < 0.999:
+                return t_z
+        return tangent
+
+    # ----- past corners ------------------------------------------------------------------
+    def hop(self, attempt):
+        """Corner of a piecewise-smooth branch (e.g. birth of a slip phase): the corrector
+        cycles between the two pieces at any step size; hop over it at fixed omega. On success
+        fills ``attempt`` (accepted, hopped; its tangent the new piece's, or None)."""
+        n = self.n
+        last = self.points[-1]
+        w_last = last[n]
+        saved_orientation = self.orientation      # a rejected hop tangent must not re-orient the branch
+        for frac in (1e-3, 1e-2, 1e-1):
+            w_try = w_last + self.direction * frac * self.max_dw
+            jump = newton(self.fun, last[:n], w_try, self.x_scale, self.residual_scale, tol=self.tol,
+                          factorize=self.factorize)
+            if not jump.converged:
+                continue
+            # only a hop along the same branch, never a jump to another one: short, or along
+            # the branch that leaves the corner (the chord within ~25 degrees of the tangent
+            # at the point reached). The second covers a corner beyond which an unknown with
+            # a small scale moves fast, e.g. the mean roll of a cylinder damper held only by
+            # the weak static retention once slip begins (the chord is then long in scaled
+            # units, yet it runs along the new piece of the branch)
+            chord = np.append(jump.x - last[:n], w_try - w_last) / self.scale()
+            if np.linalg.norm(chord[:n]) < 2 * self.max_step:
+                hop_tangent = None
+                break
+            try:
+                hop_tangent = self.tangent_at(np.append(jump.x, w_try) / self.scale(), chord * self.scale())
+            except (np.linalg.LinAlgError, RuntimeError):
+                continue
+            if hop_tangent @ chord > 0.9 * np.linalg.norm(chord):
+                break
+            self.orientation = saved_orientation
+        else:
+            return
+        attempt.point = np.append(jump.x, w_try) / self.scale()
+        attempt.iterations = jump.iterations
+        attempt.accepted = attempt.hopped = True
+        attempt.next_tangent = None
+        attempt.tangent = hop_tangent    # go on along the new piece (scaled), or None
+
+    def past_corner(self, y, attempt):
+        """The old paths (shorter steps, the turn at a 2-cycle, the hop) all failed: accept the
+        first converged corrector point rejected as off the tangent (``attempt.corner``) if the
+        chord to it runs along its own branch (:meth:`corner_tangent`)."""
+        if attempt.corner is None:
+            return
+        t_corner = self.corner_tangent(y, attempt.corner[0], attempt.corner[2])
+        if t_corner is not None:
+            attempt.point, attempt.iterations = attempt.corner[0], attempt.corner[1]
+            attempt.next_tangent, attempt.accepted = t_corner, True
+
+    def corner_tangent(self, y, yc, h):
         """The oriented tangent at ``yc`` if ``yc`` (a converged corrector point more than 45
         degrees off the predictor's tangent) lies past a corner on the piece of the branch that
         leaves ``y``, else None.
@@ -344,39 +552,38 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         hyperplane) and stays short (at most 10 steps and 2 max_step)."""
         chord = yc - y
         length = np.linalg.norm(chord)
-        if not (0 < length <= min(10 * h, 2 * max_step)):
+        if not (0 < length <= min(10 * h, 2 * self.max_step)):
             return None
         chord = chord / length
-        found = bordered_tangent(yc, chord)
+        found = self.bordered_tangent(yc, chord)
         if found is None:
             return None
         t_z, sign = found
         if sign == 0:                       # sparse: no orientation, the chord gives the sense
             t_z = np.sign(t_z @ chord) * t_z / np.linalg.norm(t_z)
         else:
-            t_z = oriented(t_z, sign, chord, corner=True)
+            t_z = self.oriented(t_z, sign, chord, corner=True)
         return t_z if t_z @ chord > 0.9 else None
 
-    def sphere_solution(y, v, radius):
+    def sphere_solution(self, y, v, radius):
         """Newton on R = 0, |y_c - y| = radius from y + radius v (scaled); (point, iterations) or None."""
         yc = y + radius * v
-        for it in range(1, max_corrector + 1):
-            R, A = scaled_system(yc, v)
+        for it in range(1, self.max_corrector + 1):
+            d = yc - y
+            R, A = self.scaled_system(yc, 2 * d / radius)     # bordered by the row of (|d|^2 - radius^2) / radius
             if not np.all(np.isfinite(R)):
                 return None
-            d = yc - y
-            A[n] = 2 * d / radius            # the row of (|d|^2 - radius^2) / radius
             G = np.append(R, (d @ d - radius ** 2) / radius)
             try:
-                dy = -factorize(A)(G)
+                dy = -self.factorize(A)(G)
             except (np.linalg.LinAlgError, RuntimeError):
                 return None
             yc = yc + dy
-            if np.linalg.norm(R) < tol and np.linalg.norm(dy) < np.sqrt(tol):
+            if np.linalg.norm(R) < self.tol and np.linalg.norm(dy) < np.sqrt(self.tol):
                 return yc, it
         return None
 
-    def corner_escape(y, tangent, cycles, h_first):
+    def corner_escape(self, y, tangent, cycles, h_first):
         """The branch's next point past a sharp corner or a non-smooth fold at ``y``, found on a
         sphere around ``y``: (point, next tangent (scaled), iterations) or None.
 
@@ -389,13 +596,13 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         111 degrees off the tangent, omega turning back). Newton on the sphere from the
         directions of the cycles' tangents (both senses, largest steps first) finds it; the
         one leaving (not within 60 degrees of -tangent) and turning least is taken, and the
-        orientation is re-recorded on the new piece (a dense problem only)."""
-        if sparse_jacobian[0]:     # the sphere corrector below writes a dense row
-            return None
+        orientation is re-recorded on the new piece (the branch has one only where the
+        factorisation gives det signs: dense, or :class:`~bladedamp.hbm.linsolve.BlockRing`)."""
+        n = self.n
         directions = [tangent]
         for _, iterates in cycles[:4]:
             for z in iterates:
-                found = bordered_tangent(z, tangent)
+                found = self.bordered_tangent(z, tangent)
                 if found is None:
                     continue
                 t_z = found[0] / np.linalg.norm(found[0])
@@ -404,15 +611,15 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
                 if np.linalg.norm(chord) > 0:
                     directions.append(chord / np.linalg.norm(chord))
         best = None
-        r0 = max(h_first, min(step, 1e-3))
+        r0 = max(h_first, min(self.step, 1e-3))
         for radius in (r0, 0.1 * r0, 0.01 * r0):
             for v in directions:
-                found = sphere_solution(y, v, radius)
+                found = self.sphere_solution(y, v, radius)
                 if found is None:
                     continue
                 yc, it = found
                 d = (yc - y) / np.linalg.norm(yc - y)
-                if d @ tangent < -0.5 or abs(yc[n] - y[n]) * w_scale > max_dw:
+                if d @ tangent < -0.5 or abs(yc[n] - y[n]) * self.w_scale > self.max_dw:
                     continue          # the piece it came from, or too long a step
                 if best is None or d @ tangent > best[1] @ tangent:
                     best = (yc, d, it)
@@ -421,14 +628,14 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         if best is None:
             return None
         yc, d, it = best
-        found = bordered_tangent(yc, d)
+        found = self.bordered_tangent(yc, d)
         if found is None:
             return None
         t, sign = found                 # d . t = 1 > 0: t points along d
-        orientation[0] = sign or orientation[0]
+        self.orientation = sign or self.orientation
         return yc, t / np.linalg.norm(t), it
 
-    def retraced(points, new, h):
+    def retraced(self, new, h):
         """Index of an earlier point (not among the last 5) that ``new`` comes back to, within
         1 % of the step ``h`` (scaled), or None. An FRF branch never passes through one of its
         own points again: measured on random disk 51 (a 7 g cylinder, (0, 1, 2, 3)), past a
@@ -436,224 +643,151 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         at full steps, coming back to within 1e-5..5e-7 of earlier points, until the 2000-point
         cap. The caller stops after MAX_REVISITS returns (a corner may send a branch back over a
         few points before it passes)."""
+        n, points = self.n, self.points
         if len(points) < 6:
             return None
         radius = 1e-2 * h
         w = np.fromiter((p[n] for p in points[:-5]), float, len(points) - 5)
-        near = np.flatnonzero(np.abs(w - new[n]) < radius * w_scale)   # |d omega| bounds the distance
+        near = np.flatnonzero(np.abs(w - new[n]) < radius * self.w_scale)   # |d omega| bounds the distance
         if near.size == 0:
             return None
-        d = np.linalg.norm((np.array([points[j] for j in near]) - new) / scale(), axis=1)
+        d = np.linalg.norm((np.array([points[j] for j in near]) - new) / self.scale(), axis=1)
         k = int(np.argmin(d))
         return int(near[k]) if d[k] < radius else None
 
-    def solve_at(w, x_from):
-        """Newton at fixed omega = w from the point(s) x_from (tried in turn)."""
-        for x in x_from:
-            r = newton(fun, x, w, x_scale, residual_scale, tol=tol, factorize=factorize)
-            if r.converged:
-                return r
-        return None
+    # ----- the ends of the range ---------------------------------------------------------
+    def land_at_start(self, new):
+        """The branch turned back and reached the start of the range: it stops there (never a
+        point outside the range; an FRF never runs to zero or negative frequency). Returns the
+        message."""
+        n, points, omega_start, direction = self.n, self.points, self.omega_start, self.direction
+        last = points[-1]
+        a = (last[n] - omega_start) / (last[n] - new[n])
+        land = self.solve_at(omega_start, (last[:n] + a * (new[:n] - last[:n]), last[:n], new[:n]))
+        if land is not None:
+            points.append(np.append(land.x, omega_start))
+            self.its.append(land.iterations)
+        return f"continuation turned back (fold at omega = {max(p[n] * direction for p in points) * direction:.6g}" \
+               f" rad/s) and returned to the start of the range, omega = {omega_start:.6g} rad/s; " \
+               f"branch kept up to there"
 
-    message, success = "", False
-    h = step
-    hops = 0  # consecutive fixed-omega hops over corners
-    revisits = 0  # returns to an earlier point (see retraced)
-    end_retries = 0  # steps past omega_end whose landing on omega_end failed
-    next_tangent = None  # from the last corrector's factorisation (scaled, then unscaled)
-    while len(points) < max_points:
-        y = points[-1] / scale()
-        if next_tangent is None:
-            tangent = tangent_at(y, tangent_prev)
-        else:
-            tangent = next_tangent / scale()      # unscaled -> scaled by the current x_scale
-            tangent /= np.linalg.norm(tangent)
-        accepted = hopped = False
-        h_first, cycle, turned = h, (), False
-        cycles = []   # (h, iterates) of every corrector that did not converge, largest h first
-        corner = None  # (point, iterations, h): the first converged corrector rejected as off the tangent
-        while True:
-            while h >= min_step:
-                yp = y + h * tangent
-                yc = yp.copy()
-                ok = False
-                step_norm = np.inf
-                previous_iterate = yc
-                for it in range(1, max_corrector + 1):
-                    R, A = scaled_system(yc, tangent)
-                    if not np.all(np.isfinite(R)):
-                        break
-                    G = np.append(R, tangent @ (yc - yp))
-                    try:
-                        bordered = factorize(A)
-                    except (np.linalg.LinAlgError, RuntimeError):   # singular (RuntimeError: splu)
-                        break
-                    dy = -bordered(G)
-                    previous_iterate, yc = yc, yc + dy
-                    previous_norm, step_norm = step_norm, np.linalg.norm(dy)
-                    # converged: residual at the noise level and the update computed there small
-                    if np.linalg.norm(R) < tol and step_norm < np.sqrt(tol):
-                        ok = True
-                        break
-                    if step_norm >= previous_norm:
-                        # Newton updates that do not contract: the corrector diverges or cycles
-                        # (measured: such runs go on to |omega| of hundreds of Hz); halve the step
-                        break
-                # reject corrector results that jump back along the branch, that end farther from
-                # the predictor than the predictor is from the last point (more than 45 degrees off
-                # the tangent: another branch), or that step farther in omega than max_step allows
-                forward = ok and (yc - y) @ tangent > 0 and abs(yc[n] - y[n]) * w_scale <= max_dw
-                if forward and np.linalg.norm(yc - yp) <= h:
-                    accepted = True
-                    hops = 0
-                    # the next tangent solves [J; tangent] t = e_{n+1}: the matrix just factorised
-                    # at the converged point (to the last update), so it costs one back-substitution
-                    next_tangent = oriented(bordered(np.append(np.zeros(n), 1.0)), _det_sign(A, bordered), tangent)
-                    break
-                if forward and corner is None:
-                    corner = (yc, it, h)     # a last resort, see corner_tangent
-                if not ok:
-                    cycle = (previous_iterate, yc)
-                    cycles.append((h, cycle))
-                elif len(cycles) < 4:
-                    cycles.append((h, (yc,)))      # converged, rejected: its chord is a direction to try
-                h /= 2
-            if accepted or turned or orientation[0] == 0:
-                break
-            # corner of a piecewise-smooth branch the corrector cannot pass along the tangent of
-            # the piece it leaves: its last iterates (a Newton 2-cycle) lie on the adjacent piece.
-            # Continue along that piece's tangent, oriented as the branch (det rule above): it may
-            # leave the corner at any angle, beyond 90 degrees at a non-smooth fold, where no
-            # point exists on the hyperplane of the old tangent nor at a fixed omega beyond.
-            # Measured on random disk 102 (a 0.042 g cylinder rolling into gross slip at
-            # 94.22 Hz): the adjacent piece turns back by 154 degrees and its corrector
-            # converges quadratically where the old one cycled at every step down to 1e-7.
-            turned, old_tangent = True, tangent
-            for z in cycle:
-                found = bordered_tangent(z, tangent)
-                if found is None or found[1] == 0:
-                    continue
-                t_z = oriented(found[0], found[1], tangent, corner=True)
-                if t_z @ tangent < 0.999:
-                    tangent = t_z
-                    break
-            if tangent is old_tangent:
-                break
-            h = h_first
-        if not accepted and turned:
-            tangent = old_tangent
-        if not accepted and h < step and hops < 5:
-            # corner of a piecewise-smooth branch (e.g. birth of a slip phase): the corrector
-            # cycles between the two pieces at any step size; hop over it at fixed omega
-            hops += 1
-            w_last = points[-1][n]
-            saved_orientation = orientation[0]      # a rejected hop tangent must not re-orient the branch
-            for frac in (1e-3, 1e-2, 1e-1):
-                w_try = w_last + direction * frac * max_dw
-                jump = newton(fun, points[-1][:n], w_try, x_scale, residual_scale, tol=tol, factorize=factorize)
-                if not jump.converged:
-                    continue
-                # only a hop along the same branch, never a jump to another one: short, or along
-                # the branch that leaves the corner (the chord within ~25 degrees of the tangent
-                # at the point reached). The second covers a corner beyond which an unknown with
-                # a small scale moves fast, e.g. the mean roll of a cylinder damper held only by
-                # the weak static retention once slip begins (the chord is then long in scaled
-                # units, yet it runs along the new piece of the branch)
-                chord = np.append(jump.x - points[-1][:n], w_try - w_last) / scale()
-                if np.linalg.norm(chord[:n]) < 2 * max_step:
-                    hop_tangent = None
-                    break
-                try:
-                    hop_tangent = tangent_at(np.append(jump.x, w_try) / scale(), chord * scale())
-                except (np.linalg.LinAlgError, RuntimeError):
-                    continue
-                if hop_tangent @ chord > 0.9 * np.linalg.norm(chord):
-                    break
-                orientation[0] = saved_orientation
+    def land_at_end(self, new):
+        """Land exactly on omega_end, from the point interpolated there; True if it did."""
+        n, omega_end = self.n, self.omega_end
+        last = self.points[-1]
+        a = (omega_end - last[n]) / (new[n] - last[n]) if new[n] != last[n] else 1.0
+        land = self.solve_at(omega_end, (last[:n] + a * (new[:n] - last[:n]), new[:n], last[:n]))
+        if land is None:
+            return False
+        self.points.append(np.append(land.x, omega_end))
+        self.its.append(land.iterations)
+        return True
+
+    def finish(self, success, message):
+        n = self.n
+        Y = np.array(self.points) if self.points else np.zeros((0, n + 1))
+        checks = branch_checks(Y[:, n], self.omega_start, self.omega_end, self.max_step)
+        if success and not all(checks.values()):
+            success = False
+            message += "; branch checks failed: " + ", ".join(k for k, v in checks.items() if not v)
+            _warn(message, 4)
+        # turning points: where omega stops growing along the branch and turns back
+        d = np.sign(np.diff(Y[:, n]))
+        turning = np.flatnonzero(d[1:] * d[:-1] < 0) + 1
+        return Branch(Y[:, n], Y[:, :n], np.array(self.its, dtype=int), success, message, turning, checks)
+
+    # ----- the run -----------------------------------------------------------------------
+    def run(self) -> Branch:
+        n = self.n
+        first = newton(self.fun, self.x0, self.omega_start, self.x_scale, self.residual_scale, tol=self.tol,
+                       factorize=self.factorize)
+        if not first.converged:
+            msg = f"Newton did not converge at the start, omega = {self.omega_start:.6g} rad/s " \
+                  f"(scaled residual {first.residual_norm:.3g})"
+            _warn(msg, 3)
+            return self.finish(False, msg)
+        points = self.points
+        points.append(np.append(first.x, self.omega_start))
+        self.its.append(first.iterations)
+        tangent_prev = None  # in unscaled units
+        message, success = "", False
+        h = self.step
+        hops = 0  # consecutive fixed-omega hops over corners
+        revisits = 0  # returns to an earlier point (see retraced)
+        end_retries = 0  # steps past omega_end whose landing on omega_end failed
+        next_tangent = None  # from the last corrector's factorisation (scaled, then unscaled)
+        while len(points) < self.max_points:
+            y = points[-1] / self.scale()
+            if next_tangent is None:
+                tangent = self.tangent_at(y, tangent_prev)
             else:
-                jump = None
-            if jump is not None:
-                yc = np.append(jump.x, w_try) / scale()
-                it = jump.iterations
-                accepted = hopped = True
-                tangent = next_tangent = None
-                if hop_tangent is not None:
-                    tangent = hop_tangent     # go on along the new piece (scaled; unscaled below)
-        if not accepted and corner is not None:
-            # the old paths (shorter steps, the turn at a 2-cycle, the hop) all failed: a point
-            # past a corner, if the chord to it runs along its own branch
-            t_corner = corner_tangent(y, corner[0], corner[2])
-            if t_corner is not None:
-                (yc, it, _), next_tangent = corner, t_corner
-                accepted, hops = True, 0
-        if not accepted and orientation[0] != 0:
-            escaped = corner_escape(y, tangent, cycles, h_first)
-            if escaped is not None:
-                yc, next_tangent, it = escaped
-                accepted, hops = True, 0
-        if not accepted:
-            w_stop = points[-1][n]
-            message = f"continuation did not converge after omega = {w_stop:.6g} rad/s " \
-                      f"({w_stop / (2 * np.pi):.6g} Hz), step fell below {min_step:g}; branch kept up to there"
-            warnings.warn(message, ConvergenceWarning, stacklevel=2)
-            break
-        new = yc * scale()
-        if direction * (omega_start - new[n]) > 0:
-            # the branch turned back and reached the start of the range: it stops there (never
-            # a point outside the range; an FRF never runs to zero or negative frequency)
-            last = points[-1]
-            a = (last[n] - omega_start) / (last[n] - new[n])
-            land = solve_at(omega_start, (last[:n] + a * (new[:n] - last[:n]), last[:n], new[:n]))
-            if land is not None:
-                points.append(np.append(land.x, omega_start))
-                its.append(land.iterations)
-            message = f"continuation turned back (fold at omega = {max(p[n] * direction for p in points) * direction:.6g}" \
-                      f" rad/s) and returned to the start of the range, omega = {omega_start:.6g} rad/s; " \
-                      f"branch kept up to there"
-            warnings.warn(message, ConvergenceWarning, stacklevel=2)
-            break
-        if direction * (new[n] - omega_end) >= 0:
-            # land exactly on omega_end, from the point interpolated there
-            last = points[-1]
-            a = (omega_end - last[n]) / (new[n] - last[n]) if new[n] != last[n] else 1.0
-            land = solve_at(omega_end, (last[:n] + a * (new[:n] - last[:n]), new[:n], last[:n]))
-            if land is None:
-                end_retries += 1
-                if end_retries <= 8:
-                    h /= 2
-                    tangent_prev = None if tangent is None else tangent * scale()
-                    next_tangent = None
-                    continue
-                message = f"continuation could not land on omega_end = {omega_end:.6g} rad/s; " \
-                          f"branch kept up to omega = {last[n]:.6g} rad/s"
-                warnings.warn(message, ConvergenceWarning, stacklevel=2)
+                tangent = next_tangent / self.scale()      # unscaled -> scaled by the current x_scale
+                tangent /= np.linalg.norm(tangent)
+            attempt = self.step_along(y, tangent, h)
+            h, tangent, next_tangent = attempt.h, attempt.tangent, attempt.next_tangent
+            if not attempt.accepted and h < self.step and hops < 5:
+                hops += 1
+                self.hop(attempt)
+                if attempt.accepted:
+                    tangent, next_tangent = attempt.tangent, None
+            else:
+                hops = 0 if attempt.accepted else hops
+            if not attempt.accepted:
+                self.past_corner(y, attempt)
+                if attempt.accepted:
+                    next_tangent, hops = attempt.next_tangent, 0
+            if not attempt.accepted and self.orientation != 0:
+                escaped = self.corner_escape(y, tangent, attempt.cycles, attempt.h_first)
+                if escaped is not None:
+                    attempt.point, next_tangent, attempt.iterations = escaped
+                    attempt.accepted, hops = True, 0
+            if not attempt.accepted:
+                w_stop = points[-1][n]
+                message = f"continuation did not converge after omega = {w_stop:.6g} rad/s " \
+                          f"({w_stop / (2 * np.pi):.6g} Hz), step fell below {self.min_step:g}; branch kept up to there"
+                _warn(message, 3)
                 break
-            points.append(np.append(land.x, omega_end))
-            its.append(land.iterations)
-            success, message = True, "reached the end of the frequency range"
-            break
-        tangent_prev = None if tangent is None else tangent * scale()
-        next_tangent = None if next_tangent is None else next_tangent * scale()
-        h = max(h, step) if hopped else h
-        revisited = retraced(points, new, h)
-        points.append(new)
-        its.append(it)
-        if revisited is not None:
-            revisits += 1
-            if revisits >= MAX_REVISITS:
-                message = f"continuation retraced its own path at omega = {new[n]:.6g} rad/s " \
-                          f"({new[n] / (2 * np.pi):.6g} Hz; {revisits} returns to earlier points, the last to point " \
-                          f"{revisited} of {len(points)}: a loop or a back-and-forth between corners it cannot " \
-                          f"leave); branch kept up to there"
-                warnings.warn(message, ConvergenceWarning, stacklevel=2)
+            yc, it = attempt.point, attempt.iterations
+            new = yc * self.scale()
+            if self.direction * (self.omega_start - new[n]) > 0:
+                message = self.land_at_start(new)
+                _warn(message, 3)
                 break
-        x_scale = np.maximum(x_scale, np.abs(points[-1][:n]))
-        if it <= target_iterations - 1:
-            h = min(h * 1.5, max_step)
-        elif it > target_iterations + 1:
-            h = max(h / 1.5, min_step)
-    else:
-        message = f"stopped after max_points = {max_points} points at omega = {points[-1][n]:.6g} rad/s"
-        warnings.warn(message, ConvergenceWarning, stacklevel=2)
-
-    return finish(points, its, success, message)
+            if self.direction * (new[n] - self.omega_end) >= 0:
+                if not self.land_at_end(new):
+                    end_retries += 1
+                    if end_retries <= 8:
+                        h /= 2
+                        tangent_prev = None if tangent is None else tangent * self.scale()
+                        next_tangent = None
+                        continue
+                    message = f"continuation could not land on omega_end = {self.omega_end:.6g} rad/s; " \
+                              f"branch kept up to omega = {points[-1][n]:.6g} rad/s"
+                    _warn(message, 3)
+                    break
+                success, message = True, "reached the end of the frequency range"
+                break
+            tangent_prev = None if tangent is None else tangent * self.scale()
+            next_tangent = None if next_tangent is None else next_tangent * self.scale()
+            h = max(h, self.step) if attempt.hopped else h
+            revisited = self.retraced(new, h)
+            points.append(new)
+            self.its.append(it)
+            if revisited is not None:
+                revisits += 1
+                if revisits >= MAX_REVISITS:
+                    message = f"continuation retraced its own path at omega = {new[n]:.6g} rad/s " \
+                              f"({new[n] / (2 * np.pi):.6g} Hz; {revisits} returns to earlier points, the last to point " \
+                              f"{revisited} of {len(points)}: a loop or a back-and-forth between corners it cannot " \
+                              f"leave); branch kept up to there"
+                    _warn(message, 3)
+                    break
+            self.x_scale = np.maximum(self.x_scale, np.abs(points[-1][:n]))
+            if it <= self.target_iterations - 1:
+                h = min(h * 1.5, self.max_step)
+            elif it > self.target_iterations + 1:
+                h = max(h / 1.5, self.min_step)
+        else:
+            message = f"stopped after max_points = {self.max_points} points at omega = {points[-1][n]:.6g} rad/s"
+            _warn(message, 3)
+        return self.finish(success, message)
