@@ -306,6 +306,24 @@ class ModalBlade:
             raise ValueError(f"point must be one of {sorted(self.mode_shapes)} (got {point!r})")
         return self.mode_shapes[point].copy()
 
+    @property
+    def flexible_platform(self) -> bool:
+        """Whether the blade carries per-point platform shapes (:meth:`platform_displacements`)."""
+        return False
+
+    def platform_displacements(self, side: str, points, normal=None) -> np.ndarray | None:
+        """Per-point platform shapes: the blade's own translations (P, 3, n_m) [m/sqrt(kg)] of its
+        ``side`` ("OL" or "OR") platform contact surface at ``points`` (P, 3) [m, blade frame],
+        or None; ``normal`` (3,) is the contact normal the caller assumes there (a blade with
+        surface data checks it against its own surface). None here: the modal blade has one
+        6-DOF shape per control point, so the platform moves rigidly with it (Eq. 6). A blade
+        with its own surface data (the solid FE blade, :class:`bladedamp.solid.SolidModalBlade`)
+        overrides this, and the contact kinematics then use those shapes at every contact point
+        (:func:`bladedamp.disk.contact_point_maps`)."""
+        if side not in ("OL", "OR"):
+            raise ValueError(f"side must be 'OL' or 'OR' (got {side!r})")
+        return None
+
     def modal_force(self, force: np.ndarray, at: str = "excitation") -> np.ndarray:
         """Modal force Phi_at^T f [N/sqrt(kg)], right-hand side of Eq. 4.
 

@@ -8,7 +8,11 @@ times e^{i h dphi}, dphi = 2 pi EO / n (Eq. 25), so the relative motion at the c
     w_h = G_D u_D,h - G_P [Phi_OL ; e^{i h dphi} Phi_OR] q_h          (Eq. 6, 24)
 
 and the contact forces go back to the sector through the transpose of the same (complex)
-map. The damper's equilibrium (Eq. 12, with or without inertia) is part of the residual
+map. A blade with per-point platform data (the solid FE blade: its platform face's own
+displacement at every contact point) adds a flexible platform: each point's relative
+displacement is then B_p w - R (u_FE - u_fit) q_c instead of B_p w (u_FE the face's FE motion at
+the point, u_fit the rigid motion of the control point there; :func:`contact_point_maps`).
+The damper's equilibrium (Eq. 12, with or without inertia) is part of the residual
 instead of being condensed (Eq. 13-15): same solution, exact sparse Jacobian.
 
 Static preload: with the paper's one-harmonic setting ``harmonics=(1,)`` the damper is first
@@ -36,15 +40,116 @@ from .hbm.continuation import continuation
 from .hbm.start import robust_start
 from .hbm.fourier import HarmonicBasis
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import REFINE_SAMPLES_FACTOR, FrequencyResponse, physical_checks, with_checks, plot_branch
+from .response import REFINE_SAMPLES_FACTOR, FrequencyResponse, physical_checks, with_checks, plot_branch, sampled_response
 
 DAMPER_DOFS = ("uD_x", "uD_y", "uD_z", "phiD_x", "phiD_y", "phiD_z")
+# the automatic AFT sampling of a tuned disk's branch may grow the samples this much (one step
+# of bladedamp.response.sampled_response: a disk's branch costs about 3x more with 4x the
+# samples; measured on random disks 7 (retraced with 64 samples, reached the end with 256) and
+# 56 (negative contact dissipation -2.2e-5 of the excitation work, confirmed with 1024))
+AUTO_SAMPLES_GROWTH = 4
+
+
+def contact_point_maps(geometry: DamperGeometry, platform_offsets: np.ndarray, left: ModalBlade,
+                       right: ModalBlade) -> np.ndarray | None:
+    """Point maps of a flexible platform, (2, P, 3, 6 + n_m), or None for rigid platforms.
+
+    The relative displacement of contact point p of contact c (OL: blade ``left``, the damper's
+    blade i; OR: blade ``right``, blade i+1) is, in the contact frame (xi, eta, zeta) [m],
+
+        d_p = B_p w_c - R_c (u_FE(x_p) - u_fit(x_p)) q_c      (Eq. 6, 24, the platform side per point)
+
+    w_c (6) the relative motion of the control point (the rigid-platform kinematics of Eq. 6:
+    w = G_D u_D - G_P [Phi_OL; Phi_OR] q), B_p (3, 6) the patch's rigid point map
+    (:attr:`ContactPatch.point_map`), q_c the platform blade's modal coordinates (for OR with
+    the interblade phase of Eq. 24), R_c the contact frame, u_FE(x_p) (3, n_m) the blade's own
+    FE translation of its platform surface at the point x_p (its
+    :meth:`~bladedamp.blade.ModalBlade.platform_displacements`) and u_fit(x_p) = u_c + phi_c x
+    (x_p - x_c) that of the rigid motion of the control point (the blade's OL / OR shape
+    (u_c, phi_c), the rigid fit of the face) there. So the map on the local coordinates
+    (w_c, q_c) is [B_p, -R_c (u_FE - u_fit)]: the paper's rigid kinematics plus the platform's
+    deformation relative to its rigid fit, exactly zero for a rigid platform.
+
+    x_p: the patch's actual point positions, (OL or OR point x_c) + platform offset
+    (:meth:`TunedDisk.platform_offsets`) + xi_p R_c[0] + eta_p R_c[1] (a cylinder's line at
+    xi = 0, a wedge's rows across its height h_C), projected along the contact normal onto the
+    face plane through x_c (the damper placement of ``platform_offsets`` puts a contact centre
+    half the radial mismatch off the face when the two platform angles differ; the rigid part
+    B_p w_c keeps that placement, so the rigid limit is the rigid kinematics for any angles).
+    Returns None unless both blades carry per-point data (a beam blade has none).
+
+    ``geometry``: the damper's contact frames and patches; ``platform_offsets`` (2, 3) [m].
+    """
+    faces = []
+    for c, (side, blade) in enumerate((("OL", left), ("OR", right))):
+        R, patch = geometry.frames[c], geometry.patches[c]
+        x_c = blade.points[side]
+        x = x_c + np.asarray(platform_offsets[c], dtype=float) + patch.xi[:, None] * R[0] + patch.eta[:, None] * R[1]
+        x = x - ((x - x_c) @ R[2])[:, None] * R[2]                                  # (P, 3) on the face plane
+        faces.append((x, blade.platform_displacements(side, x, R[2])))
+    if any(u is None for _, u in faces):
+        if any(u is not None for _, u in faces):
+            raise ValueError("both blades of a damper must carry per-point platform data, or neither "
+                             "(a solid and a beam blade next to each other)")
+        return None
+    maps = []
+    for c, (side, blade, (x, u_fe)) in enumerate(zip(("OL", "OR"), (left, right), faces)):
+        R, B = geometry.frames[c], geometry.patches[c].point_map                    # (3, 3), (P, 3, 6)
+        phi = blade.shape(side)                                                     # (6, n_m) about x_c
+        r = x - blade.points[side]                                                  # (P, 3)
+        u_fit = phi[None, :3] - np.cross(r[:, None, :], phi[3:].T[None]).transpose(0, 2, 1)   # u + phi x r
+        maps.append(np.concatenate([B, -np.einsum("ik,pkm->pim", R, u_fe - u_fit)], axis=-1))
+    return np.stack(maps)
+
+
+def point_map_forces(B, local, basis, k_t, mu, law, weights, offsets, jacobian, **options):
+    """Generalised contact forces of the points of n_d dampers (Eq. 11 with the point maps).
+
+    B (n_d, 2, P, 3, m): each contact's point map from its m local coordinates (the rigid
+    ContactPatch.point_map, m = 6, or :func:`contact_point_maps`, m = 6 + n_m); local
+    (C, n_d, 2, m) their harmonic coefficients; k_t, mu, weights (n_d * 2 * P,) per point
+    (damper, contact, point order) [N/m, -, -]; law the shared normal law; offsets
+    (n_d, 2, P) the static approach [m]; ``options`` go to
+    :func:`~bladedamp.contact.point.point_contact_forces`. Returns (force (C, n_d, 2, m),
+    Jacobian blocks (n_d, 2, C, m, C, m) or None, the point samples): every point in one call of
+    the point-contact kernel, the forces B^T f, the Jacobian B^T (df/dc) B (exact).
+    """
+    C = basis.n_coeffs
+    nd, _, P = B.shape[:3]
+    coeffs = np.einsum("dqpij,cdqj->cdqpi", B, local).reshape(C, nd * 2 * P, 3)
+    pts = point_contact_forces(coeffs, basis, k_t, mu, law, weights, np.ravel(offsets), jacobian=jacobian, **options)
+    f_points = basis.to_coeffs(np.moveaxis(pts.force, 1, 0)).reshape(C, nd, 2, P, 3)
+    force = np.einsum("cdqpi,dqpij->cdqj", f_points, B)
+    blocks = None
+    if jacobian:
+        # d f_coef[a, p, i] / d c_p[b, k] (point coefficient blocks direction-major), as ContactPatch
+        T = basis.n_samples
+        jp = np.matmul(basis.analysis, pts.jacobian.reshape(nd * 2 * P, T, 9 * C)).reshape(nd, 2, P, C, 3, 3, C)
+        blocks = dof_jacobian(B, jp)
+    return force, blocks, pts
+
+
+def contact_rows(contact_local: int, n_modes: int):
+    """Row indices of a damper's local coordinates (:class:`DamperContacts`, m = ``contact_local``
+    per contact): (the 12 rows w of the OL and OR control points, the n_m rows of OL's blade's
+    modal coordinates, the n_m rows of OR's); the last two are empty for rigid platforms (m = 6,
+    the rows 0..11 of Eq. 6)."""
+    m = contact_local
+    if m not in (6, 6 + n_modes):
+        raise ValueError(f"contact_local must be 6 or 6 + n_modes = {6 + n_modes} (got {m})")
+    w = np.r_[0:6, m:m + 6]
+    return w, np.arange(6, m), np.arange(m + 6, 2 * m)
 
 
 @dataclass
 class DamperContacts:
-    """Both contacts of one damper as a harmonic-balance element (12 local coordinates:
-    the relative motions w of OL and OR, Eq. 7). Forces are those on the platforms (Eq. 11).
+    """Both contacts of one damper as a harmonic-balance element. Forces are those on the
+    platforms (Eq. 11).
+
+    Local coordinates, per contact (OL, then OR): the relative motion w of its control point
+    (6, Eq. 7), and with a flexible platform (``point_maps`` given, :func:`contact_point_maps`)
+    the n_m modal coordinates of that platform's blade (OR: with the interblade phase), so
+    ``n_local`` = 12 (rigid platforms) or 12 + 2 n_m. :attr:`contact_local` = m per contact.
 
     ``approach(omega)`` gives the per-point static approach (2, P) and its omega-derivative.
 
@@ -58,17 +163,42 @@ class DamperContacts:
 
     geometry: DamperGeometry
     approach: callable
-    n_local: int = 12
+    point_maps: np.ndarray | None = None
+    n_local: int = field(default=12, init=False)
     _stacked: tuple | None = field(default=None, init=False, repr=False)
 
+    def __post_init__(self):
+        if self.point_maps is not None:
+            P = self.geometry.patches[0].n_points
+            B = np.asarray(self.point_maps, dtype=float)
+            if B.ndim != 4 or B.shape[:3] != (2, P, 3) or B.shape[3] < 6 or \
+                    self.geometry.patches[1].n_points != P:
+                raise ValueError(f"point_maps must have shape (2, {P}, 3, m >= 6) (got {B.shape})")
+            self.point_maps = B
+        self.n_local = 2 * self.contact_local
+
+    @property
+    def flexible(self) -> bool:
+        """Whether the platforms are flexible (per-point maps)."""
+        return self.point_maps is not None
+
+    @property
+    def contact_local(self) -> int:
+        """Local coordinates per contact m: 6, or 6 + n_m with a flexible platform."""
+        return 6 if self.point_maps is None else self.point_maps.shape[-1]
+
+    def relative_motion(self, local):
+        """(C, 12) relative motions w of the OL and OR control points (Eq. 7) of ``local`` (C, n_local)."""
+        local = np.asarray(local)
+        return local.reshape(len(local), 2, self.contact_local)[:, :, :6].reshape(len(local), 12)
+
     def evaluate(self, local, basis, omega, jacobian=True):
-        """Patch evaluations (OL, OR) at ``local`` (C, 12)."""
-        offsets, _ = self.approach(omega)
-        return [patch.evaluate(local[:, 6 * c:6 * c + 6], basis, offsets[c], jacobian)
-                for c, patch in enumerate(self.geometry.patches)]
+        """Patch evaluations (OL, OR) at ``local`` (C, n_local); with a flexible platform each
+        force is (C, 6 + n_m), its first 6 the forces and moments about the control point."""
+        return self.evaluate_at(local, basis, self.approach(omega)[0], jacobian)
 
     def _stack(self):
-        """(point maps (2, P, 3, 6), k_T, mu, weights (2P,), normal law) or None if the patches differ."""
+        """(point maps (2, P, 3, m), k_T, mu, weights (2P,), normal law) or None if the patches differ."""
         if self._stacked is None:
             pa, pb = self.geometry.patches
             same = (pa.normal_law == pb.normal_law and pa.friction_coefficient == pb.friction_coefficient
@@ -77,40 +207,40 @@ class DamperContacts:
                 self._stacked = (False,)
             else:
                 ps = (pa, pb)
-                self._stacked = (True, np.stack([p.point_map for p in ps]),
+                B = np.stack([p.point_map for p in ps]) if self.point_maps is None else self.point_maps
+                self._stacked = (True, B,
                                  np.concatenate([p.tangential_stiffness * p.weights for p in ps]),
                                  np.concatenate([np.full(p.n_points, p.friction_coefficient) for p in ps]),
                                  np.concatenate([p.weights for p in ps]), pa.normal_law)
         return self._stacked if self._stacked[0] else None
 
     def _forces(self, local, basis, offsets, jacobian):
-        """Forces (C, 12) and Jacobian (C*12, C*12) or None of both patches."""
-        C = basis.n_coeffs
+        """Forces (C, n_local) and Jacobian (C*n_local, C*n_local) or None of both patches."""
+        C, m = basis.n_coeffs, self.contact_local
         stack = self._stack()
         if stack is None:
-            evs = [patch.evaluate(local[:, 6 * c:6 * c + 6], basis, offsets[c], jacobian)
-                   for c, patch in enumerate(self.geometry.patches)]
+            evs = self.evaluate_at(local, basis, offsets, jacobian)
             force = np.hstack([ev.force for ev in evs])
-            blocks = [ev.jacobian.reshape(C, 6, C, 6) for ev in evs] if jacobian else None
+            blocks = [ev.jacobian.reshape(C, m, C, m) for ev in evs] if jacobian else None
         else:
             _, B, k_t, mu, weights, law = stack
-            P = B.shape[1]
-            coeffs = np.einsum("qpij,cqj->cqpi", B, local.reshape(C, 2, 6)).reshape(C, 2 * P, 3)
-            pts = point_contact_forces(coeffs, basis, k_t, mu, law, weights, np.ravel(offsets), jacobian=jacobian)
-            f_points = basis.to_coeffs(np.moveaxis(pts.force, 1, 0)).reshape(C, 2, P, 3)
-            force = np.einsum("cqpi,qpij->cqj", f_points, B).reshape(C, 12)
-            blocks = None
-            if jacobian:
-                # d f_coef[a, p, i] / d c_p[b, k] (point coefficient blocks direction-major), as ContactPatch
-                T = basis.n_samples
-                jp = np.matmul(basis.analysis, pts.jacobian.reshape(2 * P, T, 9 * C)).reshape(2, P, C, 3, 3, C)
-                blocks = dof_jacobian(B, jp)
+            f, jb, _ = point_map_forces(B[None], local.reshape(C, 1, 2, m), basis, k_t, mu, law, weights, offsets,
+                                        jacobian)
+            force = f.reshape(C, 2 * m)
+            blocks = None if jb is None else jb[0]
         if not jacobian:
             return force, None
-        jac = np.zeros((C, 12, C, 12))
+        jac = np.zeros((C, 2 * m, C, 2 * m))
         for c in range(2):
-            jac[:, 6 * c:6 * c + 6, :, 6 * c:6 * c + 6] = blocks[c]
-        return force, jac.reshape(C * 12, C * 12)
+            jac[:, m * c:m * c + m, :, m * c:m * c + m] = blocks[c]
+        return force, jac.reshape(C * 2 * m, C * 2 * m)
+
+    def evaluate_at(self, local, basis, offsets, jacobian=True):
+        """Patch evaluations (OL, OR) at ``local`` (C, n_local) with the static approach ``offsets`` (2, P)."""
+        m = self.contact_local
+        maps = (None, None) if self.point_maps is None else self.point_maps
+        return [patch.evaluate(local[:, m * c:m * c + m], basis, offsets[c], jacobian, point_map=maps[c])
+                for c, patch in enumerate(self.geometry.patches)]
 
     def harmonic_forces(self, local, basis, omega, jacobian=True):
         offsets, doffsets = self.approach(omega)
@@ -272,20 +402,26 @@ class TunedDisk:
             geometry = self.damper_geometry()
             if self.damper_inertia:
                 M[nm:, nm:] = geometry.inertia
-            G_D, G_P = geometry.G_D, geometry.G_P(self.platform_offsets(geometry))
+            offsets = self.platform_offsets(geometry)
+            G_D, G_P = geometry.G_D, geometry.G_P(offsets)
             phi = np.vstack([self.blade.shape("OL"), self.blade.shape("OR")])  # (12, nm)
             dphi = self.interblade_phase
+            contacts = DamperContacts(geometry, self._approach_function(geometry, basis),
+                                      contact_point_maps(geometry, offsets, self.blade, self.blade))
+            w_rows, left_rows, right_rows = contact_rows(contacts.contact_local, nm)
 
             def sector_map(h):
                 phase = np.ones(12, dtype=complex)
                 phase[6:] = np.exp(1j * h * dphi)          # Eq. 24: the OR platform is the next blade's
-                out = np.zeros((12, n), dtype=complex)
-                out[:, :nm] = -G_P @ (phase[:, None] * phi)
-                out[:, nm:] = G_D
+                out = np.zeros((contacts.n_local, n), dtype=complex)
+                out[w_rows, :nm] = -G_P @ (phase[:, None] * phi)
+                out[w_rows, nm:] = G_D
+                if contacts.flexible:                      # the platforms' modal coordinates:
+                    out[left_rows, :nm] = np.eye(nm)       # OL on this blade, OR on the next
+                    out[right_rows, :nm] = phase[-1] * np.eye(nm)
                 return out
 
-            couplings.append(Coupling(DamperContacts(geometry, self._approach_function(geometry, basis)),
-                                      basis.real_form(sector_map), "damper contacts"))
+            couplings.append(Coupling(contacts, basis.real_form(sector_map), "damper contacts"))
             if basis.has_static:
                 k_n = sum(p.normal_law.stiffness for p in geometry.patches)
                 static_stiffness = np.zeros((n, n))
@@ -375,7 +511,9 @@ class TunedDisk:
         result above the tolerance says so).
         ``max_step`` is the largest arc-length step in scaled units (the frequency range is 1;
         smaller: more points). The result is ``success`` only if the branch reached the end and
-        passed :func:`bladedamp.response.physical_checks`.
+        passed :func:`bladedamp.response.physical_checks`. ``n_samples``: AFT samples per period;
+        None (default): the basis default, and once four times more if that branch fails
+        (:func:`bladedamp.response.sampled_response`; ``AUTO_SAMPLES_GROWTH``).
         ``extra_couplings``: your own nonlinear elements, a callable ``basis -> sequence of
         Coupling`` (called for every harmonic set, the solved ones and the enriched one of the
         error estimate; ``self.point_map(basis, "tip")`` gives a blade point's map), added to
@@ -390,11 +528,15 @@ class TunedDisk:
         model = self if extra_couplings is None else WithCouplings(self, extra_couplings)
 
         def solve(H):
+            first = HarmonicBasis(tuple(H)).n_samples
+            return sampled_response(lambda n: solve_sampled(H, n), n_samples, first, AUTO_SAMPLES_GROWTH * first)
+
+        def solve_sampled(H, n_samples):
             system = model.hbm_system(H, n_samples)
             scales = self._scales(system, w0, w1)
             x0 = self._start_solution(system, w0, scales)
-            branch = continuation(system.residual, x0, w0, w1, x_scale=scales,
-                                  max_step=max_step, **continuation_options)
+            branch = continuation(system.residual, x0, w0, w1, x_scale=scales, max_step=max_step,
+                                  start_at_end=lambda: self._start_solution(system, w1, scales), **continuation_options)
             response = DiskResponse.from_branch(self, system, branch)
             T = system.basis.n_samples
 
@@ -545,8 +687,10 @@ class DiskResponse(FrequencyResponse):
 
     tip_amplitude : (n, 3) first-harmonic tip amplitude in x, y, z [m]
     modal_amplitude : (n, n_m) first-harmonic modal amplitudes [sqrt(kg) m]
-    contact_force : (n, C, 12) generalised contact forces on the platforms, OL then OR (Eq. 11)
-    relative_motion : (n, C, 12) generalised relative motions w, OL then OR (Eq. 7)
+    contact_force : (n, C, 12) generalised contact forces on the platforms, OL then OR (Eq. 11;
+        forces and moments of the point forces about the control points)
+    relative_motion : (n, C, 12) generalised relative motions w, OL then OR (Eq. 7; with a
+        flexible platform those of its rigid-body fit, the blade's OL / OR shapes)
     point_displacement : (n, C, 2, P, 3) relative displacement coefficients of every patch point
     point_state : (n, 2, P, 3) fraction of the period each point sticks, slips, is separated
     point_dissipation : (n, 2, P) energy dissipated per period at each point [J]
@@ -583,7 +727,8 @@ class DiskResponse(FrequencyResponse):
                                                  for x, w in zip(X, branch.omega)]))
         if disk.has_damper and npts:
             coupling = system.couplings[0]
-            P = coupling.element.geometry.patches[0].n_points
+            element = coupling.element
+            P = element.geometry.patches[0].n_points
             cf = np.zeros((npts, C, 12))
             rm = np.zeros((npts, C, 12))
             pdisp = np.zeros((npts, C, 2, P, 3))
@@ -591,11 +736,11 @@ class DiskResponse(FrequencyResponse):
             pdiss = np.zeros((npts, 2, P))
             load = np.zeros((npts, 2))
             for i, (x, w) in enumerate(zip(X, branch.omega)):
-                local = (coupling.matrix @ x.ravel()).reshape(C, 12)
-                evs = coupling.element.evaluate(local, basis, w, jacobian=False)
-                rm[i] = local
+                local = (coupling.matrix @ x.ravel()).reshape(C, element.n_local)
+                evs = element.evaluate(local, basis, w, jacobian=False)
+                rm[i] = element.relative_motion(local)
                 for c, ev in enumerate(evs):
-                    cf[i, :, 6 * c:6 * c + 6] = ev.force
+                    cf[i, :, 6 * c:6 * c + 6] = ev.force[:, :6]
                     pts = ev.points
                     pdisp[i, :, c] = basis.to_coeffs(np.moveaxis(pts.displacement, 1, 0))
                     for s in range(3):

@@ -47,10 +47,9 @@ import scipy.sparse as sp
 from . import _validate
 from .blade import ModalBlade
 from .contact.laws import LinearNormalLaw
-from .contact.patch import dof_jacobian
-from .contact.point import damper_contact_forces, normal_law_parameters, point_contact_forces
+from .contact.point import damper_contact_forces, normal_law_parameters
 from .damper.kinetics import seat
-from .disk import DAMPER_DOFS, DamperContacts, TunedDisk
+from .disk import DAMPER_DOFS, DamperContacts, TunedDisk, contact_point_maps, contact_rows, point_map_forces
 from .hbm.accuracy import HARMONIC_TOLERANCE, converged_response
 from .hbm.continuation import Branch, continuation
 from .hbm.start import robust_start
@@ -89,9 +88,11 @@ def sparse_real_form(basis: HarmonicBasis, per_harmonic) -> sp.csr_matrix:
 class AssemblyContacts:
     """The contacts of all dampers of an assembly as one harmonic-balance element.
 
-    Local coordinates: the 12 relative motions (OL, OR) of each damper in turn
-    (``n_local = 12 * n_dampers``). ``contacts[d]`` is damper d's :class:`DamperContacts`
-    (built by its TunedDisk). Returns a sparse block-diagonal local Jacobian.
+    Local coordinates: those of each damper's :class:`DamperContacts` in turn (the 12 relative
+    motions of OL and OR, and with flexible platforms the platform blades' modal coordinates:
+    ``n_local = L * n_dampers``, L = :attr:`damper_local`, the same for every damper).
+    ``contacts[d]`` is damper d's :class:`DamperContacts` (built as its TunedDisk's). Returns a
+    sparse block-diagonal local Jacobian.
     """
 
     contacts: list[DamperContacts]
@@ -105,11 +106,20 @@ class AssemblyContacts:
     _tol = 1e-10
 
     def __post_init__(self):
-        self.n_local = 12 * len(self.contacts)
+        sizes = {c.n_local for c in self.contacts}
+        if len(sizes) > 1:
+            raise ValueError("the dampers' contacts must all have flexible platforms or all rigid ones "
+                             f"(local coordinates per damper: {sorted(sizes)})")
+        self.n_local = sum(c.n_local for c in self.contacts)
 
     @property
     def n_dampers(self) -> int:
         return len(self.contacts)
+
+    @property
+    def damper_local(self) -> int:
+        """Local coordinates per damper L: 12 (rigid platforms) or 12 + 2 n_m (flexible)."""
+        return self.n_local // max(self.n_dampers, 1)
 
     def _stacked(self):
         """Batched point data of all dampers, or None if their patches do not share a normal law."""
@@ -126,22 +136,23 @@ class AssemblyContacts:
         return self._batch if self._batch[0] else None
 
     def _block_index(self, C: int):
-        """COO indices of the (n_d, C, 12, C, 12) per-damper blocks in the local Jacobian."""
+        """COO indices of the (n_d, C, L, C, L) per-damper blocks in the local Jacobian."""
         if C not in self._index:
-            nd = self.n_dampers
-            d, a, m, b, k = np.meshgrid(np.arange(nd), np.arange(C), np.arange(12), np.arange(C), np.arange(12),
+            nd, L = self.n_dampers, self.damper_local
+            d, a, m, b, k = np.meshgrid(np.arange(nd), np.arange(C), np.arange(L), np.arange(C), np.arange(L),
                                         indexing="ij")
-            self._index[C] = ((a * 12 * nd + 12 * d + m).ravel(), (b * 12 * nd + 12 * d + k).ravel())
+            self._index[C] = ((a * L * nd + L * d + m).ravel(), (b * L * nd + L * d + k).ravel())
         return self._index[C]
 
     def _forces(self, local, basis, offsets, jacobian):
-        """Forces (C, n_d, 12) and Jacobian blocks (n_d, C, 12, C, 12) or None.
+        """Forces (C, n_d, L) and Jacobian blocks (n_d, C, L, C, L) or None.
 
-        Batched dampers with a normal law the fused kernel knows go through
+        Batched dampers with rigid platforms and a normal law the fused kernel knows go through
         :func:`~bladedamp.contact.point.damper_contact_forces` (one numba call: point motion,
-        normal law, return map, AFT and the projections); otherwise :meth:`_forces_numpy`."""
+        normal law, return map, AFT and the projections); otherwise (flexible platforms too,
+        whose point maps the fused kernel does not take) :meth:`_forces_numpy`."""
         stack = self._stacked()
-        law = None if stack is None else normal_law_parameters(stack[5])
+        law = None if stack is None or self.damper_local != 12 else normal_law_parameters(stack[5])
         if law is None:
             return self._forces_numpy(local, basis, offsets, jacobian)
         C, nd = basis.n_coeffs, self.n_dampers
@@ -155,35 +166,31 @@ class AssemblyContacts:
         return force, blocks if jacobian else None
 
     def _forces_numpy(self, local, basis, offsets, jacobian):
-        """:meth:`_forces` through :func:`point_contact_forces` and numpy projections (the
-        reference of the fused kernel; any normal law)."""
-        C, nd = basis.n_coeffs, self.n_dampers
+        """:meth:`_forces` through :func:`~bladedamp.disk.point_map_forces` (the point-contact
+        kernel and numpy projections; the reference of the fused kernel; any normal law and
+        flexible platforms)."""
+        C, nd, L = basis.n_coeffs, self.n_dampers, self.damper_local
         stack = self._stacked()
         if stack is None:
-            force = np.zeros((C, nd, 12))
-            blocks = np.zeros((nd, C, 12, C, 12)) if jacobian else None
+            force = np.zeros((C, nd, L))
+            blocks = np.zeros((nd, C, L, C, L)) if jacobian else None
             for d, c in enumerate(self.contacts):
                 f, j = c._forces(local[:, d], basis, offsets[d], jacobian)
                 force[:, d] = f
                 if jacobian:
-                    blocks[d] = j.reshape(C, 12, C, 12)
+                    blocks[d] = j.reshape(C, L, C, L)
             return force, blocks
-        _, B, k_t, mu, weights, law = stack                      # B (n_d, 2, P, 3, 6)
-        P = B.shape[2]
-        coeffs = np.einsum("dqpij,cdqj->cdqpi", B, local.reshape(C, nd, 2, 6)).reshape(C, nd * 2 * P, 3)
-        pts = point_contact_forces(coeffs, basis, k_t, mu, law, weights, np.ravel(offsets), jacobian=jacobian,
-                                   max_passes=self._max_passes, tol=self._tol)
-        f_points = basis.to_coeffs(np.moveaxis(pts.force, 1, 0)).reshape(C, nd, 2, P, 3)
-        force = np.einsum("cdqpi,dqpij->cdqj", f_points, B).reshape(C, nd, 12)
+        _, B, k_t, mu, weights, law = stack                      # B (n_d, 2, P, 3, m)
+        m = B.shape[-1]
+        force, q_blocks, _ = point_map_forces(B, local.reshape(C, nd, 2, m), basis, k_t, mu, law, weights, offsets,
+                                              jacobian, max_passes=self._max_passes, tol=self._tol)
+        force = force.reshape(C, nd, L)
         if not jacobian:
             return force, None
-        T = basis.n_samples
-        jp = np.matmul(basis.analysis, pts.jacobian.reshape(nd * 2 * P, T, 9 * C)).reshape(nd, 2, P, C, 3, 3, C)
-        q_blocks = dof_jacobian(B, jp)
-        blocks = np.zeros((nd, C, 2, 6, C, 2, 6))
+        blocks = np.zeros((nd, C, 2, m, C, 2, m))
         for q in range(2):
             blocks[:, :, q, :, :, q, :] = q_blocks[:, q]
-        return force, blocks.reshape(nd, C, 12, C, 12)
+        return force, blocks.reshape(nd, C, L, C, L)
 
     def _approach(self, omega):
         """Static approach (n_d, 2, P) of every damper and its omega-derivative (last omega cached)."""
@@ -198,10 +205,10 @@ class AssemblyContacts:
         return sp.csr_matrix((blocks.ravel(), (rows, cols)), shape=(n, n))
 
     def evaluate(self, local, basis, omega, jacobian=True):
-        """``(force (C, n_d, 12), Jacobian blocks (n_d, C*12, C*12) or None, d force / d omega
-        (C, n_d, 12) or None)``; damper d's block in its own (coefficient, coordinate) order."""
-        C, nd = basis.n_coeffs, self.n_dampers
-        local = np.asarray(local).reshape(C, nd, 12)
+        """``(force (C, n_d, L), Jacobian blocks (n_d, C*L, C*L) or None, d force / d omega
+        (C, n_d, L) or None)``; damper d's block in its own (coefficient, coordinate) order."""
+        C, nd, L = basis.n_coeffs, self.n_dampers, self.damper_local
+        local = np.asarray(local).reshape(C, nd, L)
         offsets, doffsets = self._approach(omega)
         force, blocks = self._forces(local, basis, offsets, jacobian)
         if not jacobian:
@@ -222,7 +229,7 @@ class AssemblyContacts:
                 fp, _ = self._forces(local, basis, offsets + h * doffsets, False)
                 fm, _ = self._forces(local, basis, offsets - h * doffsets, False)
                 domega = (fp - fm) / (2 * h)
-        return force, blocks.reshape(nd, C * 12, C * 12), domega
+        return force, blocks.reshape(nd, C * L, C * L), domega
 
     def harmonic_forces(self, local, basis, omega, jacobian=True):
         C = basis.n_coeffs
@@ -256,10 +263,10 @@ class AssemblySystem(HarmonicBalanceSystem):
         if self.couplings:
             c = self.couplings[0]
             T = sp.csr_matrix(c.matrix)
-            nd = c.element.n_dampers
+            nd, L = c.element.n_dampers, c.element.damper_local
             Tb, idx = [], []
             for d in range(nd):
-                r = (np.arange(C)[:, None] * 12 * nd + 12 * d + np.arange(12)[None, :]).ravel()
+                r = (np.arange(C)[:, None] * L * nd + L * d + np.arange(L)[None, :]).ravel()
                 Td = T[r]
                 cols_d = np.unique(Td.indices)
                 Tb.append(Td[:, cols_d].toarray())
@@ -462,6 +469,10 @@ class MistunedDisk:
             if set(b.points) != set(self.blades[0].points) or any(
                     not np.allclose(b.points[p], self.blades[0].points[p]) for p in b.points):
                 raise ValueError(f"blades must have the same point positions (blades[{k}] differs from blades[0])")
+        flexible = [b.flexible_platform for b in self.blades]
+        if any(flexible) and not all(flexible):
+            raise ValueError("blades must all carry per-point platform data (solid blades: flexible platforms) "
+                             f"or none (blades {[k for k, f in enumerate(flexible) if f]} do, the others not)")
         self.dampers = _as_list("dampers", self.dampers, s)
         angles = {}
         for name in ("gamma_left", "gamma_right"):
@@ -573,24 +584,33 @@ class MistunedDisk:
             sl = self.damper_slice(d)
             if self.damper_inertia:
                 mass[sl, sl] = g.inertia
-            maps.append((g.G_D, g.G_P(sector.platform_offsets(g))))
-            contacts.append(DamperContacts(g, sector._approach_function(g, basis)))
+            offsets = sector.platform_offsets(g)
+            maps.append((g.G_D, g.G_P(offsets)))
+            # damper k: blade k's OL platform, blade k+1's OR platform (that of the next sector's blade 0)
+            contacts.append(DamperContacts(g, sector._approach_function(g, basis),
+                                           contact_point_maps(g, offsets, self.blades[k], self.blades[(k + 1) % s])))
             if static is not None:
                 k_n = sum(p.normal_law.stiffness for p in g.patches)
                 static[sl, sl] = static_retention * k_n * np.diag([1, 1, 1, 1e-4, 1e-4, 1e-4])
         dphi = self.interblade_phase
 
+        L = contacts[0].n_local if contacts else 12           # local coordinates per damper
+        w_rows, left_rows, right_rows = contact_rows(L // 2, nm)
+
         def contact_map(h):
-            T = sp.lil_matrix((12 * len(active), N), dtype=complex)
+            T = sp.lil_matrix((L * len(active), N), dtype=complex)
             for d, k in enumerate(active):
                 G_D, G_P = maps[d]
                 nxt = (k + 1) % s
                 phase = np.exp(1j * h * s * dphi) if k + 1 == s else 1.0   # next sector's blade 0
-                rows = slice(12 * d, 12 * d + 12)
+                rows = L * d + w_rows if L != 12 else slice(12 * d, 12 * d + 12)
                 T[rows, self.blade_slice(k)] = -G_P[:, :6] @ self.blades[k].shape("OL")
                 T[rows, self.blade_slice(nxt)] = T[rows, self.blade_slice(nxt)].toarray() \
                     - phase * (G_P[:, 6:] @ self.blades[nxt].shape("OR"))
                 T[rows, self.damper_slice(d)] = G_D
+                if L != 12:                  # flexible platforms: the modal coordinates of both blades
+                    T[L * d + left_rows, self.blade_slice(k)] = np.eye(nm)
+                    T[L * d + right_rows, self.blade_slice(nxt)] = phase * np.eye(nm)
             return T.tocsr()
 
         couplings = []
@@ -691,8 +711,9 @@ class MistunedDisk:
             system = self.hbm_system(H, n_samples)
             scales = self.scales(system, w0, w1)
             x0 = self.start_solution(system, w0, scales)
-            branch = continuation(system.residual, x0, w0, w1, x_scale=scales,
-                                  factorize=system.factorize, max_step=max_step, **continuation_options)
+            branch = continuation(system.residual, x0, w0, w1, x_scale=scales, factorize=system.factorize,
+                                  max_step=max_step, start_at_end=lambda: self.start_solution(system, w1, scales),
+                                  **continuation_options)
             response = MistunedResponse.from_branch(self, system, branch, tuned_peak_amplitude)
             T = system.basis.n_samples
 
@@ -830,7 +851,7 @@ class MistunedResponse(FrequencyResponse):
                 c = system.couplings[0]
                 local = (c.matrix @ x).reshape(C, c.element.n_local)
                 force, _, _ = c.element.harmonic_forces(local, basis, w, False)
-                diss[i] = basis.work_per_cycle(force, local).reshape(nd, 12).sum(axis=1)
+                diss[i] = basis.work_per_cycle(force, local).reshape(nd, -1).sum(axis=1)
         return cls(branch.omega, X, basis, disk.dof_names, branch.success, branch.message, branch.iterations,
                    branch.turning_points, tip_amplitude=tip, excitation_work=np.array(exc),
                    viscous_dissipation=np.array(visc), dissipated_energy=diss.sum(axis=1), damper_dissipation=diss,

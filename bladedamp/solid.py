@@ -54,11 +54,13 @@ the weighted least-squares rigid-body fit u(x) ~ u_P + phi x (x - x_P) of the FE
 over a region, with the point P as reference (so u_P is the fitted translation at P):
 
 * OL, OR: over the platform's contact face on that side (area-weighted, exact facet
-  quadrature). This keeps the contact kinematics of the rest of bladedamp (a rigid platform at
-  the control point) working; the fit's residual (share of the face motion the rigid fit
-  misses) says how flexible the platform is, and the raw FE displacements of the face at a grid
-  of points are kept in :attr:`SolidModalBlade.contact_faces` for a later flexible-platform
-  contact model.
+  quadrature): the shapes every rigid-point use of the blade takes (``blade.shape("OL")``); the
+  fit's residual (share of the face motion the rigid fit misses) says how flexible the platform
+  is, and the raw FE displacements of the face at a grid of points are kept in
+  :attr:`SolidModalBlade.contact_faces`. The contact kinematics of the disks do not use a rigid
+  platform: :meth:`SolidModalBlade.platform_displacements` gives the FE field at every contact
+  point of the damper's patches (:func:`bladedamp.disk.contact_point_maps`, flexible
+  platforms; :meth:`SolidModalBlade.rigid_platform_blade` for the rigid ones).
 * platform: over the platform prism's volume.
 * tip (and excitation, and any point at the tip height): over the tip face; another height:
   over the blade's cross-section there (Gauss-Legendre grid, interpolated).
@@ -875,19 +877,103 @@ class SolidModalBlade(ModalBlade):
     fit_residuals : point name -> (n_m,) share of the region's motion the point's rigid fit misses.
     solid_info : n_dofs, element_size [m], mass [kg], all computed frequencies [Hz] and names,
         and the wall times [s] of meshing, assembly and eigen-solution.
+    modes : the :class:`SolidModes` the blade was built from (None: no FE field kept, the
+        platform is then rigid in the contact kinematics); mode_indices : (n_m,) the columns of
+        ``modes`` that are this blade's modes.
 
-    Saved files (``save``) hold the ModalBlade part only.
+    With ``modes``, :meth:`platform_displacements` gives the FE displacement of the platform's
+    contact faces at any point of them, and the disks (:class:`~bladedamp.disk.TunedDisk`,
+    :class:`~bladedamp.mistuned.MistunedDisk`) use it at every contact point: a flexible
+    platform (:func:`bladedamp.disk.contact_point_maps`). :meth:`rigid_platform_blade` is the
+    same blade with rigid platforms at OL / OR (the beam model's contact kinematics).
+
+    Saved files (``save``) hold the ModalBlade part only (rigid platforms when read back).
     """
 
     contact_faces: dict = field(default_factory=dict, repr=False)
     fit_residuals: dict = field(default_factory=dict, repr=False)
     solid_info: dict = field(default_factory=dict, repr=False)
+    modes: SolidModes | None = field(default=None, repr=False)
+    mode_indices: tuple = ()
 
     def __post_init__(self):
         super().__post_init__()
         for side, face in self.contact_faces.items():
             if not isinstance(face, ContactFaceModes) or face.shapes.shape[2] != self.n_modes:
                 raise ValueError(f"contact_faces[{side!r}] must be ContactFaceModes with {self.n_modes} modes")
+        if self.modes is not None:
+            if not isinstance(self.modes, SolidModes):
+                raise ValueError(f"modes must be a SolidModes or None (got {type(self.modes).__name__})")
+            idx = tuple(int(i) for i in self.mode_indices)
+            if len(idx) != self.n_modes or min(idx) < 0 or max(idx) >= self.modes.vectors.shape[1]:
+                raise ValueError(f"mode_indices must name {self.n_modes} of the {self.modes.vectors.shape[1]} "
+                                 f"columns of modes (got {self.mode_indices!r})")
+            self.mode_indices = idx
+
+    #: how far a contact point may lie off its face (along the normal, or past the face's edge)
+    #: relative to the face's size before it is refused [-]
+    FACE_TOLERANCE = 1e-6
+
+    @property
+    def flexible_platform(self) -> bool:
+        """True when the FE field is kept (``modes``): the platform is flexible at the contacts."""
+        return self.modes is not None
+
+    def platform_displacements(self, side: str, points, normal=None) -> np.ndarray | None:
+        """FE translations (P, 3, n_m) [m/sqrt(kg)] of the ``side`` ("OL", "OR") contact face at
+        ``points`` (P, 3) [m, blade frame], interpolated by the P2 shape functions (exact FE
+        field) of the mass-normalised modes; None without ``modes``. ``normal`` (3,): the
+        contact normal the caller's kinematics assume (from the platform into the damper, i.e.
+        the platform angle); ValueError if the face's differs by more than 1e-6 rad (a disk whose
+        gamma_left / gamma_right are not the solid's).
+
+        Each point is projected onto the face plane along its normal (the damper placement of
+        :meth:`~bladedamp.disk.TunedDisk.platform_offsets` puts a contact centre off the face by
+        half the radial mismatch when the two platform angles differ) and evaluated 0.1 um inside
+        the platform (as :meth:`SolidModes.contact_face`). Raises ValueError if a point lies
+        outside the face rectangle (a damper patch longer or higher than the face) or off its
+        plane by more than 5 % of the face's height.
+        """
+        if side not in ("OL", "OR"):
+            raise ValueError(f"side must be 'OL' or 'OR' (got {side!r})")
+        if self.modes is None:
+            return None
+        x = np.asarray(points, dtype=float)
+        if x.ndim != 2 or x.shape[1] != 3:
+            raise ValueError(f"points must have shape (P, 3) [m] (got {x.shape})")
+        centre, frame, xi_r, eta_r = self.modes.geometry.contact_face(side)
+        if normal is not None:
+            n = np.asarray(normal, dtype=float)
+            angle = np.arccos(np.clip(n @ frame[2] / np.linalg.norm(n), -1.0, 1.0))
+            if n.shape != (3,) or angle > 1e-6:
+                sg = self.modes.geometry
+                gamma = sg.gamma_left if side == "OL" else sg.gamma_right
+                raise ValueError(f"normal: the {side} contact normal {np.round(n, 6)} is {np.degrees(angle):.4g} deg "
+                                 f"off the solid blade's {side} face (its platform angle is "
+                                 f"{np.degrees(gamma):.6g} deg): give the disk the solid's "
+                                 f"{'gamma_left' if side == 'OL' else 'gamma_right'}, or build the solid "
+                                 "(SolidBladeGeometry gamma_left / gamma_right) with the disk's")
+        local = (x - centre) @ frame.T                                    # (xi, eta, zeta)
+        size = max(xi_r[1] - xi_r[0], eta_r[1] - eta_r[0])
+        tol = self.FACE_TOLERANCE * size
+        for k, (name, lo, hi) in enumerate((("xi (across the face)", *xi_r), ("eta (along y)", *eta_r))):
+            outside = (local[:, k] < lo - tol) | (local[:, k] > hi + tol)
+            if np.any(outside):
+                raise ValueError(f"points: contact point {np.flatnonzero(outside)[0]} lies outside the {side} "
+                                 f"platform contact face ({name} {local[outside, k][0]:.4g} m, the face spans "
+                                 f"{lo:.4g}..{hi:.4g} m): the damper's contact patch is larger than the face")
+        if np.abs(local[:, 2]).max() > 0.05 * (xi_r[1] - xi_r[0]):
+            raise ValueError(f"points lie {np.abs(local[:, 2]).max():.3g} m off the {side} contact face's plane "
+                             f"(more than 5 % of its height {xi_r[1] - xi_r[0]:.3g} m)")
+        on_face = centre + local[:, :1] * frame[0] + local[:, 1:2] * frame[1] - 1e-7 * frame[2]
+        return self.modes.displacements_at(on_face)[:, :, list(self.mode_indices)]
+
+    def rigid_platform_blade(self) -> ModalBlade:
+        """This blade as a plain :class:`~bladedamp.blade.ModalBlade` (same frequencies, damping,
+        named points and shapes): rigid platforms at the OL / OR control points in the contact
+        kinematics (the beam model's, Eq. 6)."""
+        return ModalBlade(natural_frequencies_hz=self.natural_frequencies_hz, damping_ratios=self.damping_ratios,
+                          mode_shapes=dict(self.mode_shapes), points=dict(self.points), mode_names=self.mode_names)
 
 
 def solid_blade(geometry: SolidBladeGeometry | BeamBladeGeometry | None = None,
@@ -944,4 +1030,5 @@ def solid_blade(geometry: SolidBladeGeometry | BeamBladeGeometry | None = None,
     return SolidModalBlade(natural_frequencies_hz=freqs, damping_ratios=damping_ratios,
                            mode_shapes={p: s[:, idx] for p, s in shapes.items()}, points=points,
                            mode_names=names, contact_faces=faces,
-                           fit_residuals={p: r[idx] for p, r in residuals.items()}, solid_info=info)
+                           fit_residuals={p: r[idx] for p, r in residuals.items()}, solid_info=info,
+                           modes=modes, mode_indices=tuple(idx))

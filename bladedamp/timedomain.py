@@ -342,6 +342,9 @@ def _assembly_arrays(disk) -> _AssemblyArrays:
 
     from .contact.point import normal_law_parameters
 
+    if any(b.flexible_platform for b in disk.blades):
+        raise ValueError("time_response models rigid platforms at the OL / OR control points only; the blades "
+                         "carry flexible platforms (solid FE blades): use blade.rigid_platform_blade() for them")
     system = disk.hbm_system((0, 1))
     N = system.n_dof
     s, nm = disk.n_sector, disk.n_modes

@@ -42,10 +42,11 @@ def dof_jacobian(point_map: np.ndarray, point_jacobian: np.ndarray) -> np.ndarra
     """The Jacobian of a patch's generalised forces from its points' (Eq. 11 differentiated):
     ``sum_p B_p^T (d f_p / d c_p) B_p`` per pair of harmonic coefficients.
 
-    ``point_map`` B (..., P, 3, 6) maps the 6 control-point DOF to each point's (xi, eta,
-    zeta); ``point_jacobian`` (..., P, C, 3, 3, C) is d f_coef[a, p, i] / d c_p[b, k] (force
-    coefficient a of direction i by displacement coefficient b of direction k); returns
-    (..., C, 6, C, 6). Leading axes (patches, dampers) are batched. One optimised einsum over
+    ``point_map`` B (..., P, 3, m) maps the m local coordinates (the 6 control-point DOF, or a
+    flexible platform's 6 + n_m) to each point's (xi, eta, zeta); ``point_jacobian``
+    (..., P, C, 3, 3, C) is d f_coef[a, p, i] / d c_p[b, k] (force coefficient a of direction
+    i by displacement coefficient b of direction k); returns (..., C, m, C, m). Leading axes
+    (patches, dampers) are batched. One optimised einsum over
     flattened leading axes (with one BLAS thread, measured on the 2-core box: 0.6 / 6.4 ms
     for the 2 / 32 patches of a tuned sector / a 16-blade assembly at 7 coefficients, against
     2.0 / 25 ms for two chained plain einsums)."""
@@ -53,7 +54,11 @@ def dof_jacobian(point_map: np.ndarray, point_jacobian: np.ndarray) -> np.ndarra
     L = int(np.prod(lead, dtype=int))
     B = point_map.reshape((L,) + point_map.shape[-3:])
     J = point_jacobian.reshape((L,) + point_jacobian.shape[-5:])
-    out = np.einsum("lpim,lpaikb,lpkn->lambn", B, J, B, optimize=True)
+    # m > 6 (a flexible platform's maps): numpy's optimiser would take one 8-loop einsum, 5 x slower
+    # than its own m = 6 path (B with B, then the point Jacobian), given here (measured, one BLAS
+    # thread, 2 x 25 points, 7 coefficients, m = 10: 6.3 against 1.3 ms)
+    path = True if B.shape[-1] == 6 else ["einsum_path", (0, 2), (0, 1)]
+    out = np.einsum("lpim,lpaikb,lpkn->lambn", B, J, B, optimize=path)
     return out.reshape(lead + out.shape[1:])
 
 
@@ -61,8 +66,9 @@ def dof_jacobian(point_map: np.ndarray, point_jacobian: np.ndarray) -> np.ndarra
 class PatchEvaluation:
     """Result of one AFT evaluation of a patch.
 
-    force : (C, 6) harmonic coefficients of the generalised contact forces on the platform [N, N m]
-    jacobian : (C*6, C*6) or None, d force / d w (harmonic-major)
+    force : (C, m) harmonic coefficients of the generalised contact forces on the platform [N, N m]
+        (m = 6: forces and moments about the control point), conjugate to the local coordinates w
+    jacobian : (C*m, C*m) or None, d force / d w (harmonic-major)
     points : PointContactSamples of every point over the period
     """
 
@@ -158,24 +164,32 @@ class ContactPatch:
         """(C, P, 3) point displacement coefficients from control-point coefficients (C, 6)."""
         return np.einsum("pij,cj->cpi", self.point_map, w)
 
-    def evaluate(self, w, basis, approach_offset, jacobian=True) -> PatchEvaluation:
+    def evaluate(self, w, basis, approach_offset, jacobian=True, point_map=None) -> PatchEvaluation:
         """Generalised contact forces (Eq. 11) of the patch for control-point motion ``w``.
 
         Parameters
         ----------
-        w : (C, 6) harmonic coefficients of the relative control-point motion [m, rad]
+        w : (C, m) harmonic coefficients of the patch's local coordinates: the relative
+            control-point motion (m = 6) [m, rad], or those of ``point_map``
         basis : HarmonicBasis
         approach_offset : (P,) or float, approach at w = 0 [m] (static preload, see
             :meth:`approach_for_load`)
+        point_map : (P, 3, m) map from ``w`` to the point displacements (xi, eta, zeta) [m]
+            instead of the rigid :attr:`point_map` (e.g. a flexible platform's,
+            :func:`bladedamp.disk.contact_point_maps`); the forces are then conjugate to ``w``
         """
         w = np.asarray(w, dtype=float)
         C = basis.n_coeffs
+        B = self.point_map if point_map is None else np.asarray(point_map, dtype=float)
+        m = B.shape[-1]
+        if B.shape != (self.n_points, 3, m) or w.shape != (C, m):
+            raise ValueError(f"point_map must have shape ({self.n_points}, 3, m) and w ({C}, m) "
+                             f"(got {B.shape} and {w.shape})")
         offset = np.broadcast_to(np.asarray(approach_offset, dtype=float), (self.n_points,))
-        pts = point_contact_forces(self.point_coefficients(w), basis,
+        pts = point_contact_forces(np.einsum("pij,cj->cpi", B, w), basis,
                                    self.tangential_stiffness * self.weights,
                                    np.full(self.n_points, self.friction_coefficient),
                                    self.normal_law, self.weights, offset, jacobian=jacobian)
-        B = self.point_map
         point_force_coeffs = basis.to_coeffs(np.moveaxis(pts.force, 1, 0))  # (C, P, 3)
         force = np.einsum("cpi,pij->cj", point_force_coeffs, B)
         jac = None
@@ -183,7 +197,7 @@ class ContactPatch:
             # d f_coef[a, p, i] / d c_p[b, k]  (point coefficient blocks are direction-major)
             P, T = self.n_points, basis.n_samples
             jp = np.matmul(basis.analysis, pts.jacobian.reshape(P, T, 9 * C)).reshape(P, C, 3, 3, C)
-            jac = dof_jacobian(B, jp).reshape(C * 6, C * 6)
+            jac = dof_jacobian(B, jp).reshape(C * m, C * m)
         return PatchEvaluation(force, jac, pts)
 
     def equivalent_stiffness(self, w, basis, approach_offset) -> dict[int, np.ndarray]:
