@@ -117,7 +117,7 @@ def reproduce(out: Path, processes: int | None = None) -> dict:
                        "reduction_pct": 100 * (1 - a_damp / a_free), "tip_dof": "xyz"[dof] if dof < 3 else "phi_z",
                        "peak_free": a_free, "peak_damped": a_damp})
         windows.append((name, dof, r_free, r_damp))
-        progress(f"  {name}: damped resonance {f_damp:.2f} Hz, reduction {table1[-1]['reduction_pct']:.1f} %")
+        progress(f"  {name}: damped resonance {f_damp:.2f} Hz, reduction {report.fmt_number(table1[-1]['reduction_pct'], '.1f')} %")
     timings["table1_s"] = time.perf_counter() - t0
 
     # -- mass sweep and optimum, both dampers at EO = 1 (Fig. 5, 6) --
@@ -129,25 +129,30 @@ def reproduce(out: Path, processes: int | None = None) -> dict:
         opt = optimal_mass(disk, bounds=(1e-5, 2e-2))
         optima[kind] = opt
         progress(f"optimum {kind}: {1e3 * opt.mass:.3f} g, peak {1e3 * opt.peak_amplitude:.4f} mm, "
-                 f"reduction {100 * opt.reduction:.1f} %")
+                 f"reduction {report.fmt_percent(opt.reduction)}")
     for m in (0.1e-3, 1e-3, 10e-3, 1.0):
         frfs_fig5.append((m, peak_response(reference_disk("cylinder", m), (85.0, 115.0))[2]))
     timings["mass_studies_s"] = time.perf_counter() - t0
 
     report.plot_four_modes(windows, out / "fig4_frf_four_modes.png")
+    t1 = time.perf_counter()
     free_r = reference_disk(None).frequency_response(85.0, 115.0, harmonics=PAPER_HARMONICS, max_step=0.05)
+    solve_s = {("none", "paper"): time.perf_counter() - t1}
     report.plot_mass_variation(free_r, frfs_fig5, out / "fig5_mass_variation.png")
     report.plot_mass_optimisation(sweeps, optima, out / "fig6_mass_optimisation.png")
     progress("figures of Fig. 4-6 written")
 
     # -- the paper's one-harmonic setting beside the converged harmonic balance, at both optima --
     t0 = time.perf_counter()
-    accuracy = {}
+    accuracy, frfs = {}, {}
     for kind, opt in optima.items():
         disk = reference_disk(kind, opt.mass)
         rows = {}
         for label, H in (("paper", PAPER_HARMONICS), ("converged", "auto")):
+            t1 = time.perf_counter()
             r = disk.frequency_response(90.0, 100.0, harmonics=H, max_step=0.05)
+            solve_s[kind, label] = time.perf_counter() - t1
+            frfs[kind, label] = r
             rows[label] = {"harmonics": list(r.basis.harmonics), "peak_tip_mm": 1e3 * r.peak_amplitude,
                            "resonance_hz": r.peak_frequency_hz, "harmonic_error_pct": report.plain(100 * r.harmonic_error),
                            "converged": bool(r.harmonics_converged), "success": bool(r.success)}
@@ -155,6 +160,10 @@ def reproduce(out: Path, processes: int | None = None) -> dict:
         progress(f"harmonic accuracy {kind}: paper {rows['paper']['peak_tip_mm']:.4f} mm, "
                  f"converged {rows['converged']['peak_tip_mm']:.4f} mm with harmonics {tuple(rows['converged']['harmonics'])}")
     timings["harmonic_accuracy_s"] = time.perf_counter() - t0
+
+    # -- the stability of those responses and the 1F nonlinear modes of both dampers --
+    stability, backbone = stability_and_backbones(out, free_r, frfs, solve_s, {k: o.mass for k, o in optima.items()},
+                                                  progress, timings)
 
     design = _design_studies(out, progress, processes, timings)
 
@@ -184,10 +193,71 @@ def reproduce(out: Path, processes: int | None = None) -> dict:
     summary.update(design)
     summary["mistuning"] = mistuning
     summary["harmonic_accuracy"] = accuracy
+    summary["stability"] = stability
+    summary["backbone"] = backbone
     (out / "summary.json").write_text(json.dumps(summary, indent=2))
     (out / "report.md").write_text(report.reproduce_report(summary, table1))
     print(f"wrote {out / 'summary.json'}, {out / 'report.md'} and figures in {total:.1f} s", file=sys.stderr)
     return summary
+
+
+def stability_and_backbones(out: Path, free, frfs: dict, solve_s: dict, masses: dict, progress, timings: dict):
+    """The stability of the reference responses (``free``: the disk without damper; ``frfs``:
+    {(kind, "paper" | "converged"): response at the optimal mass ``masses[kind]`` [kg]}) and the
+    1F nonlinear modes (EPMC, one harmonic) of both dampers at those masses; writes
+    ``stability_backbones.png``. ``solve_s``: the solve time of each response [s], to report the
+    stability's cost beside it. Returns the summary's ``stability`` and ``backbone`` entries."""
+    import numpy as np
+
+    from . import report
+    from .hbm.nonlinear_modes import nonlinear_mode
+    from .hbm.stability import with_stability
+    from .reference import reference_disk
+
+    t0 = time.perf_counter()
+    stability, checked = {}, {}
+    entries = [("no damper", "none", "paper", reference_disk(None), free)]
+    entries += [(f"{kind} {1e3 * masses[kind]:.3g} g, {'one harmonic' if label == 'paper' else 'converged'}",
+                 kind, label, reference_disk(kind, masses[kind]), r) for (kind, label), r in frfs.items()]
+    for name, kind, label, model, r in entries:
+        s = with_stability(model, r)
+        checked[kind, label] = s
+        stable = np.ones(len(s.omega), bool) if s.stable is None else np.asarray(s.stable, bool)
+        stability[name] = {
+            "harmonics": list(s.basis.harmonics), "method": s.stability_method or "not computed",
+            "frequency_hz": s.frequency_hz.tolist(), "tip_amplitude_mm": (1e3 * s.tip_amplitude[:, 0]).tolist(),
+            "stable": stable.tolist(),
+            "folds": [int(i) for i in s.turning_points],
+            "branch_points": [int(i) for i in s.bifurcations.get("branch point", [])],
+            "stability_changes": {k: [int(i) for i in v] for k, v in s.bifurcations.items()
+                                  if k not in ("branch point", "seconds")},
+            "seconds": float(s.bifurcations.get("seconds", 0.0)), "solve_s": solve_s.get((kind, label))}
+        progress(f"stability {name}: {int((~stable).sum())} of {len(stable)} points unstable ({s.stability_method})")
+    timings["stability_s"] = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
+    backbone, modes = {}, {}
+    for kind, mass in masses.items():
+        mode = nonlinear_mode(reference_disk(kind, mass), harmonics=(1,))
+        modes[kind] = mode
+        peak = mode.forced_peak()
+        r = frfs[kind, "paper"]
+        backbone[kind] = {
+            "mass_g": 1e3 * mass, "harmonics": list(mode.basis.harmonics), "success": bool(mode.success),
+            "message": mode.message, "modal_amplitude": np.asarray(mode.modal_amplitude).tolist(),
+            "frequency_hz": np.asarray(mode.frequency_hz).tolist(),
+            "damping_ratio": np.asarray(mode.damping_ratio).tolist(),
+            "tip_amplitude_mm": (1e3 * np.asarray(mode.output_amplitude)[:, 0]).tolist(),
+            "synthesised_peak_mm": report.plain(1e3 * peak["output_amplitude"][0]) if peak["found"] else None,
+            "synthesised_peak_hz": report.plain(peak["frequency_hz"]) if peak["found"] else None,
+            "frf_peak_mm": 1e3 * r.peak_amplitude, "frf_peak_hz": r.peak_frequency_hz}
+        progress(f"1F nonlinear mode {kind}: {len(mode.modal_amplitude)} amplitudes, "
+                 f"{mode.frequency_hz[0]:.2f} -> {mode.frequency_hz[-1]:.2f} Hz")
+    timings["backbone_s"] = time.perf_counter() - t0
+    report.plot_stability_backbones({k: checked[k, "paper"] for k in masses},
+                                    {k: checked[k, "converged"] for k in masses if (k, "converged") in checked},
+                                    modes, out / "stability_backbones.png")
+    return stability, backbone
 
 
 def _design_studies(out: Path, progress, processes, timings) -> dict:
@@ -327,7 +397,7 @@ def frf_command(args) -> int:
 def optimize_command(args) -> int:
     """``bladedamp optimize``: the optimal damper mass, optionally over platform angles or
     wedge contact heights."""
-    from .report import optimize_outputs
+    from .report import fmt_percent, optimize_outputs
     from .studies.design import platform_angle_study, with_contact_height
     from .studies.mass import optimal_mass
 
@@ -360,7 +430,7 @@ def optimize_command(args) -> int:
                                                    processes=args.processes, **options)))
     optimize_outputs(out, design, optimum, angles, heights)
     return _done(out, t0, f"optimal mass {1e3 * optimum.mass:.4g} g, peak {1e3 * optimum.peak_amplitude:.4f} mm, "
-                          f"reduction {100 * optimum.reduction:.1f} %")
+                          f"reduction {fmt_percent(optimum.reduction)}")
 
 
 def eo_sweep_command(args) -> int:
@@ -588,7 +658,7 @@ def build_parser() -> argparse.ArgumentParser:
                 "pip install 'bladedamp[viz]'. Writes ods.html, frf.npz, summary.md.")
     design_arg(p)
     p.add_argument("--layout", choices=("sector", "disk"), default=None,
-                   help="sector (three blades) or disk (every blade); default: the viewer's")
+                   help="sector (three blades) or disk (every blade); default: disk with a damper, sector without")
     out_arg(p, "results/show")
 
     p = command("reproduce", reproduce_command,

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .plotting import place_legend
 from .studies.design import tip_dof_amplitude
 
 # the paper's numbers that the reproduce report compares with
@@ -38,76 +39,264 @@ def save_figure(fig, path: Path, dpi: int = 120):
 # ---------------------------------------------------------------------------------------
 # the reproduce report (report.md)
 # ---------------------------------------------------------------------------------------
+# How every verdict is decided. Each table row states its tolerance (the ``tolerance`` column);
+# the reasons are given here and in the report's paragraph "How the verdicts are decided".
+#: calibration targets: the undamped peak to 1 %, the cylinder's optimal mass to 10 % (the paper
+#: says "~1 g") and its reduction to 2 percentage points (the paper: "~71 %")
+CALIBRATION_TOLERANCE = {"undamped_peak": 0.01, "cylinder_mass": 0.10, "cylinder_reduction_points": 2.0}
+#: "A lower than B" needs A at least 1 % below B: closer values are a tie within the peak search's
+#: resolution (the continuation's points refined by a parabola) and prove nothing
+AMPLITUDE_MARGIN = 0.01
+#: "mass A smaller than mass B" needs at least 2 %: the optimiser's tolerance is 0.02 in log(mass)
+MASS_MARGIN = 0.02
+#: the 1 kg cylinder "sticks, no friction damping": its peak within 10 % of the undamped peak
+STUCK_TOLERANCE = 0.10
+#: Table 1: the damped resonance's shift f_res - f0 and the reduction, each within 30 % of the
+#: paper's value (the higher modes are predictions whose platform mode shapes the paper does not
+#: give), but never tighter than the paper's own precision: f0 is given to 1 Hz, so the shift is
+#: known to 0.5 Hz; a reduction is compared to at least 0.5 percentage points (below that the
+#: peak is practically unchanged)
+TABLE1_RELATIVE = 0.30
+TABLE1_SHIFT_FLOOR_HZ = 0.5
+TABLE1_REDUCTION_FLOOR_POINTS = 0.5
+#: EO = 0: "no damping" is a reduction below 1 percentage point; "still damps" at least 10 %
+EO0_NO_DAMPING_POINTS = 1.0
+EO0_DAMPS_PCT = 10.0
+#: single-nonlinear-mode synthesis against the HBM peak: amplitude within 3 %, frequency within 0.1 %
+SYNTHESIS_TOLERANCE = {"amplitude": 0.03, "frequency": 0.001}
+
+
+def fmt_number(x, spec: str = ".3g", missing: str = "not found") -> str:
+    """``x`` formatted with ``spec``; ``missing`` for None, NaN or inf; a value that rounds to
+    zero is written without a sign (never '-0.0')."""
+    if x is None or not np.isfinite(x):
+        return missing
+    text = format(float(x), spec)
+    if float(text) == 0:
+        text = format(0.0, spec)
+    return text
+
+
+def _harmonics(h) -> str:
+    """A harmonic set in words: '1', '0-7', '1, 3, 5'."""
+    h = [int(k) for k in h]
+    if len(h) > 2 and h == list(range(h[0], h[-1] + 1)):
+        return f"{h[0]}-{h[-1]}"
+    return ", ".join(str(k) for k in h)
+
+
+def _verdict(ok: bool, yes: str = "reproduced", no: str = "differs") -> str:
+    return yes if ok else no
+
+
+def _lower(a, b, margin=AMPLITUDE_MARGIN) -> bool:
+    """a lower than b by at least ``margin`` of b."""
+    return bool(np.isfinite(a) and np.isfinite(b) and a <= (1 - margin) * b)
+
+
+VERDICT_HEADER = ["| quantity | paper | bladedamp | tolerance | verdict |", "|---|---|---|---|---|"]
+
+
+def verdict_rules() -> list[str]:
+    """The paragraph that says how the verdicts are decided."""
+    return [
+        "How the verdicts are decided: every row names its tolerance. 'calibrated' means a value bladedamp "
+        "was fitted to (see `bladedamp.reference`) and meets its target; 'reproduced' means the paper's "
+        "statement holds within the stated tolerance; 'differs' means it does not. Comparisons of amplitudes "
+        f"('lower', 'worse') need a difference of at least {100 * AMPLITUDE_MARGIN:g} % (closer values are a tie "
+        f"within the peak search's resolution); of optimal masses at least {100 * MASS_MARGIN:g} % (the "
+        f"optimiser's tolerance). Table 1 allows {100 * TABLE1_RELATIVE:g} % of the paper's frequency shift and "
+        f"reduction, but at least {TABLE1_SHIFT_FLOOR_HZ:g} Hz (the paper gives f0 to 1 Hz) and "
+        f"{TABLE1_REDUCTION_FLOOR_POINTS:g} percentage points (a smaller change leaves the peak practically "
+        "unchanged).", ""]
+
+
 def paper_section(s: dict, table1: list) -> str:
     cyl, wed = s["optimum"]["cylinder"]["1"], s["optimum"]["wedge"]["1"]
+    tol = CALIBRATION_TOLERANCE
+    undamped = s["no_damper_peak_tip_mm"]
+    heavy = s["mass_sweep"]["cylinder"]["peak_tip_mm"][-1]
+    heavy_g = s["mass_sweep"]["cylinder"]["mass_g"][-1]
     lines = [
         "# bladedamp reproduce: Panning, Sextro & Popp, reference configuration",
         "",
         f"Run time: {s['timings_s']['total_s']:.1f} s on this machine "
         f"(Table 1: {s['timings_s']['table1_s']:.1f} s, mass studies: {s['timings_s']['mass_studies_s']:.1f} s).",
         "",
-        "Calibrated (see `bladedamp/reference.py`): the blade's chord on the undamped 1F peak, the contact's "
+        "Calibrated (see `bladedamp.reference`): the blade's chord on the undamped 1F peak, the contact's "
         "tangential stiffness and the damper radius R on the cylinder's optimum. Everything else is a prediction.",
         "",
-        "| quantity | paper | bladedamp | verdict |",
-        "|---|---|---|---|",
-        f"| undamped 1F tip peak (F_x = 0.1 N) | 1.7 mm | {s['no_damper_peak_tip_mm']:.3f} mm | calibrated |",
-        f"| cylinder optimal mass, EO = 1 | ~1 g | {cyl['mass_g']:.3f} g | calibrated |",
-        f"| cylinder reduction at optimum | ~71 % (0.5 mm) | {cyl['reduction_pct']:.1f} % ({cyl['peak_tip_mm']:.3f} mm) | calibrated |",
+        *verdict_rules(),
+        *VERDICT_HEADER,
+        f"| undamped 1F tip peak (F_x = 0.1 N) | 1.7 mm | {undamped:.3f} mm | {100 * tol['undamped_peak']:g} % | "
+        f"{_verdict(abs(undamped / PAPER['no_damper_peak_tip_mm'] - 1) <= tol['undamped_peak'], 'calibrated', 'calibration missed')} |",
+        f"| cylinder optimal mass, EO = 1 | ~1 g | {cyl['mass_g']:.3f} g | {100 * tol['cylinder_mass']:g} % | "
+        f"{_verdict(abs(cyl['mass_g'] / PAPER['cylinder_optimum_g'] - 1) <= tol['cylinder_mass'], 'calibrated', 'calibration missed')} |",
+        f"| cylinder reduction at optimum | ~71 % (0.5 mm) | {fmt_number(cyl['reduction_pct'], '.1f')} % "
+        f"({cyl['peak_tip_mm']:.3f} mm) | {tol['cylinder_reduction_points']:g} % points | "
+        f"{_verdict(abs(cyl['reduction_pct'] - PAPER['cylinder_reduction_pct']) <= tol['cylinder_reduction_points'], 'calibrated', 'calibration missed')} |",
         f"| wedge optimal mass smaller than cylinder's | yes | {wed['mass_g']:.3f} g vs {cyl['mass_g']:.3f} g | "
-        f"{'reproduced' if wed['mass_g'] < cyl['mass_g'] else 'differs'} |",
+        f"smaller by {100 * MASS_MARGIN:g} % or more | {_verdict(_lower(wed['mass_g'], cyl['mass_g'], MASS_MARGIN))} |",
         f"| wedge lower optimal amplitude than cylinder | yes | {wed['peak_tip_mm']:.3f} mm vs {cyl['peak_tip_mm']:.3f} mm | "
-        f"{'reproduced' if wed['peak_tip_mm'] < cyl['peak_tip_mm'] else 'differs'} |",
+        f"lower by {100 * AMPLITUDE_MARGIN:g} % or more | {_verdict(_lower(wed['peak_tip_mm'], cyl['peak_tip_mm']))} |",
+        f"| {heavy_g:g} g cylinder sticks: no friction damping | amplitude ~ undamped | {heavy:.3f} mm at "
+        f"{s['mass_sweep']['cylinder']['resonance_hz'][-1]:.1f} Hz ({fmt_number(100 * (heavy / undamped - 1), '+.1f')} %) | "
+        f"within {100 * STUCK_TOLERANCE:g} % of the undamped peak | "
+        f"{_verdict(abs(heavy / undamped - 1) <= STUCK_TOLERANCE)} |",
     ]
-    heavy = s["mass_sweep"]["cylinder"]["peak_tip_mm"][-1]
-    lines.append(f"| 1 kg cylinder sticks: no friction damping | amplitude ~ undamped | {heavy:.3f} mm at "
-                 f"{s['mass_sweep']['cylinder']['resonance_hz'][-1]:.1f} Hz | "
-                 f"{'reproduced' if heavy > 0.8 * s['no_damper_peak_tip_mm'] else 'differs'} |")
     lines += ["", "## Table 1 (cylinder 1 g, F_x = 0.1 N, F_y = -0.1 N, M_z = 0.001 N m)", "",
-              "| mode | f0 [Hz] | paper f_res [Hz] | ours f_res [Hz] | paper reduction | ours reduction | verdict |",
-              "|---|---|---|---|---|---|---|"]
+              "| mode | f0 [Hz] | paper f_res [Hz] | ours f_res [Hz] | paper reduction | ours reduction | tolerance | verdict |",
+              "|---|---|---|---|---|---|---|---|"]
     for row, (name, f0, f_p, red_p) in zip(table1, PAPER["table1"]):
         shift_p, shift_o = f_p - f0, row["f_res_damped_hz"] - f0
-        ok = abs(shift_o - shift_p) <= max(0.5 * abs(shift_p), 0.3) and abs(row["reduction_pct"] - red_p) <= max(0.3 * red_p, 2.0)
+        tol_f = max(TABLE1_RELATIVE * abs(shift_p), TABLE1_SHIFT_FLOOR_HZ)
+        tol_r = max(TABLE1_RELATIVE * red_p, TABLE1_REDUCTION_FLOOR_POINTS)
+        ok_f = abs(shift_o - shift_p) <= tol_f
+        ok_r = np.isfinite(row["reduction_pct"]) and abs(row["reduction_pct"] - red_p) <= tol_r
+        verdict = "reproduced" if ok_f and ok_r else "differs: " + " and ".join(
+            w for w, ok in (("frequency", ok_f), ("reduction", ok_r)) if not ok)
         lines.append(f"| {name} | {f0:g} | {f_p:g} | {row['f_res_damped_hz']:.2f} | {red_p:g} % | "
-                     f"{_pct(row['reduction_pct'] / 100)} | {'reproduced' if ok else 'differs'} |")
-    lines += ["", "Tip DOF per mode: 1F, 2F u_x; 1T phi_z; 1E u_y. The 1F row is the calibration case with the "
-              "spatial excitation; the higher modes are predictions: their shift depends on the stuck contact stiffness "
-              "and on the blade's mode shapes at the platform, which the paper does not give.",
+                     f"{fmt_percent(row['reduction_pct'] / 100)} | shift {shift_p:.1f} +- {tol_f:.2g} Hz, reduction "
+                     f"+- {tol_r:.2g} % points | {verdict} |")
+    lines += ["", "Tip DOF per mode: 1F, 2F u_x; 1T phi_z; 1E u_y. The shift is f_res - f0. The 1F row is the "
+              "calibration case with the spatial excitation; the higher modes are predictions: their shift depends on "
+              "the stuck contact stiffness and on the blade's mode shapes at the platform, which the paper does not give.",
               "", "## Mass sweep at EO = 1 (F_x = 0.1 N)", "", "| mass [g] | cylinder peak [mm] | wedge peak [mm] |", "|---|---|---|"]
     for m, pc, pw in zip(s["mass_sweep"]["cylinder"]["mass_g"], s["mass_sweep"]["cylinder"]["peak_tip_mm"],
                          s["mass_sweep"]["wedge"]["peak_tip_mm"]):
-        lines.append(f"| {m:g} | {pc:.4f} | {pw:.4f} |")
+        lines.append(f"| {m:g} | {fmt_number(pc, '.4f')} | {fmt_number(pw, '.4f')} |")
     lines += ["", "Figures: `fig4_frf_four_modes.png`, `fig5_mass_variation.png`, `fig6_mass_optimisation.png`.", ""]
     return "\n".join(lines)
 
 
-
 def accuracy_section(summary: dict) -> str:
     """The paper's one-harmonic setting beside the converged harmonic balance."""
+    from .hbm.accuracy import HARMONIC_TOLERANCE, enriched
+
+    tol = 100 * HARMONIC_TOLERANCE
     lines = ["", "## The paper's one-harmonic setting and the converged harmonic balance", "",
              "The paper balances the first harmonic only, with the static approach from frictionless seating. "
              "bladedamp's default chooses the harmonics (static term included) until the first-harmonic tip "
-             "amplitudes change by less than the tolerance against a set with two more harmonics "
-             "(error estimate relative to the peak; see `bladedamp.hbm.accuracy`). Both at each damper's "
-             "optimal mass, 90-100 Hz:", "",
-             "| damper | mass [g] | setting | harmonics | peak [mm] | resonance [Hz] | error estimate [%] | within 1 % |",
+             "amplitudes change by less than the tolerance when the peak is solved again with the static term and "
+             "two more harmonics (the error estimate, relative to the peak; see `bladedamp.hbm.accuracy`). Both at "
+             "each damper's optimal mass, 90-100 Hz:", "",
+             f"| damper | mass [g] | setting | harmonics | peak [mm] | resonance [Hz] | error estimate | within {tol:g} % |",
              "|---|---|---|---|---|---|---|---|"]
+    notes = []
     for kind, row in summary["harmonic_accuracy"].items():
         for label in ("paper", "converged"):
             r = row[label]
-            err = "not verified" if r["harmonic_error_pct"] is None else f"{r['harmonic_error_pct']:.2g}"
-            lines.append(f"| {kind} | {row['mass_g']:.3g} | {label} | {tuple(r['harmonics'])} | {r['peak_tip_mm']:.4f} | "
-                         f"{r['resonance_hz']:.2f} | {err} | {'yes' if r['converged'] else 'no'} |")
-    lines += ["", "The automatic choice goes up to harmonic 7 for the tuned disk by default (`max_harmonic`); "
-              "a row that is not converged says so, and a larger `max_harmonic` may meet the tolerance.", ""]
+            err = r["harmonic_error_pct"]
+            if err is None or not np.isfinite(err):
+                check = _harmonics(enriched(r["harmonics"]))
+                shown, within = "not estimated (see below)", "unknown"
+                notes.append(f"{kind}, harmonics {_harmonics(r['harmonics'])}: the error could not be estimated. "
+                             f"The estimate solves the peak point again with harmonics {check}, starting from this "
+                             "solution; that solve did not converge, so the size of the truncation error there is "
+                             "unknown (the peak itself was computed and passed the physical checks).")
+            else:
+                shown, within = f"{fmt_number(err, '.2g')} %", "yes" if r["converged"] else "no"
+            lines.append(f"| {kind} | {row['mass_g']:.3g} | {label} | {_harmonics(r['harmonics'])} | "
+                         f"{fmt_number(r['peak_tip_mm'], '.4f')} | {fmt_number(r['resonance_hz'], '.2f')} | {shown} | {within} |")
+    lines += ["", *[n + "\n" for n in notes],
+              "The automatic choice goes up to harmonic 7 for the tuned disk by default (`max_harmonic`); "
+              "a row that does not meet the tolerance says so, and a larger `max_harmonic` may meet it.", ""]
     return "\n".join(lines)
 
 
+def _runs(mask) -> list[tuple[int, int]]:
+    """(first, last) index of every run of True in ``mask``."""
+    mask = np.asarray(mask, bool)
+    edges = np.flatnonzero(np.diff(np.r_[0, mask.astype(int), 0]))
+    return [(int(a), int(b) - 1) for a, b in zip(edges[0::2], edges[1::2])]
+
+
+def _unstable_runs(freq, amplitude, mask) -> str:
+    """The unstable parts of a branch in words: where (frequency and its width) and between which
+    tip amplitudes, e.g. '95.115 Hz (width below 0.001 Hz), 0.412-0.431 mm'."""
+    freq = np.asarray(freq, float)
+    amp = None if amplitude is None else np.asarray(amplitude, float)
+    parts = []
+    for a, b in _runs(mask):
+        lo, hi = freq[a:b + 1].min(), freq[a:b + 1].max()
+        width = hi - lo
+        where = (f"{lo:.3f} Hz (width below 0.001 Hz)" if width < 1e-3
+                 else f"{lo:.3f}-{hi:.3f} Hz")
+        if amp is not None:
+            lo_a, hi_a = f"{amp[a:b + 1].min():.3f}", f"{amp[a:b + 1].max():.3f}"
+            where += f", at {lo_a} mm" if lo_a == hi_a else f", {lo_a}-{hi_a} mm"
+        parts.append(where)
+    return "; ".join(parts)
+
+
+def stability_section(s: dict) -> str:
+    """The reference FRFs with their stability and the 1F backbones of both dampers (EPMC)."""
+    st, bb = s.get("stability"), s.get("backbone")
+    if not st and not bb:
+        return ""
+    lines = ["", "## Stability of the reference responses and the 1F nonlinear modes", ""]
+    if st:
+        t = s["timings_s"]
+        lines += [
+            f"Time: {t.get('stability_s', 0):.1f} s for the stability of every point below and "
+            f"{t.get('backbone_s', 0):.1f} s for the two nonlinear modes "
+            f"({100 * (t.get('stability_s', 0) + t.get('backbone_s', 0)) / t['total_s']:.1f} % of the run). "
+            "Figure: `stability_backbones.png`.", "",
+            "Method: Hill's method (the Floquet exponents of the harmonic balance Jacobian) where every element is "
+            "smooth or memoryless (the disk without damper); with friction contacts the sign of det J decides: "
+            "det J < 0 proves a real positive exponent (unstable), and a branch keeps the stability of its neighbour "
+            "between sign changes (see `bladedamp.hbm.stability`). That method cannot see a Neimark-Sacker "
+            "bifurcation (a complex pair crossing); it would need a time integration.", "",
+            "| response | harmonics | method | points | unstable | folds | branch points | stability time |",
+            "|---|---|---|---|---|---|---|---|"]
+        for label, r in st.items():
+            freq = np.asarray(r["frequency_hz"], float)
+            stable = np.asarray(r["stable"], bool)
+            unstable = (f"{int((~stable).sum())}: {_unstable_runs(freq, r.get('tip_amplitude_mm'), ~stable)}"
+                        if (~stable).any() else "none")
+            def where(idx):
+                at = sorted({f"{freq[i]:.3f}" for i in idx}, key=float)
+                return f"{len(idx)} (at {', '.join(at)} Hz)" if idx else "none"
+
+            folds, bps = where(r["folds"]), where(r["branch_points"])
+            method = {"hill": "Hill's method"}.get(r["method"], r["method"])
+            share = f" ({100 * r['seconds'] / r['solve_s']:.0f} % of the solve)" if r.get("solve_s") else ""
+            lines.append(f"| {label} | {_harmonics(r['harmonics'])} | {method} | {len(freq)} | {unstable} | "
+                         f"{folds} | {bps} | {r['seconds']:.2f} s{share} |")
+        lines += ["", "A fold is a turning point of the branch (d Omega / ds changes sign); a branch point a sign "
+                  "change of the bordered Jacobian's determinant. An unstable part lies between two folds; a test rig "
+                  "sweeping the frequency would not see it and would jump from one stable part to the next. An "
+                  "unstable part whose width is below 0.001 Hz is a fold at a corner of the branch (where a contact "
+                  "changes between stick and slip): its jump is the amplitude interval shown. In the figure unstable "
+                  "parts are dashed and their points circled.", ""]
+    if bb:
+        tol = SYNTHESIS_TOLERANCE
+        lines += [
+            "1F nonlinear modes (EPMC, `bladedamp.nonlinear_mode`, one harmonic) of both dampers at their optimal "
+            "masses, EO = 1: the natural frequency and the damping ratio over the vibration amplitude, from the stuck "
+            "contact to gross slip. The forced peak follows from the mode alone (single-nonlinear-mode synthesis) "
+            "and is compared with the one-harmonic FRF's peak of the table above (F_x = 0.1 N):", "",
+            "| damper | mass [g] | stuck frequency [Hz] | frequency at gross slip [Hz] | largest damping ratio | "
+            "synthesised peak | FRF peak | tolerance | verdict |", "|---|---|---|---|---|---|---|---|---|"]
+        for kind, b in bb.items():
+            zeta = np.asarray(b["damping_ratio"], float)
+            tip = np.asarray(b["tip_amplitude_mm"], float)
+            k = int(np.nanargmax(zeta)) if np.isfinite(zeta).any() else None
+            peak, f_peak = b["synthesised_peak_mm"], b["synthesised_peak_hz"]
+            ok = (peak is not None and np.isfinite(peak) and abs(peak / b["frf_peak_mm"] - 1) <= tol["amplitude"]
+                  and abs(f_peak / b["frf_peak_hz"] - 1) <= tol["frequency"])
+            z_text = "not found" if k is None else f"{100 * zeta[k]:.2f} % at tip u_x {tip[k]:.3g} mm"
+            lines.append(f"| {kind} | {b['mass_g']:.3g} | {b['frequency_hz'][0]:.2f} | {b['frequency_hz'][-1]:.2f} | "
+                         f"{z_text} | {fmt_number(peak, '.4f')} mm at {fmt_number(f_peak, '.2f')} Hz | {b['frf_peak_mm']:.4f} mm at "
+                         f"{b['frf_peak_hz']:.2f} Hz | amplitude {100 * tol['amplitude']:g} %, frequency "
+                         f"{100 * tol['frequency']:g} % | {_verdict(ok, 'agrees', 'differs')} |")
+        lines.append("")
+    return "\n".join(lines)
+
 
 def design_section(s: dict) -> str:
-    def row(quantity, paper, ours, ok):
-        return f"| {quantity} | {paper} | {ours} | {'reproduced' if ok else 'differs'} |"
+    def row(quantity, paper, ours, tolerance, ok):
+        return f"| {quantity} | {paper} | {ours} | {tolerance} | {_verdict(ok)} |"
 
     opt = s["optimum"]
     eos = list(range(0, 9))
@@ -119,7 +308,7 @@ def design_section(s: dict) -> str:
     mass = {k: series(k, "mass_g") for k in opt}
     pa = s["platform_angle"]
     sym = pa["gamma_r_deg"].index(35.0)
-    opt_peaks, fixed = np.array(pa["opt_peak_tip_mm"]), np.array(pa["peak_tip_mm_at_1g"])
+    opt_peaks, fixed = np.array(pa["opt_peak_tip_mm"], float), np.array(pa["peak_tip_mm_at_1g"], float)
     w85 = {c: abs(complex(*s["contact_state_85deg"][c]["w_star"])) for c in ("OL", "OR")}
     lift = s["wedge_liftoff"]
     r = np.array(lift["r"])
@@ -148,31 +337,44 @@ def design_section(s: dict) -> str:
         notes += [f"{k}: optimum not certified global" for k in trend if not certified[k]]
         return ("; " + "; ".join(notes)) if notes else ""
 
+    margin = f"by {100 * AMPLITUDE_MARGIN:g} % or more"
     t = s["timings_s"]
-    lines = ["", "## Design studies (issue 5)", "",
+    lines = ["", "## Design studies: engine orders, platform angles, contact states, lift-off", "",
              f"Times: engine orders {t['engine_orders_s']:.0f} s, platform angles {t['platform_angles_s']:.0f} s, "
              f"contact states and lift-off {t['contact_state_liftoff_s']:.0f} s, design map {t['design_map_s']:.0f} s.", "",
-             "| trend | paper | bladedamp | verdict |", "|---|---|---|---|",
+             "| trend | paper | bladedamp | tolerance | verdict |", "|---|---|---|---|---|",
              row("cylinder at EO = 0: no damping (rolling)", "amplitude = undamped",
-                 f"reduction {red['cylinder'][0]:.1f} %", abs(red["cylinder"][0]) < 1.0),
-             row("wedge at EO = 0 still damps (contact height)", "yes", f"reduction {red['wedge'][0]:.1f} %",
-                 red["wedge"][0] > 10),
-             row("reduction grows with EO (1..8)", "yes", " / ".join(f"{v:.1f}" for v in red["cylinder"][1:]) + " % (cyl.)"
-                 + trend_note(trend_red, f"{100 * REDUCTION_TREND_TOLERANCE:g} % points"), grows(trend_red)),
-             row("optimal mass grows with EO (1..8)", "yes", " / ".join(f"{v:.2g}" for v in mass["cylinder"][1:]) + " g (cyl.)"
-                 + trend_note(trend_mass, f"{100 * MASS_TREND_TOLERANCE:g} %"), grows(trend_mass)),
+                 f"reduction {fmt_number(red['cylinder'][0], '.1f')} %", f"reduction below {EO0_NO_DAMPING_POINTS:g} % point",
+                 bool(abs(red["cylinder"][0]) < EO0_NO_DAMPING_POINTS)),
+             row("wedge at EO = 0 still damps (contact height)", "yes", f"reduction {fmt_number(red['wedge'][0], '.1f')} %",
+                 f"reduction {EO0_DAMPS_PCT:g} % or more", bool(red["wedge"][0] >= EO0_DAMPS_PCT)),
+             row("reduction grows with EO (1..8)", "yes",
+                 " / ".join(fmt_number(v, ".1f") for v in red["cylinder"][1:]) + " % (cyl.)"
+                 + trend_note(trend_red, f"{100 * REDUCTION_TREND_TOLERANCE:g} % points"),
+                 f"both dampers; no step down by more than {100 * REDUCTION_TREND_TOLERANCE:g} % points; every "
+                 "optimum certified global", grows(trend_red)),
+             row("optimal mass grows with EO (1..8)", "yes",
+                 " / ".join(fmt_number(v, ".2g") for v in mass["cylinder"][1:]) + " g (cyl.)"
+                 + trend_note(trend_mass, f"{100 * MASS_TREND_TOLERANCE:g} %"),
+                 f"both dampers; no step down by more than {100 * MASS_TREND_TOLERANCE:g} % (the valley is flat at "
+                 "high EO)", grows(trend_mass)),
              row("lower gamma_R beats symmetric (mass re-optimised)", "yes",
-                 f"{min(opt_peaks[:sym]):.3f} vs {opt_peaks[sym]:.3f} mm", min(opt_peaks[:sym]) < opt_peaks[sym]),
+                 f"{np.nanmin(opt_peaks[:sym]):.3f} vs {opt_peaks[sym]:.3f} mm", f"lower {margin}",
+                 _lower(np.nanmin(opt_peaks[:sym]), opt_peaks[sym])),
              row("higher gamma_R beats symmetric (mass re-optimised)", "yes",
-                 f"{min(opt_peaks[sym + 1:]):.3f} vs {opt_peaks[sym]:.3f} mm", min(opt_peaks[sym + 1:]) < opt_peaks[sym]),
+                 f"{np.nanmin(opt_peaks[sym + 1:]):.3f} vs {opt_peaks[sym]:.3f} mm", f"lower {margin}",
+                 _lower(np.nanmin(opt_peaks[sym + 1:]), opt_peaks[sym])),
              row("gamma_R = 15 deg at 1 g worse than symmetric", "yes", f"{fixed[0]:.3f} vs {fixed[sym]:.3f} mm",
-                 fixed[0] > fixed[sym]),
-             row("gamma_R = 85 deg: left contact sticks, |w*_OL| < 1", "yes", f"|w*_OL| = {w85['OL']:.2f}", w85["OL"] < 1),
-             row("gamma_R = 85 deg: right contact slides, |w*_OR| > 1", "yes", f"|w*_OR| = {w85['OR']:.2f}", w85["OR"] > 1),
+                 f"higher {margin}", bool(fixed[0] >= (1 + AMPLITUDE_MARGIN) * fixed[sym])),
+             row("gamma_R = 85 deg: left contact sticks, abs(w*_OL) < 1", "yes", f"abs(w*_OL) = {w85['OL']:.2f}",
+                 "below 1 (Eq. 27: the contact sticks below 1)", w85["OL"] < 1),
+             row("gamma_R = 85 deg: right contact slides, abs(w*_OR) > 1", "yes", f"abs(w*_OR) = {w85['OR']:.2f}",
+                 "above 1 (Eq. 27: the contact slides above 1)", w85["OR"] > 1),
              row("wedge lift-off first at the edges xi* = +-0.5", "yes",
-                 f"max r = {r.max():.2f}; lifting points only in the outermost rows, |xi*| = "
+                 f"max r = {r.max():.2f}; lifting points only in the outermost rows, abs(xi*) = "
                  f"{', '.join(f'{v:g}' for v in sorted(set(np.round(xi[np.any(lifting, axis=0)], 2))))} "
-                 f"(cells reaching the edges +-0.5)", edge),
+                 f"(cells reaching the edges +-0.5)" if lifting.any() else f"max r = {r.max():.2f}; no point lifts off",
+                 "r > 1 only in the outermost rows of the grid", edge),
              "",
              "EO = 0: all blades move in phase; the cylinder follows the two platforms by rolling (its contact "
              "points have no relative tangential motion), so nothing slips and the amplitude is the undamped one "
@@ -180,39 +382,107 @@ def design_section(s: dict) -> str:
              "", "Engine-order sweep (mass re-optimised per EO):", "",
              "| EO | cylinder mass [g] | cylinder reduction [%] | wedge mass [g] | wedge reduction [%] |", "|---|---|---|---|---|"]
     for k, eo in enumerate(eos):
-        lines.append(f"| {eo} | {_mass_g(mass['cylinder'][k])} | {red['cylinder'][k]:.1f} | "
-                     f"{_mass_g(mass['wedge'][k])} | {red['wedge'][k]:.1f} |")
+        lines.append(f"| {eo} | {_mass_g(mass['cylinder'][k])} | {fmt_number(red['cylinder'][k], '.1f')} | "
+                     f"{_mass_g(mass['wedge'][k])} | {fmt_number(red['wedge'][k], '.1f')} |")
     lines += ["", "Wedge lift-off onset (largest r over both contacts, 1 g wedge; r > 1 separates):", "",
               "| h_C [mm] | " + " | ".join(f"F_x = {f:g} N" for f in s["wedge_liftoff_onset"]["force_n"]) + " |",
               "|---" * (1 + len(s["wedge_liftoff_onset"]["force_n"])) + "|"]
     for h, rr in zip(s["wedge_liftoff_onset"]["contact_height_mm"], s["wedge_liftoff_onset"]["max_ratio"]):
-        lines.append(f"| {h:g} | " + " | ".join(f"{v:.2f}" for v in rr) + " |")
+        lines.append(f"| {h:g} | " + " | ".join(fmt_number(v, ".2f") for v in rr) + " |")
     lines += ["", "Design map beyond the paper (best grid point of each map):", "",
               "| damper | h_C [mm] | best mass [g] | best gamma_R [deg] | peak [mm] | reduction [%] |", "|---|---|---|---|---|---|"]
     for m in s["design_map"]:
         o = m["optimum"]
-        lines.append(f"| {m['kind']} | {m['contact_height_mm'] or '-'} | {o['mass_g']:.3g} | {o['gamma_right_deg']:g} | "
-                     f"{o['peak_tip_mm']:.3f} | {o['reduction_pct']:.1f} |")
+        lines.append(f"| {m['kind']} | {m['contact_height_mm'] or '-'} | {fmt_number(o['mass_g'])} | {fmt_number(o['gamma_right_deg'], 'g')} | "
+                     f"{fmt_number(o['peak_tip_mm'], '.3f')} | {fmt_number(o['reduction_pct'], '.1f')} |")
     lines += ["", "Figures: `fig7_8_engine_orders.png`, `fig9_wedge_liftoff.png`, `fig10_platform_angles.png`, "
               "`fig11_contact_state.png`, `design_map.png`.", ""]
     return "\n".join(lines)
 
 
-
 def mistuning_section(s: dict) -> str:
     from .studies.mistuning import report_lines
 
-    return "\n".join(["", "## Mistuned disk (issue 6)", "",
-                       f"Time: {s['timings_s']['mistuning_s']:.0f} s. Figure: `fig13_17_mistuning.png`.", ""]
-                      + report_lines(s["mistuning"]) + [""])
+    body = report_lines(s["mistuning"])
+    # one heading: the study's own, with the time and the figure under it
+    return "\n".join(["", body[0], "", f"Time: {s['timings_s']['mistuning_s']:.0f} s. Figure: `fig13_17_mistuning.png`.",
+                      *body[1:], ""])
 
 
-def reproduce_report(summary: dict, table1: list) -> str:
-    """report.md of ``bladedamp reproduce``: every paper statement beside bladedamp's answer.
+def reproduce_report(summary: dict, table1: list | None = None) -> str:
+    """report.md of ``bladedamp reproduce``: every paper statement beside bladedamp's answer,
+    each verdict with its tolerance.
 
-    ``summary`` is summary.json's content; ``table1`` the rows of Table 1 with the peaks."""
-    return paper_section(summary, table1) + accuracy_section(summary) + design_section(summary) \
-        + mistuning_section(summary)
+    ``summary`` is summary.json's content; ``table1`` the rows of Table 1 (default: summary's)."""
+    table1 = summary["table1"] if table1 is None else table1
+    return paper_section(summary, table1) + accuracy_section(summary) + stability_section(summary) \
+        + design_section(summary) + mistuning_section(summary)
+
+
+README_BEGIN = "<!-- reproduce summary: written by bladedamp.report.readme_summary from a run's summary.json -->"
+README_END = "<!-- end of reproduce summary -->"
+
+
+def readme_summary(summary: dict) -> str:
+    """The README's summary of the report: per section of report.md, its verdicts counted and
+    every row that does not hold (quantity, paper, ours, tolerance), so that the README mirrors
+    the report's verdicts, the rows that differ included. Between :data:`README_BEGIN` and
+    :data:`README_END` in the README (tests/test_report.py checks it against a recorded run)."""
+    report = reproduce_report(summary)
+    sections = []
+    for line in report.splitlines():
+        if line.startswith("## "):
+            sections.append(((line[3:].split(" (")[0].split(":")[0], line), []))
+        elif line.startswith("# "):
+            sections.append((("Calibration and the paper's main statements", line), []))
+    lines = [README_BEGIN, "", "| report section | verdicts | rows that do not hold (paper / bladedamp / tolerance) |",
+             "|---|---|---|"]
+    for (title, heading), _ in sections:
+        block = report.split(heading, 1)[1]
+        nxt = [h for (_, h), _ in sections if h != heading and h in block]
+        for h in nxt:
+            block = block.split(h, 1)[0]
+        rows = verdict_rows(block)
+        if not rows:
+            continue
+        counts = {}
+        for r in rows:
+            v = r["verdict"].split(":")[0]
+            counts[v] = counts.get(v, 0) + 1
+        order = ["calibrated", "reproduced", "agrees", "calibration missed", "differs"]
+        plural = {"agrees": "agree", "differs": "differ"}
+        counted = ", ".join(f"{counts[v]} {plural.get(v, v) if counts[v] > 1 else v}"
+                            for v in sorted(counts, key=lambda v: order.index(v) if v in order else 99))
+        failing = []
+        for r in rows:
+            if r["verdict"].startswith(("differs", "calibration missed")):
+                name = r.get("quantity") or r.get("mode") or r.get("case") or r.get("trend") or r.get("damper", "")
+                paper = r.get("paper") or r.get("paper reduction", "")
+                ours = r.get("bladedamp") or r.get("ours reduction") or r.get("synthesised peak", "")
+                if "mode" in r:
+                    paper = f"f_res {r['paper f_res [Hz]']} Hz, reduction {r['paper reduction']}"
+                    ours = f"f_res {r['ours f_res [Hz]']} Hz, reduction {r['ours reduction']}"
+                failing.append(f"{name} ({r['verdict']}): {paper} / {ours} / {r['tolerance']}")
+        lines.append(f"| {title} | {counted} | {'; '.join(failing) if failing else 'none'} |")
+    lines += ["", README_END]
+    return "\n".join(lines)
+
+
+def verdict_rows(report: str) -> list[dict]:
+    """Every row of every table of ``report`` (markdown) that has a verdict column, as
+    {column: cell}: for the README's summary and the tests."""
+    rows, header = [], None
+    for line in report.splitlines():
+        if not line.startswith("|"):
+            header = None
+            continue
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if header is None:
+            header = cells
+        elif not set(line) <= set("|-: "):
+            if "verdict" in header and len(cells) == len(header):
+                rows.append(dict(zip(header, cells)))
+    return rows
 
 
 # ---------------------------------------------------------------------------------------
@@ -232,8 +502,9 @@ def plot_four_modes(windows, path: Path):
         ax.set_xlabel("frequency [Hz]")
         ax.set_ylabel(f"tip {'u_' + 'xyz'[dof] + ' [mm]' if dof < 3 else 'phi_z [mrad]'}")
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
     fig.suptitle("Fig. 4: tuned disk, EO = 1, F_x = 0.1 N, F_y = -0.1 N, M_z = 0.001 N m")
+    for ax in axes.ravel():
+        place_legend(ax, fontsize=8)
     save_figure(fig, path)
 
 
@@ -250,7 +521,7 @@ def plot_mass_variation(free, responses, path: Path):
     ax.set_ylabel("tip amplitude u_x [mm]")
     ax.set_title("Fig. 5: variation of the cylinder's mass (EO = 1, F_x = 0.1 N)")
     ax.grid(True, alpha=0.3)
-    ax.legend()
+    place_legend(ax)
     save_figure(fig, path)
 
 
@@ -261,8 +532,11 @@ def plot_mass_optimisation(sweeps: dict, optima: dict, path: Path):
     fig, ax = plt.subplots(figsize=(7, 4.5))
     for kind, sw in sweeps.items():
         sw.plot(ax=ax)
-        ax.plot(1e3 * optima[kind].mass, 1e3 * optima[kind].peak_amplitude, "k*", ms=12)
-    ax.set_title("Fig. 6: resonance amplitude over damper mass, EO = 1 (stars: optima)")
+    for k, kind in enumerate(sweeps):
+        ax.plot(1e3 * optima[kind].mass, 1e3 * optima[kind].peak_amplitude, "k*", ms=12,
+                label="optimum" if k == 0 else "_optimum")
+    ax.set_title("Fig. 6: resonance amplitude over damper mass, EO = 1")
+    place_legend(ax)
     save_figure(fig, path)
 
 
@@ -271,14 +545,20 @@ def plot_engine_orders(sweeps: dict, path: Path):
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+    missing = []
     for kind, sw in sweeps.items():
         axes[0].plot(sw.engine_orders, 100 * sw.reduction, marker="o", label=kind)
         axes[1].plot(sw.engine_orders, 1e3 * sw.optimal_mass, marker="s", label=kind)
+        gone = [int(eo) for eo, m in zip(sw.engine_orders, sw.optimal_mass) if not np.isfinite(m)]
+        if gone:
+            missing.append(f"{kind}: no mass damps at EO {', '.join(map(str, gone))}")
+    if missing:     # say why a point is absent rather than leave a gap
+        axes[1].text(0.98, 0.03, "; ".join(missing), transform=axes[1].transAxes, ha="right", va="bottom", fontsize=8)
     axes[0].set(xlabel="engine order", ylabel="amplitude reduction at optimal mass [%]", title="Fig. 7")
     axes[1].set(xlabel="engine order", ylabel="optimal damper mass [g]", yscale="log", title="Fig. 8")
     for ax in axes:
         ax.grid(True, alpha=0.3)
-        ax.legend()
+        place_legend(ax)
     save_figure(fig, path)
 
 
@@ -311,6 +591,75 @@ def plot_liftoff(lift, path: Path):
     lift.plot(ax=ax)
     ax.set_title("Fig. 9: wedge 1 g, F_x = 0.1 N, contact OL")
     save_figure(fig, path)
+
+
+def plot_stability_backbones(frfs: dict, converged: dict, modes: dict, path: Path):
+    """The reference FRFs with their stability (unstable parts dashed) and the 1F backbones.
+
+    ``frfs``: {kind: one-harmonic response with stability}; ``converged``: {kind: the converged
+    response with stability} (may be empty); ``modes``: {kind: NonlinearModeResponse}. One panel
+    per damper (tip amplitude over frequency: the FRFs, the backbone, the synthesised peak) and
+    one of the damping ratio over the tip amplitude."""
+    import matplotlib.pyplot as plt
+    from matplotlib.lines import Line2D
+
+    from .response import plot_branch
+
+    kinds = list(frfs)
+    fig, axes = plt.subplots(1, len(kinds) + 1, figsize=(5.2 * (len(kinds) + 1), 4.4))
+    for ax, kind in zip(axes, kinds):
+        top = 0.0
+        any_unstable = False
+        for r, label, color in ((frfs[kind], "FRF, one harmonic", "C0"), (converged.get(kind), "FRF, converged", "C1")):
+            if r is None or not len(r.omega):
+                continue
+            tip = 1e3 * r.tip_amplitude[:, 0]
+            plot_branch(ax, r.frequency_hz, tip, r.stable, color=color,
+                        label=f"{label} ({_harmonics(r.basis.harmonics)})")
+            if r.stable is not None and not np.all(r.stable):
+                bad = ~np.asarray(r.stable, bool)        # circled: a fold at a corner is too narrow to see dashed
+                ax.plot(r.frequency_hz[bad], tip[bad], "o", mfc="none", mec="r", ms=7, label="_unstable points")
+                any_unstable = True
+            top = max(top, float(tip.max()))
+        mode = modes.get(kind)
+        if mode is not None and len(mode.modal_amplitude):
+            tip = 1e3 * np.asarray(mode.output_amplitude)[:, 0]
+            shown = tip <= 1.3 * top if top > 0 else np.ones_like(tip, bool)
+            ax.plot(np.asarray(mode.frequency_hz)[shown], tip[shown], "k-", lw=1.2, label="backbone (1F nonlinear mode)")
+            peak = mode.forced_peak()
+            if peak["found"]:
+                ax.plot(peak["frequency_hz"], 1e3 * peak["output_amplitude"][0], "kx", ms=9, mew=2,
+                        label="peak by nonlinear-mode synthesis")
+        handles, labels = ax.get_legend_handles_labels()
+        if any_unstable:
+            handles.append(Line2D([], [], color="0.3", ls="--", marker="o", mfc="none", mec="r"))
+            labels.append("unstable (dashed, circled)")
+        place_legend(ax, handles=handles, labels=labels, fontsize=8, loc="upper left")
+        ax.set_xlabel("excitation frequency [Hz]")
+        ax.set_ylabel("tip amplitude u_x [mm]")
+        ax.set_title(f"{kind}" + (f" {1e3 * _mass_of(frfs[kind]):.3g} g" if _mass_of(frfs[kind]) else "")
+                     + ", EO = 1, F_x = 0.1 N")
+        ax.grid(True, alpha=0.3)
+    ax = axes[-1]
+    for kind, mode in modes.items():
+        tip = 1e3 * np.asarray(mode.output_amplitude)[:, 0]
+        line, = ax.semilogx(tip, 100 * np.asarray(mode.damping_ratio), label=kind)
+        peak = mode.forced_peak()
+        if peak["found"]:
+            ax.axvline(1e3 * peak["output_amplitude"][0], color=line.get_color(), ls=":", lw=1.2,
+                       label=f"{kind}: its peak at F_x = 0.1 N")
+    ax.set_xlabel("tip amplitude u_x along the mode [mm]")
+    ax.set_ylabel("modal damping ratio [%]")
+    ax.set_title("1F nonlinear modes: damping over amplitude")
+    ax.grid(True, which="both", alpha=0.3)
+    place_legend(ax, fontsize=8)
+    save_figure(fig, path)
+
+
+def _mass_of(response) -> float | None:
+    """The damper mass [kg] of a response's disk, None if unknown (a loaded result) or no damper."""
+    d = getattr(response, "disk", None)
+    return None if d is None or not d.has_damper else float(d.damper.mass)
 
 
 def plot_design_maps(maps: list, path: Path):
@@ -377,7 +726,7 @@ def _mass_g(m) -> str:
     return "none (no mass damps)" if m is None or not np.isfinite(m) else f"{m:.3g}"
 
 
-def _pct(x) -> str:
+def fmt_percent(x) -> str:
     if x is None or not np.isfinite(x):
         return "not found"
     v = 100 * x
@@ -465,7 +814,7 @@ def optimize_outputs(out: Path, design, optimum, angles=None, heights=None) -> d
     files += [saved] if saved else []
     lines = ["## Damper mass", "",
              f"Optimal mass {1e3 * optimum.mass:.4g} g: peak u_x {_mm(optimum.peak_amplitude)} against "
-             f"{_mm(optimum.undamped_peak_amplitude)} without damper (reduction {_pct(optimum.reduction)}); "
+             f"{_mm(optimum.undamped_peak_amplitude)} without damper (reduction {fmt_percent(optimum.reduction)}); "
              f"{'certified global over the mass range' if optimum.success else 'not certified global'}.", "",
              f"How: {optimum.message}.", ""]
     panels = 1 + (angles is not None) + (heights is not None)
@@ -536,7 +885,7 @@ def eo_sweep_outputs(out: Path, design, sweep) -> dict:
     for eo, m, p, u, r, c in zip(sweep.engine_orders, sweep.optimal_mass, sweep.optimal_peak_amplitude,
                                  sweep.undamped_peak_amplitude, sweep.reduction, sweep.certified):
         mass = "no mass helps" if not np.isfinite(m) else f"{1e3 * m:.4g}"
-        lines.append(f"| {eo} | {mass} | {_mm(p)} | {_mm(u)} | {_pct(r)} | {'yes' if c else 'no'} |")
+        lines.append(f"| {eo} | {mass} | {_mm(p)} | {_mm(u)} | {fmt_percent(r)} | {'yes' if c else 'no'} |")
     lines += ["", *[f"EO {k}: {v}." for k, v in sweep.messages.items()],
               *[f"EO {k} failed: {v}." for k, v in sweep.failures.items()]]
     write_summary(out, "eo-sweep", design, lines, files, analysis_line(design, studies=True))

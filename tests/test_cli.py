@@ -52,11 +52,20 @@ def test_reproduce_writes_summary_report_and_figures(tmp_path):
     import re
     assert not re.search(r"\bnan\b|(?<![\d.])-0\.0+\b(?!\.)|\d[eE][+-]0\d", report), \
         [line for line in report.splitlines() if re.search(r"\bnan\b|-0\.0|[eE][+-]0\d", line)]
-    assert "## Design studies" in report
+    assert "## Design studies" in report and "## Stability" in report
     assert "| 1F |" in report and "verdict" in report
+    assert not re.search(r"\bissue \d", report, re.IGNORECASE)
+    from bladedamp.report import verdict_rows
+    assert all(r["tolerance"] for r in verdict_rows(report))
+    # the stability of the reference responses and the 1F backbones of both dampers
+    assert summary["stability"]["no damper"]["method"] == "hill"
+    assert all(summary["stability"][k]["method"] == "determinant sign" for k in summary["stability"] if k != "no damper")
+    assert set(summary["backbone"]) == {"cylinder", "wedge"}
+    for kind, b in summary["backbone"].items():
+        assert abs(b["synthesised_peak_mm"] / b["frf_peak_mm"] - 1) < 0.03, (kind, b["synthesised_peak_mm"], b["frf_peak_mm"])
     for name in ("fig4_frf_four_modes.png", "fig5_mass_variation.png", "fig6_mass_optimisation.png",
                  "fig7_8_engine_orders.png", "fig9_wedge_liftoff.png", "fig10_platform_angles.png",
-                 "fig11_contact_state.png", "design_map.png"):
+                 "fig11_contact_state.png", "design_map.png", "fig13_17_mistuning.png", "stability_backbones.png"):
         assert (tmp_path / name).stat().st_size > 10_000, name
 
 

@@ -444,5 +444,6 @@ def test_paper_cases_summary_and_report():
     assert calls == list(range(1, 8))
     lines = mt.report_lines(s)
     print("\n".join(lines))
-    assert sum(line.startswith("| ") for line in lines) == 1 + 7   # header and seven statements
+    assert sum(line.startswith("| ") for line in lines) == 1 + 8   # header and eight statements
+    assert all(len(line.split(" | ")) == 5 for line in lines if line.startswith("| "))   # with a tolerance column
     json.dumps(s)

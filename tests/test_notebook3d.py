@@ -33,6 +33,7 @@ def test_embedding_and_saving_start_no_server(cylinder_frf, tmp_path):
     doc = out.split('srcdoc="', 1)[1].split('" style=', 1)[0]
     assert '"' not in doc                                          # attribute safely quoted
     assert html.unescape(doc) == scene.html()
+    assert nb3.embed_scene(scene, height=300).data == out
     link = nb3.save_scene(scene, tmp_path / "views" / "maps.html")
     assert (tmp_path / "views" / "maps.html").read_text(encoding="utf-8") == scene.html()
     assert "maps.html" in link.data and "<a href=" in link.data

@@ -190,3 +190,35 @@ def test_browser_renders_the_scene_and_its_animation(cylinder_frf, tmp_path):
         assert changed(shots[name], shots["empty"]) > 0.02          # the scene covers > 2 % of the picture
     assert changed(shots["phase0"], shots["phase1"]) > 0.005        # two frames of the cycle differ
     assert changed(shots["t2500"], shots["t3500"]) > 0.005          # the animation plays
+
+
+def test_show_defaults_to_the_whole_disk_with_its_dampers_and_the_maps_beside_it(cylinder_frf, tmp_path):
+    from bladedamp import geometry as bgeo
+
+    scene = mv.show(cylinder_frf, path=tmp_path / "ods.html", n_frames=4)
+    info = scene.info
+    n = cylinder_frf.disk.n_blades
+    assert info["layout"] == "disk" and len(info["blades"]) == n
+    paths = scene.paths()
+    assert all(f"/meshcat/bladedamp/dampers/damper_{k:02d}/body/mesh" in paths for k in range(n))
+    # the maps and their legend lie right of the blade tips' circle: they cross no blade
+    r_tip = info["root_radius"] + bgeo.reference_blade_geometry().total_length
+    x0 = info["map_origin"][0]
+    assert x0 > r_tip
+    # without a damper there is no disk layout to draw: the sector
+    free = bd.frequency_response(bd.reference_disk(None), (90.0, 100.0), harmonics=(1,))
+    assert mv.show(free, n_frames=4).info["layout"] == "sector"
+
+
+def test_without_meshcat_the_3d_names_give_a_one_line_install_hint(monkeypatch):
+    import sys
+
+    import bladedamp.viz as viz
+
+    monkeypatch.delitem(sys.modules, "bladedamp.viz.meshcat_view", raising=False)
+    monkeypatch.delattr(viz, "meshcat_view", raising=False)
+    monkeypatch.setitem(sys.modules, "meshcat", None)          # as if not installed
+    with pytest.raises(ModuleNotFoundError) as err:
+        viz.show
+    message = str(err.value)
+    assert "\n" not in message and "pip install 'bladedamp[viz]'" in message

@@ -30,6 +30,7 @@ from .. import _validate
 from ..damper.kinetics import seat
 from ..disk import TunedDisk
 from ..io import Saveable
+from ..plotting import place_legend
 from .parallel import parallel_map
 from .mass import optimal_mass, peak_response, with_mass
 
@@ -331,7 +332,10 @@ class ContactState(Saveable):
             for z, label, style in ((self.w_star[c], f"w*_xi,{name}", "-"), (self.F_star[c], f"F*_xi,{name}", ":")):
                 ax.annotate("", xy=(z.real, z.imag), xytext=(0, 0),
                             arrowprops=dict(arrowstyle="->", color=f"C{c}", ls=style))
-                ax.plot([z.real], [z.imag], "o" if style == "-" else "s", color=f"C{c}", label=label, **kwargs)
+                # F* hollow and w* on top: where the two nearly coincide (OL at gamma_R = 85 deg) both show
+                marker = dict(marker="o", color=f"C{c}", zorder=4) if style == "-" else \
+                    dict(marker="s", mfc="none", mec=f"C{c}", ms=9, mew=1.5, zorder=3)
+                ax.plot([z.real], [z.imag], ls="none", label=label, **marker, **kwargs)
         lim = 1.1 * max(1.0, np.abs(self.w_star).max(), np.abs(self.F_star).max())
         ax.set_xlim(-lim, lim)
         ax.set_ylim(-lim, lim)
@@ -421,7 +425,7 @@ class LiftoffMap(Saveable):
         ax.set_ylabel("eta* = eta / l_C")
         ax.set_title(f"{('OL', 'OR')[contact]} at {self.peak_frequency_hz:.2f} Hz")
         if lift.any():
-            ax.legend(fontsize=8)
+            place_legend(ax, loc="upper center", fontsize=8)     # above the points, none hidden
         return ax
 
 
@@ -484,14 +488,23 @@ class DesignMap(Saveable):
         M, G = np.meshgrid(1e3 * self.mass, self.gamma_right_deg)
         cs = ax.contourf(M, G, 1e3 * self.peak_amplitude, levels=15, cmap="viridis_r", **kwargs)
         plt.colorbar(cs, ax=ax, label="resonance tip amplitude u_x [mm]")
+        from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter, NullLocator
+
         opt = self.optimum
-        ax.plot(opt["mass_g"], opt["gamma_right_deg"], "r*", ms=14, label=f"best {opt['peak_tip_mm']:.3f} mm")
+        # the best point may lie on the grid's edge: drawn unclipped, on top, so the star shows whole
+        ax.plot(opt["mass_g"], opt["gamma_right_deg"], "r*", ms=14, mec="k", mew=0.6, clip_on=False, zorder=5)
         ax.set_xscale("log")
+        # ticks at the computed masses only, labelled plainly (no overlapping 10^x minor labels)
+        ticks = 1e3 * np.asarray(self.mass)
+        ax.xaxis.set_major_locator(FixedLocator(ticks[::max(1, int(np.ceil(len(ticks) / 8)))]))   # at most 8
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.xaxis.set_minor_locator(NullLocator())
+        ax.xaxis.set_minor_formatter(NullFormatter())
         ax.set_xlabel("damper mass [g]")
         ax.set_ylabel("platform angle gamma_R [deg]")
         extra = f", h_C = {1e3 * self.contact_height:g} mm" if self.contact_height else ""
-        ax.set_title(f"{self.kind}{extra}: design map")
-        ax.legend(loc="upper right", fontsize=8)
+        ax.set_title(f"{self.kind}{extra}: design map\nbest (star): {opt['mass_g']:.3g} g, gamma_R "
+                     f"{opt['gamma_right_deg']:g} deg, {opt['peak_tip_mm']:.3f} mm", fontsize=10, pad=10)
         return ax
 
 

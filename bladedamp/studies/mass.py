@@ -11,6 +11,7 @@ from scipy.optimize import minimize_scalar
 from .. import _validate
 from ..disk import TunedDisk
 from ..io import Saveable
+from ..plotting import place_legend
 
 
 def with_mass(disk: TunedDisk, mass: float) -> TunedDisk:
@@ -211,11 +212,13 @@ class MassSweep(Saveable):
             _, ax = plt.subplots(figsize=(6, 4))
         kwargs.setdefault("label", self.kind)
         ax.semilogx(1e3 * self.mass, 1e3 * self.peak_amplitude, marker="o", **kwargs)
-        ax.axhline(1e3 * self.undamped_peak_amplitude, color="gray", ls="--", lw=1)
+        shown = any(line.get_label() == "no damper" for line in ax.get_lines())
+        ax.axhline(1e3 * self.undamped_peak_amplitude, color="gray", ls="--", lw=1,
+                   label="_no damper" if shown else "no damper")      # one legend entry per axes
         ax.set_xlabel("damper mass [g]")
         ax.set_ylabel("resonance tip amplitude u_x [mm]")
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend()
+        place_legend(ax)
         return ax
 
 

@@ -26,6 +26,7 @@ import numpy as np
 from .. import _validate
 from ..disk import TunedDisk
 from ..io import Saveable, npz_path
+from ..plotting import place_legend
 from ..mistuned import MistunedDisk, MistunedResponse
 
 PAPER_STD = 0.02
@@ -291,26 +292,50 @@ def summary_dict(cases: dict[str, MistuningCase]) -> dict:
 
 def _relative_spread(values, reference) -> str:
     """Spread of ``values`` relative to ``reference`` in words: 'rounding' below 1e-12, else
-    a percentage."""
+    a percentage (no exponent notation: below 0.01 % it says so)."""
     spread = float(np.ptp(values) / reference)
-    return "rounding (< 1e-12)" if spread < 1e-12 else f"{100 * spread:.2g} %"
+    if spread < 1e-12:
+        return "rounding (relative spread below 10^-12)"
+    return "less than 0.01 %" if 100 * spread < 0.01 else f"{100 * spread:.2g} %"
+
+
+#: How the mistuning verdicts are decided (stated in every row of the report): "close to, slightly
+#: below the tuned" is a largest mistuned peak within -15 % .. +2 % of the tuned one; "the
+#: lowest-amplitude blade has the most different neighbours" holds when its neighbour contrast
+#: |k_i - k_i-1| + |k_i - k_i+1| ranks among the 3 largest of the 16; "several blades" is at least
+#: 2; "lowers", "helps", "below", "above" need a difference of at least 1 % of the tuned peak (a
+#: tie within the peak search's resolution proves nothing); the alternating case's numbers are
+#: compared within 30 % of the paper's reductions, as Table 1's
+CLOSE_TO_TUNED = (-0.15, 0.02)
+CONTRAST_RANK = 3
+SEVERAL_BLADES = 2
+PEAK_MARGIN = 0.01
+ALTERNATING_RELATIVE = 0.30
+#: the paper's reductions of the alternating pattern, blades 1 and 2 (Fig. 17)
+PAPER_ALTERNATING_PCT = (38.0, 15.0)
 
 
 def report_lines(summary: dict) -> list[str]:
-    """Markdown lines: the paper's statements beside ours, with a verdict per row.
+    """Markdown lines: the paper's statements beside ours, with the tolerance and the verdict of
+    each row (the criteria above).
 
     ``summary`` is :func:`summary_dict`'s output (or summary.json's ``mistuning``)."""
     def peaks(k):
-        return np.array(summary[k]["peak_tip_mm"])
+        return np.array(summary[k]["peak_tip_mm"], dtype=float)
 
-    lines = ["## Mistuning (16 blades, EO = 1, F_x = 0.1 N, cylinder; 2 % Gaussian kappa, "
+    def verdict(ok):
+        return "reproduced" if ok else "differs"
+
+    m = 100 * PEAK_MARGIN
+    lines = ["## Mistuned disk (16 blades, EO = 1, F_x = 0.1 N, cylinder; 2 % Gaussian kappa, "
              f"seed {PAPER_SEED}; full assembly)", "",
-             "| case | paper | bladedamp | verdict |", "|---|---|---|---|"]
+             "| case | paper | bladedamp | tolerance | verdict |", "|---|---|---|---|---|"]
     r1, t1 = peaks("random_1g"), summary["random_1g"]["tuned_peak_tip_mm"]
-    ok = 0.85 <= r1.max() / t1 <= 1.02
+    lo, hi = CLOSE_TO_TUNED
+    ok = 1 + lo <= r1.max() / t1 <= 1 + hi
     lines.append(f"| b, 1 g: largest mistuned vs tuned amplitude | close to, slightly below the tuned | "
                  f"{r1.max():.4f} vs {t1:.4f} mm ({100 * (r1.max() / t1 - 1):+.1f} %) | "
-                 f"{'reproduced' if ok else 'differs'} |")
+                 f"{100 * lo:+g} % to {100 * hi:+g} % of the tuned | {verdict(ok)} |")
     for key, paper_blade in (("random_1g", "No. 14"), ("reordered_1g", "No. 15")):
         k = np.array(summary[key]["kappa"])
         contrast = np.abs(k - np.roll(k, 1)) + np.abs(k - np.roll(k, -1))
@@ -319,27 +344,36 @@ def report_lines(summary: dict) -> list[str]:
         rank = int(np.where(np.argsort(-contrast) == lowest)[0][0]) + 1
         lines.append(f"| {key.split('_')[0]}, 1 g: lowest-amplitude blade has the most different neighbours | "
                      f"yes (blade {paper_blade}) | lowest: blade {lowest + 1} ({p[lowest]:.4f} mm), its neighbour "
-                     f"contrast ranks {rank} of 16; most different neighbours: blade {most + 1} | "
-                     f"{'reproduced' if rank <= 3 else 'differs'} |")
+                     f"contrast ranks {rank} of {len(k)}; most different neighbours: blade {most + 1} | "
+                     f"contrast among the {CONTRAST_RANK} largest | {verdict(rank <= CONTRAST_RANK)} |")
     re1 = peaks("reordered_1g")
+    ok = re1.max() <= (1 - PEAK_MARGIN) * r1.max() and re1.max() <= (1 - PEAK_MARGIN) * t1
     lines.append(f"| c, 1 g: reordering gives slightly lower amplitudes, below tuned | yes | max {re1.max():.4f} "
-                 f"vs random {r1.max():.4f} mm, tuned {t1:.4f} mm | "
-                 f"{'reproduced' if re1.max() <= r1.max() and re1.max() <= 1.02 * t1 else 'differs'} |")
+                 f"vs random {r1.max():.4f} mm, tuned {t1:.4f} mm | lower than both by {m:g} % or more | "
+                 f"{verdict(ok)} |")
     r5, t5 = peaks("random_5g"), summary["random_5g"]["tuned_peak_tip_mm"]
-    n_above = int(np.sum(r5 > t5))
-    lines.append(f"| b, 5 g: several blades exceed the tuned amplitude | yes | {n_above} of 16 above "
-                 f"{t5:.4f} mm (max {r5.max():.4f} mm) | {'reproduced' if n_above >= 2 else 'differs'} |")
+    n_above = int(np.sum(r5 > (1 + PEAK_MARGIN) * t5))
+    lines.append(f"| b, 5 g: several blades exceed the tuned amplitude | yes | {n_above} of {len(r5)} above "
+                 f"{t5:.4f} mm by {m:g} % or more (max {r5.max():.4f} mm) | at least {SEVERAL_BLADES} blades | "
+                 f"{verdict(n_above >= SEVERAL_BLADES)} |")
     re5 = peaks("reordered_5g")
+    ok = re5.max() <= (1 - PEAK_MARGIN) * r5.max() and re5.max() >= (1 + PEAK_MARGIN) * t5
     lines.append(f"| c, 5 g: reordering helps a little, still above tuned | yes | max {re5.max():.4f} vs random "
-                 f"{r5.max():.4f} mm, tuned {t5:.4f} mm | "
-                 f"{'reproduced' if re5.max() < r5.max() and re5.max() > t5 else 'differs'} |")
+                 f"{r5.max():.4f} mm, tuned {t5:.4f} mm | below random and above tuned by {m:g} % or more | "
+                 f"{verdict(ok)} |")
     al = peaks("alternating_1g")
     red = 100 * (1 - al[:2] / summary["alternating_1g"]["tuned_peak_tip_mm"])
-    ok = max(red) > 25 and min(red) > 5
-    lines.append(f"| d, 1 g: alternating +-2 % lowers the amplitudes | ~38 % and ~15 % (blades 1, 2) | "
-                 f"{red[0]:.1f} % (blade 1, kappa {summary['alternating_1g']['kappa'][0]:.2f}) and {red[1]:.1f} % "
-                 f"(blade 2, kappa {summary['alternating_1g']['kappa'][1]:.2f}); the odd blades' peaks agree to "
-                 f"{_relative_spread(al[0::2], al.max())} | {'reproduced' if ok else 'differs'} |")
+    kap = summary["alternating_1g"]["kappa"]
+    lines.append(f"| d, 1 g: alternating +-2 % lowers the amplitudes | yes (blades 1, 2) | "
+                 f"{red[0]:.1f} % (blade 1, kappa {kap[0]:.2f}) and {red[1]:.1f} % (blade 2, kappa {kap[1]:.2f}); "
+                 f"the odd blades' peaks agree to {_relative_spread(al[0::2], al.max())} | "
+                 f"both lowered by {m:g} % or more | {verdict(min(red) >= m)} |")
+    tol = [ALTERNATING_RELATIVE * p for p in PAPER_ALTERNATING_PCT]
+    ok = all(abs(r - p) <= t for r, p, t in zip(red, PAPER_ALTERNATING_PCT, tol))
+    lines.append(f"| d, 1 g: by how much | ~{PAPER_ALTERNATING_PCT[0]:g} % and ~{PAPER_ALTERNATING_PCT[1]:g} % "
+                 f"(blades 1, 2) | {red[0]:.1f} % and {red[1]:.1f} % | "
+                 f"+- {tol[0]:.2g} and +- {tol[1]:.2g} % points ({100 * ALTERNATING_RELATIVE:g} % of the paper's) | "
+                 f"{verdict(ok)} |")
     lines += ["", "The paper's random sample is not given: ours is a 2 % Gaussian draw with the seed above, so "
               "the blade numbers differ; the statements are compared, not the numbers.", ""]
     return lines
@@ -350,10 +384,14 @@ def plot_cases(cases: dict[str, MistuningCase], path=None):
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(2, 3, figsize=(15, 8))
+    import re
+
     for ax, (key, c) in zip(axes.ravel(), cases.items()):
-        c.response.plot(ax=ax, tuned=c.tuned_response, title=key)
+        c.response.plot(ax=ax, tuned=c.tuned_response, title=re.sub(r"_(\d+)g$", r", \1 g", key))
     axes.ravel()[-1].axis("off")
     fig.tight_layout()
+    for ax, _ in zip(axes.ravel(), cases):
+        place_legend(ax, fontsize=8)       # clear of every curve (the largest peak included)
     if path is not None:
         fig.savefig(path, dpi=110)
         plt.close(fig)

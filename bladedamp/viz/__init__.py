@@ -16,8 +16,18 @@ _MESHCAT_NAMES = ("Scene", "LiveView", "show", "ods_scene", "contact_map_scene",
 __all__ = list(_MESHCAT_NAMES)
 
 
+#: the one-line hint when the 3D view's packages are missing
+INSTALL_HINT = "the 3D view needs meshcat and trimesh: pip install 'bladedamp[viz]'"
+
+
 def __getattr__(name):
     if name in _MESHCAT_NAMES:
-        from . import meshcat_view
+        try:
+            from . import meshcat_view
+        except ModuleNotFoundError as exc:
+            if exc.name and exc.name.split(".")[0] in ("meshcat", "trimesh", "umsgpack", "zmq"):
+                raise ModuleNotFoundError(f"bladedamp.viz.{name}: {INSTALL_HINT} (missing: {exc.name})",
+                                          name=exc.name) from None
+            raise
         return getattr(meshcat_view, name)
     raise AttributeError(f"module 'bladedamp.viz' has no attribute {name!r}")

@@ -329,7 +329,7 @@ def cycle_data(result, index: int | None = None, frequency_hz: float | None = No
     if disk is not None and disk.has_damper:
         system = disk.hbm_system(basis.harmonics, basis.n_samples)
         coupling = system.couplings[0]
-        local = (coupling.matrix @ X.ravel()).reshape(basis.n_coeffs, 12)
+        local = (coupling.matrix @ X.ravel()).reshape(basis.n_coeffs, coupling.element.n_local)   # 12, or more with flexible platforms
         evs = coupling.element.evaluate(local, basis, result.omega[i], jacobian=False)
         states = np.stack([ev.points.state.T for ev in evs], axis=1)               # (T, 2, P)
         patches = coupling.element.geometry.patches
@@ -680,8 +680,12 @@ def ods_scene(result, index: int | None = None, frequency_hz: float | None = Non
 
     # contact maps
     map_origin = np.array([0.04, 0.0, z_p + 0.06])
+    r_tip = None
     if layout == "disk":
-        map_origin = np.array([0.09, -0.06, z_p + 0.04])
+        # beside the disk, right of the blade tips' circle (centre (0, 0, -r_root)), in front of
+        # the blades: the maps and the legend cross no blade
+        r_tip = r_root + g.total_length
+        map_origin = np.array([r_tip + 0.03, -0.02, -r_root + 0.09])
     if contact_maps and has_damper:
         samples = _add_contact_maps(scene, data, map_origin, n_frames)
         _map_frames(scene, anim, n_frames, phase)
@@ -693,8 +697,10 @@ def ods_scene(result, index: int | None = None, frequency_hz: float | None = Non
     # camera
     if camera is None:
         if layout == "disk":
-            target = np.array([0.0, 0.0, -r_root + 0.02])
-            camera = (target, np.array([0.12, -0.55, 0.18]))
+            # the whole disk and the maps beside it, seen from the front and a little from the side
+            # and above so that the dampers between the platforms show
+            target = np.array([0.06, 0.0, -r_root])
+            camera = (target, np.array([0.02, -0.42, 0.04]))
         else:
             target = np.array([0.01, 0.0, 0.5 * g.total_length - 0.01])
             camera = (target, np.array([0.05, -0.245, 0.04]))
@@ -752,7 +758,10 @@ def contact_map_scene(result, index: int | None = None, frequency_hz: float | No
 def show(result, path=None, live: bool = False, open_browser: bool = False, **options):
     """Build :func:`ods_scene` for ``result``; write it to ``path`` (standalone HTML) if given; with
     ``live=True`` also start a localhost meshcat server and return ``(scene, view)`` (close the view).
-    Returns the Scene otherwise."""
+    Returns the Scene otherwise. Default layout: the whole disk ("disk", every blade and damper,
+    the contact maps and their legend beside it) for a damped disk, the sector without damper."""
+    disk = getattr(result, "disk", None)
+    options.setdefault("layout", "disk" if disk is not None and disk.has_damper else "sector")
     scene = ods_scene(result, **options)
     if path is not None:
         scene.save_html(path)

@@ -40,7 +40,10 @@ def scene_iframe(scene, height: int = 480) -> str:
 
 
 def embed_scene(scene, height: int = 480):
-    """``IPython.display.HTML`` showing ``scene`` in the cell (about 1.5 MB of output)."""
+    """``IPython.display.HTML`` showing ``scene`` in the cell (about 1.5 MB of output). Saved with
+    the notebook, it shows before anything runs wherever HTML outputs are shown: JupyterLab once
+    the notebook is trusted (``jupyter trust``: JupyterLab strips iframes, and draws no widget,
+    in a notebook it does not trust), VS Code, nbviewer."""
     from IPython.display import HTML
 
     return HTML(scene_iframe(scene, height))
