@@ -78,10 +78,11 @@ NEWTON_STEP_MAX = 1e-6
 def touchdown_seats(approach, seat, seat_rate):
     """Where a separated point closes between two samples, for the slider's seat.
 
-    approach (T,) samples of the normal approach a (contact where a > 0, periodic). Writes
-    seat[t] = theta = -a_t / (a_{t+1} - a_t) in [0, 1) and seat_rate[t] = 1 / (a_{t+1} - a_t)
-    [1/m] at every separated sample t followed by a closed one (the linear interpolation of
-    the approach crosses zero at t + theta), zero elsewhere.
+    approach (P, T) samples of the normal approach a of P points (contact where a > 0,
+    periodic). Writes seat[p, t] = theta = -a_t / (a_{t+1} - a_t) in [0, 1) and
+    seat_rate[p, t] = 1 / (a_{t+1} - a_t) [1/m] at every separated sample t followed by a
+    closed one (the linear interpolation of the approach crosses zero at t + theta), zero
+    elsewhere (all points in one call: a call per point cost 1 us each).
 
     A separated slider follows the displacement and is seated where the contact closes: at
     u_t + theta (u_{t+1} - u_t), not at the last separated sample u_t. Seating it at the
@@ -96,16 +97,17 @@ def touchdown_seats(approach, seat, seat_rate):
     da, d theta / d a_{t+1} = -theta / da, da = a_{t+1} - a_t, and a = offset - u_zeta, so
     d theta / d c_zeta = ((1 - theta) E_t + theta E_{t+1}) * seat_rate (E the synthesis rows).
     """
-    T = approach.shape[0]
-    for t in range(T):
-        a0 = approach[t]
-        a1 = approach[(t + 1) % T]
-        if a0 <= 0.0 < a1:
-            seat[t] = -a0 / (a1 - a0)
-            seat_rate[t] = 1.0 / (a1 - a0)
-        else:
-            seat[t] = 0.0
-            seat_rate[t] = 0.0
+    P, T = approach.shape
+    for p in range(P):
+        for t in range(T):
+            a0 = approach[p, t]
+            a1 = approach[p, (t + 1) % T]
+            if a0 <= 0.0 < a1:
+                seat[p, t] = -a0 / (a1 - a0)
+                seat_rate[p, t] = 1.0 / (a1 - a0)
+            else:
+                seat[p, t] = 0.0
+                seat_rate[p, t] = 0.0
 
 
 @njit(cache=True)
@@ -585,9 +587,11 @@ def damper_contact_forces(B, local, synthesis, analysis, k_t, mu, weight, approa
     uz = np.empty(T)
     normal = np.empty(T)
     dnormal = np.empty(T)
-    approach = np.empty(T)
-    seat = np.empty(T)
-    seat_rate = np.empty(T)
+    approach = np.empty((1, T))      # one point at a time (touchdown_seats takes (P, T))
+    seats = np.empty((1, T))
+    seat_rates = np.empty((1, T))
+    seat = seats[0]
+    seat_rate = seat_rates[0]
     f_t = np.empty((T, 2))
     df = np.zeros((T, 2, n3p))       # d f_tangential / d c of the last pass; padding stays 0
     df_flat = df.reshape((T, 2 * n3p))
@@ -638,7 +642,7 @@ def damper_contact_forces(B, local, synthesis, analysis, k_t, mu, weight, approa
                 off = approach_offset[g]
                 for t in range(T):
                     app = off - uz[t]
-                    approach[t] = app
+                    approach[0, t] = app
                     if app > 0.0:
                         if law_kind == LAW_LINEAR:
                             kw = k_law * w
@@ -652,7 +656,7 @@ def damper_contact_forces(B, local, synthesis, analysis, k_t, mu, weight, approa
                     else:
                         normal[t] = 0.0
                         dnormal[t] = 0.0
-                touchdown_seats(approach, seat, seat_rate)
+                touchdown_seats(approach, seats, seat_rates)
                 if static_index >= 0:
                     s0 = c[static_index, 0]
                     s1 = c[static_index, 1]
@@ -778,9 +782,8 @@ def point_contact_forces(coeffs, basis, tangential_stiffness, friction_coefficie
     else:
         static_index = -1
         s_start = np.zeros((P, 2))
-    seat, seat_rate = np.zeros((P, T)), np.zeros((P, T))
-    for p in range(P):
-        touchdown_seats(np.ascontiguousarray(approach[p]), seat[p], seat_rate[p])
+    seat, seat_rate = np.empty((P, T)), np.empty((P, T))
+    touchdown_seats(np.ascontiguousarray(approach), seat, seat_rate)
     f_t = np.empty((P, T, 2))
     df = np.zeros((P, T, 3, 3 * C)) if jacobian else np.zeros((1, 1, 2, 1))
     state = np.empty((P, T), dtype=np.int8)
