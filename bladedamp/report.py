@@ -727,10 +727,10 @@ def _mass_g(m) -> str:
 
 
 def fmt_percent(x) -> str:
-    if x is None or not np.isfinite(x):
-        return "not found"
-    v = 100 * x
-    return f"{0.0 if abs(v) < 0.05 else v:.1f} %"
+    """A fraction ``x`` in per cent with one decimal, by :func:`fmt_number` ('not found' if
+    missing, never '-0.0 %')."""
+    text = fmt_number(None if x is None else 100 * x, ".1f")
+    return text if text == "not found" else f"{text} %"
 
 
 def analysis_line(design, studies: bool = False) -> str:
