@@ -39,7 +39,7 @@ def residual_time(disk, repeat):
     """Best time [s] of one residual + Jacobian of the sector at (0, 1, 2, 3), 50 calls each."""
     system = disk.hbm_system((0, 1, 2, 3))
     omega = 2 * np.pi * 97.0
-    x = 3.0 * disk._initial_guess(system, omega)
+    x = 3.0 * disk.initial_guess(system, omega)
     system.residual(x, omega)
     t, _ = best_of(lambda: [system.residual(x, omega) for _ in range(50)], repeat)
     return t / 50

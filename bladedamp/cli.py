@@ -91,6 +91,7 @@ def reproduce(out: Path, processes: int | None = None) -> dict:
     from .reference import EXCITATION_TABLE1, reference_disk
     from .studies.design import mode_window
     from .studies.mass import mass_sweep, optimal_mass, peak_response
+    from .studies.parallel import parallel_map
 
     warnings.simplefilter("ignore")
     output_dir(out)
@@ -108,11 +109,12 @@ def reproduce(out: Path, processes: int | None = None) -> dict:
     free = reference_disk(None, excitation=EXCITATION_TABLE1)
     damped = reference_disk("cylinder", 1e-3, excitation=EXCITATION_TABLE1)
     progress("Table 1: four modes with and without the 1 g cylinder")
+    modes = [(name, f0, report.MODE_TIP_DOF[name]) for name, f0, _, _ in report.PAPER["table1"]]
+    windows_of = parallel_map(_call, [(mode_window, d, f0, dof) for _, f0, dof in modes for d in (free, damped)],
+                              processes)
     table1, windows = [], []
-    for name, f0, _, _ in report.PAPER["table1"]:
-        dof = report.MODE_TIP_DOF[name]
-        r_free, a_free, _ = mode_window(free, f0, dof)
-        r_damp, a_damp, f_damp = mode_window(damped, f0, dof)
+    for k, (name, f0, dof) in enumerate(modes):
+        (r_free, a_free, _), (r_damp, a_damp, f_damp) = windows_of[2 * k], windows_of[2 * k + 1]
         table1.append({"mode": name, "f0_hz": f0, "f_res_damped_hz": f_damp,
                        "reduction_pct": 100 * (1 - a_damp / a_free), "tip_dof": "xyz"[dof] if dof < 3 else "phi_z",
                        "peak_free": a_free, "peak_damped": a_damp})
@@ -122,22 +124,22 @@ def reproduce(out: Path, processes: int | None = None) -> dict:
 
     # -- mass sweep and optimum, both dampers at EO = 1 (Fig. 5, 6) --
     t0 = time.perf_counter()
-    sweeps, optima, frfs_fig5 = {}, {}, []
+    sweeps, optima = {}, {}
     for kind in ("cylinder", "wedge"):
         disk = reference_disk(kind)
         sweeps[kind] = mass_sweep(disk, masses, progress=progress.bar(f"mass sweep {kind}"), processes=processes)
-        opt = optimal_mass(disk, bounds=(1e-5, 2e-2))
+        opt = optimal_mass(disk, bounds=(1e-5, 2e-2), processes=processes)   # EO 1, also the EO study's
         optima[kind] = opt
         progress(f"optimum {kind}: {1e3 * opt.mass:.3f} g, peak {1e3 * opt.peak_amplitude:.4f} mm, "
                  f"reduction {report.fmt_percent(opt.reduction)}")
-    for m in (0.1e-3, 1e-3, 10e-3, 1.0):
-        frfs_fig5.append((m, peak_response(reference_disk("cylinder", m), (85.0, 115.0))[2]))
+    fig5_masses = (0.1e-3, 1e-3, 10e-3, 1.0)
+    fig5 = parallel_map(_timed_frf, [(reference_disk(None), 85.0, 115.0, PAPER_HARMONICS)]
+                        + [(reference_disk("cylinder", m), 85.0, 115.0, None) for m in fig5_masses], processes)
+    (free_r, free_s), frfs_fig5 = fig5[0], [(m, r) for m, (r, _) in zip(fig5_masses, fig5[1:])]
+    solve_s = {("none", "paper"): free_s}
     timings["mass_studies_s"] = time.perf_counter() - t0
 
     report.plot_four_modes(windows, out / "fig4_frf_four_modes.png")
-    t1 = time.perf_counter()
-    free_r = reference_disk(None).frequency_response(85.0, 115.0, harmonics=PAPER_HARMONICS, max_step=0.05)
-    solve_s = {("none", "paper"): time.perf_counter() - t1}
     report.plot_mass_variation(free_r, frfs_fig5, out / "fig5_mass_variation.png")
     report.plot_mass_optimisation(sweeps, optima, out / "fig6_mass_optimisation.png")
     progress("figures of Fig. 4-6 written")
@@ -145,33 +147,32 @@ def reproduce(out: Path, processes: int | None = None) -> dict:
     # -- the paper's one-harmonic setting beside the converged harmonic balance, at both optima --
     t0 = time.perf_counter()
     accuracy, frfs = {}, {}
-    for kind, opt in optima.items():
-        disk = reference_disk(kind, opt.mass)
-        rows = {}
-        for label, H in (("paper", PAPER_HARMONICS), ("converged", "auto")):
-            t1 = time.perf_counter()
-            r = disk.frequency_response(90.0, 100.0, harmonics=H, max_step=0.05)
-            solve_s[kind, label] = time.perf_counter() - t1
-            frfs[kind, label] = r
-            rows[label] = {"harmonics": list(r.basis.harmonics), "peak_tip_mm": 1e3 * r.peak_amplitude,
-                           "resonance_hz": r.peak_frequency_hz, "harmonic_error_pct": report.plain(100 * r.harmonic_error),
-                           "converged": bool(r.harmonics_converged), "success": bool(r.success)}
-        accuracy[kind] = {"mass_g": 1e3 * opt.mass, **rows}
+    settings = [(kind, label, H) for kind in optima for label, H in (("paper", PAPER_HARMONICS), ("converged", "auto"))]
+    solved = parallel_map(_timed_frf, [(reference_disk(kind, optima[kind].mass), 90.0, 100.0, H)
+                                       for kind, _, H in settings], processes)
+    for (kind, label, _), (r, seconds) in zip(settings, solved):
+        solve_s[kind, label] = seconds
+        frfs[kind, label] = r
+        accuracy.setdefault(kind, {"mass_g": 1e3 * optima[kind].mass})[label] = {
+            "harmonics": list(r.basis.harmonics), "peak_tip_mm": 1e3 * r.peak_amplitude,
+            "resonance_hz": r.peak_frequency_hz, "harmonic_error_pct": report.plain(100 * r.harmonic_error),
+            "converged": bool(r.harmonics_converged), "success": bool(r.success)}
+    for kind, rows in accuracy.items():
         progress(f"harmonic accuracy {kind}: paper {rows['paper']['peak_tip_mm']:.4f} mm, "
                  f"converged {rows['converged']['peak_tip_mm']:.4f} mm with harmonics {tuple(rows['converged']['harmonics'])}")
     timings["harmonic_accuracy_s"] = time.perf_counter() - t0
 
     # -- the stability of those responses and the 1F nonlinear modes of both dampers --
     stability, backbone = stability_and_backbones(out, free_r, frfs, solve_s, {k: o.mass for k, o in optima.items()},
-                                                  progress, timings)
+                                                  progress, timings, processes)
 
-    design = _design_studies(out, progress, processes, timings)
+    design = _design_studies(out, progress, processes, timings, optima, sweeps)
 
     # -- mistuned disk: the paper's cases (Figs. 13-17) --
     from .studies.mistuning import paper_cases, plot_cases, summary_dict
 
     t0 = time.perf_counter()
-    cases = paper_cases(progress=lambda i, n, msg: progress(f"mistuning {i}/{n}: {msg}"))
+    cases = paper_cases(progress=lambda i, n, msg: progress(f"mistuning {i}/{n}: {msg}"), processes=processes)
     mistuning = summary_dict(cases)
     plot_cases(cases, out / "fig13_17_mistuning.png")
     timings["mistuning_s"] = time.perf_counter() - t0
@@ -201,26 +202,48 @@ def reproduce(out: Path, processes: int | None = None) -> dict:
     return summary
 
 
-def stability_and_backbones(out: Path, free, frfs: dict, solve_s: dict, masses: dict, progress, timings: dict):
+def _call(case):
+    """``fn(*args)`` of ``case = (fn, *args)`` (``fn`` module-level): one case of ``parallel_map``."""
+    fn, *args = case
+    return fn(*args)
+
+
+def _timed_frf(case):
+    """(response, solve time [s]) of one (disk, f_start [Hz], f_end [Hz], harmonics) at max_step
+    0.05; harmonics None: :func:`bladedamp.studies.mass.peak_response`'s (peak searched, range
+    widened until the peak is interior)."""
+    from .studies.mass import peak_response
+
+    disk, lo, hi, harmonics = case
+    t = time.perf_counter()
+    r = peak_response(disk, (lo, hi))[2] if harmonics is None else \
+        disk.frequency_response(lo, hi, harmonics=harmonics, max_step=0.05)
+    return r, time.perf_counter() - t
+
+
+def stability_and_backbones(out: Path, free, frfs: dict, solve_s: dict, masses: dict, progress, timings: dict,
+                            processes: int | None = 1):
     """The stability of the reference responses (``free``: the disk without damper; ``frfs``:
     {(kind, "paper" | "converged"): response at the optimal mass ``masses[kind]`` [kg]}) and the
     1F nonlinear modes (EPMC, one harmonic) of both dampers at those masses; writes
     ``stability_backbones.png``. ``solve_s``: the solve time of each response [s], to report the
-    stability's cost beside it. Returns the summary's ``stability`` and ``backbone`` entries."""
+    stability's cost beside it; ``processes``: worker processes over the responses (None: every
+    core). Returns the summary's ``stability`` and ``backbone`` entries."""
     import numpy as np
 
     from . import report
     from .hbm.nonlinear_modes import nonlinear_mode
     from .hbm.stability import with_stability
     from .reference import reference_disk
+    from .studies.parallel import parallel_map
 
     t0 = time.perf_counter()
     stability, checked = {}, {}
     entries = [("no damper", "none", "paper", reference_disk(None), free)]
     entries += [(f"{kind} {1e3 * masses[kind]:.3g} g, {'one harmonic' if label == 'paper' else 'converged'}",
                  kind, label, reference_disk(kind, masses[kind]), r) for (kind, label), r in frfs.items()]
-    for name, kind, label, model, r in entries:
-        s = with_stability(model, r)
+    checks = parallel_map(_call, [(with_stability, model, r) for _, _, _, model, r in entries], processes)
+    for (name, kind, label, model, r), s in zip(entries, checks):
         checked[kind, label] = s
         stable = np.ones(len(s.omega), bool) if s.stable is None else np.asarray(s.stable, bool)
         stability[name] = {
@@ -260,23 +283,27 @@ def stability_and_backbones(out: Path, free, frfs: dict, solve_s: dict, masses: 
     return stability, backbone
 
 
-def _design_studies(out: Path, progress, processes, timings) -> dict:
+def _design_studies(out: Path, progress, processes, timings, optima: dict, sweeps_eo1: dict) -> dict:
     """The paper's design studies (Fig. 7-11) and the design map beyond the paper, on the
-    reference disk."""
+    reference disk. The mass study's results at EO 1 on the reference disk are not recomputed:
+    ``optima`` {kind: MassOptimum}, ``sweeps_eo1`` {kind: MassSweep} (the 1 g cylinder's peak)."""
     import dataclasses
 
     import numpy as np
 
     from . import report
     from .reference import reference_disk
-    from .studies.design import (contact_state, design_map, engine_order_sweep, liftoff_onset,
+    from .studies.design import (contact_state, design_map, engine_order_sweeps, liftoff_onset,
                                  platform_angle_study, wedge_liftoff_map)
+    from .studies.parallel import parallel_map
 
     result = {}
     # -- engine orders 0..8, mass re-optimised (Fig. 7, 8) --
     t0 = time.perf_counter()
-    sweeps = {kind: engine_order_sweep(reference_disk(kind), range(0, 9), progress=progress.bar(f"engine orders {kind}"),
-                                       processes=processes) for kind in ("cylinder", "wedge")}
+    kinds = ("cylinder", "wedge")
+    sweeps = dict(zip(kinds, engine_order_sweeps([reference_disk(kind) for kind in kinds], range(0, 9),
+                                                 progress=progress.bar("engine orders"), processes=processes,
+                                                 known=[{1: optima[kind]} for kind in kinds])))
     result["optimum"] = {kind: {str(eo): {"mass_g": report.plain(1e3 * m), "peak_tip_mm": report.plain(1e3 * p),
                                           "reduction_pct": report.plain(100 * r), "certified": bool(c),
                                           "message": sw.messages.get(int(eo), sw.failures.get(int(eo), ""))}
@@ -290,8 +317,9 @@ def _design_studies(out: Path, progress, processes, timings) -> dict:
     # -- asymmetric platforms (Fig. 10) --
     t0 = time.perf_counter()
     angles = np.array([15.0, 25.0, 35.0, 45.0, 55.0, 65.0, 75.0, 85.0])
+    at_1g = float(sweeps_eo1["cylinder"].peak_amplitude[np.isclose(sweeps_eo1["cylinder"].mass, 1e-3)][0])
     pa = platform_angle_study(reference_disk("cylinder", 1e-3), angles, progress=progress.bar("platform angles"),
-                              processes=processes)
+                              processes=processes, known={35.0: (at_1g, optima["cylinder"])})   # the reference angle
     result["platform_angle"] = {"gamma_r_deg": list(angles), "opt_mass_g": list(1e3 * pa.optimal_mass),
                                 "opt_peak_tip_mm": list(1e3 * pa.optimal_peak_amplitude),
                                 "peak_tip_mm_at_1g": list(1e3 * pa.peak_amplitude_at_fixed_mass)}
@@ -300,8 +328,12 @@ def _design_studies(out: Path, progress, processes, timings) -> dict:
 
     # -- contact state in the complex plane (Fig. 11, Eq. 27) --
     t0 = time.perf_counter()
-    states = {g: contact_state(dataclasses.replace(reference_disk("cylinder", 1e-3), gamma_right=np.radians(g)))
-              for g in (35.0, 85.0)}
+    state_angles = (35.0, 85.0)
+    *states, lift = parallel_map(_call, [(contact_state, dataclasses.replace(reference_disk("cylinder", 1e-3),
+                                                                            gamma_right=np.radians(g)))
+                                         for g in state_angles] + [(wedge_liftoff_map, reference_disk("wedge", 1e-3))],
+                                 processes)
+    states = dict(zip(state_angles, states))
     progress("contact states at gamma_R = 35, 85 deg")
     for g, state in states.items():  # complex as [re, im] (Eq. 27)
         result[f"contact_state_{g:g}deg"] = {name: {"w_star": [float(state.w_star[c].real), float(state.w_star[c].imag)],
@@ -310,7 +342,6 @@ def _design_studies(out: Path, progress, processes, timings) -> dict:
     report.plot_contact_states(states, out / "fig11_contact_state.png")
 
     # -- wedge lift-off (Fig. 9) and its onset over contact height and excitation --
-    lift = wedge_liftoff_map(reference_disk("wedge", 1e-3))
     result["wedge_liftoff"] = {"xi_star": list(map(float, lift.xi_star)), "eta_star": list(map(float, lift.eta_star)),
                                "r": lift.ratio.tolist(), "mass_g": 1.0, "force_n": 0.1}
     result["wedge_liftoff_onset"] = liftoff_onset(reference_disk("wedge", 1e-3), [1e-3, 2e-3, 3e-3, 4e-3],
@@ -447,7 +478,7 @@ def eo_sweep_command(args) -> int:
             raise UsageError(f"--engine-orders {eo}: must be in [0, {disk.n_blades // 2}] (n_blades / 2)")
     out = output_dir(args.out)
     progress = Progress()
-    sweep = engine_order_sweep(design.disk_at(1), sorted(set(eos)), a.mass_bounds, design.rotor_speed_eo0, a.f_range_hz,
+    sweep = engine_order_sweep(design.disk_at(1), sorted(set(eos)), a.mass_bounds, design.rotor_speed_eo0_hz, a.f_range_hz,
                                harmonics=a.study_harmonics, progress=progress.bar("engine orders"),
                                processes=args.processes)
     eo_sweep_outputs(out, design, sweep)

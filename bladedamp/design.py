@@ -436,8 +436,9 @@ class Design:
 
     disk : TunedDisk at the first engine order; engine_orders : every EO of the file;
     analysis : :class:`Analysis`; mistuning : :class:`Mistuning` or None;
-    rotor_speed_eo0 : rotor speed used at EO = 0 when the file's rotor speed is 'auto' [rad/s];
-    rotor_speed : the file's fixed rotor speed [rad/s], None for 'auto' (Omega_E / EO);
+    rotor_speed_eo0_hz : rotor speed used at EO = 0 when the file's rotor speed is 'auto' [Hz,
+    revolutions per second: the file's rpm / 60]; rotor_speed_hz : the file's fixed rotor speed
+    [Hz], None for 'auto' (Omega_E / EO);
     values : {table: {key: value}} in the file's units, every key (defaults filled in);
     path : the file (None: the reference design); blade_geometry : the BeamBladeGeometry of a
     beam blade (None for modal data from a file)
@@ -446,19 +447,20 @@ class Design:
     engine_orders: tuple
     analysis: Analysis
     mistuning: Mistuning | None
-    rotor_speed_eo0: float
-    rotor_speed: float | None = None
+    rotor_speed_eo0_hz: float
+    rotor_speed_hz: float | None = None
     values: dict = field(repr=False, default_factory=dict)
     path: Path | None = None
     blade_geometry: object = None
 
     def disk_at(self, engine_order: int):
-        """The design's disk at another engine order (at EO = 0 with the speed rotor_speed_eo0
+        """The design's disk at another engine order (at EO = 0 with the speed rotor_speed_eo0_hz
         if the file's rotor speed is 'auto')."""
         from .studies.design import at_engine_order
 
-        base = dataclasses.replace(self.disk, engine_order=1, rotor_speed=self.rotor_speed)   # valid for n >= 2
-        return at_engine_order(base, engine_order, self.rotor_speed_eo0)
+        base = dataclasses.replace(self.disk, engine_order=1, rotor_speed_hz=self.rotor_speed_hz,
+                                   rotor_speed=None)   # valid for n >= 2
+        return at_engine_order(base, engine_order, self.rotor_speed_eo0_hz)
 
     def mistuned_disk(self):
         """The full assembly with the design's mistuning (:class:`bladedamp.mistuned.MistunedDisk`)."""
@@ -560,9 +562,8 @@ def _build(path: Path, v: dict, given: set, has_mistuning: bool) -> Design:
         mass, length = 1e-3 * k["mass_g"], 1e-3 * k["length_mm"]
         damper = (CylinderDamper(mass, 1e-3 * k["cylinder_radius_mm"], length, contact) if k["kind"] == "cylinder"
                   else WedgeDamper(mass, 1e-3 * k["contact_height_mm"], length, contact))
-    rpm = 2 * np.pi / 60
-    speed = None if d["rotor_speed_rpm"] == "auto" else rpm * d["rotor_speed_rpm"]
-    speed_eo0 = rpm * d["rotor_speed_eo0_rpm"]
+    speed = None if d["rotor_speed_rpm"] == "auto" else d["rotor_speed_rpm"] / 60.0      # rpm -> Hz
+    speed_eo0 = d["rotor_speed_eo0_rpm"] / 60.0
     disk = TunedDisk(blade, damper, n, 1, np.radians(d["gamma_left_deg"]), np.radians(d["gamma_right_deg"]),
                      1e-3 * d["damper_radius_mm"], np.array(d["excitation_n_nm"], dtype=float), speed,
                      bool(k["inertia"]))

@@ -43,11 +43,14 @@ from .hbm.system import Coupling, HarmonicBalanceSystem
 from .response import REFINE_SAMPLES_FACTOR, FrequencyResponse, physical_checks, with_checks, plot_branch, sampled_response
 
 DAMPER_DOFS = ("uD_x", "uD_y", "uD_z", "phiD_x", "phiD_y", "phiD_z")
-# the automatic AFT sampling of a tuned disk's branch may grow the samples this much (one step
-# of bladedamp.response.sampled_response: a disk's branch costs about 3x more with 4x the
+# the automatic AFT sampling of a disk's branch (TunedDisk and MistunedDisk) may grow the samples
+# this much (one step of bladedamp.response.sampled_response: a disk's branch costs about 3x more with 4x the
 # samples; measured on random disks 7 (retraced with 64 samples, reached the end with 256) and
 # 56 (negative contact dissipation -2.2e-5 of the excitation work, confirmed with 1024))
 AUTO_SAMPLES_GROWTH = 4
+# ... and this much when the branch reached the end and failed only the dissipation check (the
+# AFT's sampling error: random disk 56 failed it with 256 samples and passes with 1024)
+AUTO_SAMPLES_GROWTH_DISSIPATION = 16
 
 
 def contact_point_maps(geometry: DamperGeometry, platform_offsets: np.ndarray, left: ModalBlade,
@@ -197,8 +200,12 @@ class DamperContacts:
         force is (C, 6 + n_m), its first 6 the forces and moments about the control point."""
         return self.evaluate_at(local, basis, self.approach(omega)[0], jacobian)
 
-    def _stack(self):
-        """(point maps (2, P, 3, m), k_T, mu, weights (2P,), normal law) or None if the patches differ."""
+    def stacked_points(self):
+        """The points of both patches as one batch: ``(True, point maps (2, P, 3, m), k_T (2P,)
+        [N/m per point: the patch's tangential stiffness times the point's weight], mu (2P,),
+        weights (2P,), normal law)``, or None if the patches differ in normal law, friction
+        coefficient or point count (then they are evaluated one by one). Cached; the batch of
+        :func:`point_map_forces` and of :class:`~bladedamp.mistuned.AssemblyContacts`."""
         if self._stacked is None:
             pa, pb = self.geometry.patches
             same = (pa.normal_law == pb.normal_law and pa.friction_coefficient == pb.friction_coefficient
@@ -214,10 +221,12 @@ class DamperContacts:
                                  np.concatenate([p.weights for p in ps]), pa.normal_law)
         return self._stacked if self._stacked[0] else None
 
-    def _forces(self, local, basis, offsets, jacobian):
-        """Forces (C, n_local) and Jacobian (C*n_local, C*n_local) or None of both patches."""
+    def forces_at(self, local, basis, offsets, jacobian):
+        """Forces (C, n_local) [N, N m] and Jacobian (C*n_local, C*n_local) or None of both patches
+        at ``local`` (C, n_local) with the per-point static approach ``offsets`` (2, P) [m] (no
+        omega: the approach is given; :meth:`harmonic_forces` takes it from :attr:`approach`)."""
         C, m = basis.n_coeffs, self.contact_local
-        stack = self._stack()
+        stack = self.stacked_points()
         if stack is None:
             evs = self.evaluate_at(local, basis, offsets, jacobian)
             force = np.hstack([ev.force for ev in evs])
@@ -244,7 +253,7 @@ class DamperContacts:
 
     def harmonic_forces(self, local, basis, omega, jacobian=True):
         offsets, doffsets = self.approach(omega)
-        force, jac = self._forces(local, basis, offsets, jacobian)
+        force, jac = self.forces_at(local, basis, offsets, jacobian)
         if not jacobian:
             return force, None, None
         domega = None
@@ -261,10 +270,37 @@ class DamperContacts:
                 # central difference in omega, both ends without the Jacobian so that both take
                 # the same return-map passes (two extra AFT passes)
                 h = 1e-6 * omega
-                force_p, _ = self._forces(local, basis, offsets + h * doffsets, False)
-                force_m, _ = self._forces(local, basis, offsets - h * doffsets, False)
+                force_p, _ = self.forces_at(local, basis, offsets + h * doffsets, False)
+                force_m, _ = self.forces_at(local, basis, offsets - h * doffsets, False)
                 domega = ((force_p - force_m) / (2 * h)).ravel()
         return force, jac, domega
+
+
+def rotor_speed_in_hz(rotor_speed_hz, rotor_speed=None):
+    """The rotor speed [Hz, revolutions per second] of a disk given ``rotor_speed_hz`` [Hz] and/or
+    the deprecated ``rotor_speed`` [rad/s] (a DeprecationWarning when only that is given; both
+    must agree). None: the speed follows the excitation (Omega_E / EO). Validated: > 0, and a
+    :class:`~bladedamp._validate.PlausibilityWarning` outside 1-3000 Hz (60-180 000 rpm)."""
+    if rotor_speed is not None:
+        rotor_speed = _validate.positive("rotor_speed (rad/s, deprecated: use rotor_speed_hz)", rotor_speed)
+        from_rad = float(rotor_speed) / (2 * np.pi)
+        if rotor_speed_hz is None:
+            import warnings
+
+            warnings.warn("rotor_speed [rad/s] is deprecated: give rotor_speed_hz [Hz] = rotor_speed / (2 pi) "
+                          "(rpm / 60)", DeprecationWarning, stacklevel=4)
+            rotor_speed_hz = from_rad
+        elif not np.isclose(float(rotor_speed_hz), from_rad, rtol=1e-12, atol=0.0):
+            raise ValueError(f"rotor_speed_hz = {rotor_speed_hz!r} Hz and the deprecated rotor_speed = {rotor_speed!r} "
+                             "rad/s disagree: give rotor_speed_hz only (or rotor_speed=None with it)")
+    if rotor_speed_hz is None:
+        return None
+    _validate.positive("rotor_speed_hz (rotor revolutions per second)", rotor_speed_hz)
+    # 60 rpm (a slow test rig) to 180 000 rpm (micro gas turbines); a value in rad/s is 2 pi times
+    # too large, which only this range can catch at its top
+    _validate.plausible("rotor_speed_hz", rotor_speed_hz, 1.0, 3000.0, "Hz",
+                        "rotor revolutions per second, 60 to 180 000 rpm; a speed in rad/s is 2 pi times larger")
+    return float(rotor_speed_hz)
 
 
 @dataclass
@@ -281,10 +317,13 @@ class TunedDisk:
     damper_radius : R, distance of the damper's centre of gravity to the rotor axis [m]
     excitation : (6,) harmonic tip load (F_x, F_y, F_z, M_x, M_y, M_z) at the blade's
         "excitation" point [N, N m] (cosine amplitude)
-    rotor_speed : [rad/s], required when EO = 0; otherwise Omega_R = Omega_E / EO
+    rotor_speed_hz : rotor speed [Hz, revolutions per second] (rpm / 60), required when EO = 0;
+        None (default): Omega_R = Omega_E / EO follows the excitation frequency (Eq. 3, 26)
     damper_inertia : include the damper's mass and rotary inertia in Eq. 12
     initial_gaps : (2, P) gaps of the OL and OR patch points before loading [m] (default: a
         perfect fit), e.g. :func:`bladedamp.geometry.misfit_gaps` of a damper that does not fit
+    rotor_speed : deprecated, the rotor speed in rad/s (use ``rotor_speed_hz``); kept equal to
+        2 pi ``rotor_speed_hz`` so that code written for it still reads and replaces it
     """
 
     blade: ModalBlade
@@ -295,11 +334,14 @@ class TunedDisk:
     gamma_right: float = np.radians(35.0)
     damper_radius: float = 0.1
     excitation: np.ndarray = field(default_factory=lambda: np.array([0.1, 0, 0, 0, 0, 0]))
-    rotor_speed: float | None = None
+    rotor_speed_hz: float | None = None
     damper_inertia: bool = True
     initial_gaps: np.ndarray | None = None
+    rotor_speed: float | None = field(default=None, repr=False)
 
     def __post_init__(self):
+        self.rotor_speed_hz = rotor_speed_in_hz(self.rotor_speed_hz, self.rotor_speed)
+        self.rotor_speed = None if self.rotor_speed_hz is None else 2 * np.pi * self.rotor_speed_hz
         _validate.integer("n_blades", self.n_blades, minimum=2)
         _validate.integer("engine_order (EO)", self.engine_order, minimum=0, maximum=self.n_blades // 2)
         _validate.in_range("gamma_left (platform angle, rad)", self.gamma_left, 0.0, np.pi / 2, closed="neither")
@@ -312,10 +354,9 @@ class TunedDisk:
         self.excitation = np.asarray(_validate.finite("excitation", self.excitation), dtype=float)
         if self.excitation.shape != (6,):
             raise ValueError("excitation must be a 6-vector (F_x, F_y, F_z, M_x, M_y, M_z) in N and N m")
-        if self.engine_order == 0 and self.has_damper and self.rotor_speed is None:
-            raise ValueError("engine_order = 0 needs an explicit rotor_speed (rad/s, > 0)")
-        if self.rotor_speed is not None:
-            _validate.positive("rotor_speed", self.rotor_speed)
+        if self.engine_order == 0 and self.has_damper and self.rotor_speed_hz is None:
+            raise ValueError("engine_order = 0 needs an explicit rotor_speed_hz (rotor revolutions per second, "
+                             "> 0; rpm / 60)")
 
     # ----- geometry --------------------------------------------------------------------
     @property
@@ -365,12 +406,13 @@ class TunedDisk:
 
     def centrifugal_force(self, f_hz: float):
         """(F_CG [N], dF_CG / dOmega_E [N s/rad]) at the excitation frequency ``f_hz`` [Hz] (Eq. 26;
-        Omega_E = 2 pi f_hz, the rotor speed Omega_E / EO unless ``rotor_speed`` is given)."""
+        Omega_E = 2 pi f_hz, the rotor speed Omega_E / EO unless ``rotor_speed_hz`` is given)."""
         return self._centrifugal_force(2 * np.pi * f_hz)
 
     def _centrifugal_force(self, omega: float):
         """:meth:`centrifugal_force` at the angular excitation frequency ``omega`` [rad/s] (the residual's)."""
-        return centrifugal_force(self.damper.mass, self.damper_radius, omega, self.engine_order, self.rotor_speed)
+        return centrifugal_force(self.damper.mass, self.damper_radius, engine_order=self.engine_order,
+                                 f_hz=omega / (2 * np.pi), rotor_speed_hz=self.rotor_speed_hz)
 
     # ----- harmonic balance --------------------------------------------------------------
     def hbm_system(self, harmonics=(1,), n_samples=None, static_retention: float = 1e-4) -> HarmonicBalanceSystem:
@@ -406,7 +448,7 @@ class TunedDisk:
             G_D, G_P = geometry.G_D, geometry.G_P(offsets)
             phi = np.vstack([self.blade.shape("OL"), self.blade.shape("OR")])  # (12, nm)
             dphi = self.interblade_phase
-            contacts = DamperContacts(geometry, self._approach_function(geometry, basis),
+            contacts = DamperContacts(geometry, self.approach_function(geometry, basis),
                                       contact_point_maps(geometry, offsets, self.blade, self.blade))
             w_rows, left_rows, right_rows = contact_rows(contacts.contact_local, nm)
 
@@ -445,12 +487,17 @@ class TunedDisk:
         (the residual calls it at every evaluation): F = c Omega_E^2, or constant at a given
         rotor speed."""
         c, _ = self._centrifugal_force(1.0)
-        if self.rotor_speed is not None:
+        if self.rotor_speed_hz is not None:
             return lambda omega: (c, 0.0)
         return lambda omega: (c * omega ** 2, 2 * c * omega)
 
-    def _approach_function(self, geometry: DamperGeometry, basis: HarmonicBasis):
-        """omega -> (per-point static approach (2, P) [m], its omega-derivative)."""
+    def approach_function(self, geometry: DamperGeometry, basis: HarmonicBasis):
+        """The static approach of ``geometry``'s contact points under this disk's F_CG (Eq. 26):
+        a function omega [rad/s, the residual's excitation frequency] -> (per-point static
+        approach (2, P) [m], its omega-derivative (2, P) [m s/rad]). With a static harmonic in
+        ``basis`` the seating is part of the harmonic balance and the approach is the rest state
+        (minus the initial gaps); otherwise the frictionless seating under F_CG (``seat``).
+        The :attr:`DamperContacts.approach` of this disk's and of a MistunedDisk's dampers."""
         gaps = np.array([p.initial_gap for p in geometry.patches])
         if basis.has_static:
             rest = -gaps  # the seating is part of the harmonic balance
@@ -513,7 +560,8 @@ class TunedDisk:
         smaller: more points). The result is ``success`` only if the branch reached the end and
         passed :func:`bladedamp.response.physical_checks`. ``n_samples``: AFT samples per period;
         None (default): the basis default, and once four times more if that branch fails
-        (:func:`bladedamp.response.sampled_response`; ``AUTO_SAMPLES_GROWTH``).
+        (:func:`bladedamp.response.sampled_response`; ``AUTO_SAMPLES_GROWTH``), once more again
+        if it reached the end and failed only the dissipation check (``AUTO_SAMPLES_GROWTH_DISSIPATION``).
         ``extra_couplings``: your own nonlinear elements, a callable ``basis -> sequence of
         Coupling`` (called for every harmonic set, the solved ones and the enriched one of the
         error estimate; ``self.point_map(basis, "tip")`` gives a blade point's map), added to
@@ -529,14 +577,15 @@ class TunedDisk:
 
         def solve(H):
             first = HarmonicBasis(tuple(H)).n_samples
-            return sampled_response(lambda n: solve_sampled(H, n), n_samples, first, AUTO_SAMPLES_GROWTH * first)
+            return sampled_response(lambda n: solve_sampled(H, n), n_samples, first, AUTO_SAMPLES_GROWTH * first,
+                                    AUTO_SAMPLES_GROWTH_DISSIPATION * first)
 
         def solve_sampled(H, n_samples):
             system = model.hbm_system(H, n_samples)
-            scales = self._scales(system, w0, w1)
-            x0 = self._start_solution(system, w0, scales)
+            scales = self.unknown_scales(system, w0, w1)
+            x0 = self.start_solution(system, w0, scales)
             branch = continuation(system.residual, x0, w0, w1, x_scale=scales, max_step=max_step,
-                                  start_at_end=lambda: self._start_solution(system, w1, scales), **continuation_options)
+                                  start_at_end=lambda: self.start_solution(system, w1, scales), **continuation_options)
             response = DiskResponse.from_branch(self, system, branch)
             T = system.basis.n_samples
 
@@ -569,12 +618,10 @@ class TunedDisk:
         q1 = coefficients[:, j1, :nm] - 1j * coefficients[:, j1 + 1, :nm]
         return np.abs(q1 @ self.blade.shape("tip")[:3].T)
 
-    def unknown_scales(self, system: HarmonicBalanceSystem, omega_start: float, omega_end: float) -> np.ndarray:
-        """Scale of each unknown of ``system`` over omega_start..omega_end [rad/s]."""
-        return self._scales(system, omega_start, omega_end)
-
-    def _start_solution(self, system, omega, scales, tol=1e-10):
-        """Solution at the first frequency, robust in gross slip (:func:`bladedamp.hbm.start.robust_start`).
+    def start_solution(self, system, omega, scales, tol=1e-10):
+        """Solution (C * n_dof,) of ``system`` at the first frequency ``omega`` [rad/s], robust in
+        gross slip (:func:`bladedamp.hbm.start.robust_start`); ``scales`` (C * n_dof,) from
+        :meth:`unknown_scales`.
 
         Damped Newton from the stuck linear solution; if that fails (a light damper sliding far
         from its stuck state), an excitation homotopy on the dynamic excitation (the centrifugal
@@ -585,7 +632,7 @@ class TunedDisk:
             f[system.basis.cos_index(0)] = 0.0          # the preload is not ramped
         base = self.static_state(system, omega)
         residual_scale = max(np.linalg.norm(system.residual(np.zeros(system.n_unknowns), omega, False)[0]), 1e-300)
-        return robust_start(system.residual, {"stuck linear solution": self._initial_guess(system, omega)},
+        return robust_start(system.residual, {"stuck linear solution": self.initial_guess(system, omega)},
                             omega, scales, f.ravel(), base=base, residual_scale=residual_scale, tol=tol).x
 
     def static_state(self, system, omega):
@@ -598,8 +645,10 @@ class TunedDisk:
             x.reshape(system.basis.n_coeffs, system.n_dof)[system.basis.cos_index(0), nm:] = u_seat
         return x
 
-    def _initial_guess(self, system, omega):
-        """Stuck linear solution: one Newton step from the static state, where every contact point sticks.
+    def initial_guess(self, system, omega):
+        """Stuck linear solution (C * n_dof,) of ``system`` at ``omega`` [rad/s, the residual's
+        excitation frequency]: one Newton step from the static state, where every contact point
+        sticks (without a damper: the linear solution itself).
 
         With a static harmonic the contacts have no preload at x = 0 (zero approach: every
         point is open and the Jacobian there has no contact stiffness at all), so the step
@@ -609,8 +658,9 @@ class TunedDisk:
         R, J, _ = system.residual(x, omega)
         return x - np.linalg.solve(J, R)
 
-    def _scales(self, system, w0, w1):
-        """Scale of each unknown: its largest value in the stuck linear responses across the
+    def unknown_scales(self, system: HarmonicBalanceSystem, omega_start: float, omega_end: float) -> np.ndarray:
+        """Scale (C * n_dof,) of each unknown of ``system`` over omega_start..omega_end [rad/s]
+        (the continuation's ``x_scale``): its largest value in the stuck linear responses across the
         range (harmonic coefficients pooled per DOF), floored at 1e-3 of the largest scale of
         its kind (modal / damper translation / damper rotation). A damper group that the stuck
         response leaves at exactly zero (e.g. no damper rotation in the symmetric EO = n/2
@@ -618,8 +668,8 @@ class TunedDisk:
         (a 1e-300 floor turned round-off in the Newton step into an overflow)."""
         C, n = system.basis.n_coeffs, system.n_dof
         nm = self.blade.n_modes
-        omegas = np.linspace(w0, w1, 7)
-        X = np.array([np.abs(self._initial_guess(system, w)).reshape(C, n).max(axis=0) for w in omegas]).max(axis=0)
+        omegas = np.linspace(omega_start, omega_end, 7)
+        X = np.array([np.abs(self.initial_guess(system, w)).reshape(C, n).max(axis=0) for w in omegas]).max(axis=0)
         groups = [(slice(0, nm), 0.0)]
         if self.has_damper:
             phi = np.abs(np.stack([self.blade.shape("OL"), self.blade.shape("OR")]))   # (2, 6, nm)

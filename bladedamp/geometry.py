@@ -38,7 +38,7 @@ from .damper.geometry import CylinderDamper, DamperGeometry, WedgeDamper
 
 __all__ = ["prism", "BladeMesh", "blade_mesh", "cylinder_mesh", "wedge_mesh", "damper_mesh", "SectorLayout",
            "sector_layout", "sector_meshes", "DerivedPatch", "surface_gaps", "derive_patch", "derive_patches",
-           "seat_damper_mesh", "disk_placements", "rotation_y"]
+           "seat_damper_mesh", "disk_placements", "rotation_y", "homogeneous"]
 
 
 # --------------------------------------------------------------------------------------
@@ -81,7 +81,8 @@ def rotation_y(angle: float) -> np.ndarray:
     return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
 
-def _homogeneous(rotation=np.eye(3), translation=(0.0, 0.0, 0.0)) -> np.ndarray:
+def homogeneous(rotation=np.eye(3), translation=(0.0, 0.0, 0.0)) -> np.ndarray:
+    """(4, 4) homogeneous transform x -> rotation @ x + translation (rotation (3, 3), translation (3,) [m])."""
     T = np.eye(4)
     T[:3, :3] = rotation
     T[:3, 3] = translation
@@ -565,7 +566,7 @@ def disk_placements(layout: SectorLayout, n_blades: int, blade_points, sectors=N
     blades, dampers = [], []
     for k in idx:
         R = rotation_y(-2 * np.pi * k / n)
-        blades.append(_homogeneous(R, axis - R @ axis))
+        blades.append(homogeneous(R, axis - R @ axis))
         Rd = rotation_y(-2 * np.pi * k / n + beta)
-        dampers.append(_homogeneous(Rd, axis + Rd @ np.array([0.0, cg[1], radius_cg])))
+        dampers.append(homogeneous(Rd, axis + Rd @ np.array([0.0, cg[1], radius_cg])))
     return np.array(blades), np.array(dampers), np.array(idx), r_root

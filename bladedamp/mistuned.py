@@ -25,7 +25,9 @@ blade k's motion is blade 0's shifted by k dphi; the discrete friction laws are 
 only when that shift is a whole number of samples. By default ``n_samples`` is therefore
 rounded up to a multiple of n / gcd(n, EO) (n = 16, EO = 1: 64, as the tuned disk); with
 another ``n_samples`` a tuned full assembly differs from the cyclic solution by the AFT
-discretisation error (measured: ~1e-3 relative with 6 blades, EO = 1, 64 samples).
+discretisation error (measured: ~1e-3 relative with 6 blades, EO = 1, 64 samples). A branch
+that fails its checks with the default is solved once more with ``AUTO_SAMPLES_GROWTH`` times
+the samples (still such a multiple), as the tuned disk's (:func:`bladedamp.response.sampled_response`).
 
 The Jacobian is sparse (each damper couples two neighbours): the structural matrices and
 the contact map are scipy.sparse matrices (the Jacobian itself dense up to
@@ -49,7 +51,8 @@ from .blade import ModalBlade
 from .contact.laws import LinearNormalLaw
 from .contact.point import damper_contact_forces, normal_law_parameters
 from .damper.kinetics import seat
-from .disk import DAMPER_DOFS, DamperContacts, TunedDisk, contact_point_maps, contact_rows, point_map_forces
+from .disk import (AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION, DAMPER_DOFS, DamperContacts, TunedDisk,
+                   contact_point_maps, contact_rows, point_map_forces, rotor_speed_in_hz)
 from .hbm.accuracy import HARMONIC_TOLERANCE, converged_response
 from .hbm.continuation import Branch, continuation
 from .hbm.start import robust_start
@@ -57,7 +60,8 @@ from .hbm.linsolve import BlockCondensation, BlockRing, one_blas_thread
 from .hbm.linsolve import factorize as lu_factorize
 from .hbm.fourier import HarmonicBasis
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import REFINE_SAMPLES_FACTOR, FrequencyResponse, physical_checks, with_checks
+from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, physical_checks, refined_peak, sampled_response,
+                       with_checks)
 
 
 def sparse_real_form(basis: HarmonicBasis, per_harmonic) -> sp.csr_matrix:
@@ -124,7 +128,7 @@ class AssemblyContacts:
     def _stacked(self):
         """Batched point data of all dampers, or None if their patches do not share a normal law."""
         if self._batch is None:
-            stacks = [c._stack() for c in self.contacts]
+            stacks = [c.stacked_points() for c in self.contacts]
             ok = all(s is not None for s in stacks) and all(
                 s[5] == stacks[0][5] and s[1].shape == stacks[0][1].shape for s in stacks)
             if not ok:
@@ -175,7 +179,7 @@ class AssemblyContacts:
             force = np.zeros((C, nd, L))
             blocks = np.zeros((nd, C, L, C, L)) if jacobian else None
             for d, c in enumerate(self.contacts):
-                f, j = c._forces(local[:, d], basis, offsets[d], jacobian)
+                f, j = c.forces_at(local[:, d], basis, offsets[d], jacobian)
                 force[:, d] = f
                 if jacobian:
                     blocks[d] = j.reshape(C, L, C, L)
@@ -431,8 +435,10 @@ class MistunedDisk:
         blade k+1's OR platform (gamma_right[k])
     initial_gaps : None, one (2, P) array of gaps [m] (as :class:`~bladedamp.disk.TunedDisk`) for
         all positions, or a list of s such arrays / None: each damper's own misfit
-    engine_order, damper_radius, excitation, rotor_speed, damper_inertia : as
-        :class:`~bladedamp.disk.TunedDisk` (the same for every position)
+    engine_order, damper_radius, excitation, rotor_speed_hz, damper_inertia : as
+        :class:`~bladedamp.disk.TunedDisk` (the same for every position; ``rotor_speed_hz`` in Hz,
+        revolutions per second)
+    rotor_speed : deprecated, the rotor speed in rad/s (as :class:`~bladedamp.disk.TunedDisk`)
     """
 
     blades: Sequence[ModalBlade]
@@ -443,14 +449,17 @@ class MistunedDisk:
     gamma_right: float | Sequence[float] = np.radians(35.0)
     damper_radius: float = 0.1
     excitation: np.ndarray = field(default_factory=lambda: np.array([0.1, 0, 0, 0, 0, 0]))
-    rotor_speed: float | None = None
+    rotor_speed_hz: float | None = None
     damper_inertia: bool = True
     initial_gaps: object = None
+    rotor_speed: float | None = field(default=None, repr=False)
     #: linear solver of the continuation (:attr:`AssemblySystem.linear_solver`); set it on an
     #: instance (``disk.linear_solver = "condensation"``) to change that disk's solver
     linear_solver: ClassVar[str] = "auto"
 
     def __post_init__(self):
+        self.rotor_speed_hz = rotor_speed_in_hz(self.rotor_speed_hz, self.rotor_speed)
+        self.rotor_speed = None if self.rotor_speed_hz is None else 2 * np.pi * self.rotor_speed_hz
         if isinstance(self.blades, ModalBlade) or len(self.blades) == 0:
             raise ValueError("blades must be a non-empty sequence of ModalBlade (one per blade of the model)")
         self.blades = list(self.blades)
@@ -481,7 +490,7 @@ class MistunedDisk:
         gaps = _as_list("initial_gaps", self.initial_gaps, s)
         # one TunedDisk per position: validates the parameters and builds each coupling
         self.sectors = [TunedDisk(b, d, self.n_blades, self.engine_order, gl, gr, self.damper_radius,
-                                  self.excitation, self.rotor_speed, self.damper_inertia, g)
+                                  self.excitation, self.rotor_speed_hz, self.damper_inertia, g)
                         for b, d, gl, gr, g in zip(self.blades, self.dampers, angles["gamma_left"],
                                                    angles["gamma_right"], gaps)]
         self.excitation = self.sectors[0].excitation
@@ -503,7 +512,7 @@ class MistunedDisk:
         blades = [disk.blade.scaled(k) for k in kappa]
         same = isinstance(dampers, str) and dampers == "same"
         return cls(blades, disk.damper if same else dampers, disk.n_blades, disk.engine_order,
-                   disk.gamma_left, disk.gamma_right, disk.damper_radius, disk.excitation, disk.rotor_speed,
+                   disk.gamma_left, disk.gamma_right, disk.damper_radius, disk.excitation, disk.rotor_speed_hz,
                    disk.damper_inertia, disk.initial_gaps)
 
     # ----- layout ----------------------------------------------------------------------
@@ -587,7 +596,7 @@ class MistunedDisk:
             offsets = sector.platform_offsets(g)
             maps.append((g.G_D, g.G_P(offsets)))
             # damper k: blade k's OL platform, blade k+1's OR platform (that of the next sector's blade 0)
-            contacts.append(DamperContacts(g, sector._approach_function(g, basis),
+            contacts.append(DamperContacts(g, sector.approach_function(g, basis),
                                            contact_point_maps(g, offsets, self.blades[k], self.blades[(k + 1) % s])))
             if static is not None:
                 k_n = sum(p.normal_law.stiffness for p in g.patches)
@@ -651,7 +660,8 @@ class MistunedDisk:
         return x
 
     def initial_guess(self, system: HarmonicBalanceSystem, omega: float) -> np.ndarray:
-        """Stuck linear solution (one Newton step from the static state; see TunedDisk._initial_guess)."""
+        """Stuck linear solution (C * n_dof,) at ``omega`` [rad/s] (one Newton step from the static
+        state; see :meth:`TunedDisk.initial_guess`)."""
         x = self.static_state(system, omega)
         R, J, _ = system.residual(x, omega)
         return x - system.factorize(J)(R)
@@ -669,7 +679,7 @@ class MistunedDisk:
                             residual_scale=residual_scale, factorize=system.factorize).x
 
     def scales(self, system: HarmonicBalanceSystem, w0: float, w1: float) -> np.ndarray:
-        """Scale of each unknown (as TunedDisk._scales), pooled over the blades for each mode and
+        """Scale of each unknown (as :meth:`TunedDisk.unknown_scales`), pooled over the blades for each mode and
         over the dampers for each damper DOF, so that every blade is measured alike, times sqrt(s)."""
         C, N, nm, s = system.basis.n_coeffs, system.n_dof, self.n_modes, self.n_sector
         X = np.array([np.abs(self.initial_guess(system, w)).reshape(C, N).max(axis=0)
@@ -700,7 +710,9 @@ class MistunedDisk:
         disk's cap of 7 would make the default FRF take minutes. On the reference dampers
         (0, 1, 2, 3) is 2-5 % off, and the result says so (``harmonics_converged`` False and the
         message); pass ``max_harmonic=7`` for the 1 % answer. ``tuned_peak_amplitude`` [m]: the tuned disk's
-        peak, kept for amplification factors."""
+        peak, kept for amplification factors. ``n_samples``: AFT samples per period; None
+        (default): :meth:`default_samples`, and once ``AUTO_SAMPLES_GROWTH`` times more if that
+        branch fails (:func:`bladedamp.response.sampled_response`, as the tuned disk)."""
         _validate.positive("f_start_hz", f_start_hz)
         _validate.positive("f_end_hz", f_end_hz)
         if f_start_hz == f_end_hz:
@@ -708,6 +720,11 @@ class MistunedDisk:
         w0, w1 = 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz
 
         def solve(H):
+            first = self.default_samples(H)
+            return sampled_response(lambda n: solve_sampled(H, n), n_samples, first, AUTO_SAMPLES_GROWTH * first,
+                                    AUTO_SAMPLES_GROWTH_DISSIPATION * first)
+
+        def solve_sampled(H, n_samples):
             system = self.hbm_system(H, n_samples)
             scales = self.scales(system, w0, w1)
             x0 = self.start_solution(system, w0, scales)
@@ -802,22 +819,6 @@ class MistunedDisk:
         return disk_time_response(self, f_hz, **options)
 
 
-def _refined_peak(f, a):
-    """(peak, frequency) of samples a(f): largest sample refined by the parabola through it and
-    its neighbours (as studies.mass.peak_response)."""
-    i = int(np.argmax(a))
-    peak, fp = float(a[i]), float(f[i])
-    if 0 < i < len(a) - 1:
-        x, y = f[i - 1:i + 2], a[i - 1:i + 2]
-        if np.all(np.diff(x) > 0):
-            c = np.polyfit(x - x[1], y, 2)
-            if c[0] < 0:
-                fv = -c[1] / (2 * c[0])
-                if x[0] - x[1] <= fv <= x[2] - x[1]:
-                    peak, fp = max(peak, float(np.polyval(c, fv))), float(x[1] + fv)
-    return peak, fp
-
-
 @dataclass
 class MistunedResponse(FrequencyResponse):
     """Frequency response of every blade of a :class:`MistunedDisk`.
@@ -863,7 +864,7 @@ class MistunedResponse(FrequencyResponse):
 
     def peaks(self, direction: int = 0) -> tuple[np.ndarray, np.ndarray]:
         """(peak tip amplitude [m], its frequency [Hz]) of every blade, parabola-refined."""
-        out = [_refined_peak(self.frequency_hz, self.tip_amplitude[:, k, direction]) for k in range(self.n_sector)]
+        out = [refined_peak(self.frequency_hz, self.tip_amplitude[:, k, direction]) for k in range(self.n_sector)]
         return np.array([o[0] for o in out]), np.array([o[1] for o in out])
 
     @property

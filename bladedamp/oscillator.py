@@ -25,7 +25,7 @@ from .hbm.elements import CubicSpring
 from .hbm.fourier import HarmonicBasis
 from .hbm.system import Coupling, HarmonicBalanceSystem
 from .response import REFINE_SAMPLES_FACTOR, FrequencyResponse, physical_checks, sampled_response, with_checks
-from .timedomain import TimeResponse, _oscillator_steady_state
+from .timedomain import TimeResponse, oscillator_steady_state
 
 # most AFT samples per period the automatic sampling may choose (sampled_response; one DOF:
 # a branch with 4096 samples takes 5-45 s, measured on the random oscillators that need it)
@@ -240,7 +240,7 @@ class FrictionOscillator:
         converged = np.zeros(omega.size, dtype=bool)
         sin_a, cos_a = np.sin(self.contact_angle), np.cos(self.contact_angle)
         for i, w in enumerate(omega):
-            periods[i], converged[i] = _oscillator_steady_state(
+            periods[i], converged[i] = oscillator_steady_state(
                 w, self.mass, self.damping, self.stiffness, self.cubic_stiffness, self.contact_stiffness,
                 self.friction_coefficient, self.normal_load, self.normal_stiffness, sin_a, cos_a,
                 self.forcing, steps_per_period, max_periods, min_periods, tol, samples[i],

@@ -1,6 +1,6 @@
-"""Solid (3D finite-element) blade from the parametric geometry: gmsh tetrahedra, quadratic
-linear elasticity (scikit-fem), clamped-root modes, and a :class:`~bladedamp.blade.ModalBlade`
-with the beam blade's named points (issue 16, first step).
+"""Solid (3D finite-element) blade from geometry: the parametric blade or a user's closed surface
+mesh (STL), gmsh tetrahedra, quadratic linear elasticity (scikit-fem), clamped-root modes, and a
+:class:`~bladedamp.blade.ModalBlade` with the beam blade's named points (issue 16).
 
 Needs the ``fe`` extra (``pip install 'bladedamp[fe]'``: gmsh and scikit-fem); without it every
 entry point raises an ImportError saying so.
@@ -47,6 +47,32 @@ tip face's displacement, split into flatwise F (u_x, phi_y), edgewise E (u_y, ph
 T (phi_z) and axial A (u_z) shares of its fitted motion; counted per family ("1F", "2F", "1E",
 ...). A mode whose tip face deforms more than it moves rigidly is named "nP" (plate / local).
 
+A user's blade (STL)
+--------------------
+:class:`SurfaceBladeGeometry` takes a closed, consistently oriented triangle surface (an STL path
+or a trimesh.Trimesh) in the blade frame, with ``scale`` converting its units to metres (1 for
+metres, 1e-3 for a millimetre file; a surface larger than :data:`MAX_SURFACE_EXTENT` after
+scaling is refused as a units mistake). STL has no face names, so the named regions are given
+beside it as selectors, each picking triangles of the surface:
+
+* :class:`PlaneRegion` (point, outward normal, tolerance [m], optional box): the triangles on
+  that plane facing that way, e.g. ``PlaneRegion((0, 0, 0), (0, 0, -1))`` for a root at z = 0;
+* :class:`SurfacePatch` (an STL path or mesh): the region exported as its own file from the
+  same model; the triangles within tolerance of it.
+
+Regions: "clamp" (the root faces, clamped), "OL" and "OR" (the platform's underside contact
+faces; each planar with its normal in the x-z plane: the platform angles gamma_left /
+gamma_right are read from them, the control points default to the faces' centroids), "tip"
+(optional: default the flat top at the largest z). Missing or empty regions, a non-watertight
+surface, a face on the wrong side raise ValueError naming the region. :func:`mesh_surface` hands
+the triangles to gmsh, which splits them into faces at sharp edges, reparametrises and remeshes
+them at ``element_size`` and fills the volume with tetrahedra; the regions are picked again on
+the new boundary. The modal pipeline is then the parametric blade's (:func:`solid_modes`,
+:func:`solid_blade`, ``ModalBlade.from_solid(SurfaceBladeGeometry(...))``); points other than
+OL, OR and the tip are fitted over the elements within one element size of them. Checked
+against the parametric path (the reference solid's surface written to STL in mm and read back:
+frequencies within the mesh tolerance, the same contact faces and shapes; tests/test_solid_blade.py).
+
 Named points (the beam blade's: "OL", "OR", "platform", "tip", "excitation")
 -----------------------------------------------------------------------------
 Each point's 6-DOF motion (u_x, u_y, u_z [m/sqrt(kg)], phi_x, phi_y, phi_z [rad/sqrt(kg)]) is
@@ -64,9 +90,13 @@ over a region, with the point P as reference (so u_P is the fitted translation a
 * platform: over the platform prism's volume.
 * tip (and excitation, and any point at the tip height): over the tip face; another height:
   over the blade's cross-section there (Gauss-Legendre grid, interpolated).
+
+For pictures the blade keeps its FE boundary surface compactly (:class:`BladeSurface`: the outer
+triangles' corner vertices, and the mode shapes there), which the 3D view draws deformed.
 """
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import time
 from dataclasses import dataclass, field
@@ -79,8 +109,9 @@ import scipy.sparse.linalg
 from . import _validate as check
 from .blade import SHIFT_INVERT_SIGMA, BeamBladeGeometry, ModalBlade, PAPER_MODE_ORDER, platform_section
 
-__all__ = ["FE_HINT", "SolidBladeGeometry", "SolidMesh", "SolidModes", "ContactFaceModes", "SolidModalBlade",
-           "mesh_blade", "solid_modes", "solid_blade", "rigid_fit", "classify_tip_motion",
+__all__ = ["FE_HINT", "SolidBladeGeometry", "SurfaceBladeGeometry", "PlaneRegion", "SurfacePatch", "SolidMesh",
+           "SolidModes", "ContactFaceModes", "BladeSurface", "SolidModalBlade", "mesh_blade", "mesh_surface",
+           "boundary_faces", "point_triangle_distances", "solid_modes", "solid_blade", "rigid_fit", "classify_tip_motion",
            "cantilever_frequencies_hz"]
 
 FE_HINT = "the solid blade needs the fe extra: pip install 'bladedamp[fe]'"
@@ -200,6 +231,27 @@ class SolidBladeGeometry:
         """z of the tip [m]."""
         return self.beam.total_length
 
+    # the interface solid_modes / solid_blade use (shared with SurfaceBladeGeometry): the material
+    youngs_modulus = property(lambda self: self.beam.youngs_modulus, doc="E [Pa] (the beam geometry's).")
+    poisson_ratio = property(lambda self: self.beam.poisson_ratio, doc="nu [-] (the beam geometry's).")
+    density = property(lambda self: self.beam.density, doc="rho [kg/m^3] (the beam geometry's).")
+
+    def points(self) -> dict:
+        """Named points [m]: the beam geometry's ("OL", "OR", "platform", "tip", "excitation")."""
+        return self.beam.points()
+
+    def fit_region(self, name: str, position) -> tuple:
+        """Where the rigid-body fit of point ``name`` at ``position`` (3,) [m] is taken: ("face",
+        "OL" / "OR" / "tip"), ("platform",) the platform prism's volume, or ("section", z) the
+        cross-section at the point's height (module docstring)."""
+        if name in ("OL", "OR"):
+            return ("face", name)
+        if name == "platform" and self.platform:
+            return ("platform",)
+        if abs(position[2] - self.total_length) <= 1e-9 * self.total_length:
+            return ("face", "tip")
+        return ("section", float(position[2]))
+
     @property
     def platform_top(self) -> float:
         """z of the platform's top face [m] (geometry.py: z_p + max(contact offset, 1 mm))."""
@@ -306,13 +358,7 @@ def mesh_blade(geometry: SolidBladeGeometry | BeamBladeGeometry | None = None,
     mirror_y = bool(symmetric) and sg.twist == 0.0
     mirror_x = mirror_y and (not sg.platform or sg.gamma_left == sg.gamma_right)
     start = time.perf_counter()
-    was_initialised = gmsh.isInitialized()
-    if not was_initialised:
-        gmsh.initialize(readConfigFiles=False)
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.option.setNumber("General.NumThreads", 1)
-        gmsh.model.add("bladedamp_solid_blade")
+    with _gmsh_model(gmsh, "bladedamp_solid_blade"):
         occ = gmsh.model.occ
         z_p, L = g.shank_length, g.total_length
         volumes = [occ.addBox(-g.shank_thickness_x / 2, -g.shank_chord_y / 2, 0.0,
@@ -391,50 +437,84 @@ def mesh_blade(geometry: SolidBladeGeometry | BeamBladeGeometry | None = None,
         if empty:
             raise RuntimeError(f"gmsh geometry: no surface found for {empty} (geometry {sg})")
 
-        gmsh.option.setNumber("Mesh.MeshSizeMax", h)
-        gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
-        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
-        gmsh.option.setNumber("Mesh.Algorithm3D", int(algorithm))
-        gmsh.option.setNumber("Mesh.Optimize", 1 if optimize else 0)
-        gmsh.model.mesh.generate(3)
-
-        node_tags, coords, _ = gmsh.model.mesh.getNodes()
-        index = np.full(int(node_tags.max()) + 1, -1, dtype=np.int64)
-        tets, is_platform = [], []
-        for _, vtag in gmsh.model.getEntities(3):
-            types, _, nodes = gmsh.model.mesh.getElements(3, vtag)
-            for etype, enodes in zip(types, nodes):
-                if etype != 4:   # 4-node tetrahedron
-                    raise RuntimeError(f"gmsh produced volume elements of type {etype}, expected tetrahedra (4)")
-                tets.append(enodes.reshape(-1, 4).astype(np.int64))
-                is_platform.append(np.full(len(tets[-1]), vtag in platform_volumes))
-        tets = np.vstack(tets)
-        used = np.unique(tets)
-        index[used] = np.arange(used.size)
-        xyz = coords.reshape(-1, 3)
-        position = np.full(index.size, -1, dtype=np.int64)
-        position[node_tags.astype(np.int64)] = np.arange(node_tags.size)
-        vertices = xyz[position[used]].T.copy()
-        faces = {}
-        for name, tags in surface_groups.items():
-            tri = []
-            for tag in tags:
-                types, _, nodes = gmsh.model.mesh.getElements(2, tag)
-                for etype, enodes in zip(types, nodes):
-                    if etype == 2:   # 3-node triangle
-                        tri.append(index[enodes.reshape(-1, 3).astype(np.int64)])
-            faces[name] = np.vstack(tri).T
-        gmsh.model.remove()
-    finally:
-        if not was_initialised:
-            gmsh.finalize()
-    tets, platform = index[tets].T.copy(), np.concatenate(is_platform)
+        _gmsh_generate(gmsh, h, algorithm, optimize)
+        vertices, tets, is_platform, index = _gmsh_tetrahedra(gmsh, platform_volumes)
+        faces = {name: _gmsh_triangles(gmsh, tags, index) for name, tags in surface_groups.items()}
+    platform = is_platform
     if mirror_x:
         vertices, tets, platform, faces = _mirrored(vertices, tets, platform, faces, 0, tol, {"OR": "OL"})
     if mirror_y:
         vertices, tets, platform, faces = _mirrored(vertices, tets, platform, faces, 1, tol, {})
     return SolidMesh(vertices=vertices, tets=tets, platform=platform, faces=faces, element_size=h,
                      seconds=time.perf_counter() - start)
+
+
+@contextlib.contextmanager
+def _gmsh_model(gmsh, name: str):
+    """A fresh gmsh model ``name`` (quiet, one thread, so the same input gives the same mesh),
+    removed on exit; gmsh is initialised for it and finalised after it unless it already ran."""
+    was_initialised = gmsh.isInitialized()
+    if not was_initialised:
+        gmsh.initialize(readConfigFiles=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.option.setNumber("General.NumThreads", 1)
+        gmsh.model.add(name)
+        try:
+            yield
+        finally:
+            gmsh.model.remove()
+    finally:
+        if not was_initialised:
+            gmsh.finalize()
+
+
+def _gmsh_generate(gmsh, element_size: float, algorithm: int, optimize: bool):
+    """Mesh the current model with tetrahedra of largest size ``element_size`` [m] (gmsh's
+    Mesh.Algorithm3D ``algorithm``, quality optimisation if ``optimize``)."""
+    gmsh.option.setNumber("Mesh.MeshSizeMax", element_size)
+    gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
+    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+    gmsh.option.setNumber("Mesh.Algorithm3D", int(algorithm))
+    gmsh.option.setNumber("Mesh.Optimize", 1 if optimize else 0)
+    gmsh.model.mesh.generate(3)
+
+
+def _gmsh_tetrahedra(gmsh, platform_volumes=frozenset()):
+    """The current gmsh model's volume mesh: vertices (3, n_v) [m] (the nodes the tetrahedra
+    use), tets (4, n_e) vertex indices, platform (n_e,) bool (elements of ``platform_volumes``
+    tags), and index (max node tag + 1,) node tag -> vertex index (-1: unused)."""
+    node_tags, coords, _ = gmsh.model.mesh.getNodes()
+    index = np.full(int(node_tags.max()) + 1, -1, dtype=np.int64)
+    tets, is_platform = [], []
+    for _, vtag in gmsh.model.getEntities(3):
+        types, _, nodes = gmsh.model.mesh.getElements(3, vtag)
+        for etype, enodes in zip(types, nodes):
+            if etype != 4:   # 4-node tetrahedron
+                raise RuntimeError(f"gmsh produced volume elements of type {etype}, expected tetrahedra (4)")
+            tets.append(enodes.reshape(-1, 4).astype(np.int64))
+            is_platform.append(np.full(len(tets[-1]), vtag in platform_volumes))
+    if not tets:
+        raise RuntimeError("gmsh produced no tetrahedra")
+    tets = np.vstack(tets)
+    used = np.unique(tets)
+    index[used] = np.arange(used.size)
+    position = np.full(index.size, -1, dtype=np.int64)
+    position[node_tags.astype(np.int64)] = np.arange(node_tags.size)
+    vertices = coords.reshape(-1, 3)[position[used]].T.copy()
+    return vertices, index[tets].T.copy(), np.concatenate(is_platform), index
+
+
+def _gmsh_triangles(gmsh, surface_tags, index) -> np.ndarray:
+    """(3, n_f) vertex indices (``index`` of :func:`_gmsh_tetrahedra`) of the 3-node triangles
+    of the gmsh surfaces ``surface_tags``."""
+    tri = [np.zeros((0, 3), dtype=np.int64)]
+    for tag in surface_tags:
+        types, _, nodes = gmsh.model.mesh.getElements(2, tag)
+        for etype, enodes in zip(types, nodes):
+            if etype == 2:   # 3-node triangle
+                tri.append(index[enodes.reshape(-1, 3).astype(np.int64)])
+    return np.vstack(tri).T
 
 
 def _mirrored(vertices, tets, platform, faces, axis: int, tol: float, renamed: dict):
@@ -457,15 +537,418 @@ def _mirrored(vertices, tets, platform, faces, axis: int, tol: float, renamed: d
             {name: np.hstack(tris) for name, tris in out_faces.items()})
 
 
-def _solid_geometry(geometry) -> SolidBladeGeometry:
+def _solid_geometry(geometry):
+    """SolidBladeGeometry or SurfaceBladeGeometry from the accepted forms."""
     if geometry is None:
         return SolidBladeGeometry()
-    if isinstance(geometry, SolidBladeGeometry):
+    if isinstance(geometry, (SolidBladeGeometry, SurfaceBladeGeometry)):
         return geometry
     if isinstance(geometry, BeamBladeGeometry):
         return SolidBladeGeometry(beam=geometry)
-    raise ValueError(f"geometry must be None, a SolidBladeGeometry or a BeamBladeGeometry "
+    raise ValueError(f"geometry must be None, a SolidBladeGeometry, a SurfaceBladeGeometry or a BeamBladeGeometry "
                      f"(got {type(geometry).__name__})")
+
+
+# --------------------------------------------------------------------------------------
+# a user's geometry: a closed surface mesh (STL) with named regions
+# --------------------------------------------------------------------------------------
+# Largest extent [m] a blade surface may have: a surface larger than this is taken to be in the
+# wrong units (a millimetre STL read as metres spans 200 m for the reference blade).
+MAX_SURFACE_EXTENT = 2.0
+# Outward normals of a region's triangles may deviate from the selector's normal by this [rad].
+REGION_ANGLE_TOLERANCE = np.radians(1.0)
+# gmsh's feature angle [rad] splitting the STL into faces before it remeshes them: below the
+# reference platform's 35 deg between a contact face and the flat bottom, so that edge stays sharp.
+DEFAULT_FEATURE_ANGLE = np.radians(20.0)
+
+
+@dataclass(frozen=True)
+class PlaneRegion:
+    """A named region of a surface mesh selected by a plane: the triangles whose three vertices lie
+    within ``tolerance`` [m] of the plane through ``point`` (3,) [m] normal to ``normal`` (3,),
+    whose outward normal points along ``normal`` (within :data:`REGION_ANGLE_TOLERANCE`), and, if
+    ``bounds`` ((2, 3) lower and upper corner [m]) is given, whose vertices lie in that box.
+
+    The plane is in the blade frame after ``scale`` (metres). Example: the root face of a blade
+    with its root at z = 0 is ``PlaneRegion((0, 0, 0), (0, 0, -1))`` (outward = -z).
+    """
+
+    point: tuple
+    normal: tuple
+    tolerance: float = 1e-5
+    bounds: tuple | None = None
+
+    def select(self, vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+        """(n_f,) bool: the triangles ``faces`` (n_f, 3) of ``vertices`` (n_v, 3) [m] in the region."""
+        p = np.asarray(self.point, dtype=float)
+        n = np.asarray(self.normal, dtype=float)
+        if p.shape != (3,) or n.shape != (3,) or not np.linalg.norm(n) > 0:
+            raise ValueError(f"PlaneRegion: point and normal must be 3-vectors, normal nonzero (got {self.point!r}, "
+                             f"{self.normal!r})")
+        n = n / np.linalg.norm(n)
+        tol = check.positive("tolerance", self.tolerance)
+        tri = vertices[faces]                                           # (n_f, 3, 3)
+        on_plane = np.all(np.abs((tri - p) @ n) <= tol, axis=1)
+        facing = _triangle_normals(vertices, faces) @ n >= np.cos(REGION_ANGLE_TOLERANCE)
+        mask = on_plane & facing
+        if self.bounds is not None:
+            lo, hi = np.asarray(self.bounds, dtype=float)
+            mask &= np.all((tri >= lo - tol) & (tri <= hi + tol), axis=(1, 2))
+        return mask
+
+
+@dataclass(frozen=True)
+class SurfacePatch:
+    """A named region of a surface mesh given as its own surface: ``surface`` (an STL path or a
+    trimesh.Trimesh, in the same units as the blade's STL: the blade's ``scale`` applies to it) is
+    the region exported separately from the same CAD model; a triangle of the blade surface is in
+    the region when its three vertices lie within ``tolerance`` [m] of the patch's triangles."""
+
+    surface: object
+    tolerance: float = 1e-5
+
+    def select(self, vertices: np.ndarray, faces: np.ndarray, patch_vertices: np.ndarray,
+               patch_faces: np.ndarray) -> np.ndarray:
+        """(n_f,) bool: the triangles ``faces`` (n_f, 3) of ``vertices`` (n_v, 3) [m] on the patch
+        (``patch_vertices`` (m_v, 3) [m], ``patch_faces`` (m_f, 3), already scaled)."""
+        tol = check.positive("tolerance", self.tolerance)
+        used = np.unique(faces)
+        near = np.zeros(vertices.shape[0], dtype=bool)
+        near[used] = point_triangle_distances(vertices[used], patch_vertices[patch_faces]) <= tol
+        return np.all(near[faces], axis=1)
+
+
+def point_triangle_distances(points: np.ndarray, triangles: np.ndarray, chunk: int = 256) -> np.ndarray:
+    """(P,) distance [m] of each point (P, 3) to the nearest of ``triangles`` (T, 3, 3) [m]: the
+    projection on the triangle's plane if it falls inside the triangle, else the nearest edge."""
+    points = np.asarray(points, dtype=float)
+    tri = np.asarray(triangles, dtype=float)
+    a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
+    n = np.cross(b - a, c - a)
+    n2 = np.einsum("ij,ij->i", n, n)
+    keep = n2 > 0                                   # degenerate triangles: their edges still count
+    out = np.empty(points.shape[0])
+
+    def segment(p, s0, s1):                         # (p, T) distance to the segments s0 s1 (T, 3)
+        d = s1 - s0
+        t = np.clip(np.einsum("ptk,tk->pt", p[:, None, :] - s0[None], d) / np.maximum(np.einsum("tk,tk->t", d, d),
+                                                                                          1e-300), 0.0, 1.0)
+        return np.linalg.norm(p[:, None, :] - (s0[None] + t[..., None] * d[None]), axis=2)
+
+    for start in range(0, points.shape[0], chunk):
+        p = points[start:start + chunk]
+        best = np.minimum(np.minimum(segment(p, a, b), segment(p, b, c)), segment(p, c, a))
+        if keep.any():
+            nk, ak, bk, ck = n[keep], a[keep], b[keep], c[keep]
+            rel = p[:, None, :] - ak[None]
+            height = np.einsum("ptk,tk->pt", rel, nk) / n2[keep]
+            q = p[:, None, :] - height[..., None] * nk[None]       # projection on the plane
+            inside = np.ones(height.shape, dtype=bool)
+            for s0, s1 in ((ak, bk), (bk, ck), (ck, ak)):
+                inside &= np.einsum("ptk,tk->pt", np.cross(s1 - s0, q - s0[None]), nk) >= 0
+            plane = np.where(inside, np.abs(height) * np.sqrt(n2[keep]), np.inf)
+            best[:, keep] = np.minimum(best[:, keep], plane)
+        out[start:start + chunk] = best.min(axis=1)
+    return out
+
+
+def _triangle_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(n_f, 3) unit normals of triangles (n_f, 3) (right-hand rule; zero for a degenerate one)."""
+    tri = vertices[faces]
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    length = np.linalg.norm(n, axis=1, keepdims=True)
+    return n / np.where(length > 0, length, 1.0)
+
+
+def boundary_faces(tets: np.ndarray, vertices: np.ndarray | None = None) -> np.ndarray:
+    """(3, n_b) vertex indices of the boundary triangles of a tetrahedral mesh (the faces that
+    belong to one tetrahedron only) of ``tets`` (4, n_e); with ``vertices`` (3, n_v) [m] oriented
+    outward (right-hand normal away from the tetrahedron's fourth vertex)."""
+    t = np.asarray(tets, dtype=np.int64)
+    local = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])
+    opposite = np.array([0, 1, 2, 3])
+    tri = np.concatenate([t[local[k]] for k in range(4)], axis=1)              # (3, 4 n_e)
+    opp = np.concatenate([t[opposite[k]] for k in range(4)])
+    key = np.sort(tri, axis=0)
+    _, first, counts = np.unique(key.T, axis=0, return_index=True, return_counts=True)
+    single = first[counts == 1]
+    tri, opp = tri[:, single], opp[single]
+    if vertices is not None:
+        v = np.asarray(vertices, dtype=float)
+        n = np.cross(v[:, tri[1]] - v[:, tri[0]], v[:, tri[2]] - v[:, tri[0]], axis=0)
+        inward = np.einsum("ki,ki->i", n, v[:, opp] - v[:, tri[0]]) > 0
+        tri[:, inward] = tri[[1, 0, 2]][:, inward]
+    return tri
+
+
+@dataclass(eq=False)
+class SurfaceBladeGeometry:
+    """A user's blade: a closed surface mesh (STL, or any mesh trimesh reads) with named regions.
+
+    STL has no face names, so the regions are given beside the file, each as a selector
+    (:class:`PlaneRegion`: a plane with a tolerance, optionally a box; :class:`SurfacePatch`: the
+    region as its own STL file exported from the same model):
+
+    * ``"clamp"`` (required): the root faces clamped in the disk;
+    * ``"OL"``, ``"OR"`` (required): the platform's underside contact faces the damper touches
+      (OL on the -x side of the blade, OR on +x). Each must be planar, contain the damper axis
+      direction y (its outward normal in the x-z plane: the contact model's platform angle gamma,
+      :func:`bladedamp.damper.geometry.contact_normal`, is read from it: gamma_left from OL,
+      gamma_right from OR, each in (0, 90) deg) and be a rectangle in its (xi, eta) frame as far as
+      the damper's contact patch reaches (the patch must lie on the face);
+    * ``"tip"`` (optional): the tip face (the mode names and the tip point's fit); default the
+      triangles at the surface's largest z facing +z (a flat tip).
+
+    The surface must be in the blade frame (x circumferential, y axial along the damper, z radial
+    outward), closed and consistently oriented (watertight: ValueError otherwise). Units: the
+    coordinates times ``scale`` are metres: 1 (default) for a file in metres, ``scale=1e-3`` for
+    a file in millimetres (a surface spanning more than :data:`MAX_SURFACE_EXTENT` after scaling
+    is refused as a units mistake). Selectors, ``points_given`` and tolerances are in metres.
+
+    Attributes
+    ----------
+    surface : path of the STL (or trimesh.Trimesh) of the blade's closed surface.
+    regions : name -> PlaneRegion or SurfacePatch ("clamp", "OL", "OR", optionally "tip").
+    scale : file units -> metres factor [m per unit] (> 0).
+    youngs_modulus [Pa], poisson_ratio [-], density [kg/m^3] : the material (default the
+        reference steel, bladedamp.reference).
+    points_given : optional positions [m] of "OL", "OR" (each on its face: the contact control point;
+        default the face's area centroid), "tip" (default the tip face's centroid) and
+        "excitation" (default the tip point); other names add points, fitted over the elements
+        around them (:meth:`fit_region`).
+    feature_angle : gmsh's angle [rad] between facets above which the surface is split into
+        faces before it is remeshed (:data:`DEFAULT_FEATURE_ANGLE`); keep it below the sharpest
+        edge of a named region.
+
+    After construction: vertices (n_v, 3) [m] and faces (n_f, 3) of the scaled, outward
+    surface, region_faces name -> (k,) indices of the faces in each region.
+    """
+
+    surface: object
+    regions: dict
+    scale: float = 1.0
+    youngs_modulus: float | None = None
+    poisson_ratio: float | None = None
+    density: float | None = None
+    points_given: dict | None = None
+    feature_angle: float = DEFAULT_FEATURE_ANGLE
+
+    #: the solid is all one material (no platform prism of its own), the platform is present
+    platform = True
+    platform_youngs_modulus = None
+    twist = 0.0
+
+    def __post_init__(self):
+        import trimesh
+        from .reference import reference_blade_geometry
+        self.scale = check.positive("scale", self.scale)
+        self.feature_angle = check.in_range("feature_angle", self.feature_angle, 0.0, np.pi / 2, closed="neither")
+        ref = reference_blade_geometry()
+        for name in ("youngs_modulus", "density"):
+            setattr(self, name, check.positive(name, getattr(ref, name) if getattr(self, name) is None
+                                               else getattr(self, name)))
+        nu = ref.poisson_ratio if self.poisson_ratio is None else self.poisson_ratio
+        self.poisson_ratio = check.in_range("poisson_ratio", nu, 0.0, 0.5, closed="left")
+        mesh = _load_surface("surface", self.surface)
+        if not (mesh.is_watertight and mesh.is_winding_consistent):
+            raise ValueError(f"surface must be a closed (watertight), consistently oriented triangle mesh: "
+                             f"{len(mesh.faces)} faces, watertight {mesh.is_watertight}, winding consistent "
+                             f"{mesh.is_winding_consistent} (repair it, e.g. trimesh.repair.fill_holes)")
+        vertices = np.asarray(mesh.vertices, dtype=float) * self.scale
+        faces = np.asarray(mesh.faces, dtype=np.int64)
+        if trimesh.Trimesh(vertices, faces, process=False).volume < 0:
+            faces = faces[:, ::-1].copy()                    # outward normals
+        extent = float(np.ptp(vertices, axis=0).max())
+        if extent > MAX_SURFACE_EXTENT:
+            raise ValueError(f"scale: the surface spans {extent:.4g} m after scale = {self.scale:g}, more than "
+                             f"{MAX_SURFACE_EXTENT:g} m; coordinates times scale must be metres (a file in mm "
+                             "needs scale=1e-3)")
+        self.vertices, self.faces = vertices, faces
+        if not isinstance(self.regions, dict):
+            raise ValueError(f"regions must be a dict name -> PlaneRegion or SurfacePatch (got "
+                             f"{type(self.regions).__name__})")
+        unknown = set(self.regions) - {"clamp", "OL", "OR", "tip"}
+        if unknown:
+            raise ValueError(f"regions: unknown names {sorted(unknown)} (allowed: 'clamp', 'OL', 'OR', 'tip')")
+        regions = dict(self.regions)
+        if "tip" not in regions:
+            regions["tip"] = PlaneRegion((0.0, 0.0, float(vertices[:, 2].max())), (0.0, 0.0, 1.0),
+                                         tolerance=1e-6 * extent)
+        self._selectors = regions
+        self.region_faces = {}
+        for name in ("clamp", "tip", "OL", "OR"):
+            if name not in regions:
+                raise ValueError(f"regions: the {name!r} region is missing (required: 'clamp', 'OL', 'OR')")
+            picked = np.flatnonzero(self.select(name, vertices, faces))
+            if picked.size == 0:
+                hint = (" (the default tip region is the flat top face at the largest z: give a 'tip' region)"
+                        if name == "tip" and "tip" not in self.regions else "")
+                raise ValueError(f"regions[{name!r}] selects no triangle of the surface{hint}: check its plane, "
+                                 "normal (outward), tolerance and the surface's units (scale)")
+            self.region_faces[name] = picked
+        given = {} if self.points_given is None else dict(self.points_given)
+        self._points = {}
+        self._faces = {side: self._contact_face_geometry(side, given.get(side)) for side in ("OL", "OR")}
+        tri = vertices[faces[self.region_faces["tip"]]]
+        area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+        tip = (area @ tri.mean(axis=1)) / area.sum()
+        self._points.update(OL=self._faces["OL"][0], OR=self._faces["OR"][0], tip=tip, excitation=tip)
+        for name, value in given.items():
+            if name in ("OL", "OR"):
+                continue
+            pos = np.asarray(value, dtype=float)
+            if pos.shape != (3,) or not np.all(np.isfinite(pos)):
+                raise ValueError(f"points_given[{name!r}] must be a finite 3-vector [m] (got {value!r})")
+            self._points[name] = pos
+        if "excitation" not in given:
+            self._points["excitation"] = self._points["tip"].copy()
+
+    def select(self, name: str, vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+        """(n_f,) bool: the triangles ``faces`` (n_f, 3) of ``vertices`` (n_v, 3) [m] in region ``name``."""
+        selector = self._selectors[name]
+        if isinstance(selector, PlaneRegion):
+            return selector.select(vertices, faces)
+        if isinstance(selector, SurfacePatch):
+            patch = _load_surface(f"regions[{name!r}]", selector.surface)
+            return selector.select(vertices, faces, np.asarray(patch.vertices, dtype=float) * self.scale,
+                                   np.asarray(patch.faces, dtype=np.int64))
+        raise ValueError(f"regions[{name!r}] must be a PlaneRegion or a SurfacePatch (got {type(selector).__name__})")
+
+    def _contact_face_geometry(self, side: str, given):
+        """(centre, frame, xi_range, eta_range, gamma) of a contact face from its triangles."""
+        from .damper.geometry import contact_frame, contact_normal
+        tri = self.vertices[self.faces[self.region_faces[side]]]
+        normals = _triangle_normals(self.vertices, self.faces[self.region_faces[side]])
+        area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+        n = area @ normals
+        n /= np.linalg.norm(n)
+        if abs(n[1]) > np.sin(REGION_ANGLE_TOLERANCE):
+            raise ValueError(f"regions[{side!r}]: the contact face's outward normal {np.round(n, 4)} has a y "
+                             "component; it must lie in the x-z plane (the damper axis is y)")
+        gamma = float(np.arctan2(-n[0] if side == "OL" else n[0], -n[2]))
+        if not 0.0 < gamma < np.pi / 2:
+            raise ValueError(f"regions[{side!r}]: the contact face's platform angle is {np.degrees(gamma):.4g} deg, "
+                             f"outside (0, 90) deg (its outward normal {np.round(n, 4)} must point down and "
+                             f"{'-x' if side == 'OL' else '+x'}: is the face on the right side of the blade?)")
+        frame = contact_frame(contact_normal(side, gamma))
+        centre = (area @ tri.mean(axis=1)) / area.sum() if given is None else np.asarray(given, dtype=float)
+        if centre.shape != (3,):
+            raise ValueError(f"points_given[{side!r}] must be a 3-vector [m] (got {given!r})")
+        local = (tri.reshape(-1, 3) - centre) @ frame.T
+        size = np.ptp(local[:, :2], axis=0).max()
+        if np.abs(local[:, 2]).max() > 1e-3 * size:
+            raise ValueError(f"regions[{side!r}]: the contact face is not planar (or points_given[{side!r}] is off it: "
+                             f"{np.abs(local[:, 2]).max():.3g} m from its plane)")
+        xi_r, eta_r = np.array([local[:, 0].min(), local[:, 0].max()]), np.array([local[:, 1].min(), local[:, 1].max()])
+        if not (xi_r[0] <= 0 <= xi_r[1] and eta_r[0] <= 0 <= eta_r[1]):
+            raise ValueError(f"points_given[{side!r}] must lie on the {side} contact face")
+        return centre, frame, xi_r, eta_r, gamma
+
+    @property
+    def gamma_left(self) -> float:
+        """Platform angle of the OL face [rad] (from its normal)."""
+        return self._faces["OL"][4]
+
+    @property
+    def gamma_right(self) -> float:
+        """Platform angle of the OR face [rad] (from its normal)."""
+        return self._faces["OR"][4]
+
+    @property
+    def total_length(self) -> float:
+        """z of the tip point [m]."""
+        return float(self._points["tip"][2])
+
+    def contact_face(self, side: str):
+        """(centre (3,), frame (3, 3), xi_range (2,), eta_range (2,)) of the ``side`` contact face,
+        as :meth:`SolidBladeGeometry.contact_face` (the face's bounding rectangle in its frame)."""
+        if side not in ("OL", "OR"):
+            raise ValueError(f"side must be 'OL' or 'OR' (got {side!r})")
+        centre, frame, xi_r, eta_r, _ = self._faces[side]
+        return centre.copy(), frame.copy(), xi_r.copy(), eta_r.copy()
+
+    def points(self) -> dict:
+        """Named points [m]: "OL", "OR", "tip", "excitation" and any others of ``points_given``."""
+        return {name: p.copy() for name, p in self._points.items()}
+
+    def fit_region(self, name: str, position) -> tuple:
+        """Where point ``name``'s rigid-body fit is taken: ("face", "OL" / "OR") its contact face,
+        ("face", "tip") the tip face for the tip point (and any point there), else ("ball", None)
+        the elements within one element size of the point."""
+        if name in ("OL", "OR"):
+            return ("face", name)
+        if np.linalg.norm(np.asarray(position) - self._points["tip"]) <= 1e-9 * max(self.total_length, 1.0):
+            return ("face", "tip")
+        return ("ball", None)
+
+
+def _load_surface(name: str, surface):
+    """A trimesh.Trimesh from a path or a Trimesh (ValueError naming ``name`` otherwise)."""
+    import trimesh
+    if isinstance(surface, trimesh.Trimesh):
+        return surface
+    import os
+    if not isinstance(surface, (str, os.PathLike)):
+        raise ValueError(f"{name} must be a path of an STL file or a trimesh.Trimesh (got {type(surface).__name__})")
+    if not os.path.exists(surface):
+        raise FileNotFoundError(f"{name}: no file {os.fspath(surface)!r}")
+    try:
+        mesh = trimesh.load(surface, force="mesh")
+    except Exception as err:          # trimesh raises many kinds on a broken file
+        raise ValueError(f"{name}: {os.fspath(surface)!r} is not a surface mesh trimesh reads ({err})") from err
+    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
+        raise ValueError(f"{name}: {os.fspath(surface)!r} holds no triangles")
+    return mesh
+
+
+def mesh_surface(geometry: SurfaceBladeGeometry, element_size: float = DEFAULT_ELEMENT_SIZE, *,
+                 algorithm: int = 1, optimize: bool = True) -> SolidMesh:
+    """Tetrahedral mesh of a user's closed surface (:class:`SurfaceBladeGeometry`) by gmsh.
+
+    The STL's triangles become a discrete gmsh surface; gmsh splits it into faces at edges
+    sharper than ``geometry.feature_angle`` and builds a parametrisation of each
+    (``classifySurfaces`` / ``createGeometry``), so the faces are remeshed with triangles of size
+    ``element_size`` [m] whatever the STL's triangles are; the closed faces bound one volume,
+    meshed with tetrahedra. The named regions are then picked on the new boundary triangles by
+    the same selectors. No mirror symmetry is used (the modes carry the mesh's asymmetry,
+    about 1e-5: :func:`mesh_blade`).
+    """
+    gmsh, _ = _require_fe()
+    if not isinstance(geometry, SurfaceBladeGeometry):
+        raise ValueError(f"geometry must be a SurfaceBladeGeometry (got {type(geometry).__name__})")
+    h = check.positive("element_size", element_size)
+    start = time.perf_counter()
+    with _gmsh_model(gmsh, "bladedamp_surface_blade"):
+        surface = gmsh.model.addDiscreteEntity(2)
+        n_v = geometry.vertices.shape[0]
+        gmsh.model.mesh.addNodes(2, surface, np.arange(1, n_v + 1), geometry.vertices.ravel())
+        gmsh.model.mesh.addElementsByType(surface, 2, [], (geometry.faces + 1).ravel())
+        gmsh.model.mesh.classifySurfaces(geometry.feature_angle, True, True, np.pi)
+        gmsh.model.mesh.createGeometry()
+        faces_2d = [tag for _, tag in gmsh.model.getEntities(2)]
+        loop = gmsh.model.geo.addSurfaceLoop(faces_2d)
+        gmsh.model.geo.addVolume([loop])
+        gmsh.model.geo.synchronize()
+        try:
+            _gmsh_generate(gmsh, h, algorithm, optimize)
+        except Exception as err:      # gmsh raises a bare Exception with its log line
+            raise RuntimeError(f"gmsh could not mesh the surface's volume ({err}); try another element_size "
+                               "or feature_angle") from err
+        vertices, tets, platform, index = _gmsh_tetrahedra(gmsh)
+        boundary = _gmsh_triangles(gmsh, faces_2d, index)
+    # orient the boundary outward by the tetrahedra, then pick the regions on it
+    outer = boundary_faces(tets, vertices)
+    if np.unique(np.sort(outer, axis=0), axis=1).shape[1] != np.unique(np.sort(boundary, axis=0), axis=1).shape[1]:
+        raise RuntimeError("gmsh's volume mesh does not fill the surface (its boundary is not the remeshed surface)")
+    faces = {}
+    for name in ("clamp", "tip", "OL", "OR"):
+        picked = geometry.select(name, vertices.T, outer.T)
+        if not picked.any():
+            raise RuntimeError(f"the remeshed surface has no triangle in region {name!r}: lower feature_angle "
+                               f"(now {np.degrees(geometry.feature_angle):g} deg) or raise the region's tolerance")
+        faces[name] = outer[:, picked]
+    return SolidMesh(vertices=vertices, tets=tets, platform=platform, faces=faces, element_size=h,
+                     seconds=time.perf_counter() - start)
 
 
 # --------------------------------------------------------------------------------------
@@ -580,6 +1063,8 @@ class SolidModes:
     mass : the blade's total mass [kg] (property).
     free_dofs : (n_free,) indices of the free DOF.
     seconds : wall times [s] of "mesh", "assemble", "solve".
+    rotor_speed_hz [Hz], hub_radius [m] : the centrifugal prestress (0: at rest; :func:`solid_modes`);
+        with it, static_displacement (property) is the centrifugal static displacement (n_dofs,) [m].
     """
 
     geometry: SolidBladeGeometry
@@ -597,11 +1082,18 @@ class SolidModes:
     free_dofs: np.ndarray = field(repr=False)
     seconds: dict = field(default_factory=dict)
     _fe: dict = field(default_factory=dict, repr=False)   # skfem mesh and bases
+    rotor_speed_hz: float = 0.0
+    hub_radius: float = 0.0
 
     @property
     def mass(self) -> float:
         """Total blade mass [kg] (above the clamp)."""
         return float(self._fe["mass"])
+
+    @property
+    def static_displacement(self) -> np.ndarray | None:
+        """(n_dofs,) displacement of the centrifugal static step [m] (None at rest)."""
+        return self._fe.get("static_displacement")
 
     # -- evaluation ----------------------------------------------------------------------
     def _face_quadrature(self, name: str):
@@ -617,18 +1109,28 @@ class SolidModes:
                      axis=-1)                                # (3, nf, nq, n)
         return (x.reshape(3, -1).T, w.ravel(), u.reshape(3, -1, u.shape[-1]).transpose(1, 0, 2))
 
-    def _platform_quadrature(self):
-        """Quadrature of the platform prism's volume: points (N, 3), weights (N,) [m^3], values (N, 3, n)."""
+    def _volume_quadrature(self, elements):
+        """Quadrature of the volume of ``elements`` (tetrahedron indices): points (N, 3), weights
+        (N,) [m^3], values (N, 3, n)."""
         from skfem import Basis
         fe = self._fe
-        elements = np.flatnonzero(self.mesh.platform)
+        elements = np.asarray(elements, dtype=np.int64)
         if elements.size == 0:
-            raise ValueError("this solid has no platform")
+            raise ValueError("no elements to fit over (this solid has no platform)")
         cb = Basis(fe["mesh"], fe["element"], elements=elements, intorder=4)
         x = np.asarray(cb.global_coordinates())
         w = np.asarray(cb.dx)
         u = np.stack([np.asarray(cb.interpolate(self.vectors[:, j])) for j in range(self.vectors.shape[1])], axis=-1)
         return (x.reshape(3, -1).T, w.ravel(), u.reshape(3, -1, u.shape[-1]).transpose(1, 0, 2))
+
+    def _elements_near(self, position, radius: float | None = None) -> np.ndarray:
+        """Indices of the tetrahedra whose centroid lies within ``radius`` [m] (None: the element
+        size) of ``position`` (3,); at least the 8 nearest."""
+        centroids = self.mesh.vertices[:, self.mesh.tets].mean(axis=1).T        # (n_e, 3)
+        distance = np.linalg.norm(centroids - np.asarray(position, dtype=float), axis=1)
+        r = self.mesh.element_size if radius is None else radius
+        inside = np.flatnonzero(distance <= r)
+        return inside if inside.size >= 8 else np.argsort(distance)[:8]
 
     def displacements_at(self, points: np.ndarray) -> np.ndarray:
         """(P, 3, n) FE displacements of every mode at points (P, 3) inside the solid [m/sqrt(kg)]
@@ -663,17 +1165,17 @@ class SolidModes:
         prism, a point at the tip height over the tip face, any other over the cross-section at
         its height (module docstring)."""
         shapes, residuals = {}, {}
-        L = self.geometry.total_length
         for name, pos in points.items():
             pos = np.asarray(pos, dtype=float)
-            if name in ("OL", "OR"):
-                quad = self._face_quadrature(name)
-            elif name == "platform":
-                quad = self._platform_quadrature()
-            elif abs(pos[2] - L) <= 1e-9 * L:
-                quad = self._face_quadrature("tip")
-            else:
-                quad = self._section_quadrature(pos[2])
+            region = self.geometry.fit_region(name, pos)
+            if region[0] == "face":
+                quad = self._face_quadrature(region[1])
+            elif region[0] == "platform":
+                quad = self._volume_quadrature(np.flatnonzero(self.mesh.platform))
+            elif region[0] == "section":
+                quad = self._section_quadrature(region[1])
+            else:                         # ("ball", radius): the elements around the point
+                quad = self._volume_quadrature(self._elements_near(pos, region[1]))
             x, w, u = quad
             motion, residual, _ = rigid_fit(x, w, u, pos)
             shapes[name], residuals[name] = motion, residual
@@ -706,15 +1208,14 @@ def _assemble(mesh: SolidMesh, sg: SolidBladeGeometry):
     """K, M (sparse, unclamped), skfem objects, total mass."""
     from skfem import Basis, BilinearForm, ElementTetP2, ElementVector, Functional, MeshTet, asm
     from skfem.helpers import ddot, dot, sym_grad, trace
-    g = sg.beam
     skmesh = MeshTet(mesh.vertices, mesh.tets)
     element = ElementVector(ElementTetP2())
     # intorder 2 integrates the P2 stiffness exactly on straight-edged tetrahedra (grad P2 is
     # linear), 4 the consistent mass (P2 x P2)
     basis_k = Basis(skmesh, element, intorder=2)
     basis_m = Basis(skmesh, element, intorder=4)
-    E = np.where(mesh.platform, sg.platform_youngs_modulus or g.youngs_modulus, g.youngs_modulus)
-    nu = g.poisson_ratio
+    E = np.where(mesh.platform, sg.platform_youngs_modulus or sg.youngs_modulus, sg.youngs_modulus)
+    nu = sg.poisson_ratio
     lam_e = E * nu / ((1 + nu) * (1 - 2 * nu))
     mu_e = E / (2 * (1 + nu))
     nq = basis_k.X.shape[1]
@@ -726,19 +1227,19 @@ def _assemble(mesh: SolidMesh, sg: SolidBladeGeometry):
 
     @BilinearForm
     def mass(u, v, w):
-        return g.density * dot(u, v)
+        return sg.density * dot(u, v)
 
     @Functional
     def volume(w):
-        return g.density + 0.0 * w.x[0]
+        return sg.density + 0.0 * w.x[0]
 
-    K = asm(stiffness, basis_k, lam=np.repeat(lam_e[:, None], nq, axis=1),
-            mu=np.repeat(mu_e[:, None], nq, axis=1)).tocsr()
+    lam_q, mu_q = np.repeat(lam_e[:, None], nq, axis=1), np.repeat(mu_e[:, None], nq, axis=1)
+    K = asm(stiffness, basis_k, lam=lam_q, mu=mu_q).tocsr()
     M = asm(mass, basis_m).tocsr()
     total_mass = asm(volume, basis_k)
     facets = _facet_indices(skmesh, mesh.faces)
     return K, M, {"mesh": skmesh, "element": element, "basis_k": basis_k, "basis_m": basis_m,
-                  "facets": facets, "mass": total_mass}
+                  "facets": facets, "mass": total_mass, "lam": lam_q, "mu": mu_q}
 
 
 def _facet_indices(skmesh, faces: dict) -> dict:
@@ -780,26 +1281,73 @@ def _eigen(K, M, free: np.ndarray, n_modes: int):
     return lam, V
 
 
+def _centrifugal_prestress(K, fe, sg, free: np.ndarray, omega: float, hub_radius: float):
+    """Stiffness of the spinning blade (rotor axis y through z = -hub_radius, speed omega [rad/s]):
+    K + K_sigma - omega^2 M_perp. The centrifugal body force rho omega^2 (x, 0, z + R) is applied
+    in a linear static step (K - omega^2 M_perp) u0 = F on the clamped blade; its stress sigma0
+    gives the geometric (stress) stiffness K_sigma = int sigma0_ij (d_i v_k)(d_j u_k) dV, and
+    M_perp = int rho (u_x v_x + u_z v_z) dV is the spin softening of motion in the plane of
+    rotation. Coriolis coupling is left out (the modes stay real)."""
+    from skfem import BilinearForm, LinearForm, asm
+    basis = fe["basis_k"]
+
+    @BilinearForm
+    def in_plane_mass(u, v, w):
+        return sg.density * (u[0] * v[0] + u[2] * v[2])
+
+    @LinearForm
+    def body_force(v, w):
+        return sg.density * omega**2 * (w.x[0] * v[0] + (w.x[2] + hub_radius) * v[2])
+
+    M_perp = asm(in_plane_mass, fe["basis_m"]).tocsr()
+    F = asm(body_force, fe["basis_m"])
+    A = (K - omega**2 * M_perp)[free][:, free].tocsc()
+    u0 = np.zeros(K.shape[0])
+    u0[free] = scipy.sparse.linalg.spsolve(A, F[free])
+    grad = basis.interpolate(u0).grad                               # (3, 3, n_e, n_q)
+    eps = 0.5 * (grad + np.swapaxes(grad, 0, 1))
+    tr = np.einsum("iien->en", eps)
+    sigma = 2.0 * fe["mu"] * eps + fe["lam"] * tr * np.eye(3)[:, :, None, None]   # Hooke, per element
+
+    @BilinearForm
+    def stress_stiffness(u, v, w):
+        return np.einsum("ijen,kien,kjen->en", w.s, v.grad, u.grad)
+
+    K_sigma = asm(stress_stiffness, basis, s=sigma).tocsr()
+    return (K + K_sigma - omega**2 * M_perp).tocsr(), u0
+
+
 def solid_modes(geometry: SolidBladeGeometry | BeamBladeGeometry | None = None,
                 element_size: float = DEFAULT_ELEMENT_SIZE, n_modes: int = DEFAULT_SEARCH_MODES,
-                mesh: SolidMesh | None = None, symmetric: bool = True) -> SolidModes:
+                mesh: SolidMesh | None = None, symmetric: bool = True, rotor_speed_hz: float = 0.0,
+                hub_radius: float = 0.0) -> SolidModes:
     """The ``n_modes`` lowest clamped-root modes of the solid blade (module docstring).
 
     geometry : SolidBladeGeometry, or a BeamBladeGeometry (its solid with the default platform),
-        or None (the reference blade).
+        a SurfaceBladeGeometry (a user's STL), or None (the reference blade).
     element_size : gmsh's largest element size [m] (ignored if ``mesh`` is given).
     mesh : an existing :func:`mesh_blade` mesh of the same geometry.
     symmetric : mesh the symmetric part and mirror it (:func:`mesh_blade`).
+    rotor_speed_hz : rotor speed [Hz] (rev/s, >= 0): > 0 gives the modes of the spinning blade,
+        prestressed by the centrifugal load of a linear static step (stress stiffening and spin
+        softening, no Coriolis; the rotor axis is y through z = -``hub_radius`` [m], >= 0: the
+        radius of the blade frame's z = 0); ``stiffness`` is then that of the spinning blade.
     """
     _require_fe()
     sg = _solid_geometry(geometry)
     n_modes = check.integer("n_modes", n_modes, minimum=1)
+    rotor_speed_hz = check.nonnegative("rotor_speed_hz", rotor_speed_hz)
+    hub_radius = check.nonnegative("hub_radius", hub_radius)
     if mesh is None:
-        mesh = mesh_blade(sg, element_size, symmetric=symmetric)
+        mesh = (mesh_surface(sg, element_size) if isinstance(sg, SurfaceBladeGeometry)
+                else mesh_blade(sg, element_size, symmetric=symmetric))
     t0 = time.perf_counter()
     K, M, fe = _assemble(mesh, sg)
     clamp_dofs = fe["basis_k"].get_dofs(facets=fe["facets"]["clamp"]).all()
     free = np.setdiff1d(np.arange(K.shape[0]), clamp_dofs)
+    if rotor_speed_hz > 0:
+        K, fe["static_displacement"] = _centrifugal_prestress(K, fe, sg, free, 2 * np.pi * rotor_speed_hz,
+                                                              hub_radius)
     t1 = time.perf_counter()
     lam, V = _eigen(K, M, free, n_modes)
     t2 = time.perf_counter()
@@ -809,7 +1357,8 @@ def solid_modes(geometry: SolidBladeGeometry | BeamBladeGeometry | None = None,
                        frequencies_hz=np.sqrt(np.clip(lam, 0.0, None)) / (2 * np.pi), vectors=vectors,
                        mode_names=(), families=(), family_fractions=np.zeros((V.shape[1], 4)),
                        tip_residual=np.zeros(V.shape[1]), stiffness=K, mass_matrix=M, free_dofs=free,
-                       seconds={"mesh": mesh.seconds, "assemble": t1 - t0, "solve": t2 - t1}, _fe=fe)
+                       seconds={"mesh": mesh.seconds, "assemble": t1 - t0, "solve": t2 - t1}, _fe=fe,
+                       rotor_speed_hz=rotor_speed_hz, hub_radius=hub_radius)
     # names from the tip motion, signs: tip u_x > 0 (F), u_y > 0 (E), phi_z > 0 (T), u_z > 0 (A)
     x, w, u = modes._face_quadrature("tip")
     centroid = (w @ x) / w.sum()
@@ -868,6 +1417,37 @@ class ContactFaceModes:
 
 
 @dataclass(eq=False)
+class BladeSurface:
+    """The FE blade's boundary surface and its mode shapes there, for pictures (compact: the
+    corner vertices of the outer triangles of the tetrahedral mesh only).
+
+    vertices : (n_v, 3) positions [m] in the blade frame; faces : (n_f, 3) vertex indices of
+        the outward triangles; shapes : (n_v, 3, n_m) FE translations of the blade's
+        mass-normalised modes at the vertices [m/sqrt(kg)] (the displacement of the surface for
+        modal coordinates q (n_m,) [sqrt(kg) m] is ``shapes @ q``).
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    shapes: np.ndarray
+
+    def displaced(self, q) -> np.ndarray:
+        """(n_v, 3) vertex positions [m] displaced by the modal coordinates ``q`` (n_m,)."""
+        return self.vertices + self.shapes @ np.asarray(q, dtype=float)
+
+    @classmethod
+    def from_modes(cls, modes: "SolidModes", mode_indices) -> "BladeSurface":
+        """The boundary of ``modes``'s mesh with the modes ``mode_indices`` (columns of modes.vectors)."""
+        mesh = modes.mesh
+        tri = boundary_faces(mesh.tets, mesh.vertices)
+        used, faces = np.unique(tri.T, return_inverse=True)
+        dofs = modes._fe["basis_k"].nodal_dofs[:, used]                       # (3, n_v) P2 vertex DOF
+        shapes = modes.vectors[dofs.T][:, :, list(mode_indices)]              # (n_v, 3, n_m)
+        return cls(vertices=mesh.vertices[:, used].T.copy(), faces=faces.reshape(-1, 3).astype(np.int64),
+                   shapes=shapes)
+
+
+@dataclass(eq=False)
 class SolidModalBlade(ModalBlade):
     """A :class:`~bladedamp.blade.ModalBlade` from the solid FE blade (:func:`solid_blade`): every
     ModalBlade field and use, plus
@@ -876,10 +1456,13 @@ class SolidModalBlade(ModalBlade):
         platform contact faces at sampled points (the OL / OR shapes are their rigid fits).
     fit_residuals : point name -> (n_m,) share of the region's motion the point's rigid fit misses.
     solid_info : n_dofs, element_size [m], mass [kg], all computed frequencies [Hz] and names,
-        and the wall times [s] of meshing, assembly and eigen-solution.
+        the rotor speed [Hz] and hub radius [m] of the prestress (0: at rest), and the wall times [s]
+        of meshing, assembly and eigen-solution.
     modes : the :class:`SolidModes` the blade was built from (None: no FE field kept, the
         platform is then rigid in the contact kinematics); mode_indices : (n_m,) the columns of
         ``modes`` that are this blade's modes.
+    surface : :class:`BladeSurface`, the FE boundary surface with the mode shapes at its
+        vertices (the 3D view draws it deformed: :func:`bladedamp.viz.show`), or None.
 
     With ``modes``, :meth:`platform_displacements` gives the FE displacement of the platform's
     contact faces at any point of them, and the disks (:class:`~bladedamp.disk.TunedDisk`,
@@ -895,6 +1478,7 @@ class SolidModalBlade(ModalBlade):
     solid_info: dict = field(default_factory=dict, repr=False)
     modes: SolidModes | None = field(default=None, repr=False)
     mode_indices: tuple = ()
+    surface: BladeSurface | None = field(default=None, repr=False)
 
     def __post_init__(self):
         super().__post_init__()
@@ -980,7 +1564,8 @@ def solid_blade(geometry: SolidBladeGeometry | BeamBladeGeometry | None = None,
                 element_size: float | None = None, n_modes: int = 4, *,
                 natural_frequencies_hz=None, damping_ratios=0.001, mode_names=None,
                 face_samples=DEFAULT_FACE_SAMPLES, search_modes: int | None = None,
-                symmetric: bool = True, modes: SolidModes | None = None) -> SolidModalBlade:
+                symmetric: bool = True, modes: SolidModes | None = None, rotor_speed_hz: float = 0.0,
+                hub_radius: float = 0.0) -> SolidModalBlade:
     """The solid blade as a ModalBlade (:meth:`bladedamp.blade.ModalBlade.from_solid`).
 
     n_modes = 4 returns the paper's modes in the order ("1F", "2F", "1T", "1E") (named by the
@@ -989,7 +1574,9 @@ def solid_blade(geometry: SolidBladeGeometry | BeamBladeGeometry | None = None,
     ``mode_names`` overrides the names, ``face_samples`` (n_xi, n_eta) is the raw contact-face
     grid, ``search_modes`` how many modes are computed before picking (default
     max(10, n_modes + 4)), ``symmetric`` the mirrored mesh (:func:`mesh_blade`), ``modes`` an
-    existing :func:`solid_modes` result to use (then geometry and element_size are ignored).
+    existing :func:`solid_modes` result to use (then geometry and element_size are ignored),
+    ``rotor_speed_hz`` [Hz] and ``hub_radius`` [m] the spinning blade's centrifugal prestress
+    (:func:`solid_modes`; 0: the blade at rest).
     The points are the beam geometry's (OL, OR, platform, tip, excitation), each with its
     rigid-fit 6-DOF shape (module docstring).
     """
@@ -997,7 +1584,8 @@ def solid_blade(geometry: SolidBladeGeometry | BeamBladeGeometry | None = None,
     if modes is None:
         search = max(DEFAULT_SEARCH_MODES, n_modes + 4) if search_modes is None else search_modes
         size = DEFAULT_ELEMENT_SIZE if element_size is None else element_size
-        modes = solid_modes(geometry, size, search, symmetric=symmetric)
+        modes = solid_modes(geometry, size, search, symmetric=symmetric, rotor_speed_hz=rotor_speed_hz,
+                            hub_radius=hub_radius)
     if not modes.geometry.platform:
         raise ValueError("a ModalBlade needs the platform (its OL / OR contact faces); "
                          "the geometry has platform=False")
@@ -1020,15 +1608,16 @@ def solid_blade(geometry: SolidBladeGeometry | BeamBladeGeometry | None = None,
         if freqs.shape != (n_modes,):
             raise ValueError(f"natural_frequencies_hz must have n_modes = {n_modes} entries "
                              f"(got shape {freqs.shape})")
-    points = modes.geometry.beam.points()
+    points = modes.geometry.points()
     shapes, residuals = modes.point_shapes(points)
     faces = {side: modes.contact_face(side, face_samples).select(idx) for side in ("OL", "OR")}
     info = {"n_dofs": modes.n_dofs, "n_free": modes.n_free, "n_elements": int(modes.mesh.tets.shape[1]),
             "element_size": modes.mesh.element_size, "mass": modes.mass,
             "frequencies_hz": modes.frequencies_hz.copy(), "mode_names": modes.mode_names,
+            "rotor_speed_hz": modes.rotor_speed_hz, "hub_radius": modes.hub_radius,
             "seconds": dict(modes.seconds)}
     return SolidModalBlade(natural_frequencies_hz=freqs, damping_ratios=damping_ratios,
                            mode_shapes={p: s[:, idx] for p, s in shapes.items()}, points=points,
                            mode_names=names, contact_faces=faces,
                            fit_residuals={p: r[idx] for p, r in residuals.items()}, solid_info=info,
-                           modes=modes, mode_indices=tuple(idx))
+                           modes=modes, mode_indices=tuple(idx), surface=BladeSurface.from_modes(modes, idx))

@@ -24,16 +24,42 @@ from .io import Saveable
 
 
 @njit(cache=True)
-def _oscillator_steady_state(omega, m, c, k, k3, k_t, mu, n0, k_n, sin_a, cos_a, force,
-                             steps, max_periods, min_periods, tol, last_period, x0=0.0, v0=0.0):
-    """Integrate one frequency from x0 [m], v0 [m/s] (default rest; the slider relaxed at 0);
-    returns (periods used, converged) and fills last_period."""
+def oscillator_step(x, x_prev, s0, dt, m, c, k, k3, k_t, mu, n0, k_n, sin_a, cos_a, force):
+    """One central-difference step of the friction oscillator
+    m x'' + c x' + k x + k3 x^3 + f_C = F cos(omega t), step dt [s], ``force`` the excitation
+    F cos(omega t) [N] at the step's time t: from x(t), x(t - dt) [m] and the slider
+    position s0 [m] before the step, returns (x(t + dt), the slider position after the step).
+    The contact of :class:`~bladedamp.oscillator.FrictionOscillator` (tangential x cos alpha,
+    normal N0 + k_N x sin alpha, lifting off at zero) by the AFT's return-map step
+    :func:`slider_step` (also the step of the monodromy matrix,
+    :func:`bladedamp.hbm.monodromy.oscillator_period_map`)."""
+    normal = n0 + k_n * sin_a * x
+    if normal < 0.0:
+        normal = 0.0
+    f0, f1, s0, s1, st = slider_step(cos_a * x, 0.0, s0, 0.0, k_t, mu * normal, normal > 0.0)
+    rhs = force - k * x - k3 * x ** 3 - (cos_a * f0 + sin_a * normal) \
+        + m * (2 * x - x_prev) / dt ** 2 + c * x_prev / (2 * dt)
+    return rhs / (m / dt ** 2 + c / (2 * dt)), s0
+
+
+@njit(cache=True)
+def oscillator_steady_state(omega, m, c, k, k3, k_t, mu, n0, k_n, sin_a, cos_a, force,
+                            steps, max_periods, min_periods, tol, last_period, x0=0.0, v0=0.0):
+    """Steady state of the friction oscillator (:class:`bladedamp.oscillator.FrictionOscillator`)
+    at one excitation frequency by central-difference time integration, from x0 [m], v0 [m/s]
+    (default rest; the slider relaxed at 0).
+
+    ``omega`` [rad/s] (the integrator's own variable; the oscillator's ``time_response`` takes
+    Hz); m [kg], c [N s/m], k [N/m], k3 [N/m^3], k_t [N/m], mu [-], n0 [N] (normal preload),
+    k_n [N/m], sin_a, cos_a of the contact angle, force [N] (cosine amplitude); ``steps`` per
+    period; at most ``max_periods`` and at least ``min_periods`` periods, until the
+    first-harmonic amplitude changes by at most ``tol`` (relative) from one period to the next.
+    Fills ``last_period`` (steps,) with the displacement [m] over the last period; returns
+    (periods used, converged)."""
     dt = 2 * np.pi / omega / steps
-    a_lhs = m / dt ** 2 + c / (2 * dt)
     x_prev = x0 - v0 * dt
     x = x0
     s0 = 0.0
-    s1 = 0.0
     amp_old = -1.0
     stable = 0
     step = 0
@@ -41,18 +67,13 @@ def _oscillator_steady_state(omega, m, c, k, k3, k_t, mu, n0, k_n, sin_a, cos_a,
         cs = 0.0
         sn = 0.0
         for j in range(steps):
-            normal = n0 + k_n * sin_a * x
-            if normal < 0.0:
-                normal = 0.0
-            f0, f1, s0, s1, st = slider_step(cos_a * x, 0.0, s0, s1, k_t, mu * normal, normal > 0.0)
-            contact = cos_a * f0 + sin_a * normal
-            rhs = force * np.cos(omega * step * dt) - k * x - k3 * x ** 3 - contact \
-                + m * (2 * x - x_prev) / dt ** 2 + c * x_prev / (2 * dt)
+            x_next, s0 = oscillator_step(x, x_prev, s0, dt, m, c, k, k3, k_t, mu, n0, k_n, sin_a, cos_a,
+                                         force * np.cos(omega * step * dt))
             last_period[j] = x
             cs += x * np.cos(2 * np.pi * j / steps)
             sn += x * np.sin(2 * np.pi * j / steps)
             x_prev = x
-            x = rhs / a_lhs
+            x = x_next
             step += 1
         amp = 2.0 / steps * np.sqrt(cs * cs + sn * sn)
         if amp_old >= 0 and abs(amp - amp_old) <= tol * amp:
@@ -373,7 +394,9 @@ def _assembly_arrays(disk) -> _AssemblyArrays:
             raise ValueError("time_response needs the damper inertia (damper_inertia=True): the explicit "
                              "scheme integrates every damper as a rigid body with mass")
         minv[d] = np.linalg.inv(Md)
-        if np.abs(M[sl, :].toarray()).sum() - np.abs(Md).sum() > 0:
+        rows = M[sl, :].toarray()
+        rows[:, sl] = 0.0                  # the entries coupling this damper to any other unknown
+        if np.any(rows != 0.0):
             raise ValueError("time_response needs damper inertia blocks without coupling")
     tip = np.stack([b.shape("tip")[:3] for b in disk.blades])          # (s, 3, nm)
     if nd == 0:
@@ -410,7 +433,7 @@ def _assembly_arrays(disk) -> _AssemblyArrays:
             P = patch.n_points
             pts["pt_local"].append(np.full(P, 12 * d + 6 * q))
             pts["B"].append(patch.point_map)
-            pts["k_t"].append(patch.tangential_stiffness * patch.weights)     # as DamperContacts._stack
+            pts["k_t"].append(patch.tangential_stiffness * patch.weights)     # as DamperContacts.stacked_points
             pts["mu"].append(np.full(P, patch.friction_coefficient))
             pts["weight"].append(patch.weights)
             pts["offset"].append(-patch.initial_gap)                          # approach at w = 0

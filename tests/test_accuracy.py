@@ -52,6 +52,7 @@ def test_linear_system_has_zero_harmonic_error():
     assert r.success and r.harmonic_error < 1e-9 and r.harmonics_converged
 
 
+@pytest.mark.slow   # 8-26 s: kept out of the default run (under 10 min); CI runs it
 def test_one_harmonic_on_an_inclined_contact_is_flagged_and_auto_is_right():
     """The issue's case: the one-harmonic answer is 8.7x the time integration and nothing said so.
     Now its error estimate is far above the tolerance, and the default answer agrees with the time
@@ -173,25 +174,80 @@ def test_automatic_aft_sampling_grows_the_samples_until_the_branch_passes():
     assert "AFT samples per period raised to 1024 (the branch failed with 256)" in auto.message
 
 
-def test_negative_dissipation_of_a_disk_is_not_success():
-    """The issue's disk (EO 8, 74.86 deg platforms, a 0.058 g cylinder separated about half the
-    cycle): with one harmonic and 64 AFT samples the contacts give energy back (-1.7 % of the
-    excitation work) while the energy balance holds to rounding. That is the AFT's sampling of
-    the lift-off (at the worst point, the same coefficients: -3.4 % / -0.15 % / +8e-5 / -2.6e-6 /
-    -1.7e-7 at 64 / 256 / 1024 / 4096 / 16384 samples), too coarse for this design, and still
-    with the automatic sampling's one step to 256: the result must not be success."""
+def test_automatic_sampling_grows_further_only_for_a_branch_that_failed_the_dissipation_check():
+    """sampled_response: a branch that reached the end and failed only the dissipation check (the
+    AFT's sampling error) may grow to ``most_for_dissipation``; a branch that stalled stops at
+    ``most``; a success stops at once. A fake solve records the samples it is asked for."""
+    from bladedamp.hbm.fourier import HarmonicBasis
+    from bladedamp.response import FrequencyResponse, sampled_response
+
+    def fake(passes_at, failure):
+        asked = []
+
+        def solve(n):
+            asked.append(n)
+            ok = n >= passes_at
+            message = "reached the end of the frequency range" if ok or failure == "dissipation" else \
+                "continuation did not converge after omega = 1 rad/s"
+            checks = {} if ok or failure != "dissipation" else {"dissipation": "negative"}
+            if checks:
+                message += "; failed checks: dissipation: negative"
+            return FrequencyResponse(np.ones(3), np.zeros((3, 3, 1)), HarmonicBasis((1,), n), ("x",), ok, message,
+                                     failed_checks=checks)
+        return solve, asked
+
+    solve, asked = fake(1024, "dissipation")
+    r = sampled_response(solve, None, 64, 256, 1024)
+    assert asked == [64, 256, 1024] and r.success and "raised to 1024 (the branch failed with 64, 256)" in r.message
+    solve, asked = fake(1024, "dissipation")
+    assert not sampled_response(solve, None, 64, 256).success and asked == [64, 256]      # without the option
+    solve, asked = fake(1024, "stall")
+    r = sampled_response(solve, None, 64, 256, 1024)
+    assert asked == [64, 256] and not r.success                 # a stalled branch does not get a third try
+    solve, asked = fake(64, "dissipation")
+    assert sampled_response(solve, None, 64, 256, 1024).success and asked == [64]
+    solve, asked = fake(1024, "dissipation")
+    assert not sampled_response(solve, 128, 64, 256, 1024).success and asked == [128]   # given: used once
+
+
+def issue_disk_with_negative_dissipation():
+    """The issue's disk (EO 8, 74.86 deg platforms, a 0.058 g cylinder separated about half the cycle)."""
     from bladedamp import ContactProperties, CylinderDamper, TunedDisk, reference_blade
 
-    disk = TunedDisk(reference_blade(), CylinderDamper(5.815e-05, 0.002, 0.02,
+    return TunedDisk(reference_blade(), CylinderDamper(5.815e-05, 0.002, 0.02,
                                                        ContactProperties(0.63, 1.7e7, 1.25, 1.0, 10.0, 4, 5)),
                      16, 8, np.radians(74.86), np.radians(74.86), 0.0261,
                      2.38 * np.array([0.1, -0.1, 0, 0, 0, 0.001]))
+
+
+def test_negative_dissipation_of_a_disk_is_not_success():
+    """The issue's disk with one harmonic and 256 AFT samples: its contacts give energy back
+    (-1.7e-6 of the excitation work at 15 points, confirmed with 4096 samples) while the energy
+    balance holds to rounding. That is the AFT's sampling of the lift-off (at the worst point of
+    the 64-sample branch, the same coefficients: -3.4 % / -0.15 % / +8e-5 / -2.6e-6 / -1.7e-7 at
+    64 / 256 / 1024 / 4096 / 16384 samples), too coarse for this design: not success."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = issue_disk_with_negative_dissipation().frequency_response(85.0, 123.2, harmonics=(1,), max_step=0.05,
+                                                                      n_samples=256)
+    assert np.max(r.energy_balance_error()) < 1e-8         # the energy balance cannot see it
+    assert "dissipation" in r.failed_checks and not r.success, r.message
+
+
+@pytest.mark.slow
+def test_automatic_sampling_cures_the_negative_dissipation_of_a_disk():
+    """The same disk with the default (automatic) sampling: 64 and 256 samples fail the
+    dissipation check; the branch reached the end with 256, so it is solved once more with 1024,
+    where every check passes (measured 2026-12-02: 238 s on the loaded 2 cores). The peak moves
+    by 1.2e-4 relative from the 256-sample branch (3.9565 / 3.9569 mm): far below the 1 % target."""
+    disk = issue_disk_with_negative_dissipation()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         r = disk.frequency_response(85.0, 123.2, harmonics=(1,), max_step=0.05)
-    assert np.max(r.energy_balance_error()) < 1e-8         # the energy balance cannot see it
-    assert "dissipation" in r.failed_checks and not r.success, r.message
-    assert r.basis.n_samples == 256 and "raised to 256 (the branch failed with 64)" in r.message
+        coarse = disk.frequency_response(85.0, 123.2, harmonics=(1,), max_step=0.05, n_samples=256)
+    assert r.success and not r.failed_checks and r.basis.n_samples == 1024, r.message
+    assert "raised to 1024 (the branch failed with 64, 256)" in r.message
+    assert abs(r.peak_amplitude / coarse.peak_amplitude - 1) < 1e-3
 
 
 @pytest.mark.slow

@@ -60,6 +60,35 @@ def test_public_frequency_arguments_are_named_in_hz():
         assert list(inspect.signature(method).parameters)[1] == "f_hz", method
     assert list(inspect.signature(bd.FrictionOscillator.linear_amplitude).parameters)[1] == "f_hz"
     assert list(inspect.signature(bd.frequency_response).parameters)[:2] == ["model", "f_range_hz"]
+    for cls in (bd.TunedDisk, MistunedDisk):             # the rotor speed: revolutions per second
+        params = inspect.signature(cls).parameters
+        assert "rotor_speed_hz" in params and params["rotor_speed_hz"].default is None, cls
+    for method in (bd.ModalBlade.dynamic_stiffness, bd.ModalBlade.linear_frf):
+        assert inspect.signature(method).parameters["f_hz"].kind is inspect.Parameter.KEYWORD_ONLY, method
+
+
+def test_blade_frequency_arguments_in_hz_are_eq5():
+    """ModalBlade.dynamic_stiffness(f_hz=) is Eq. 5 at Omega = 2 pi f; linear_frf(f_hz=) peaks at the
+    1F natural frequency in Hz; the deprecated rad/s positional argument gives the same numbers
+    with a DeprecationWarning; neither or both is a ValueError naming f_hz."""
+    blade = bd.reference_blade()
+    f = 100.0
+    w0, w = blade.natural_angular_frequencies, 2 * np.pi * f
+    np.testing.assert_allclose(blade.dynamic_stiffness(f_hz=f), w0 ** 2 - w ** 2 + 2j * blade.damping_ratios * w0 * w,
+                               rtol=1e-14)
+    force = np.array([0.1, 0, 0, 0, 0, 0])
+    grid = np.linspace(94.0, 96.0, 2001)
+    f1 = blade.natural_frequencies_hz[0]
+    assert grid[np.argmax(np.abs(blade.linear_frf(f_hz=grid, force=force)[:, 0]))] == pytest.approx(f1, abs=2e-3)
+    with pytest.warns(DeprecationWarning, match="f_hz"):
+        old = blade.linear_frf(2 * np.pi * grid, force)
+    np.testing.assert_array_equal(old, blade.linear_frf(f_hz=grid, force=force))
+    with pytest.warns(DeprecationWarning, match="f_hz"):
+        np.testing.assert_array_equal(blade.dynamic_stiffness(w), blade.dynamic_stiffness(f_hz=f))
+    for bad in (lambda: blade.dynamic_stiffness(), lambda: blade.dynamic_stiffness(w, f_hz=f),
+                lambda: blade.linear_frf(force=force)):
+        with pytest.raises(ValueError, match="f_hz"):
+            bad()
 
 
 def test_frequency_response_of_anything_else_is_a_type_error_naming_it():
@@ -134,3 +163,26 @@ def test_plausible_designs_and_no_damper_do_not_warn():
         bd.reference_disk("wedge", 0.28e-3)
         bd.reference_disk("cylinder", 15e-3)
         bd.CylinderDamper(0.0)                  # mass 0: no damper
+
+
+def test_centrifugal_force_takes_hz():
+    """damper.kinetics.centrifugal_force (Eq. 26) at f_hz [Hz]: m R (2 pi f)^2 / EO^2, and at a
+    fixed rotor_speed_hz [Hz] m R (2 pi n)^2; the former rad/s arguments give the same numbers
+    with a DeprecationWarning."""
+    from bladedamp.damper import centrifugal_force
+
+    m, R, f = 1.3e-3, 0.05, 95.0
+    for eo in (1, 3):
+        F, dF = centrifugal_force(m, R, f_hz=f, engine_order=eo)
+        assert F == pytest.approx(m * R * (2 * np.pi * f) ** 2 / eo ** 2, rel=1e-14)
+        assert dF == pytest.approx(2 * F / (2 * np.pi * f), rel=1e-14)          # per rad/s of Omega_E
+        with pytest.warns(DeprecationWarning, match="f_hz"):
+            assert centrifugal_force(m, R, 2 * np.pi * f, eo)[0] == pytest.approx(F, rel=1e-14)
+    F0, dF0 = centrifugal_force(m, R, f_hz=f, engine_order=0, rotor_speed_hz=50.0)
+    assert F0 == pytest.approx(m * R * (2 * np.pi * 50.0) ** 2, rel=1e-14) and dF0 == 0.0
+    for bad, name in ((lambda: centrifugal_force(m, R, f_hz=f, engine_order=0), "rotor_speed_hz"),
+                      (lambda: centrifugal_force(m, R, f_hz=f), "engine_order"),
+                      (lambda: centrifugal_force(m, R, engine_order=1), "f_hz"),
+                      (lambda: centrifugal_force(m, R, f_hz=f, engine_order=0, rotor_speed_hz=-1.0), "rotor_speed_hz")):
+        with pytest.raises(ValueError, match=name):
+            bad()

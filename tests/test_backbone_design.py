@@ -37,6 +37,8 @@ def test_backbone_optimum_within_2_percent_of_the_frf_optimum(design):
     disk = bd.reference_disk("cylinder", 1e-3)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        frf = optimal_mass(dataclasses.replace(disk, excitation=0.5 * disk.excitation), bounds=(0.1e-3, 2e-3))
+        # the FRF optimum to 0.5 % in mass (its default xatol, 2 %, is as wide as the tolerance)
+        frf = optimal_mass(dataclasses.replace(disk, excitation=0.5 * disk.excitation), bounds=(0.1e-3, 2e-3),
+                           xatol=5e-3)
     assert frf.success, frf.message
     assert abs(design.optimal_mass[0] / frf.mass - 1) < 0.02

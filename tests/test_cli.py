@@ -171,6 +171,7 @@ def test_optimize_on_an_init_design_finds_the_calibrated_optimum(fast_design, tm
     assert m["certified_global"] and "Optimal mass" in summary
 
 
+@pytest.mark.slow   # 8-26 s: kept out of the default run (under 10 min); CI runs it
 def test_eo_sweep_on_an_init_design(fast_design, tmp_path):
     out = tmp_path / "eo"
     assert main(["eo-sweep", str(fast_design), "--engine-orders", "0", "--out", str(out)]) == 0

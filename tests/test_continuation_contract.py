@@ -239,6 +239,7 @@ def test_robust_start_finds_the_oscillator_solution_in_gross_slip():
     assert s.converged
 
 
+@pytest.mark.slow   # 8-26 s: kept out of the default run (under 10 min); CI runs it
 def test_a_branch_retracing_itself_is_stopped_and_says_so():
     """Random disk 51 (a 7 g cylinder, (0, 1, 2, 3)): past a non-smooth fold at 94.18 Hz the
     branch went back and forth between 94.28 and 94.30 Hz at full steps, back to within
@@ -251,6 +252,7 @@ def test_a_branch_retracing_itself_is_stopped_and_says_so():
     assert r["points"] < 2000
 
 
+@pytest.mark.slow   # 8-26 s: kept out of the default run (under 10 min); CI runs it
 def test_a_corner_past_which_the_corrector_lands_off_the_tangent_is_passed():
     """Random disk 6 (a 0.094 g wedge at slip onset, 94.996 Hz): the corrector converged at
     every step on the adjacent piece of the branch, 3.6 / 4.5 / 8.0 steps from its predictor at

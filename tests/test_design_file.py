@@ -22,7 +22,7 @@ def _write(tmp_path, text: str, name: str = "design.toml"):
 
 def _same_disk(a, b):
     """Every model parameter of two TunedDisks is equal (the blade's shapes exactly)."""
-    for name in ("n_blades", "engine_order", "gamma_left", "gamma_right", "damper_radius", "rotor_speed",
+    for name in ("n_blades", "engine_order", "gamma_left", "gamma_right", "damper_radius", "rotor_speed_hz",
                  "damper_inertia"):
         assert getattr(a, name) == getattr(b, name), name
     assert np.array_equal(a.excitation, b.excitation)
@@ -172,9 +172,9 @@ def test_wedge_angles_speed_and_engine_orders_in_si(tmp_path):
     assert d.gamma_left == pytest.approx(np.radians(30)) and d.gamma_right == pytest.approx(np.radians(60))
     assert d.damper_radius == pytest.approx(0.1)
     assert design.engine_orders == (0, 2, 4) and d.engine_order == 0
-    assert d.rotor_speed == pytest.approx(3000 * 2 * np.pi / 60)      # EO = 0 needs a speed
+    assert d.rotor_speed_hz == pytest.approx(3000 / 60)               # EO = 0 needs a speed: rpm / 60 in Hz
     eo2 = design.disk_at(2)
-    assert eo2.engine_order == 2 and eo2.rotor_speed is None          # 'auto': Omega_E / EO
+    assert eo2.engine_order == 2 and eo2.rotor_speed_hz is None       # 'auto': Omega_E / EO
     assert design.analysis.harmonics == (0, 1, 3) and design.analysis.study_harmonics == (0, 1, 3)
     assert design.analysis.mass_bounds == pytest.approx((1e-4, 5e-3))
 
@@ -182,7 +182,7 @@ def test_wedge_angles_speed_and_engine_orders_in_si(tmp_path):
 def test_no_damper_and_a_fixed_rotor_speed(tmp_path):
     design = load_design(_write(tmp_path, "[damper]\nkind = \"none\"\n[disk]\nrotor_speed_rpm = 6000.0\n"))
     assert not design.disk.has_damper
-    assert design.disk.rotor_speed == pytest.approx(200 * np.pi)
+    assert design.disk.rotor_speed_hz == pytest.approx(100.0)       # 6000 rpm
 
 
 def test_beam_overrides_change_the_blade(tmp_path):

@@ -22,7 +22,7 @@ from bladedamp.reference import reference_disk
 
 F_RANGE = (92.0, 104.0)            # around the 1F resonance (95 Hz undamped)
 MAX_STEP = 0.05
-ROTOR_SPEED_95 = 2 * np.pi * 95.0  # EO = 0: the rotor speed of the EO = 1 resonance
+ROTOR_SPEED_95_HZ = 95.0  # EO = 0: the rotor speed of the EO = 1 resonance [Hz, revolutions per second]
 REFERENCE_MASS = {"cylinder": 1.0e-3, "wedge": 0.28e-3}   # paper's cylinder optimum; wedge near its optimum
 HARMONICS = [(1,), (0, 1, 2, 3)]
 
@@ -145,7 +145,7 @@ def test_zero_mass_damper_gives_the_linear_blade_frf(kind):
     r = frf(kind, 0.0)
     disk = r.disk
     assert not disk.has_damper and r.coefficients.shape[2] == disk.blade.n_modes
-    ref = np.abs(disk.blade.linear_frf(r.omega, disk.excitation)[:, :3])
+    ref = np.abs(disk.blade.linear_frf(f_hz=r.frequency_hz, force=disk.excitation)[:, :3])
     err = np.abs(r.tip_amplitude - ref).max() / ref.max()
     p, f, _ = peak(r)
     print(f"\n[linear] {kind}: {len(r.omega)} points, max rel. difference to closed form {err:.2e}, "
@@ -192,7 +192,7 @@ def test_eo0_cylinder_rolls_without_slip_or_dissipation():
     angles to the (horizontal) line between them, which a cylinder follows by rolling about one
     contact: no slip, no dissipation, the undamped resonance amplitude (paper Fig. 7, 8)."""
     m = REFERENCE_MASS["cylinder"]
-    r0 = frf("cylinder", m, engine_order=0, rotor_speed=ROTOR_SPEED_95)
+    r0 = frf("cylinder", m, engine_order=0, rotor_speed_hz=ROTOR_SPEED_95_HZ)
     r1 = frf("cylinder", m)
     lin = frf(None, 0.0)
     p0, f0, i0 = peak(r0)
@@ -216,7 +216,7 @@ def test_eo0_wedge_dissipates():
     """The wedge's flat faces of height h_C cannot roll (paper: "pure rolling is excluded in the
     case of the wedge-shaped damper, even ... (EO = 0)"): it slips, dissipates, damps."""
     m = REFERENCE_MASS["wedge"]
-    r0 = frf("wedge", m, engine_order=0, rotor_speed=ROTOR_SPEED_95)
+    r0 = frf("wedge", m, engine_order=0, rotor_speed_hz=ROTOR_SPEED_95_HZ)
     pu, _, _ = peak(frf(None, 0.0))
     p0, f0, i0 = peak(r0)
     diss0 = r0.dissipated_energy[i0] / r0.excitation_work[i0]
@@ -435,7 +435,7 @@ def test_exchanged_platform_angles_standing_wave(kind):
     """EO = 0 is a standing wave: (gamma_L, gamma_R) = (35, 55) deg and (55, 35) deg are mirror
     images of each other and have the same peak."""
     m = REFERENCE_MASS[kind]
-    base = reference_disk(kind, m, engine_order=0, rotor_speed=ROTOR_SPEED_95)
+    base = reference_disk(kind, m, engine_order=0, rotor_speed_hz=ROTOR_SPEED_95_HZ)
     peaks = []
     for angles in [(35.0, 55.0), (55.0, 35.0)]:
         with warnings.catch_warnings():
@@ -571,8 +571,10 @@ def test_merged_patch_evaluation_equals_separate_patches(kind, harmonics):
     (lambda: dataclasses.replace(reference_disk("cylinder"), gamma_right=np.pi / 2), "gamma_right"),
     (lambda: dataclasses.replace(reference_disk("wedge"), gamma_right=np.radians(95.0)), "gamma_right"),
     (lambda: reference_disk("cylinder", -1e-3), "damper mass"),
-    (lambda: reference_disk("cylinder", 1e-3, engine_order=0), "rotor_speed"),
-    (lambda: reference_disk("cylinder", 1e-3, engine_order=0, rotor_speed=-5.0), "rotor_speed"),
+    (lambda: reference_disk("cylinder", 1e-3, engine_order=0), "rotor_speed_hz"),
+    (lambda: reference_disk("cylinder", 1e-3, engine_order=0, rotor_speed_hz=-5.0), "rotor_speed_hz"),
+    (lambda: reference_disk("cylinder", 1e-3, engine_order=0, rotor_speed_hz=float("nan")), "rotor_speed_hz"),
+    (lambda: reference_disk("cylinder", 1e-3, engine_order=0, rotor_speed_hz=50.0, rotor_speed=100.0), "rotor_speed"),
     (lambda: reference_disk("cylinder", excitation=[0.1, 0.0]), "excitation"),
     (lambda: reference_disk("cylinder").frequency_response(92.0, 92.0), "f_end_hz"),
     (lambda: reference_disk("cylinder").frequency_response(-1.0, 92.0), "f_start_hz"),
@@ -586,3 +588,35 @@ def test_wedge_without_contact_height_is_rejected():
     from bladedamp.damper import WedgeDamper
     with pytest.raises(ValueError, match="contact_height"):
         TunedDisk(reference_disk("wedge").blade, WedgeDamper(1e-3, contact_height=None))
+
+
+@pytest.mark.parametrize("engine_order", [1, 2])
+def test_rotor_speed_in_hz_at_omega_e_over_eo_is_the_automatic_preload(engine_order):
+    """``rotor_speed_hz`` is the rotor's revolutions per second: given at f / EO it is the speed
+    the automatic law (Omega_R = Omega_E / EO, Eq. 3, 26) takes at the excitation frequency f, so
+    F_CG, the seating loads and the one-harmonic residual at f are those of the automatic disk
+    (only dF_CG / dOmega differs: a fixed speed does not follow the excitation). The deprecated
+    rad/s argument gives the same disk; a speed in rpm (60 times too large) is flagged."""
+    import warnings
+
+    from bladedamp._validate import PlausibilityWarning
+
+    f = 95.3
+    auto = reference_disk("cylinder", 1e-3, engine_order=engine_order)
+    fixed = reference_disk("cylinder", 1e-3, engine_order=engine_order, rotor_speed_hz=f / engine_order)
+    assert fixed.centrifugal_force(f)[0] == pytest.approx(auto.centrifugal_force(f)[0], rel=1e-14)
+    assert fixed.centrifugal_force(f)[1] == 0.0 and auto.centrifugal_force(f)[1] > 0
+    assert fixed.centrifugal_force(1.5 * f)[0] == pytest.approx(fixed.centrifugal_force(f)[0], rel=1e-14)
+    np.testing.assert_allclose(fixed.static_normal_loads(f), auto.static_normal_loads(f), rtol=1e-12)
+    x = auto.initial_guess(auto.hbm_system((1,)), 2 * np.pi * f)
+    R_auto = auto.hbm_system((1,)).residual(x, 2 * np.pi * f, False)[0]
+    R_fixed = fixed.hbm_system((1,)).residual(x, 2 * np.pi * f, False)[0]
+    np.testing.assert_allclose(R_fixed, R_auto, rtol=0, atol=1e-12 * np.abs(R_auto).max())
+    with pytest.warns(DeprecationWarning, match="rotor_speed_hz"):
+        old = reference_disk("cylinder", 1e-3, engine_order=engine_order, rotor_speed=2 * np.pi * f / engine_order)
+    assert old.rotor_speed_hz == pytest.approx(fixed.rotor_speed_hz, rel=1e-15)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert dataclasses.replace(fixed, engine_order=1).rotor_speed_hz == fixed.rotor_speed_hz
+    with pytest.warns(PlausibilityWarning, match="rotor_speed_hz"):
+        reference_disk("cylinder", 1e-3, engine_order=0, rotor_speed_hz=60 * 95.0)      # rpm given as Hz

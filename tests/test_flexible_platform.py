@@ -320,7 +320,7 @@ def _state(disk, system, omega, factor=3.0):
     """A state with stick, slip and (wedge) partial lift-off: the stuck linear solution, amplified."""
     if isinstance(disk, MistunedDisk):
         return factor * disk.initial_guess(system, omega)
-    return factor * disk._initial_guess(system, omega)
+    return factor * disk.initial_guess(system, omega)
 
 
 @needs_fe

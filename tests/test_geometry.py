@@ -143,3 +143,12 @@ def test_disk_placements_wrap_the_sector(cylinder_disk):
         assert np.isclose((angle + 2 * np.pi * k / n + np.pi) % (2 * np.pi) - np.pi, 0.0, atol=1e-12)
         # damper CG at its radius from the axis
         assert np.linalg.norm(D[k, :3, 3] - axis) == pytest.approx(np.hypot(cg[0], cg[2] + r_root), rel=1e-12)
+
+
+def test_homogeneous_transform_rotates_then_translates():
+    from bladedamp.geometry import homogeneous, rotation_y
+    R, t = rotation_y(0.3), np.array([1.0, -2.0, 0.5])
+    T = homogeneous(R, t)
+    x = np.array([0.2, 0.1, -0.4])
+    np.testing.assert_allclose(T @ np.r_[x, 1.0], np.r_[R @ x + t, 1.0], rtol=0, atol=1e-15)
+    np.testing.assert_array_equal(homogeneous(), np.eye(4))

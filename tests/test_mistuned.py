@@ -24,7 +24,7 @@ from bladedamp.studies import mistuning as mt
 
 F_RANGE = (92.0, 104.0)
 MAX_STEP = 0.05
-ROTOR_SPEED_95 = 2 * np.pi * 95.0
+ROTOR_SPEED_95_HZ = 95.0        # [Hz, revolutions per second]
 
 
 def tuned(n, eo=1, mass=1e-3, kind="cylinder", **kw):
@@ -95,7 +95,7 @@ def compare_full_to_cyclic(tdisk, harmonics=(1,), n_check=6, f_range=F_RANGE):
 # ---------------------------------------------------------------------------------------
 @pytest.mark.parametrize("n, eo, harmonics, opts", [
     (4, 1, (1,), {}),
-    (4, 0, (1,), {"rotor_speed": ROTOR_SPEED_95}),
+    (4, 0, (1,), {"rotor_speed_hz": ROTOR_SPEED_95_HZ}),
     (4, 2, (1,), {}),               # EO = n/2: standing wave, neighbours in anti-phase
     (4, 1, (0, 1, 3), {}),          # static and a higher harmonic: seating in the harmonic balance
 ])
@@ -306,7 +306,7 @@ def test_massless_dampers_give_each_blade_its_linear_frf(dampers):
     dphi = td.interblade_phase
     worst = 0.0
     for k, b in enumerate(md.blades):
-        ref = np.abs(b.linear_frf(r.omega, td.excitation * np.exp(1j * k * dphi))[:, :3])
+        ref = np.abs(b.linear_frf(f_hz=r.frequency_hz, force=td.excitation * np.exp(1j * k * dphi))[:, :3])
         worst = max(worst, np.abs(r.tip_amplitude[:, k] - ref).max() / ref.max())
     f_peak = r.peak_frequency_hz
     print(f"\n[linear] {dampers}: max rel. difference {worst:.2e}; peaks at {np.round(f_peak, 3)} Hz")
@@ -447,3 +447,53 @@ def test_paper_cases_summary_and_report():
     assert sum(line.startswith("| ") for line in lines) == 1 + 8   # header and eight statements
     assert all(len(line.split(" | ")) == 5 for line in lines if line.startswith("| "))   # with a tolerance column
     json.dumps(s)
+
+
+def test_automatic_aft_sampling_goes_through_sampled_response(monkeypatch):
+    """MistunedDisk.frequency_response chooses its AFT samples as the tuned disk and the
+    oscillator do, through bladedamp.response.sampled_response (one code path): n_samples=None
+    starts from default_samples(H) (a multiple of n / gcd(n, EO)) and may grow AUTO_SAMPLES_GROWTH
+    times; a given n_samples is used as given. The growth itself on a failing branch:
+    test_automatic_aft_sampling_rescues_a_retracing_branch (slow)."""
+    import bladedamp.mistuned as mistuned_module
+    from bladedamp.disk import AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION
+    from bladedamp.response import sampled_response
+
+    calls = []
+
+    def spy(solve, n_samples, first, most, most_for_dissipation=None):
+        calls.append((n_samples, first, most, most_for_dissipation))
+        return sampled_response(solve, n_samples, first, most, most_for_dissipation)
+
+    monkeypatch.setattr(mistuned_module, "sampled_response", spy)
+    disk = MistunedDisk.from_tuned(tuned(4), [1.0, 1.01, 0.99, 1.005])
+    first = disk.default_samples((1,))
+    r = run(disk, (94.0, 96.0), max_step=0.1)
+    assert calls == [(None, first, AUTO_SAMPLES_GROWTH * first, AUTO_SAMPLES_GROWTH_DISSIPATION * first)]
+    assert r.basis.n_samples == first
+    fixed = run(disk, (94.0, 96.0), max_step=0.1, n_samples=48)
+    assert calls[-1][0] == 48 and fixed.basis.n_samples == 48
+
+
+@pytest.mark.slow
+def test_automatic_aft_sampling_rescues_a_retracing_branch():
+    """Random disk 7 (a 0.034 g wedge, (0, 1, 2, 3), tests/test_random_designs.py) as a
+    MistunedDisk sector of one blade: with 64 AFT samples per period its continuation retraces
+    itself near 94.9 Hz (a coarse AFT: the friction forces jump between samples) and does not
+    reach 98 Hz; the default sampling grows the samples to 256 and the branch reaches the end
+    with every check passing, the message saying why (as TunedDisk, FrictionOscillator)."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from test_random_designs import disk_design, make_disk
+
+    d = disk_design(7)
+    disk = MistunedDisk.from_tuned(make_disk(d), [1.0], n_sector=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        coarse = disk.frequency_response(92.0, 98.0, harmonics=d["harmonics"], max_step=d["max_step"], n_samples=64)
+        auto = disk.frequency_response(92.0, 98.0, harmonics=d["harmonics"], max_step=d["max_step"])
+    assert not coarse.success and coarse.basis.n_samples == 64
+    assert auto.success and not auto.failed_checks and auto.basis.n_samples == 256, auto.message
+    assert "AFT samples per period raised to 256 (the branch failed with 64)" in auto.message

@@ -127,13 +127,16 @@ def test_disk_small_amplitude_is_the_linear_stuck_mode(disk, disk_mode):
     assert r.frequency_hz[-1] < r.frequency_hz[0] - 0.5          # and softens the mode
 
 
-@pytest.mark.parametrize("kind, forcing, harmonics", [("cylinder", 0.1, (1,)), ("cylinder", 1.0, (1,)),
-                                                      ("wedge", 0.01, (1,)), ("wedge", 0.1, (1,)),
-                                                      ("cylinder", 0.1, (0, 1))])
+@pytest.mark.parametrize("kind, forcing, harmonics", [("cylinder", 0.1, (1,)),
+                                                      pytest.param("cylinder", 1.0, (1,), marks=pytest.mark.slow),
+                                                      pytest.param("wedge", 0.01, (1,), marks=pytest.mark.slow),
+                                                      ("wedge", 0.1, (1,)), ("cylinder", 0.1, (0, 1))])
 def test_disk_synthesis_matches_the_frf_peak(kind, forcing, harmonics):
-    """EO = 1: the synthesis peak of the 1F nonlinear mode against the HBM FRF peak, at the
-    reference excitation 0.1 N and at 0.01 N / 1 N (near stuck, towards gross slip); with a
-    static harmonic the centrifugal preload F_CG stays in the autonomous problem."""
+    """EO = 1: the synthesis peak of the 1F nonlinear mode (interpolated between its points)
+    against the HBM FRF peak, at the reference excitation 0.1 N and at 0.01 N / 1 N (near stuck,
+    towards gross slip; slow: test_disk_synthesis_over_the_excitation_range covers 0.01-1 N with
+    the resolved peaks); with a static harmonic the centrifugal preload F_CG stays in the
+    autonomous problem."""
     disk, mode = reference(kind, harmonics)
     assert mode.success, mode.message
     peak = mode.forced_peak(scale=forcing / disk.excitation[0])
@@ -173,9 +176,115 @@ def test_bad_inputs_name_the_parameter_and_range():
         nonlinear_mode(OSC, max_log_step=0)
     with pytest.raises(TypeError, match="hbm_system"):
         nonlinear_mode(object())
+    with pytest.raises(ValueError, match=r"resolve_peaks \(excitation scales\) must be in \(0, inf\)"):
+        nonlinear_mode(OSC, resolve_peaks=[1.0, 0.0])
     with pytest.raises(ValueError, match="force must have shape"):
         nonlinear_mode(OSC, amplitudes=[1e-5, 1e-4]).forced_peak(np.ones(3))
 
 
 def test_top_level_export():
     assert bd.nonlinear_mode is nonlinear_mode
+
+
+def test_resolved_peaks_are_epmc_roots_independent_of_the_points():
+    """``resolve_peaks``: the synthesis peak is an EPMC solution at the root of
+    h(a) = 2 zeta omega^2 sqrt(1 - zeta^2) a - |phi^H F| (a direct EPMC solve at that amplitude
+    gives h = 0 and the same tip amplitude), so it does not depend on the mode's points; the
+    interpolated peak of 15 points is off by percents."""
+    from bladedamp.hbm.nonlinear_modes import peak_function
+
+    scales = (0.25, 1.0, 4.0)
+    coarse, fine = (nonlinear_mode(OSC, n_points=n, resolve_peaks=scales) for n in (15, 60))
+    assert "3 of 3 forced peaks resolved" in coarse.message
+    interpolated = nonlinear_mode(OSC, n_points=15)
+    for s in scales:
+        p_coarse, p_fine = coarse.forced_peak(scale=s), fine.forced_peak(scale=s)
+        np.testing.assert_allclose(p_coarse["output_amplitude"], p_fine["output_amplitude"], rtol=1e-7)
+        np.testing.assert_allclose(p_coarse["frequency_hz"], p_fine["frequency_hz"], rtol=1e-9)
+    worst = max(abs(interpolated.forced_peak(scale=s)["output_amplitude"][0]
+                    / fine.forced_peak(scale=s)["output_amplitude"][0] - 1) for s in scales)
+    assert worst > 1e-2, "15 interpolated points should not resolve the peak"
+    peak = coarse.forced_peak(scale=1.0)
+    direct = nonlinear_mode(OSC, amplitudes=[peak["modal_amplitude"]])
+    h = peak_function(direct.modal_amplitude, direct.omega, direct.damping_ratio, direct.shape(1), direct.excitation)
+    assert abs(h[0]) < 1e-8 * abs(direct.shape(1)[0].conj() @ direct.excitation)
+    np.testing.assert_allclose(direct.output_amplitude[0], peak["output_amplitude"], rtol=1e-8)
+
+
+def free_disk(kind, **contact):
+    """The reference disk of ``kind`` with its damper's contact properties changed."""
+    disk = reference(kind)[0]
+    return dataclasses.replace(disk, damper=dataclasses.replace(
+        disk.damper, contact=dataclasses.replace(disk.damper.contact, **contact)))
+
+
+@pytest.mark.parametrize("kind", ["cylinder", "wedge"])
+def test_disk_free_limit_is_the_linear_mode_without_tangential_stiffness(kind):
+    """The free limit: with friction coefficient 0 the contacts carry their (linear) normal
+    springs and no tangential force, so the nonlinear mode is, at every amplitude, the linear
+    mode of the disk whose contacts have no tangential stiffness (k_T 1e-12 of the reference, k_N
+    unchanged: its first mode of the blade, above the damper's rigid-body modes), frequency and
+    damping ratio to rounding. The reference damper (mu = 0.3) tends to it at gross slip."""
+    from bladedamp.hbm.nonlinear_modes import linear_stuck_mode
+
+    contact = reference(kind)[0].damper.contact
+    r = nonlinear_mode(free_disk(kind, friction_coefficient=0.0), amplitudes=np.logspace(-6, -3, 4))
+    assert r.success, r.message
+    soft = free_disk(kind, tangential_stiffness_per_length=1e-12 * contact.tangential_stiffness_per_length,
+                     normal_to_tangential_stiffness=1e12 * contact.normal_to_tangential_stiffness)
+    system = soft.hbm_system((1,))
+    mode = 0
+    while True:                          # skip the damper's rigid-body modes (roll, slide: ~0.2 Hz)
+        w, zeta, _, _, _ = linear_stuck_mode(soft, system, mode)
+        if w > 2 * np.pi * 50:
+            break
+        mode += 1
+    np.testing.assert_allclose(2 * np.pi * r.frequency_hz, w, rtol=1e-9)
+    np.testing.assert_allclose(r.damping_ratio, zeta, rtol=1e-8)
+    # not the stuck mode (the tangential springs in): the check can tell them apart
+    stuck = reference(kind)[1]
+    assert stuck.linear_frequency_hz - r.frequency_hz[0] > 0.5
+    # the reference damper at the top of its default range (gross slip) has nearly reached it
+    assert abs(stuck.frequency_hz[-1] / r.frequency_hz[0] - 1) < 1e-4
+
+
+SYNTHESIS_LEVELS = (0.01, 0.03, 0.1, 0.3, 1.0)      # first-harmonic tip force [N], the issue's range
+
+
+@pytest.fixture(scope="module")
+def resolved_modes():
+    """The 1F mode of each reference damper with the synthesis peaks of every level resolved."""
+    out = {}
+    for kind in ("cylinder", "wedge"):
+        disk = reference(kind)[0]
+        out[kind] = nonlinear_mode(disk, resolve_peaks=np.array(SYNTHESIS_LEVELS) / disk.excitation[0])
+    return out
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("level", SYNTHESIS_LEVELS)
+@pytest.mark.parametrize("kind", ["cylinder", "wedge"])
+def test_disk_synthesis_over_the_excitation_range(resolved_modes, kind, level):
+    """Issue 14 item 3: the single-nonlinear-mode synthesis of the 1 g cylinder and the 0.3 g
+    wedge against the HBM FRF peak (one harmonic, both), 0.01-1 N, from near stuck to gross slip.
+    The issue's bound is 3 %; measured (one run) at most 0.06 % in amplitude and 0.008 % in
+    frequency with the resolved peaks, so 1 % and 0.1 % are asserted. From 0.03 N on, the stuck
+    linear mode's resonance misses the peak by more than 10 % (15 % to a factor 3.5): the
+    agreement is the nonlinear mode's."""
+    disk = reference(kind)[0]
+    mode = resolved_modes[kind]
+    assert mode.success and f"{len(SYNTHESIS_LEVELS)} of {len(SYNTHESIS_LEVELS)} forced peaks resolved" in mode.message
+    scale = level / disk.excitation[0]
+    peak = mode.forced_peak(scale=scale)
+    assert peak["found"], peak["message"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")                       # one harmonic: AccuracyWarning
+        frf = dataclasses.replace(disk, excitation=disk.excitation * scale).frequency_response(90, 105, harmonics=(1,))
+    assert frf.success, frf.message
+    np.testing.assert_allclose(peak["output_amplitude"][0], frf.peak_amplitude, rtol=0.01)
+    np.testing.assert_allclose(peak["frequency_hz"], frf.peak_frequency_hz, rtol=1e-3)
+    if level >= 0.03:                 # the stuck linear mode's resonance is off by more than 10 %
+        z0, w0 = mode.damping_ratio[0], 2 * np.pi * mode.frequency_hz[0]
+        linear = abs(mode.shape(1)[0].conj() @ mode.excitation) * scale \
+            * (mode.output_amplitude[0, 0] / mode.modal_amplitude[0]) / (2 * z0 * w0 ** 2)
+        assert abs(linear / frf.peak_amplitude - 1) > 0.1

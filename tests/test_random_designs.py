@@ -55,7 +55,7 @@ INCLINED_N_SAMPLES = None
 # a branch that needs more points than this at the suite's max_step has stalled
 MAX_POINTS = 2000
 N_TIME_CHECKS = 10
-ROTOR_SPEED_95 = 2 * np.pi * 95.0   # EO = 0: the rotor speed of the EO = 1 resonance
+ROTOR_SPEED_95_HZ = 95.0   # EO = 0: the rotor speed of the EO = 1 resonance [Hz]
 
 
 def _log_uniform(rng, lo, hi):
@@ -112,7 +112,7 @@ def make_disk(d: dict) -> TunedDisk:
     base = ref.EXCITATION_TABLE1 if d["table1"] else ref.EXCITATION_FX
     return TunedDisk(reference_blade(), damper, ref.N_BLADES, d["engine_order"], d["gamma_left"], d["gamma_right"],
                      ref.DAMPER_RADIUS, d["excitation_scale"] * base,
-                     rotor_speed=ROTOR_SPEED_95 if d["engine_order"] == 0 else None)
+                     rotor_speed_hz=ROTOR_SPEED_95_HZ if d["engine_order"] == 0 else None)
 
 
 def branch_checks(omega, lo, hi, max_step) -> list[str]:

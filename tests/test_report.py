@@ -61,6 +61,20 @@ def test_recorded_report_is_readable_and_has_one_heading_per_section(summary):
             assert line.count("|") == header_len, line
 
 
+def test_report_states_every_study_time(summary):
+    """Each study's wall-clock time is in the report, with its share of the run; a study whose
+    time the run did not record is left out rather than shown as zero."""
+    text = report.reproduce_report(summary)
+    t = summary["timings_s"]
+    rows = {line.split(" | ")[0].strip("| "): line for line in text.splitlines() if line.startswith("| ")}
+    for key, name in report.STUDY_TIMES:
+        assert f"| {name} | {t[key]:.1f} | {100 * t[key] / t['total_s']:.0f} % |" == rows[name], (key, rows.get(name))
+    assert set(t) - {"total_s"} == {key for key, _ in report.STUDY_TIMES}     # no study unnamed
+    assert f"Run time: {t['total_s']:.1f} s" in text
+    del summary["timings_s"]["mistuning_s"]
+    assert "| mistuning (Fig. 13-17) |" not in report.paper_section(summary, summary["table1"])
+
+
 def test_every_verdict_names_its_tolerance(summary):
     text = report.reproduce_report(summary)
     rows = report.verdict_rows(text)

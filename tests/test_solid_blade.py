@@ -381,3 +381,175 @@ def test_tuned_disk_frf_with_the_solid_blade(beam, capsys):
     assert runs["solid, FE"].peak_frequency_hz / runs["beam, FE"].peak_frequency_hz == pytest.approx(f_ratio, abs=5e-3)
     assert runs["solid, Table 1"].peak_frequency_hz == pytest.approx(runs["beam, Table 1"].peak_frequency_hz, rel=5e-3)
     assert runs["solid, Table 1"].peak_amplitude == pytest.approx(runs["beam, Table 1"].peak_amplitude, rel=0.05)
+
+
+# --------------------------------------------------------------------------------------
+# a user's geometry: closed surface mesh (STL) with named regions
+# --------------------------------------------------------------------------------------
+def _reference_regions():
+    """Selectors of the reference solid's named faces: the root plane z = 0 (outward -z) and the
+    platform undersides (planes through OL / OR, outward along the contact normals)."""
+    from bladedamp.damper.geometry import contact_normal
+    sg = solid.SolidBladeGeometry()
+    pts = sg.points()
+    return {"clamp": solid.PlaneRegion((0.0, 0.0, 0.0), (0.0, 0.0, -1.0)),
+            "OL": solid.PlaneRegion(pts["OL"], contact_normal("OL", sg.gamma_left)),
+            "OR": solid.PlaneRegion(pts["OR"], contact_normal("OR", sg.gamma_right))}
+
+
+@pytest.fixture(scope="module")
+def reference_stl_mm(coarse_modes, tmp_path_factory):
+    """The parametric reference solid's boundary (the 9 mm tetrahedral mesh's outer triangles)
+    written as an STL in millimetres: an independent path to the same blade."""
+    trimesh = pytest.importorskip("trimesh")
+    m = coarse_modes.mesh
+    tri = solid.boundary_faces(m.tets, m.vertices)
+    path = tmp_path_factory.mktemp("stl") / "reference_mm.stl"
+    trimesh.Trimesh(1e3 * m.vertices.T, tri.T).export(path)
+    return path
+
+
+def test_boundary_faces_are_the_closed_outward_surface(coarse_modes):
+    trimesh = pytest.importorskip("trimesh")
+    m = coarse_modes.mesh
+    surface = trimesh.Trimesh(m.vertices.T, solid.boundary_faces(m.tets, m.vertices).T, process=False)
+    assert surface.is_watertight and surface.is_winding_consistent
+    assert surface.volume * coarse_modes.geometry.density == pytest.approx(coarse_modes.mass, rel=1e-9)
+    # every named face of the mesher is on it
+    keys = {tuple(sorted(t)) for t in surface.faces.tolist()}
+    for tri in m.faces.values():
+        assert {tuple(sorted(t)) for t in tri.T.tolist()} <= keys
+
+
+def test_stl_geometry_recovers_the_parametric_faces(reference_stl_mm):
+    """Read back in mm (scale=1e-3): the contact faces (control point = the face's centroid, the
+    platform angle from its normal, the face rectangle) are the parametric solid's."""
+    sg = solid.SolidBladeGeometry()
+    # by default the control point is the face's centroid: the middle of the parametric rectangle
+    centroid = solid.SurfaceBladeGeometry(reference_stl_mm, _reference_regions(), scale=1e-3)
+    for side in ("OL", "OR"):
+        centre, frame, xi_r, eta_r = sg.contact_face(side)
+        np.testing.assert_allclose(centroid.points()[side], centre + xi_r.mean() * frame[0] + eta_r.mean() * frame[1],
+                                   atol=1e-6)
+    ug = solid.SurfaceBladeGeometry(reference_stl_mm, _reference_regions(), scale=1e-3,
+                                    points_given={side: sg.points()[side] for side in ("OL", "OR")})
+    assert ug.gamma_left == pytest.approx(sg.gamma_left, abs=1e-6)
+    assert ug.gamma_right == pytest.approx(sg.gamma_right, abs=1e-6)
+    for side in ("OL", "OR"):
+        for a, b in zip(ug.contact_face(side), sg.contact_face(side)):
+            np.testing.assert_allclose(a, b, rtol=0, atol=1e-6)          # float32 STL in mm: ~1e-8 m
+    np.testing.assert_allclose(ug.points()["tip"], sg.points()["tip"], atol=1e-6)   # default tip: the top face
+    # the same faces selected by separate STL files per region (SurfacePatch)
+    import trimesh
+    patches = {}
+    for side in ("OL", "OR"):
+        idx = ug.region_faces[side]
+        patch = trimesh.Trimesh(ug.vertices / 1e-3, ug.faces[idx])
+        patches[side] = solid.SurfacePatch(patch)
+    by_patch = solid.SurfaceBladeGeometry(reference_stl_mm, {**_reference_regions(), **patches}, scale=1e-3,
+                                          points_given=ug.points_given)
+    for side in ("OL", "OR"):
+        np.testing.assert_array_equal(by_patch.region_faces[side], ug.region_faces[side])
+
+
+def test_stl_blade_has_the_parametric_blades_modes(reference_stl_mm, coarse_modes, coarse_blade):
+    """The STL path (gmsh remeshes the surface, then tetrahedra; no symmetry) against the parametric
+    path at the same element size (9 mm). Both converge from above and the 9 mm values lie above the
+    3 mm ones by 0.4 % (1F) and 1.0 % (1T) (DEFAULT_ELEMENT_SIZE's table), so two 9 mm meshes of the
+    same blade may differ by that much: 0.5 % for the bending modes, 1 % for 1T (measured 0.16 %,
+    0.12 %, 0.35 %, 0.03 % for 1F, 2F, 1T, 1E). The mass is the same volume (planar faces): 1e-6."""
+    points = coarse_modes.geometry.points()
+    ug = solid.SurfaceBladeGeometry(reference_stl_mm, _reference_regions(), scale=1e-3,
+                                    points_given={"OL": points["OL"], "OR": points["OR"]})
+    m = solid.solid_modes(ug, COARSE, n_modes=4)          # the reference's lowest four are 1F, 2F, 1T, 1E
+    assert m.mass == pytest.approx(coarse_modes.mass, rel=1e-6)
+    assert m.mode_names[:4] == ("1F", "2F", "1T", "1E")
+    f, f_ref = _by_name(m), _by_name(coarse_modes)
+    for name, tol in (("1F", 5e-3), ("2F", 5e-3), ("1T", 1e-2), ("1E", 5e-3)):
+        assert f[name] / f_ref[name] == pytest.approx(1.0, abs=tol), name
+    sb = solid.solid_blade(modes=m)
+    assert set(sb.points) == {"OL", "OR", "tip", "excitation"}
+    # the contact faces' rigid-fit shapes and the raw face displacements (same samples: the same
+    # face rectangle) agree to 1 % of each mode's largest value
+    for side in ("OL", "OR", "tip"):
+        scale = np.abs(coarse_blade.shape(side)).max(axis=0)
+        np.testing.assert_allclose(sb.shape(side) / scale, coarse_blade.shape(side) / scale, rtol=0, atol=1e-2)
+    for side in ("OL", "OR"):
+        a, b = sb.contact_faces[side], coarse_blade.contact_faces[side]
+        np.testing.assert_allclose(a.points, b.points, atol=1e-6)
+        scale = np.abs(b.shapes).max(axis=(0, 1))
+        np.testing.assert_allclose(a.shapes / scale, b.shapes / scale, rtol=0, atol=2e-2)
+
+
+def test_stl_bad_input(reference_stl_mm, tmp_path):
+    import trimesh
+    regions = _reference_regions()
+    with pytest.raises(ValueError, match="scale: the surface spans 200 m"):
+        solid.SurfaceBladeGeometry(reference_stl_mm, regions)               # mm read as metres
+    with pytest.raises(ValueError, match="scale must be"):
+        solid.SurfaceBladeGeometry(reference_stl_mm, regions, scale=-1.0)
+    for missing in ("clamp", "OL", "OR"):
+        with pytest.raises(ValueError, match=f"regions: the '{missing}' region is missing"):
+            solid.SurfaceBladeGeometry(reference_stl_mm, {k: v for k, v in regions.items() if k != missing},
+                                       scale=1e-3)
+    with pytest.raises(ValueError, match=r"regions\['OL'\] selects no triangle"):   # a plane off the blade
+        solid.SurfaceBladeGeometry(reference_stl_mm, {**regions, "OL": solid.PlaneRegion((0, 0, 0.5), (0, 0, 1))},
+                                   scale=1e-3)
+    with pytest.raises(ValueError, match=r"regions\['OL'\].*platform angle"):    # the OR face named OL
+        solid.SurfaceBladeGeometry(reference_stl_mm, {**regions, "OL": regions["OR"]}, scale=1e-3)
+    with pytest.raises(ValueError, match="unknown names"):
+        solid.SurfaceBladeGeometry(reference_stl_mm, {**regions, "hub": regions["clamp"]}, scale=1e-3)
+    # not watertight: one triangle removed
+    mesh = trimesh.load(reference_stl_mm, force="mesh")
+    holed = tmp_path / "holed.stl"
+    trimesh.Trimesh(mesh.vertices, mesh.faces[1:]).export(holed)
+    with pytest.raises(ValueError, match="surface must be a closed"):
+        solid.SurfaceBladeGeometry(holed, regions, scale=1e-3)
+    with pytest.raises(FileNotFoundError, match="no file"):
+        solid.SurfaceBladeGeometry(tmp_path / "absent.stl", regions, scale=1e-3)
+    # a pointed tip has no flat top face: the default tip region says to give one
+    with pytest.raises(ValueError, match="give a 'tip' region"):
+        cone = trimesh.creation.cone(0.01, 0.2)
+        solid.SurfaceBladeGeometry(cone, regions)
+
+
+# --------------------------------------------------------------------------------------
+# centrifugal stiffening (optional part of item 1)
+# --------------------------------------------------------------------------------------
+def test_rotor_speed_bad_input():
+    with pytest.raises(ValueError, match="rotor_speed_hz"):
+        solid.solid_modes(None, PLATE, 4, rotor_speed_hz=-1.0)
+    with pytest.raises(ValueError, match="hub_radius"):
+        solid.solid_modes(None, PLATE, 4, rotor_speed_hz=10.0, hub_radius=-0.1)
+
+
+@pytest.mark.slow
+def test_centrifugal_stiffening_of_the_plain_plate():
+    """The plain plate (nu = 0: a uniaxial bar and an Euler-Bernoulli beam) spinning about y.
+
+    Static step: the tip's radial displacement is the bar's closed form
+    u(L) = rho Omega^2 / E (L^3 / 3 + R L^2 / 2) (the axial force N(z) = rho A Omega^2 int_z^L (s + R) ds).
+    Modes (R = 0, Omega = 20 Hz): omega^2 = omega_0^2 + S Omega^2 with Southwell's coefficient of a
+    uniform cantilever, S = 1.1933 for the first bending mode: out of the plane of rotation (1E here,
+    u_y along the axis) S, in the plane (1F, u_x) S - 1 (spin softening). Measured 1.193 for 1F and
+    1.155 for 1E (the edgewise plate, L / chord 4.4, is no Euler-Bernoulli beam: shear lowers it)."""
+    g, plate = _plate(0.0)
+    sg = plate.geometry
+    omega_hz, R = 50.0, 0.1
+    spun = solid.solid_modes(sg, PLATE, 6, rotor_speed_hz=omega_hz, hub_radius=R)
+    tip_vertices = np.unique(spun.mesh.faces["tip"])
+    uz = spun.static_displacement[spun._fe["basis_k"].nodal_dofs[2, tip_vertices]]
+    tip_uz = uz.mean()
+    assert np.ptp(uz) < 1e-3 * tip_uz              # nu = 0: the tip face moves as a whole
+    L = g.total_length
+    closed = g.density * (2 * np.pi * omega_hz) ** 2 / g.youngs_modulus * (L**3 / 3 + R * L**2 / 2)
+    assert tip_uz == pytest.approx(closed, rel=2e-3)
+    slow = solid.solid_modes(sg, PLATE, 6, rotor_speed_hz=20.0)
+    f0, f1 = _by_name(plate), _by_name(slow)
+    southwell = {n: (f1[n] ** 2 - f0[n] ** 2) / 20.0**2 for n in ("1F", "1E")}
+    assert southwell["1F"] + 1.0 == pytest.approx(1.1933, rel=5e-3)
+    assert southwell["1E"] == pytest.approx(1.1933, rel=0.05)
+    # the hub radius raises the tension and so every bending frequency
+    assert all(_by_name(spun)[n] > f1[n] for n in ("1F", "2F", "1E"))
+    blade = solid.solid_blade(None, PLATE, rotor_speed_hz=20.0)
+    assert blade.solid_info["rotor_speed_hz"] == 20.0

@@ -133,17 +133,24 @@ def jenkins():
 
 def test_hill_on_the_aft_jacobian_of_friction_is_not_valid_so_the_determinant_decides():
     """The 1-DOF Jenkins oscillator is stable (time integration from rest reaches the HBM
-    solution); Hill's method on the AFT Jacobian of its friction contact would call it unstable
-    (the memory of the last reversal breaks the copy structure), so friction systems are
-    decided by the sign of det J, positive all along this fold-free branch."""
+    solution); Hill's method on the AFT Jacobian of its friction contact does not give its
+    exponents (the memory of the last reversal is not in it), so friction systems are decided by
+    the sign of det J, positive all along this fold-free branch, or by the monodromy matrix."""
     osc = jenkins()
     r = osc.frequency_response(0.7, 1.8, harmonics=(0, 1, 2, 3, 4, 5))
     system = osc.hbm_system(r.basis.harmonics, r.basis.n_samples)
     auto = branch_stability(system, r.coefficients, r.omega)
     assert auto.method == "determinant sign" and auto.stable.all() and auto.changes.size == 0
-    forced = [floquet_exponents(system, r.coefficients[i].ravel(), float(r.omega[i]), method="hill")
-              for i in (0, len(r.omega) // 2)]
-    assert max(f.max_real for f in forced) > 0.5, "Hill on the AFT Jacobian finds growth that is not there"
+    # Hill's method on the AFT Jacobian: the viscous decay -c / 2m alone at a point below the
+    # resonance where the monodromy matrix (memory included) shows the friction damping the
+    # perturbation 40 times faster
+    i = len(r.omega) // 12
+    w = float(r.omega[i])
+    forced = floquet_exponents(system, r.coefficients[i].ravel(), w, method="hill")
+    exact = floquet_exponents(system, r.coefficients[i].ravel(), w, method="monodromy", model=osc)
+    assert exact.method == "monodromy" and exact.stable
+    assert forced.max_real == pytest.approx(-osc.damping / (2 * osc.mass), rel=1e-3)
+    assert exact.max_real < 20 * forced.max_real, "the AFT Jacobian misses the friction's damping of perturbations"
     f = np.array([0.75, 1.0, 1.2, 1.6])
     td = osc.time_response(f)
     hbm = np.interp(2 * np.pi * f, r.omega, r.harmonic_amplitude(0, 1))
@@ -252,3 +259,110 @@ def test_reference_disk_has_no_fold_and_keeps_det_j_positive():
     assert r.stability_method == "determinant sign" and r.stable.all()
     assert r.bifurcations["branch point"] == [] and len(r.turning_points) == 0
     assert r.bifurcations["seconds"] > 0
+
+
+# ----- the monodromy matrix of the time integration ----------------------------------------
+
+def test_monodromy_multipliers_are_hills_on_the_duffing_oscillator():
+    """Smooth system: the eigenvalues of the monodromy matrix (finite differences of one period
+    of the central-difference integration started on the HBM solution) equal Hill's multipliers
+    exp(lambda T), on both stable parts and between the folds; both put the folds at the same
+    points."""
+    osc = duffing()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = osc.frequency_response(0.8, 1.4, harmonics=(1, 3, 5), max_step=0.02)
+    system = osc.hbm_system(r.basis.harmonics, r.basis.n_samples)
+    lo, hi = sorted(int(t) for t in r.turning_points)
+    points = sorted(set(range(0, len(r.omega), 9)) | {lo - 5, (lo + hi) // 2, hi + 5})
+    unstable_seen = 0
+    for i in points:
+        w, x = float(r.omega[i]), r.coefficients[i].ravel()
+        hill = floquet_exponents(system, x, w)
+        mono = floquet_exponents(system, x, w, method="monodromy", model=osc)
+        assert hill.method == "hill" and mono.method == "monodromy"
+        assert mono.periodicity_error < 1e-4
+        # the slider of the frictionless contact is always separated: it forgets (multiplier 0)
+        assert abs(mono.multipliers[2]) < 1e-9
+        pairs = [min(abs(a - b) for b in mono.multipliers[:2]) for a in hill.multipliers]
+        assert len(pairs) == 2 and max(pairs) < 1e-4, (i, hill.multipliers, mono.multipliers)
+        assert mono.stable == hill.stable
+        unstable_seen += not mono.stable
+    assert unstable_seen >= 3
+    st = branch_stability(system, r.coefficients[lo - 6:hi + 6], r.omega[lo - 6:hi + 6], method="monodromy", model=osc)
+    assert st.method == "monodromy" and st.kinds == ("fold", "fold")
+    assert [int(c) + lo - 6 for c in st.changes] in ([lo - 1, hi - 1], [lo, hi - 1], [lo - 1, hi], [lo, hi])
+
+
+def test_monodromy_of_a_stuck_contact_is_the_stuck_linear_system():
+    """A contact that never slips: the multipliers are those of the linear oscillator with the
+    contact stiffness added, exp((-zeta w0 +- i w_d) T), plus exactly 1 for the slider (a stuck
+    contact holds any offset: a neutral family of orbits, counted as stable)."""
+    k, kt, c = W0 ** 2, 0.5 * W0 ** 2, 0.2
+    osc = FrictionOscillator(mass=1.0, stiffness=k, damping=c, contact_stiffness=kt, friction_coefficient=0.5,
+                             normal_load=100.0, forcing=0.1)
+    r = osc.frequency_response(0.9, 1.1, harmonics=(0, 1, 2, 3))
+    system = osc.hbm_system(r.basis.harmonics, r.basis.n_samples)
+    i = len(r.omega) // 2
+    w = float(r.omega[i])
+    mono = floquet_exponents(system, r.coefficients[i].ravel(), w, method="monodromy", model=osc)
+    w0 = np.sqrt(k + kt)
+    lam = -c / 2 + 1j * np.sqrt(w0 ** 2 - c ** 2 / 4)
+    T = 2 * np.pi / w
+    expected = np.exp(np.array([lam, lam.conjugate()]) * T)
+    mu = mono.multipliers
+    one = np.argmin(np.abs(mu - 1))
+    assert abs(mu[one] - 1) < 1e-9 and mono.stable
+    rest = np.delete(mu, one)
+    # second order in the step: (w0 dt)^2 / 24 of the phase per step
+    assert max(min(abs(a - b) for b in rest) for a in expected) < 2e-4
+
+
+def test_monodromy_finds_the_friction_folds_and_the_time_integration_agrees(friction_fold_branch):
+    """Friction oscillator with a hardening spring: the monodromy matrix, with the slider
+    position in the state, puts the loss of stability at the folds (within a point of the
+    determinant sign's change) and calls the segment between them unstable through a real
+    multiplier > 1; the perturbed time integrations of test_friction_fold_stability_confirmed_by_
+    time_integration confirm the same three verdicts."""
+    osc, r, st = friction_fold_branch
+    lo, hi = sorted(int(t) for t in r.turning_points)
+    idx = np.array(sorted(set(range(0, len(r.omega), 20)) | set(range(lo - 3, lo + 4)) | set(range(hi - 3, hi + 4))))
+    system = osc.hbm_system(r.basis.harmonics, r.basis.n_samples)
+    mono = branch_stability(system, r.coefficients[idx], r.omega[idx], method="monodromy", model=osc)
+    assert mono.method == "monodromy"
+    far = np.abs(idx[:, None] - np.array([lo, hi])[None, :]).min(axis=1) > 1
+    np.testing.assert_array_equal(mono.stable[far], st.stable[idx][far])
+    changes = idx[mono.changes]
+    assert len(changes) == 2 and abs(changes[0] - lo) <= 2 and abs(changes[1] - hi) <= 2
+    assert mono.kinds == ("fold", "fold")
+    mid = int(np.argmin(np.abs(idx - (lo + hi) // 2)))
+    lead = floquet_exponents(system, r.coefficients[idx[mid]].ravel(), float(r.omega[idx[mid]]),
+                             method="monodromy", model=osc)
+    assert lead.unstable_kind() == "real" and lead.multipliers[0].real > 1.05 and lead.multipliers[0].imag == 0
+    for where, i in {"upper stable": lo - 30, "unstable": (lo + hi) // 2, "lower stable": hi + 30}.items():
+        point = floquet_exponents(system, r.coefficients[i].ravel(), float(r.omega[i]), method="monodromy", model=osc)
+        assert point.stable == (where != "unstable"), where
+        # started on the HBM orbit with the AFT's periodic slider: one period returns to it
+        assert point.periodicity_error < 3e-4, (where, point.periodicity_error)
+
+
+def test_multiplier_crossing_kinds():
+    from bladedamp.hbm.stability import multiplier_crossing
+
+    assert multiplier_crossing(np.array([0.3, 1.02 + 0j])) == "fold"
+    assert multiplier_crossing(np.array([-1.01 + 0j, 0.2])) == "period doubling"
+    assert multiplier_crossing(np.array([0.6 + 0.8j, 0.6 - 0.8j, 0.1])) == "neimark-sacker"
+
+
+def test_monodromy_refuses_models_without_a_period_map():
+    import bladedamp as bd
+
+    osc = duffing()
+    system = osc.hbm_system((1,))
+    x = np.zeros(system.n_unknowns)
+    with pytest.raises(ValueError, match="method"):
+        floquet_exponents(system, x, W0, method="monodromy")                  # no model
+    with pytest.raises(ValueError, match="FrictionOscillator"):
+        floquet_exponents(system, x, W0, method="monodromy", model=bd.reference_disk("cylinder"))
+    with pytest.raises(ValueError, match="method must be one of"):
+        floquet_exponents(system, x, W0, method="shooting")

@@ -222,3 +222,145 @@ def test_without_meshcat_the_3d_names_give_a_one_line_install_hint(monkeypatch):
         viz.show
     message = str(err.value)
     assert "\n" not in message and "pip install 'bladedamp[viz]'" in message
+
+
+# --------------------------------------------------------------------------------------
+# the solid FE blade's deformed surface (issue 16)
+# --------------------------------------------------------------------------------------
+SOLID_ELEMENT_SIZE = 12e-3     # [m] coarse solid blade: ~340 surface vertices, 4 s
+
+
+@pytest.fixture(scope="module")
+def solid_frf():
+    """The reference cylinder (1 g) with the solid FE blade, through its 1F resonance, one harmonic."""
+    pytest.importorskip("gmsh")
+    pytest.importorskip("skfem")
+    import dataclasses
+    from bladedamp import solid
+
+    blade = solid.solid_blade(None, SOLID_ELEMENT_SIZE)
+    disk = dataclasses.replace(bd.reference_disk("cylinder", 1e-3), blade=blade)
+    frf = bd.frequency_response(disk, (97.5, 100.5), harmonics=(1,), max_step=0.1)
+    assert frf.success, frf.message
+    return frf
+
+
+def _html_commands(html: str) -> list:
+    """The meshcat commands packed in a standalone HTML (base64 msgpack of every fetch)."""
+    import base64
+    import re
+    import umsgpack
+
+    return [umsgpack.unpackb(base64.b64decode(b))
+            for b in re.findall(r'fetch\("data:application/octet-binary;base64,([A-Za-z0-9+/=]+)"\)', html)]
+
+
+def _array(packed, width=3) -> np.ndarray:
+    return np.frombuffer(packed["array"].data, dtype=np.float32).reshape(-1, width).astype(float)
+
+
+def _fe_surface_expected(frf, q) -> np.ndarray:
+    """Vertices of the FE surface displaced by modal coordinates q, from the solid's own FE field
+    (P2 interpolation at the points, not the stored surface shapes)."""
+    blade = frf.disk.blade
+    x = blade.surface.vertices
+    u = blade.modes.displacements_at(x)[:, :, list(blade.mode_indices)]           # (n_v, 3, n_m)
+    return x, u @ q
+
+
+def test_solid_blade_view_draws_the_fe_surface_deformed_by_the_modes(solid_frf):
+    """show() of a disk with the solid blade: every blade is the FE boundary surface (the
+    tetrahedral mesh's outer triangles), drawn once with the scaled mode shapes as morph targets;
+    the animation sets the morph influences to the modal coordinates, so the drawn vertices at a
+    frame are the mode superposition x + scale sum_j q_j(tau) phi_j(x)."""
+    blade = solid_frf.disk.blade
+    scene = mv.show(solid_frf, n_frames=N_FRAMES)
+    assert scene.info["layout"] == "disk"
+    commands = _html_commands(scene.html())
+    objects = {c["path"]: c["object"] for c in commands if c["type"] == "set_object"}
+    base = "/meshcat/bladedamp/blades/blade_00/fe_surface"
+    assert all(f"/meshcat/bladedamp/blades/blade_{k:02d}/fe_surface" in objects
+               for k in range(solid_frf.disk.n_blades))
+    assert not any("segment_" in p for p in objects)                    # no beam segments
+    geometry = objects[base]["geometries"][0]["data"]
+    vertices = _array(geometry["attributes"]["position"])
+    faces = np.frombuffer(geometry["index"]["array"].data, dtype=np.uint32).reshape(-1, 3)
+    np.testing.assert_allclose(vertices, blade.surface.vertices, rtol=0, atol=1e-7)
+    np.testing.assert_array_equal(faces, blade.surface.faces)
+    targets = np.array([_array(t) for t in geometry["morphAttributes"]["position"]])   # (n_m, n_v, 3)
+    assert geometry["morphTargetsRelative"] is True and targets.shape == (blade.n_modes,) + vertices.shape
+    # influences per frame from the recorded animation
+    animation = next(c for c in commands if c["type"] == "set_animation")["animations"]
+    clip = next(a["clip"] for a in animation if a["path"] == base + "/<object>")
+    influences = np.array([[k["value"] for k in t["keys"]] for t in sorted(clip["tracks"], key=lambda t: t["name"])])
+    assert [t["name"] for t in sorted(clip["tracks"], key=lambda t: t["name"])] == \
+        [f".morphTargetInfluences[{j}]" for j in range(blade.n_modes)]
+    assert influences.shape == (blade.n_modes, N_FRAMES + 1)
+    # frame f (tau = 2 pi f / N): q = a cos(tau) + b sin(tau) of the first harmonic (harmonics (1,):
+    # rows cos, sin) at the resonance point; the drawn displacement (morph part; the base vertices
+    # are float32) against the solid's FE field there
+    X = np.asarray(solid_frf.coefficients[scene.info["index"]])
+    x, _ = _fe_surface_expected(solid_frf, np.zeros(blade.n_modes))
+    drawn, expected = [], []
+    for f in range(N_FRAMES):
+        tau = 2 * np.pi * f / N_FRAMES
+        q = X[0, :blade.n_modes] * np.cos(tau) + X[1, :blade.n_modes] * np.sin(tau)
+        drawn.append(np.tensordot(influences[:, f], targets, axes=1))
+        expected.append(scene.info["scale"] * _fe_surface_expected(solid_frf, q)[1])
+    drawn, expected = np.array(drawn), np.array(expected)
+    np.testing.assert_allclose(drawn, expected, rtol=0, atol=1e-5 * np.abs(expected).max())
+    # over the cycle the tip face's centre swings by the drawn tip amplitude (8 % of the span)
+    tip = np.argmin(np.linalg.norm(blade.surface.vertices - blade.points["tip"], axis=1))
+    swing = np.array([vertices[tip] + np.tensordot(w, targets[:, tip], axes=1) for w in influences.T])[:, 0]
+    assert 0.5 * np.ptp(swing) == pytest.approx(scene.info["scale"] * scene.info["tip_amplitude"], rel=0.05)
+
+
+def test_solid_blade_still_frame_is_the_deformed_surface(solid_frf):
+    blade = solid_frf.disk.blade
+    phase = np.pi / 3
+    scene = mv.ods_scene(solid_frf, animate=False, phase=phase, layout="sector")
+    geometry = scene.object("bladedamp/blades/blade_00/fe_surface").geometry
+    assert not isinstance(geometry, mv.MorphMeshGeometry)
+    X = np.asarray(solid_frf.coefficients[scene.info["index"]])           # (cos, sin) x DOF
+    q = X[0, :blade.n_modes] * np.cos(phase) + X[1, :blade.n_modes] * np.sin(phase)
+    x, u = _fe_surface_expected(solid_frf, q)
+    expected = x + scene.info["scale"] * u
+    # float32 vertices: ~1e-8 m of rounding on displacements of up to 16 mm (8 % of the span)
+    np.testing.assert_allclose(geometry.vertices, expected, rtol=0, atol=1e-5 * np.abs(expected - x).max())
+    assert np.abs(expected - x).max() > 0.02 * scene.info["scale"] * scene.info["tip_amplitude"]
+
+
+@pytest.mark.slow
+def test_browser_applies_the_fe_surface_morph_animation(solid_frf, tmp_path):
+    """Headless Chromium: the animation drives the FE surface's morph influences (the viewer binds
+    the tracks to the mesh itself; the page reports them in its title)."""
+    import subprocess
+    import tempfile
+
+    exe = mv.chromium_executable()
+    if exe is None:
+        pytest.skip("no chromium on this machine (.ci/run installs the Debian package)")
+    scene = mv.ods_scene(solid_frf, n_frames=N_FRAMES, layout="sector", contact_maps=False, period_s=2.0)
+    # the page samples the mesh's morph influences every 50 ms for 1.2 s (over half a period: q
+    # passes zero twice per period, so one sample could be near zero) and reports them in its title
+    probe = ("<script>let seen = []; let probe = setInterval(() => {let o = viewer.scene_tree.find(['meshcat', "
+             "'bladedamp', 'blades', 'blade_00', 'fe_surface', '<object>']).object; "
+             "seen.push(Array.from(o.morphTargetInfluences)); if (seen.length >= 24) {clearInterval(probe); "
+             "document.title = 'MORPH' + JSON.stringify(seen);}}, 50);</script></body>")
+    html = tmp_path / "solid.html"
+    html.write_text(scene.html().replace("</body>", probe), encoding="utf-8")
+    with tempfile.TemporaryDirectory() as profile:
+        out = subprocess.run([exe, "--headless", "--no-sandbox", "--disable-gpu", "--enable-unsafe-swiftshader",
+                              f"--user-data-dir={profile}", "--virtual-time-budget=2500", "--dump-dom",
+                              "file://" + str(html)], capture_output=True, text=True, timeout=180).stdout
+    import json
+    import re
+    found = re.search(r"<title>MORPH(\[.*?\])</title>", out)
+    assert found, "the page did not report the morph influences"
+    w = np.array(json.loads(found.group(1)))                                   # (24 samples, n_m)
+    X = np.asarray(solid_frf.coefficients[scene.info["index"]])[:, :solid_frf.disk.blade.n_modes]
+    amplitude = np.hypot(X[0], X[1])                                           # |q_j| over the cycle
+    assert w.shape == (24, solid_frf.disk.blade.n_modes)
+    # playing: the 1F weight swings through most of its amplitude, and never beyond it
+    assert np.ptp(w[:, 0]) > 0.5 * amplitude[0]
+    assert np.all(np.abs(w) <= amplitude * (1 + 1e-3) + 1e-12)

@@ -274,7 +274,7 @@ def _lu_signed(A):
     if sp.issparse(A):
         lu = splu(sp.csc_matrix(A))
         d = lu.U.diagonal()
-        sign = np.prod(np.sign(d)) * _perm_sign(lu.perm_r) * _perm_sign(lu.perm_c)
+        sign = np.prod(np.sign(d)) * permutation_sign(lu.perm_r) * permutation_sign(lu.perm_c)
 
         def solve(b):
             return lu.solve(np.asarray(b, dtype=float))
@@ -300,7 +300,7 @@ def _lu_signed(A):
 
 
 @njit(cache=True)
-def _perm_sign(perm):
+def permutation_sign(perm) -> int:
     """Sign (+1 / -1) of the permutation ``perm`` (an arrangement of 0..n-1), by its cycles."""
     n = perm.size
     seen = np.zeros(n, dtype=np.bool_)

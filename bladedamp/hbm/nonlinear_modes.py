@@ -222,7 +222,7 @@ def linear_stuck_mode(model, system, mode: int = 0, omega_guess: float | None = 
         xs = _static_equilibrium(model, system, omega)
         _, J, _ = system.residual(xs, omega)
         J = J.toarray() if hasattr(J, "toarray") else np.asarray(J)
-        A, _ = system._dynamic_stiffness(omega)
+        A, _ = system.dynamic_stiffness(omega)
         A = A.toarray() if hasattr(A, "toarray") else np.asarray(A)
         Jnl = J - A
         K1 = K + Jnl[ca, ca] + 1j * Jnl[ca, cb]
@@ -251,6 +251,28 @@ def linear_stuck_mode(model, system, mode: int = 0, omega_guess: float | None = 
     phi = phi / np.sqrt(np.real(phi.conj() @ M @ phi))
     zeta = float(np.real(phi.conj() @ D @ phi)) / (2 * omega)
     return omega, zeta, phi, xs, len(order)
+
+
+# ----- single-nonlinear-mode synthesis ------------------------------------------------------
+def peak_function(a, omega, zeta, phi1, force) -> np.ndarray:
+    """h(a) (n,) = 2 zeta omega^2 sqrt(1 - zeta^2) a - |phi_1^H F| [N per modal amplitude unit]
+    at the mode's points: amplitudes ``a`` (n,), omega (n,) [rad/s], zeta (n,), first-harmonic
+    shapes ``phi1`` (n, n_dof) complex and the first-harmonic force ``force`` (n_dof,) [N]. The
+    resonance of the single-mode synthesis is its largest root (Krack 2014)."""
+    zeta = np.asarray(zeta, dtype=float)
+    return 2 * zeta * np.asarray(omega) ** 2 * np.sqrt(np.clip(1 - zeta ** 2, 0, None)) * np.asarray(a) \
+        - np.abs(np.asarray(phi1).conj() @ force)
+
+
+def peak_bracket(h) -> int:
+    """Index i of the interval [a_i, a_i+1] holding the resonance: the last point with h <= 0,
+    if h starts <= 0 and some later point has h > 0; -1 otherwise (the peak is below or above
+    the computed range)."""
+    h = np.asarray(h)
+    below = np.flatnonzero(h <= 0)
+    if h[0] > 0 or not below.size or below[-1] == h.size - 1:
+        return -1
+    return int(below[-1])
 
 
 # ----- the result -------------------------------------------------------------------------
@@ -316,14 +338,23 @@ class NonlinearModeResponse(Saveable):
 
         ``force``: (n_dof,) first-harmonic force amplitude (real: a cosine load; complex X = a - i b),
         default the model's own ``excitation``; ``scale`` multiplies it (excitation levels).
-        The peak amplitude solves 2 zeta(a) omega(a)^2 sqrt(1 - zeta^2) a = |phi_1(a)^H F|
-        (the largest a on the computed range; a, omega, zeta and phi interpolated monotonically in
-        log a), at the excitation frequency Omega = omega sqrt(1 - 2 zeta^2).
+        The peak amplitude is the largest root a on the computed range of
+        h(a) = 2 zeta(a) omega(a)^2 sqrt(1 - zeta^2) a - |phi_1(a)^H F|, at the excitation
+        frequency Omega = omega sqrt(1 - 2 zeta^2).
+
+        Between the computed amplitudes zeta, omega, |phi_1^H F| and log(output / a) are
+        interpolated by not-a-knot cubic splines in log a (exact at the computed points). The
+        mode's zeta(a) has kinks (a time sample of the AFT switching stick / slip), so any
+        interpolation errs by up to ~1e-3 of the peak with 60 points per mode, and that error
+        jumps as the points move with a design parameter (a damper mass). A peak computed with
+        ``nonlinear_mode(..., resolve_peaks=...)`` for this force has an EPMC solution at its root
+        (to 1e-7 in log a): the spline passes through it, so the peak is the EPMC's to its Newton
+        tolerance, not interpolated.
 
         Returns {"modal_amplitude", "frequency_hz", "output_amplitude" (k,) [m],
         "damping_ratio", "found" (bool), "message"}; nan values when the peak is beyond the
         computed range (the message says which end)."""
-        from scipy.interpolate import PchipInterpolator
+        from scipy.interpolate import CubicSpline
         from scipy.optimize import brentq
 
         F = self.excitation if force is None else np.asarray(force)
@@ -332,36 +363,29 @@ class NonlinearModeResponse(Saveable):
         if F.shape != (n_dof,):
             raise ValueError(f"force must have shape ({n_dof},) (one first-harmonic amplitude per DOF; got {F.shape})")
         a = np.asarray(self.modal_amplitude, dtype=float)
+        out = np.asarray(self.output_amplitude, dtype=float)
         nan = {"modal_amplitude": np.nan, "frequency_hz": np.nan, "damping_ratio": np.nan,
-               "output_amplitude": np.full(np.shape(self.output_amplitude)[1:], np.nan), "found": False}
+               "output_amplitude": np.full(np.shape(out)[1:], np.nan), "found": False}
         if a.size < 2:
             return {**nan, "message": "need at least two amplitudes"}
-        phi1 = self.shape(1)
-        modal_force = np.abs(phi1.conj() @ F)           # |phi_1^H F| at every point
-        w, z = self.omega, np.asarray(self.damping_ratio)
-        h = 2 * z * w ** 2 * np.sqrt(np.clip(1 - z ** 2, 0, None)) * a - modal_force
+        h = peak_function(a, self.omega, self.damping_ratio, self.shape(1), F)
+        i = peak_bracket(h)
+        if i < 0:
+            where = "below the smallest" if h[0] > 0 else "above the largest"
+            return {**nan, "message": f"the peak lies {where} amplitude {a[0 if h[0] > 0 else -1]:.4g}"}
         la = np.log(a)
-        if h[0] > 0:
-            return {**nan, "message": f"the peak lies below the smallest amplitude {a[0]:.4g}"}
-        above = np.flatnonzero(h > 0)
-        if not above.size or above[-1] < np.flatnonzero(h <= 0)[-1]:
-            return {**nan, "message": f"the peak lies above the largest amplitude {a[-1]:.4g}"}
-        last_below = np.flatnonzero(h <= 0)[-1]
-        i = last_below
-        fz, fw = PchipInterpolator(la, z), PchipInterpolator(la, w)
-        fphi_r, fphi_i = PchipInterpolator(la, phi1.real, axis=0), PchipInterpolator(la, phi1.imag, axis=0)
+        z = np.asarray(self.damping_ratio, dtype=float)
+        fz, fw = CubicSpline(la, z), CubicSpline(la, self.omega)
+        fg = CubicSpline(la, np.abs(self.shape(1).conj() @ F))
 
         def hfun(s):
             zz, ww = float(fz(s)), float(fw(s))
-            p = fphi_r(s) + 1j * fphi_i(s)
-            return 2 * zz * ww ** 2 * np.sqrt(max(1 - zz ** 2, 0.0)) * np.exp(s) - abs(p.conj() @ F)
+            return 2 * zz * ww ** 2 * np.sqrt(max(1 - zz ** 2, 0.0)) * np.exp(s) - float(fg(s))
 
-        s = brentq(hfun, la[i], la[i + 1], xtol=1e-13, rtol=1e-13)
+        s = brentq(hfun, la[i], la[i + 1], xtol=1e-14, rtol=1e-14) if h[i] < 0 else la[i]
         ap, zp, wp = float(np.exp(s)), float(fz(s)), float(fw(s))
-        out = np.asarray(self.output_amplitude, dtype=float)
         if out.size:
-            out_amp = np.array([np.exp(PchipInterpolator(la, np.log(np.maximum(out[:, k] / a, 1e-300)))(s))
-                                for k in range(out.shape[1])]) * ap
+            out_amp = np.exp(CubicSpline(la, np.log(np.maximum(out / a[:, None], 1e-300)), axis=0)(s)) * ap
         else:
             out_amp = np.zeros(0)
         return {"modal_amplitude": ap, "frequency_hz": wp * np.sqrt(max(1 - 2 * zp ** 2, 0.0)) / (2 * np.pi),
@@ -411,7 +435,7 @@ def _default_amplitudes(problem: EPMCProblem, x_static, phi_u, omega, n_points=6
     onset / 10 to 10 x gross slip."""
     system = problem.system
     _, J, _ = system.residual(x_static, omega)
-    A, _ = system._dynamic_stiffness(omega)
+    A, _ = system.dynamic_stiffness(omega)
     J = J.toarray() if hasattr(J, "toarray") else np.asarray(J)
     A = A.toarray() if hasattr(A, "toarray") else np.asarray(A)
     Jnl = J - A
@@ -446,7 +470,7 @@ def _default_amplitudes(problem: EPMCProblem, x_static, phi_u, omega, n_points=6
 
 def nonlinear_mode(model, mode: int = 0, amplitudes=None, harmonics=(1,), n_samples=None,
                    reference_dof: int | None = None, tol: float = 1e-10, max_log_step: float = 0.25,
-                   n_points: int = 60) -> NonlinearModeResponse:
+                   n_points: int = 60, resolve_peaks=()) -> NonlinearModeResponse:
     """Damped nonlinear mode ``mode`` of ``model`` by EPMC (see the module docstring).
 
     Parameters
@@ -464,6 +488,14 @@ def nonlinear_mode(model, mode: int = 0, amplitudes=None, harmonics=(1,), n_samp
         the stuck mode)
     tol : Newton tolerance (scaled residual; scaled update sqrt(tol))
     max_log_step : largest continuation step in log10(a) [decades], (0, 2]
+    resolve_peaks : excitation scales (multiples of the model's first-harmonic excitation, > 0)
+        whose single-mode synthesis resonance (:meth:`NonlinearModeResponse.forced_peak`) is
+        solved for, not interpolated: after the continuation, a root search in log a on the
+        interval that brackets the root of h(a) (a secant from the spline's root, Brent on the
+        interval as the fallback), each evaluation an EPMC Newton solve from the interpolated
+        neighbours, to 1e-7 in log a; the solution at the root is added to the
+        points (so ``modal_amplitude`` holds these amplitudes besides ``amplitudes``). A peak
+        outside the computed range, or a Newton failure in the interval, leaves it interpolated
 
     Continuation starts at the stuck linear mode at min(amplitudes[0], onset / 10) and steps in
     log(a) (secant predictor, step halving down to 1e-3 decades on failure, then a jump of up to
@@ -484,6 +516,12 @@ def nonlinear_mode(model, mode: int = 0, amplitudes=None, harmonics=(1,), n_samp
     _validate.in_range("tol", tol, 0.0, 1e-3, closed="right")
     _validate.in_range("max_log_step (decades)", max_log_step, 0.0, 2.0, closed="right")
     n_points = _validate.integer("n_points", n_points, minimum=2)
+    resolve_peaks = np.atleast_1d(np.asarray(resolve_peaks, dtype=float))
+    if resolve_peaks.ndim != 1:
+        raise ValueError(f"resolve_peaks must be a 1-D sequence of excitation scales in (0, inf) "
+                         f"(got shape {resolve_peaks.shape})")
+    if resolve_peaks.size:
+        _validate.positive("resolve_peaks (excitation scales)", resolve_peaks)
     if amplitudes is not None:
         amps = np.atleast_1d(np.asarray(amplitudes, dtype=float))
         if amps.ndim != 1 or amps.size == 0:
@@ -547,6 +585,12 @@ def nonlinear_mode(model, mode: int = 0, amplitudes=None, harmonics=(1,), n_samp
         except ValueError:        # nothing nonlinear along the mode: start where asked
             a_start = amps[0]
     y, ok, it = _newton(problem, y_prev, a_start, *scales(a_start), tol=tol)
+    if not ok and a_start < amps[0]:
+        # a start below the first amplitude asked for can lie under the rounding of the preload
+        # forces (a vanishing friction coefficient: slip from the first micrometre, "onset" at
+        # 1e-13, where Newton stalls at 5e-8 of the scaled residual); start there instead
+        a_start = amps[0]
+        y, ok, it = _newton(problem, y_prev, a_start, *scales(a_start), tol=tol)
     if not ok:
         return _result(model, system, problem, [], [], [], False,
                        f"no EPMC solution at the start amplitude {a_start:.4g} from the stuck linear mode "
@@ -626,6 +670,10 @@ def nonlinear_mode(model, mode: int = 0, amplitudes=None, harmonics=(1,), n_samp
         keep_a.append(target)
         keep_y.append(y_t)
         keep_it.append(it_t)
+    if len(resolve_peaks) and keep_a:
+        keep_a, keep_y, keep_it, unresolved = _resolve_peaks(problem, system, resolve_peaks, keep_a, keep_y, keep_it,
+                                                             scales, tol)
+        message += f"; {len(resolve_peaks) - unresolved} of {len(resolve_peaks)} forced peaks resolved"
     if gaps:
         message += ("; passed " + ", ".join(f"{lo:.5g}..{hi:.5g}" for lo, hi in gaps)
                     + " by a jump (non-smooth point: Newton 2-cycles onto it)")
@@ -633,6 +681,78 @@ def nonlinear_mode(model, mode: int = 0, amplitudes=None, harmonics=(1,), n_samp
                      omega_lin, zeta_lin, mode)
     result.gaps = gaps
     return result
+
+
+def _resolve_peaks(problem, system, peak_scales, amps, ys, its, scales, tol):
+    """The EPMC solution at the resonance of each excitation scale (see ``resolve_peaks`` of
+    :func:`nonlinear_mode`), inserted into the points ``amps``, ``ys``, ``its`` (ascending a).
+    Returns (amps, ys, its, number of scales left interpolated)."""
+    from scipy.interpolate import CubicSpline
+    from scipy.optimize import brentq, root_scalar
+
+    N = problem.N
+    amps, ys, its = list(amps), list(ys), list(its)
+    f = np.asarray(system.excitation(float(ys[0][N]))[0], dtype=float).reshape(problem.C, problem.n)
+    j1 = problem.basis.cos_index(1)
+    force = f[j1] - 1j * f[j1 + 1]                    # the result's ``excitation`` (see _result)
+
+    def h_of(a, y, scale):
+        u = y[:N]
+        return float(peak_function(a, y[N], y[N + 1], (u[problem.i_cos] - 1j * u[problem.i_sin])[None, :],
+                                   scale * force)[0])
+
+    failed = 0
+    for scale in peak_scales:
+        h = np.array([h_of(a, y, scale) for a, y in zip(amps, ys)])
+        i = peak_bracket(h)
+        if i < 0 or h[i] == 0:
+            failed += i < 0
+            continue
+        la0, la1 = np.log(amps[i]), np.log(amps[i + 1])
+        y0, y1 = ys[i], ys[i + 1]
+        found = {}
+
+        def fun(la):
+            if la == la0:
+                return h[i]
+            if la == la1:
+                return h[i + 1]
+            a = float(np.exp(la))
+            guess = y0 + (y1 - y0) * (la - la0) / (la1 - la0)
+            y, ok, it = _newton(problem, guess, a, *scales(a), tol=tol)
+            if not ok:
+                raise _PeakNotResolved
+            found[la] = (a, y, it)
+            return h_of(a, y, scale)
+
+        # secant from the spline's root (within ~1e-3 of the true one: 2-3 solves), Brent on the
+        # bracket if it leaves it or stalls
+        la = np.log(np.asarray(amps))
+        spline = CubicSpline(la, h)
+        start = brentq(lambda x: float(spline(x)), la0, la1, xtol=1e-12)
+        try:
+            sec = root_scalar(fun, method="secant", x0=start, x1=start + 1e-3 * (la1 - la0), xtol=1e-7, maxiter=8)
+            if sec.converged and la0 <= sec.root <= la1 and found:
+                root = min(found, key=lambda x: abs(x - sec.root))      # the last solve, within xtol of it
+            else:
+                root = brentq(fun, la0, la1, xtol=1e-7, rtol=1e-12)
+        except _PeakNotResolved:
+            failed += 1
+            continue
+        if root not in found:          # the root is an end point (h there is zero to rounding)
+            continue
+        a, y, it = found[root]
+        k = int(np.searchsorted(amps, a))
+        if (k > 0 and np.log(a / amps[k - 1]) < 1e-9) or (k < len(amps) and np.log(amps[k] / a) < 1e-9):
+            continue
+        amps.insert(k, a)
+        ys.insert(k, y)
+        its.insert(k, it)
+    return amps, ys, its, failed
+
+
+class _PeakNotResolved(Exception):
+    """Newton did not converge inside a peak's bracket (the peak stays interpolated)."""
 
 
 def _result(model, system, problem, amps, ys, its, success, message, omega_lin, zeta_lin, mode):

@@ -53,21 +53,37 @@ t_r, so for a perturbation e^{lambda t} p(tau) the linearisation depends on lamb
 e^{-lambda (t - t_r)}. The AFT Jacobian is its value at lambda = 0, and the Hill matrix built
 on it loses the copy structure of the exponents (the copies lambda +- i Omega, for which the
 memory factor is of order 1, get different real parts). Measured on the 1-DOF Jenkins
-oscillator (tests/test_stability.py): every point of its FRF would be "unstable" with real
-parts up to +1.8 1/s, while a time integration started on the HBM solution returns to it. So
+oscillator (tests/test_stability.py): Hill's method on its AFT Jacobian gives -c / 2m =
+-0.025 1/s, the viscous decay alone, where the monodromy matrix of the time integration
+(:mod:`bladedamp.hbm.monodromy`, memory included) gives down to -0.96 1/s (the friction damps
+the perturbation too); taking every distinct copy instead of the 2 n best-centred ones, Hill
+even showed real parts up to +1.8 1/s there, while a time integration started on the HBM
+solution returns to it. So
 for systems with hysteretic elements, stability is decided by the one statement that holds
 exactly: at lambda = 0 the linearisation is the AFT Jacobian J, and the characteristic function
 P(lambda) = det(J(lambda) + lambda Delta_1 + lambda^2 Delta_2) is real on the real axis with
 P(+inf) > 0 (M positive definite); so **det J < 0 proves a real positive exponent: unstable**.
 Between two such sign changes (folds, branch points) a branch's stability is that of its
 neighbour: stable where the branch starts from the linear limit and keeps det J > 0. A
-Neimark-Sacker bifurcation of a friction-damped system cannot be found this way (it needs
-the monodromy matrix of a time integration); the result says which method was used
-(``method``: "hill" or "determinant sign").
+Neimark-Sacker bifurcation (or a period doubling) of a friction-damped system cannot be found
+this way; ``method="monodromy"`` (:mod:`bladedamp.hbm.monodromy`: the Floquet multipliers of
+the period map of a time integration started on the HBM solution, the slider positions part of
+the state) finds all three, for the models it has a period map for (the FrictionOscillator).
+The result says which method was used (``method``: "hill", "determinant sign" or "monodromy").
+The default ("auto") stays Hill / determinant sign: the monodromy integrates 7 trajectories
+over one period per point, 4.3 times the cost (measured on the friction-fold branch of
+tests/test_stability.py, 2149 points, one run: 12.1 s against 2.8 s, both with the bordered
+determinant), and on this 1-DOF oscillator it puts the folds where det J does (within a point).
 
 For a tuned disk computed by cyclic symmetry the perturbations are those of the same
 travelling-wave family; the full assembly (:class:`~bladedamp.mistuned.MistunedDisk`) covers
-all nodal diameters.
+all nodal diameters. Its exponents hold the sector's, and can hold more: on a 4-blade ring of
+blades with cubic tip springs linked tip to tip (tests/test_stability_disk.py), the assembly
+loses stability one point before the sector's fold, to other nodal diameters, and a time
+integration of the assembly leaves the travelling wave there. Conversely, a fold of the
+travelling wave that every blade makes at once (uncoupled blades) is an even number of real
+crossings for the assembly: det J keeps its sign (and the bordered determinant flips, a branch
+point), so the determinant sign alone does not see it there.
 """
 from __future__ import annotations
 
@@ -78,6 +94,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 import scipy.sparse as sp
+
+from .linsolve import one_blas_thread, permutation_sign
 
 
 def hill_matrices(system, omega: float):
@@ -142,21 +160,10 @@ def determinant_sign(A) -> int:
         diag = lu.U.diagonal()
         sign = np.prod(np.sign(diag))
         for perm in (lu.perm_r, lu.perm_c):
-            sign *= _permutation_sign(perm)
+            sign *= permutation_sign(perm)
         return int(sign)
     sign, _ = np.linalg.slogdet(np.asarray(A))
     return int(np.sign(sign))
-
-
-def _permutation_sign(perm: np.ndarray) -> int:
-    perm = np.asarray(perm).copy()
-    sign = 1
-    for i in range(perm.size):
-        while perm[i] != i:
-            j = perm[i]
-            perm[i], perm[j] = perm[j], perm[i]
-            sign = -sign
-    return sign
 
 
 @dataclass
@@ -172,10 +179,21 @@ class FloquetResult:
     omega : excitation angular frequency [rad/s]
     stable : every selected exponent has Re lambda < ``tolerance`` * omega
     tolerance : the relative threshold on Re lambda / omega used for ``stable``
-    method : "hill" (every element memoryless: the exponents decide) or "determinant sign"
+    method : "hill" (every element memoryless: the exponents decide), "determinant sign"
         (hysteretic elements: ``stable`` is det J > 0, exponents are not computed; see the
-        module docstring)
+        module docstring) or "monodromy" (the multipliers of the period map decide; ``exponents``
+        are log(mu) / T of its nonzero multipliers, Im in (-Omega/2, Omega/2])
     jacobian_sign : sign of det(dR/dx) at the point
+    floquet_multipliers : (k,) the multipliers exp(lambda T) of ``exponents`` from the raw Hill
+        eigenvalues lambda (the centroid frequency of ``exponents`` is a label, not a copy
+        lambda + i k Omega, so exp(exponents T) has the right modulus but not the right phase);
+        for "monodromy" the eigenvalues of the monodromy matrix, largest modulus first, zeros
+        included; None for the determinant sign
+    periodicity_error : for method "monodromy": |P(z) - z| / the orbit's largest |x|, the HBM
+        solution's distance from a periodic orbit of the discretised period map
+    eigensolver : for method "hill": "dense" (every eigenvalue of the (2N, 2N) pencil by QZ) or
+        "shift-invert" (a sparse Jacobian and fewer than half the eigenvalues wanted: the
+        ``n_near`` nearest to zero by ARPACK); "" for the other methods
     unresolved : (2n - k,) physical exponents whose perturbation frequency lies beyond the basis's
         highest harmonic H, |Im mu| > (H + 1/2) Omega: not resolved by the
         truncated Hill matrix, so they do not decide ``stable`` (see the module docstring)
@@ -189,6 +207,9 @@ class FloquetResult:
     unresolved: np.ndarray = None
     method: str = "hill"
     jacobian_sign: int = 0
+    floquet_multipliers: np.ndarray = None
+    periodicity_error: float = float("nan")
+    eigensolver: str = ""
 
     @property
     def max_real(self) -> float:
@@ -197,7 +218,9 @@ class FloquetResult:
 
     @property
     def multipliers(self) -> np.ndarray:
-        """Floquet multipliers exp(lambda T), T = 2 pi / omega."""
+        """Floquet multipliers (see ``floquet_multipliers``)."""
+        if self.floquet_multipliers is not None:
+            return self.floquet_multipliers
         return np.exp(self.exponents * 2 * np.pi / self.omega)
 
     def unstable_kind(self) -> str:
@@ -211,15 +234,26 @@ class FloquetResult:
             return "real"
         if not self.exponents.size:
             return "unresolved"
-        lead = self.exponents[0]
-        # a real multiplier (fold, branch point: mu real; period doubling: Im mu = Omega / 2 mod Omega)
-        # crosses alone; a complex pair crossing is a Neimark-Sacker bifurcation
-        phase = np.mod(lead.imag / self.omega, 1.0)
-        if min(phase, 1 - phase) < 1e-3:
-            return "real"
-        if abs(phase - 0.5) < 1e-3:
-            return "period doubling"
-        return "complex"
+        kind = multiplier_crossing(self.multipliers[:1] if self.method == "hill" else self.multipliers)
+        return {"fold": "real", "neimark-sacker": "complex"}.get(kind, kind)
+
+
+REAL_PHASE_TOLERANCE = 1e-3   # a multiplier within this fraction of a cycle of the real axis is real
+
+
+def multiplier_crossing(multipliers: np.ndarray) -> str:
+    """Kind of the largest multiplier (by modulus) of ``multipliers`` (k,) complex: 'fold' (real,
+    positive: a turning point or a branch point), 'period doubling' (real, negative) or
+    'neimark-sacker' (a complex pair); real means within ``REAL_PHASE_TOLERANCE`` of a cycle of
+    the real axis. A real multiplier crosses the unit circle alone, a complex one with its
+    conjugate."""
+    lead = multipliers[np.argmax(np.abs(multipliers))]
+    phase = np.mod(np.angle(lead) / (2 * np.pi), 1.0)
+    if min(phase, 1 - phase) < REAL_PHASE_TOLERANCE:
+        return "fold"
+    if abs(phase - 0.5) < REAL_PHASE_TOLERANCE:
+        return "period doubling"
+    return "neimark-sacker"
 
 
 STABILITY_TOLERANCE = 1e-7   # Re lambda / Omega below which an exponent counts as not growing
@@ -236,6 +270,12 @@ def physical_exponents(values: np.ndarray, vectors: np.ndarray, basis, n_dof: in
     Copies are taken best-centred first (smallest |kbar|, then smallest |Im lambda|: the
     copies the truncation resolves best) and one per exponent is kept: a copy whose mu lies
     within ``DUPLICATE_TOLERANCE * omega`` of one already kept is dropped."""
+    mu, kept = _physical_selection(values, vectors, basis, n_dof, omega, n_select)
+    return mu[kept]
+
+
+def _physical_selection(values, vectors, basis, n_dof, omega, n_select):
+    """(mu (m,), kept indices) of :func:`physical_exponents`."""
     k, weight = harmonic_weights(vectors, basis, n_dof)
     centroid = k @ weight                                   # (m,)
     mu = values.real + 1j * (values.imag + centroid * omega)
@@ -247,56 +287,99 @@ def physical_exponents(values: np.ndarray, vectors: np.ndarray, basis, n_dof: in
             kept.append(j)
             if n_select is not None and len(kept) == n_select:
                 break
-    return mu[np.array(kept, dtype=int)]
+    return mu, np.array(kept, dtype=int)
 
 
 def floquet_exponents(system, x: np.ndarray, omega: float, tolerance: float = STABILITY_TOLERANCE,
-                      n_near: int | None = None, method: str = "auto") -> FloquetResult:
+                      n_near: int | None = None, method: str = "auto", model=None) -> FloquetResult:
     """Floquet exponents of the solution ``x`` (N,) of ``system`` at ``omega`` [rad/s] by Hill's
     method.
 
     ``method``: "auto" (Hill's method when every element is memoryless, otherwise the
     determinant sign, see the module docstring), "hill" (forced, also on hysteretic elements:
-    for study only, its exponents are then not those of the system) or "determinant sign".
+    for study only, its exponents are then not those of the system), "determinant sign" or
+    "monodromy" (the multipliers of the period map of ``model``, whose ``hbm_system`` gave
+    ``system``; see :mod:`bladedamp.hbm.monodromy`).
 
     Dense systems: every eigenvalue of the linearised (2N, 2N) pencil. Sparse systems (the
-    mistuned assembly): the ``n_near`` (default ``min(2N - 2, max(24, 4 n_dof))``) eigenvalues
-    nearest to zero by shift-invert Arnoldi, the region where the exponents of the lightly damped
-    modes near resonance cross the imaginary axis; the exponents of far modes are not computed.
+    mistuned assembly): the ``n_near`` (default ``max(24, 4 n_dof)``) eigenvalues nearest to zero
+    by shift-invert Arnoldi, the region where the exponents of the lightly damped modes near
+    resonance cross the imaginary axis; the exponents of far modes are not computed. When that
+    is half the spectrum or more (``n_near >= N``; always for one harmonic, N = 2 n_dof) every
+    eigenvalue is computed densely instead (``FloquetResult.eigensolver`` says which).
     """
+    _check_method(method, model)
     _, J, _ = system.residual(x, omega, True)
-    return _floquet_from_jacobian(system, J, omega, tolerance, n_near, method)
+    return _floquet_from_jacobian(system, J, omega, tolerance, n_near, method, x, model)
 
 
-def _floquet_from_jacobian(system, J, omega, tolerance, n_near, method) -> FloquetResult:
+METHODS = ("auto", "hill", "determinant sign", "monodromy")
+
+
+def _check_method(method, model):
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {', '.join(repr(m) for m in METHODS)} (got {method!r})")
+    if method == "monodromy":
+        from .monodromy import supports
+
+        if model is None or not supports(model):
+            raise ValueError(f"method 'monodromy' needs the model and has a period map for the FrictionOscillator "
+                             f"only (got model={type(model).__qualname__}); use method 'auto'")
+
+
+def _floquet_from_jacobian(system, J, omega, tolerance, n_near, method, x=None, model=None) -> FloquetResult:
     """:func:`floquet_exponents` from the Jacobian dR/dx at the point (computed once per point
     by :func:`branch_stability`, which also needs it for the bordered determinant)."""
     sign = determinant_sign(J)
-    if method not in ("auto", "hill", "determinant sign"):
-        raise ValueError(f"method must be 'auto', 'hill' or 'determinant sign' (got {method!r})")
+    if method == "monodromy":
+        from .monodromy import monodromy_multipliers
+
+        mu, error = monodromy_multipliers(model, x, system.basis, omega)
+        growth = np.log(np.maximum(np.abs(mu), 1e-300)) / (2 * np.pi)        # Re lambda / Omega
+        exponents = np.log(mu[np.abs(mu) > 1e-12]) * omega / (2 * np.pi)    # mu = exp(lambda T); 0: a slipping slider
+        return FloquetResult(exponents, exponents, float(omega), bool(growth.max() < tolerance), tolerance,
+                             np.zeros(0, dtype=complex), "monodromy", sign, mu, error)
     if method == "determinant sign" or (method == "auto" and hysteretic(system)):
         empty = np.zeros(0, dtype=complex)
         return FloquetResult(empty, empty, float(omega), sign > 0, tolerance, empty, "determinant sign", sign)
     d1, d2 = hill_matrices(system, omega)
     n_dof = system.n_dof
     N = system.n_unknowns
-    if sp.issparse(J):
-        values, vectors = _sparse_quadratic_eigs(J, d1, d2, omega, n_near or min(2 * N - 2, max(24, 4 * n_dof)))
+    n_wanted = n_near or max(24, 4 * n_dof)
+    if sp.issparse(J) and n_wanted < N:
+        eigensolver = "shift-invert"
+        values, vectors = _sparse_quadratic_eigs(J, d1, d2, omega, n_wanted)
     else:
-        values, vectors = _dense_quadratic_eig(np.asarray(J), d1, d2)
+        # half the spectrum or more (always so for one harmonic, C = 2: 4 n_dof = 2 N): ARPACK
+        # cannot return all 2 N eigenvalues (at most 2 N - 2) and is not faster than the dense QZ
+        # there (measured, one run: 16 blades x 4 modes, harmonics (1, 3), 2 N = 512: 256
+        # eigenvalues by shift-invert 5.0 s, all by QZ 4.1 s; 4 blades, 2 N = 128: 0.78 s
+        # against 0.047 s; 24 of 512 by shift-invert 0.37 s)
+        eigensolver = "dense"
+        dense = (lambda A: A.toarray()) if sp.issparse(J) else np.asarray
+        values, vectors = _dense_quadratic_eig(dense(J), dense(d1), dense(d2))
     keep = np.isfinite(values)
     values, vectors = values[keep], vectors[:, keep]
-    # all distinct exponents, not just 2 n: copies of the unresolved fast modes of a strongly
-    # nonlinear solution need not coincide (their vectors spread over the few harmonics), and a
-    # cap of 2 n would let them crowd out a resolved one
-    mu = physical_exponents(values, vectors, system.basis, n_dof, omega)
+    # all distinct exponents, then at most 2 n of the resolved ones: copies of the unresolved
+    # fast modes of a strongly nonlinear solution need not coincide (their vectors spread over
+    # the few harmonics), and a cap of 2 n before the resolution test would let them crowd out a
+    # resolved one
+    mu, kept = _physical_selection(values, vectors, system.basis, n_dof, omega, None)
+    mu, lam = mu[kept], values[kept]
     resolved = np.abs(mu.imag) <= (max(system.basis.harmonics) + 0.5) * omega
-    decisive = mu[resolved]
-    decisive = decisive[np.argsort(-decisive.real)]
+    # at most 2 n resolved exponents, best-centred first: the further distinct ones are copies
+    # whose truncation error separated them from their exponent (measured on the Duffing
+    # oscillator with harmonics (0..5): 4-8 "distinct" resolved exponents, one with Re lambda
+    # > 0 twelve points before the fold, where the monodromy matrix and the best-centred
+    # copies agree on 0.992)
+    decisive_index = np.flatnonzero(resolved)[:2 * n_dof]
+    order = decisive_index[np.argsort(-mu[decisive_index].real)]
+    decisive, multipliers = mu[order], np.exp(lam[order] * 2 * np.pi / omega)
     unresolved = mu[~resolved]
     unresolved = unresolved[np.argsort(-unresolved.real)]
     stable = bool(decisive.size and decisive.real.max() < tolerance * omega)
-    return FloquetResult(decisive, values, float(omega), stable, tolerance, unresolved, "hill", sign)
+    return FloquetResult(decisive, values, float(omega), stable, tolerance, unresolved, "hill", sign, multipliers,
+                         eigensolver=eigensolver)
 
 
 def _dense_quadratic_eig(J, d1, d2):
@@ -332,7 +415,8 @@ class BranchStability:
     ----------
     stable : (n,) bool per point
     floquet_exponents : (n, k) resolved exponents per point [1/s], largest real part first
-        (nan-padded; width 0 for the determinant-sign method)
+        (nan-padded; width 0 for the determinant-sign method; for "monodromy" log(mu) / T of the
+        nonzero multipliers, largest modulus first)
     max_real : (n,) largest real part per point [1/s] (nan for the determinant-sign method)
     changes : indices i where stability changes between points i and i + 1
     kinds : for each change, 'fold' (a real exponent crosses: a turning point or a branch
@@ -340,7 +424,7 @@ class BranchStability:
     branch_points : indices i where the determinant of the bordered Jacobian [[dR/dx,
         dR/domega], [tangent]] changes sign between points i and i + 1 (a turning point keeps
         it, a branch point flips it)
-    method : "hill" or "determinant sign" (see :class:`FloquetResult`)
+    method : "hill", "determinant sign" or "monodromy" (see :class:`FloquetResult`)
     seconds : time spent [s]
     """
 
@@ -354,12 +438,16 @@ class BranchStability:
     seconds: float
 
 
+@one_blas_thread       # many small determinants: measured on the 16-blade mistuned disk (2 %, seed 1,
+                       # (1,), 776 points, one run): 4.7 s with one thread, 18.6 s threaded (the solve: 11.4 s)
 def branch_stability(system, coefficients: np.ndarray, omega: np.ndarray, x_scale=1.0,
-                     tolerance: float = STABILITY_TOLERANCE, method: str = "auto") -> BranchStability:
+                     tolerance: float = STABILITY_TOLERANCE, method: str = "auto", model=None) -> BranchStability:
     """Stability of every point of a branch (:func:`floquet_exponents`) and its branch points:
     ``coefficients`` (n, C, n_dof) or (n, N), ``omega`` (n,) [rad/s]; ``x_scale`` (scalar or
     (N,)) scales the unknowns of the tangent as in the continuation (the bordered determinant's
-    sign does not depend on it, its conditioning does)."""
+    sign does not depend on it, its conditioning does); ``model`` (whose ``hbm_system`` gave
+    ``system``) for method "monodromy"."""
+    _check_method(method, model)
     t0 = time.perf_counter()
     omega = np.asarray(omega, dtype=float)
     X = np.asarray(coefficients).reshape(len(omega), -1)
@@ -367,7 +455,7 @@ def branch_stability(system, coefficients: np.ndarray, omega: np.ndarray, x_scal
     results, bordered = [], np.zeros(len(omega), dtype=int)
     for i, w in enumerate(omega):          # one Jacobian per point serves both determinants
         _, J, Jw = system.residual(X[i], float(w), True)
-        results.append(_floquet_from_jacobian(system, J, float(w), tolerance, None, method))
+        results.append(_floquet_from_jacobian(system, J, float(w), tolerance, None, method, X[i], model))
         bordered[i] = _bordered_sign(J, Jw, tangents[i], scale, w_scale)
     width = max((r.exponents.size for r in results), default=0)
     exps = np.full((len(omega), width), np.nan + 0j)
@@ -423,7 +511,7 @@ def with_stability(model, response, method: str = "auto"):
     system = model.hbm_system(basis.harmonics, basis.n_samples)
     w = response.omega
     scales = model.unknown_scales(system, float(w.min()), float(w.max()))
-    st = branch_stability(system, response.coefficients, w, scales, method=method)
+    st = branch_stability(system, response.coefficients, w, scales, method=method, model=model)
     bifurcations = {kind: [int(i) for i, k in zip(st.changes, st.kinds) if k == kind] for kind in set(st.kinds)}
     bifurcations["branch point"] = [int(i) for i in st.branch_points]
     bifurcations["seconds"] = st.seconds

@@ -103,7 +103,10 @@ class HarmonicBalanceSystem:
         K0, M2, G = self._sparse_parts
         return (K0 - omega ** 2 * M2 + omega * G).tocsc(), (-2 * omega * M2 + G).tocsc()
 
-    def _dynamic_stiffness(self, omega: float):
+    def dynamic_stiffness(self, omega: float):
+        """(A, dA/domega) of the linear part at ``omega`` [rad/s] (the residual's variable): the
+        harmonic dynamic stiffness of M, D, K with the static stiffness on the static harmonic;
+        dense (C*n, C*n) ndarrays, or scipy.sparse for a sparse system."""
         if self.sparse:
             return self._sparse_dynamic_stiffness(omega)
         A, dA = self.basis.dynamic_stiffness(omega, self.mass, self.damping, self.stiffness)
@@ -115,7 +118,7 @@ class HarmonicBalanceSystem:
 
     def linear_solution(self, omega: float) -> np.ndarray:
         """Solution without the nonlinear elements (initial guess, scaling)."""
-        A, _ = self._dynamic_stiffness(omega)
+        A, _ = self.dynamic_stiffness(omega)
         f, _ = self.excitation(omega)
         if sp.issparse(A):
             from scipy.sparse.linalg import splu
@@ -143,7 +146,7 @@ class HarmonicBalanceSystem:
         """``(R, dR/dx, dR/domega)``; the last two are None when ``jacobian`` is False."""
         basis = self.basis
         C = basis.n_coeffs
-        A, dA = self._dynamic_stiffness(omega)
+        A, dA = self.dynamic_stiffness(omega)
         f, df = self.excitation(omega)
         R = A @ x - f
         sparse = sp.issparse(A)

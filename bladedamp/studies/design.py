@@ -105,11 +105,12 @@ class EngineOrderSweep(Saveable):
         return ax
 
 
-def at_engine_order(disk: TunedDisk, engine_order: int, rotor_speed_eo0: float) -> TunedDisk:
-    """``disk`` at another engine order; at EO = 0 with the rotor speed ``rotor_speed_eo0``
-    [rad/s] unless the disk has its own (the excitation does not fix the speed there)."""
-    speed = disk.rotor_speed if disk.rotor_speed is not None or engine_order != 0 else rotor_speed_eo0
-    return dataclasses.replace(disk, engine_order=int(engine_order), rotor_speed=speed)
+def at_engine_order(disk: TunedDisk, engine_order: int, rotor_speed_eo0_hz: float) -> TunedDisk:
+    """``disk`` at another engine order; at EO = 0 with the rotor speed ``rotor_speed_eo0_hz``
+    [Hz, revolutions per second] unless the disk has its own (the excitation does not fix the
+    speed there)."""
+    speed = disk.rotor_speed_hz if disk.rotor_speed_hz is not None or engine_order != 0 else rotor_speed_eo0_hz
+    return dataclasses.replace(disk, engine_order=int(engine_order), rotor_speed_hz=speed, rotor_speed=None)
 
 
 def _engine_order_case(case):
@@ -122,8 +123,8 @@ def _engine_order_case(case):
 
 
 def engine_order_sweep(disk: TunedDisk, engine_orders=range(0, 9), mass_bounds=(1e-5, 2e-2),
-                       rotor_speed_eo0: float = 2 * np.pi * 95, f_range_hz=(90.0, 105.0), xatol: float = 0.02,
-                       harmonics=(1,), progress=None, processes: int | None = 1) -> EngineOrderSweep:
+                       rotor_speed_eo0_hz: float = 95.0, f_range_hz=(90.0, 105.0), xatol: float = 0.02,
+                       harmonics=(1,), progress=None, processes: int | None = 1, known=None) -> EngineOrderSweep:
     """Re-optimise the damper mass of ``disk`` for each engine order (Fig. 7, 8).
 
     Parameters
@@ -131,7 +132,7 @@ def engine_order_sweep(disk: TunedDisk, engine_orders=range(0, 9), mass_bounds=(
     disk : TunedDisk with a damper (its mass is the one thing not used: it is optimised)
     engine_orders : EOs in 0..n/2 (non-empty)
     mass_bounds : (low, high) [kg], 0 < low < high
-    rotor_speed_eo0 : rotor speed at EO = 0 [rad/s] (> 0) if the disk has none; otherwise
+    rotor_speed_eo0_hz : rotor speed at EO = 0 [Hz] (> 0) if the disk has none; otherwise
         Omega_R = Omega_E / EO (or the disk's fixed rotor speed)
     f_range_hz : (low, high) [Hz] around the resonance; ``peak_response`` widens it when
         the peak sits at an end
@@ -139,27 +140,58 @@ def engine_order_sweep(disk: TunedDisk, engine_orders=range(0, 9), mass_bounds=(
     harmonics : of every peak search (default the paper's (1,))
     progress : optional callable(done, total)
     processes : worker processes over the engine orders (None: every core)
+    known : {EO: MassOptimum} optima already found by :func:`optimal_mass` for this disk at those
+        EOs with the same bounds, range, ``xatol`` and harmonics: used as given, not recomputed
     """
-    _check_disk(disk)
-    n_max = disk.n_blades // 2
+    return engine_order_sweeps([disk], engine_orders, mass_bounds, rotor_speed_eo0_hz, f_range_hz, xatol, harmonics,
+                               progress, processes, None if known is None else [known])[0]
+
+
+def engine_order_sweeps(disks, engine_orders=range(0, 9), mass_bounds=(1e-5, 2e-2),
+                        rotor_speed_eo0_hz: float = 95.0, f_range_hz=(90.0, 105.0), xatol: float = 0.02,
+                        harmonics=(1,), progress=None, processes: int | None = 1, known=None) -> list[EngineOrderSweep]:
+    """:func:`engine_order_sweep` of each disk of ``disks`` (non-empty sequence), every
+    (disk, EO) optimisation one case of a single pool of ``processes`` workers (the costly
+    high EOs first, so that no worker is left with a long case at the end). ``known``: one
+    {EO: MassOptimum} (or None) per disk. Returns one EngineOrderSweep per disk."""
+    disks = list(disks)
+    if not disks:
+        raise ValueError("disks must be a non-empty sequence of TunedDisk with a damper")
+    for disk in disks:
+        _check_disk(disk)
+    n_max = min(disk.n_blades for disk in disks) // 2
     eos = np.atleast_1d(np.asarray(list(engine_orders) if not np.isscalar(engine_orders) else [engine_orders]))
     if eos.size == 0:
         raise ValueError(f"engine_orders must be a non-empty range of integers in [0, {n_max}]")
     for eo in eos:
         _validate.integer("engine_orders", eo, minimum=0, maximum=n_max)
     bounds = _check_mass_bounds(mass_bounds)
-    _validate.positive("rotor_speed_eo0 (rad/s)", rotor_speed_eo0)
+    _validate.positive("rotor_speed_eo0_hz", rotor_speed_eo0_hz)
     f_range = _check_f_range(f_range_hz)
     _validate.positive("xatol", xatol)
+    known = [dict(k or {}) for k in (known if known is not None else [None] * len(disks))]
+    if len(known) != len(disks):
+        raise ValueError(f"known must give one dict of optima per disk ({len(disks)}), got {len(known)}")
 
+    results = [dict(k) for k in known]
+    todo = sorted(((d, int(eo)) for d in range(len(disks)) for eo in eos if int(eo) not in known[d]),
+                  key=lambda de: -de[1])
+    cases = [(at_engine_order(disks[d], eo, rotor_speed_eo0_hz), bounds, f_range, xatol, tuple(harmonics)) for d, eo in todo]
+    for (d, eo), result in zip(todo, parallel_map(_engine_order_case, cases, processes, progress)):
+        results[d][eo] = result
+    return [_sweep_of(disk.damper.kind, eos, res) for disk, res in zip(disks, results)]
+
+
+def _sweep_of(kind: str, eos, results: dict) -> EngineOrderSweep:
+    """The EngineOrderSweep of ``results`` {EO: MassOptimum or the failure's text}."""
     k = eos.size
     m_opt, p_opt, p_und = np.full(k, np.nan), np.full(k, np.nan), np.full(k, np.nan)
     certified, messages, failures = np.zeros(k, dtype=bool), {}, {}
-    cases = [(at_engine_order(disk, eo, rotor_speed_eo0), bounds, f_range, xatol, tuple(harmonics)) for eo in eos]
-    for j, (eo, result) in enumerate(zip(eos, parallel_map(_engine_order_case, cases, processes, progress))):
+    for j, eo in enumerate(eos):
+        result = results[int(eo)]
         if isinstance(result, str):
             failures[int(eo)] = result
-            warnings.warn(f"engine order {eo}: {result}", RuntimeWarning, stacklevel=2)
+            warnings.warn(f"engine order {eo}: {result}", RuntimeWarning, stacklevel=3)
             continue
         p_und[j] = result.undamped_peak_amplitude
         certified[j], messages[int(eo)] = result.success, result.message
@@ -167,7 +199,7 @@ def engine_order_sweep(disk: TunedDisk, engine_orders=range(0, 9), mass_bounds=(
             p_opt[j] = result.undamped_peak_amplitude          # no mass helps (the rolling cylinder)
         else:
             m_opt[j], p_opt[j] = result.mass, result.peak_amplitude
-    return EngineOrderSweep(disk.damper.kind, eos.astype(int), m_opt, p_opt, p_und, 1 - p_opt / p_und, failures,
+    return EngineOrderSweep(kind, eos.astype(int), m_opt, p_opt, p_und, 1 - p_opt / p_und, failures,
                             certified, messages)
 
 
@@ -259,7 +291,7 @@ def _platform_angle_case(case):
 def platform_angle_study(disk: TunedDisk, gamma_right_deg, gamma_left_deg: float | None = None,
                          fixed_mass: float | None = None, mass_bounds=(1e-5, 2e-2), f_range_hz=(90.0, 105.0),
                          optimise: bool = True, xatol: float = 0.02, harmonics=(1,), progress=None,
-                         processes: int | None = 1) -> PlatformAngleStudy:
+                         processes: int | None = 1, known=None) -> PlatformAngleStudy:
     """Peak tip amplitude of ``disk`` over the right platform angle gamma_R (Fig. 10).
 
     Parameters
@@ -272,6 +304,8 @@ def platform_angle_study(disk: TunedDisk, gamma_right_deg, gamma_left_deg: float
     optimise : False skips the mass optimisation (optimal_* are NaN)
     harmonics : of every peak search (default the paper's (1,))
     progress : optional callable(done, total); processes : worker processes (None: every core)
+    known : {gamma_R [deg]: (peak at ``fixed_mass`` [m], MassOptimum)} already found for some of
+        the angles (same disk, bounds, range, ``xatol``, harmonics): used as given, not recomputed
     """
     _check_disk(disk)
     gl = float(np.degrees(disk.gamma_left)) if gamma_left_deg is None else gamma_left_deg
@@ -288,9 +322,12 @@ def platform_angle_study(disk: TunedDisk, gamma_right_deg, gamma_left_deg: float
     harmonics = tuple(harmonics)
     undamped, _, _ = peak_response(dataclasses.replace(disk, damper=None), f_range, harmonics)
     base = with_mass(disk, fixed_mass)
-    cases = [(with_platform_angles(base, gl, float(g)), bounds, f_range, optimise, xatol, harmonics) for g in gr]
-    results = np.array(parallel_map(_platform_angle_case, cases, processes, progress))
-    p_fix, m_opt, p_opt = results.T
+    known = {float(g): (p, opt.mass, opt.peak_amplitude) if optimise else (p, np.nan, np.nan)
+             for g, (p, opt) in (known or {}).items()}
+    todo = [float(g) for g in gr if float(g) not in known]
+    cases = [(with_platform_angles(base, gl, g), bounds, f_range, optimise, xatol, harmonics) for g in todo]
+    known.update(zip(todo, parallel_map(_platform_angle_case, cases, processes, progress)))
+    p_fix, m_opt, p_opt = np.array([known[float(g)] for g in gr], dtype=float).T
     return PlatformAngleStudy(disk.damper.kind, float(gl), float(fixed_mass), gr, m_opt, p_opt, p_fix, undamped)
 
 

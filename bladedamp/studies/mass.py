@@ -12,6 +12,7 @@ from .. import _validate
 from ..disk import TunedDisk
 from ..io import Saveable
 from ..plotting import place_legend
+from ..response import refined_peak
 
 
 def with_mass(disk: TunedDisk, mass: float) -> TunedDisk:
@@ -43,21 +44,8 @@ def peak_response(disk: TunedDisk, f_range_hz=(90.0, 105.0), harmonics=(1,), max
         lo, hi = (max(lo - width, 0.5 * lo), hi) if i == 0 else (lo, hi + width)
     else:
         raise RuntimeError(f"no interior resonance peak found up to the range {lo:.4g}-{hi:.4g} Hz")
-    peak, f = _refined_peak(r.frequency_hz, a, i)
+    peak, f = refined_peak(r.frequency_hz, a, i)
     return peak, f, r
-
-
-def _refined_peak(freq, a, i):
-    """(peak, frequency) of point ``i`` refined by the parabola through it and its neighbours."""
-    peak, f = a[i], freq[i]
-    x, y = freq[i - 1:i + 2], a[i - 1:i + 2]
-    if len(x) == 3 and np.all(np.diff(x) > 0):
-        c = np.polyfit(x, y, 2)
-        if c[0] < 0:
-            f_v = -c[1] / (2 * c[0])
-            if x[0] <= f_v <= x[2]:
-                peak, f = max(peak, np.polyval(c, f_v)), f_v
-    return float(peak), float(f)
 
 
 class IncompleteResponse(RuntimeError):
@@ -182,7 +170,7 @@ def robust_peak(disk: TunedDisk, f_range_hz=(90.0, 105.0), harmonics=(1,), direc
     a = b.tip_amplitude[:, direction]
     if b is down:                             # runs from hi to lo: the parabola wants rising frequency
         f, a, i = f[::-1], a[::-1], len(f) - 1 - i
-    p, fp = _refined_peak(f, a, i)
+    p, fp = refined_peak(f, a, i)
     how = "downward sweep" if len(branches) == 1 else "upward and downward partial branches joined"
     return PeakEvaluation(True, p, fp, np.nan, f"{how} (before: {'; '.join(messages)})", runs)
 

@@ -242,8 +242,19 @@ def paper_kappas(n_blades: int = 16, std: float = PAPER_STD, seed=PAPER_SEED) ->
     return {"random": k, "reordered": k[reorder(k)], "alternating": alternating(n_blades, std)}
 
 
+def _tuned_case(case):
+    disk, f_range, max_step = case
+    return tuned_peak(disk, f_range or auto_range(disk, [1.0], 0.05), max_step=max_step)
+
+
+def _mistuned_case(case):
+    disk, kappa, f_range, max_step, tuned_peak_amplitude, n_sector = case
+    return mistuned_response(disk, kappa, f_range, max_step=max_step, tuned_peak_amplitude=tuned_peak_amplitude,
+                             n_sector=n_sector)
+
+
 def paper_cases(disk_factory=None, progress=None, f_range_hz=None, max_step: float = 0.05,
-                seed=PAPER_SEED) -> dict[str, MistuningCase]:
+                seed=PAPER_SEED, processes: int | None = 1) -> dict[str, MistuningCase]:
     """Cases b (random), c (reordered), d (alternating) at m = 1 g and b, c at m = 5 g, each
     beside the tuned disk of the same mass (16 blades, EO = 1, F_x = 0.1 N): b and c as full
     16-blade assemblies, d as its exact two-blade cyclic sector (equal to the full assembly to
@@ -251,8 +262,12 @@ def paper_cases(disk_factory=None, progress=None, f_range_hz=None, max_step: flo
     ``f_range_hz``: None -> :func:`auto_range` of each case.
 
     ``disk_factory(mass) -> TunedDisk`` (default: the reference cylinder disk);
-    ``progress(done, total, message)`` is called after every FRF.
+    ``progress(done, total, message)`` is called after
+    every FRF; ``processes``: worker processes over the tuned, then the mistuned responses
+    (None: every core).
     Keys: ``random_1g, reordered_1g, alternating_1g, random_5g, reordered_5g``."""
+    from .parallel import parallel_map
+
     if disk_factory is None:
         from ..reference import reference_disk
 
@@ -261,27 +276,32 @@ def paper_cases(disk_factory=None, progress=None, f_range_hz=None, max_step: flo
 
     kappas = paper_kappas(16, PAPER_STD, seed)
     plan = [(1e-3, "random"), (1e-3, "reordered"), (1e-3, "alternating"), (5e-3, "random"), (5e-3, "reordered")]
-    total, done = len(plan) + 2, 0
-    tuned = {}
-    out = {}
-    for mass, name in plan:
-        disk = disk_factory(mass)
-        if mass not in tuned:
-            p, f, r = tuned_peak(disk, f_range_hz or auto_range(disk, [1.0], 0.05), max_step=max_step)
-            tuned[mass] = (p, r)
-            done += 1
-            if progress:
-                progress(done, total, f"tuned {1e3 * mass:g} g: peak {1e3 * p:.4f} mm at {f:.2f} Hz")
-        kappa = kappas[name]
-        sector = 2 if name == "alternating" else None
-        r = mistuned_response(disk, kappa[:sector] if sector else kappa, f_range_hz, max_step=max_step,
-                              tuned_peak_amplitude=tuned[mass][0], n_sector=sector)
-        key = f"{name}_{1e3 * mass:g}g"
-        out[key] = MistuningCase(key, mass, kappa, r, tuned[mass][0], tuned[mass][1])
+    masses = sorted({m for m, _ in plan})
+    total, done = len(plan) + len(masses), 0
+    disks = {m: disk_factory(m) for m in masses}
+
+    def tick(message):
+        nonlocal done
         done += 1
         if progress:
-            progress(done, total, f"{key}: max peak {1e3 * r.peak_amplitude.max():.4f} mm "
-                                  f"(tuned {1e3 * tuned[mass][0]:.4f} mm), {len(r.omega)} points")
+            progress(done, total, message)
+
+    tuned = {}
+    for m, (p, f, r) in zip(masses, parallel_map(_tuned_case, [(disks[m], f_range_hz, max_step) for m in masses],
+                                                processes)):
+        tuned[m] = (p, r)
+        tick(f"tuned {1e3 * m:g} g: peak {1e3 * p:.4f} mm at {f:.2f} Hz")
+    cases = []
+    for mass, name in plan:
+        sector = 2 if name == "alternating" else None
+        kappa = kappas[name]
+        cases.append((disks[mass], kappa[:sector] if sector else kappa, f_range_hz, max_step, tuned[mass][0], sector))
+    out = {}
+    for (mass, name), r in zip(plan, parallel_map(_mistuned_case, cases, processes)):
+        key = f"{name}_{1e3 * mass:g}g"
+        out[key] = MistuningCase(key, mass, kappas[name], r, tuned[mass][0], tuned[mass][1])
+        tick(f"{key}: max peak {1e3 * r.peak_amplitude.max():.4f} mm (tuned {1e3 * tuned[mass][0]:.4f} mm), "
+             f"{len(r.omega)} points")
     return out
 
 

@@ -3,7 +3,8 @@
 * :mod:`bladedamp.viz.meshcat_view` (needs the "viz" extra: meshcat, trimesh): ``show(result)``
   builds the operating deflection shape of a :class:`~bladedamp.disk.DiskResponse` at a frequency
   of its FRF, with per-point contact maps (stick / slip / separated over the cycle, lift-off
-  ratio) and a colour legend; ``Scene.save_html`` writes a standalone HTML file that opens in a
+  ratio) and a colour legend (a solid FE blade is drawn as its deformed FE surface, the exact
+  mode superposition; ``MorphMeshGeometry``); ``Scene.save_html`` writes a standalone HTML file that opens in a
   browser without a server; ``Scene.serve`` starts a meshcat server bound to localhost (close it).
 * :mod:`bladedamp.viz.widgets`: slider callbacks of the notebooks (no meshcat needed).
 
@@ -11,7 +12,7 @@ Nothing here imports meshcat until a 3D name is used, so ``bladedamp.viz.widgets
 without the "viz" extra.
 """
 _MESHCAT_NAMES = ("Scene", "LiveView", "show", "ods_scene", "contact_map_scene", "cycle_data",
-                  "blade_deflection", "screenshot")
+                  "blade_deflection", "screenshot", "MorphMeshGeometry")
 
 __all__ = list(_MESHCAT_NAMES)
 

@@ -18,6 +18,12 @@ What is drawn (blade frame: x circumferential, y axial, z radial):
   and tip. This is a plausible cantilever-like shape matching the modal values at those points,
   not the FE shape between them. Each span segment moves rigidly with the interpolated motion
   at its middle, the platform with the platform node, the root not at all;
+* a solid FE blade (:class:`bladedamp.solid.SolidModalBlade`, which keeps its boundary surface
+  and the mode shapes at its vertices, ``blade.surface``) is drawn as that surface instead: sent
+  once per blade as a mesh with the scaled mode shapes as relative morph targets
+  (:class:`MorphMeshGeometry`), and the animation sets the morph weights to the modal
+  coordinates q_j(tau), so each frame is the exact mode superposition x + scale sum_j q_j phi_j(x)
+  (a still frame draws the displaced vertices themselves);
 * dampers: rigid-body motion u_D (6 DOF) about their centre of gravity;
 * blade k moves with x_0(tau + k dphi) (cyclic symmetry, Eq. 25); displacements are multiplied
   by ``scale`` (default: the tip amplitude shown as 8 % of the blade length);
@@ -97,7 +103,7 @@ class _RecordingWindow:
 
     def get_scene(self) -> str:
         """Standalone HTML, as meshcat's server builds it for ``static_html()``."""
-        commands = []
+        commands, animations = [], []
         for node in walk(self.tree):
             if node.object is not None:
                 commands.append(create_command(node.object))
@@ -105,7 +111,11 @@ class _RecordingWindow:
             if node.transform is not None:
                 commands.append(create_command(node.transform))
             if node.animation is not None:
-                commands.append(create_command(node.animation))
+                animations.append(create_command(node.animation))
+        # animations last: the viewer binds each track to the object at its path when the
+        # animation loads, so a track on an object itself (".../<object>", e.g. its morph target
+        # influences) needs that object set first
+        commands += animations
         with open(os.path.join(VIEWER_ROOT, "main.min.js")) as f:
             js = f.read()
         return ("<!DOCTYPE html>\n<html>\n<head><meta charset=utf-8><title>bladedamp</title></head>\n<body>\n"
@@ -421,6 +431,31 @@ def _mesh_geometry(mesh, color=None):
     return mg.TriangularMeshGeometry(mesh.vertices, mesh.faces, color)
 
 
+class MorphMeshGeometry(mg.TriangularMeshGeometry):
+    """A triangle mesh with relative morph targets (three.js ``morphAttributes.position``): drawn
+    at ``vertices + sum_j w_j targets[j]`` for the object's ``morphTargetInfluences`` w, which an
+    animation track ``morphTargetInfluences[j]`` (number) sets per frame. The FE blade's surface
+    is drawn so: targets = the (scaled) mode shapes at its vertices, w = the modal coordinates, so
+    every frame is the exact mode superposition and the scene holds the surface once.
+
+    vertices (n_v, 3) [m], faces (n_f, 3), targets (n_t, n_v, 3) [m].
+    """
+
+    __slots__ = ["targets"]
+
+    def __init__(self, vertices, faces, targets):
+        super().__init__(vertices, faces)
+        self.targets = np.asarray(targets, dtype=np.float32)
+        if self.targets.ndim != 3 or self.targets.shape[1:] != self.vertices.shape:
+            raise ValueError(f"targets must have shape (n_t, {self.vertices.shape[0]}, 3) (got {self.targets.shape})")
+
+    def lower(self, object_data):
+        out = super().lower(object_data)
+        out["data"]["morphAttributes"] = {"position": [mg.pack_numpy_array(t.T) for t in self.targets]}
+        out["data"]["morphTargetsRelative"] = True
+        return out
+
+
 def _legend_png(title: str, ratio_max: float) -> bytes:
     import matplotlib
     from matplotlib.figure import Figure
@@ -526,13 +561,13 @@ def _add_contact_maps(scene, data, origin, n_frames, width=0.05, gap=0.008):
                                       mg.MeshBasicMaterial(color=0x000000))
     cursor_z = top[2] + strip_h - cursor_h / 2 + gap / 2
     scene.info["cursor"] = lambda f: np.array([top[0] + (f % n_frames + 0.5) / n_frames * lw, -1e-3, cursor_z])
-    vis["cycle"]["cursor"].set_transform(bgeo._homogeneous(translation=scene.info["cursor"](0)))
+    vis["cycle"]["cursor"].set_transform(bgeo.homogeneous(translation=scene.info["cursor"](0)))
     title = f"{data.frequency_hz:.2f} Hz      rows 1-2: OL left, OR right"
     png = mg.PngImage(_legend_png(title, ratio_max))
     legend = mg.MeshBasicMaterial(map=mg.ImageTexture(image=png, wrap=[1001, 1001], repeat=[1, 1]))
     lo = np.array(origin) + np.array([lw / 2, 0.0, -2 * height - 2 * strip_h - 5 * gap - 0.3 * lw])
     scene.vis[ROOT]["legend"].set_object(mg.Box([lw, 1e-4, 0.6 * lw]), legend)
-    scene.vis[ROOT]["legend"].set_transform(bgeo._homogeneous(translation=lo))   # texture upright on the -y face
+    scene.vis[ROOT]["legend"].set_transform(bgeo.homogeneous(translation=lo))   # texture upright on the -y face
     scene.info.update(state_colors=colors, state_samples=samples, liftoff_colors=ratio_colors,
                       map_origin=np.array(origin), map_size=(lw, 2 * height + 2 * strip_h + 5 * gap + 0.6 * lw),
                       first_row_height=height)
@@ -554,7 +589,7 @@ def _map_frames(scene, anim, n_frames, phase):
                     maps["state"][c][name].set_property("visible", "boolean", bool(m == f % n_frames))
                 else:
                     maps["state"][c][name].set_property("visible", bool(m == f % n_frames))
-        maps["cycle"]["cursor"].set_transform(bgeo._homogeneous(translation=cursor(f)))
+        maps["cycle"]["cursor"].set_transform(bgeo.homogeneous(translation=cursor(f)))
 
     if anim is None:
         pose(vis, int(round(phase / (2 * np.pi) * n_frames)) % n_frames, False)
@@ -576,7 +611,8 @@ def ods_scene(result, index: int | None = None, frequency_hz: float | None = Non
     n_frames, period_s : frames per cycle and the cycle's duration in the viewer [s]
     animate : False draws one still frame at ``phase`` [rad] (no animation)
     contact_maps : draw the contact-state and lift-off maps and the legend
-    blade_geometry : BeamBladeGeometry for the shapes (default the reference blade)
+    blade_geometry : BeamBladeGeometry for the shapes (default the reference blade, or the solid
+        blade's own parametric geometry; a solid blade is drawn as its deformed FE surface)
     camera : (target (3,), camera position relative to the target (3,)) in the blade frame [m]
     """
     disk = result.disk
@@ -591,24 +627,31 @@ def ods_scene(result, index: int | None = None, frequency_hz: float | None = Non
     vis["/Grid"].set_property("visible", False)
     vis["/Axes"].set_property("visible", False)
 
+    # a solid FE blade (bladedamp.solid.SolidModalBlade) brings its boundary surface and the
+    # mode shapes there: drawn deformed (exact superposition) instead of the beam's segments
+    surface = getattr(blade, "surface", None)
+    if blade_geometry is None:
+        fe_geometry = getattr(getattr(blade, "modes", None), "geometry", None)
+        blade_geometry = getattr(fe_geometry, "beam", None)     # the parametric solid's beam
     g = bgeo.reference_blade_geometry() if blade_geometry is None else blade_geometry
+    points = g.points() if surface is None else dict(blade.points)
     if has_damper:
-        lay = bgeo.sector_layout(g.points(), disk.damper, disk.gamma_left, disk.gamma_right)
-        centres = lay.own_contact_centres(g.points())
+        lay = bgeo.sector_layout(points, disk.damper, disk.gamma_left, disk.gamma_right)
+        centres = lay.own_contact_centres(points)
         pitch = lay.pitch
     else:
         lay, centres, pitch = None, None, 2.5 * g.platform_half_width
-    bm = bgeo.blade_mesh(g, disk.gamma_left, disk.gamma_right, centres)
+    bm = bgeo.blade_mesh(g, disk.gamma_left, disk.gamma_right, centres) if surface is None else None
     n = disk.n_blades
     if layout == "disk":
         if lay is None:
             raise ValueError('layout="disk" needs a damper')
-        B, D, ks, r_root = bgeo.disk_placements(lay, n, g.points())
+        B, D, ks, r_root = bgeo.disk_placements(lay, n, points)
     elif layout == "sector":
         ks = np.arange(3)
-        B = np.array([bgeo._homogeneous(translation=(-k * pitch, 0, 0)) for k in ks])
-        D = np.array([bgeo._homogeneous(translation=(lay.damper_cg if lay is not None else 0) - np.array([k * pitch, 0, 0]))
-                      for k in ks])
+        B = np.array([bgeo.homogeneous(translation=(-k * pitch, 0, 0)) for k in ks])
+        cg = lay.damper_cg if lay is not None else 0.0
+        D = np.array([bgeo.homogeneous(translation=cg - np.array([k * pitch, 0, 0])) for k in ks])
         r_root = None
     else:
         raise ValueError('layout must be "sector" or "disk"')
@@ -616,20 +659,42 @@ def ods_scene(result, index: int | None = None, frequency_hz: float | None = Non
 
     # amplitude scale
     tip_amp = max(data.tip_amplitude, 1e-15)
+    blade_length = g.total_length if surface is None else float(blade.points["tip"][2])
     if scale is None:
-        scale = 0.08 * g.total_length / tip_amp
+        scale = 0.08 * blade_length / tip_amp
     scale = float(scale)
 
     dphi = disk.interblade_phase
     taus = [2 * np.pi * f / n_frames for f in range(n_frames + 1)] if animate else [phase]
-    z_seg = np.array([zm for _, zm in bm.segments])
-    z_p = bm.platform_node_z
+    if surface is None:
+        z_seg = np.array([zm for _, zm in bm.segments])
+        z_p = bm.platform_node_z
+    else:
+        z_p = float(blade.points["OL"][2])
     p_platform = np.array([0.0, 0.0, z_p])
+    targets = None if surface is None else scale * surface.shapes.transpose(2, 0, 1)    # (n_m, n_v, 3)
+    synth = {}
+
+    def sector_state_at(k, tau):
+        """State of blade k at phase tau: x_0(tau + k dphi) (cyclic symmetry, Eq. 25)."""
+        key = (k, tau)
+        if key not in synth:
+            S = _synthesis(data.basis, np.array([tau + k * dphi]))[0]
+            synth[key] = S @ data.coefficients
+        return synth[key]
 
     # static geometry
     for j, k in enumerate(ks):
         bp = vis[ROOT]["blades"][f"blade_{k:02d}"]
         bp.set_transform(B[j])
+        if surface is not None:
+            if animate:
+                fe = MorphMeshGeometry(surface.vertices, surface.faces, targets)
+            else:                              # one still frame: the deformed surface itself
+                q = sector_state_at(k, phase)[:nm]
+                fe = mg.TriangularMeshGeometry(surface.vertices + np.tensordot(q, targets, axes=1), surface.faces)
+            bp["fe_surface"].set_object(fe, mg.MeshLambertMaterial(color=BLADE_COLOR))
+            continue
         bp["root"].set_object(_mesh_geometry(bm.root), mg.MeshLambertMaterial(color=PLATFORM_COLOR))
         bp["platform"]["mesh"].set_object(_mesh_geometry(bm.platform), mg.MeshLambertMaterial(color=PLATFORM_COLOR))
         for s, (mesh, _) in enumerate(bm.segments):
@@ -642,19 +707,16 @@ def ods_scene(result, index: int | None = None, frequency_hz: float | None = Non
             dp["body"]["mesh"].set_object(_mesh_geometry(dmesh), mg.MeshLambertMaterial(color=DAMPER_COLOR))
 
     # motion per frame
-    synth = {}
-
-    def sector_state(k, tau):
-        key = (k, tau)
-        if key not in synth:
-            S = _synthesis(data.basis, np.array([tau + k * dphi]))[0]
-            synth[key] = S @ data.coefficients
-        return synth[key]
-
-    def pose(frame_vis, tau):
+    def pose(frame_vis, tau, animated):
         for j, k in enumerate(ks):
-            x = sector_state(k, tau)
+            x = sector_state_at(k, tau)
             q = x[:nm]
+            if surface is not None:            # a still frame has the deformed surface already
+                if animated:                   # the morph influences are the modal coordinates
+                    obj = frame_vis[ROOT]["blades"][f"blade_{k:02d}"]["fe_surface"]["<object>"]
+                    for m in range(nm):
+                        obj.set_property(f"morphTargetInfluences[{m}]", "number", float(q[m]))
+                continue
             u, phi = blade_deflection(blade, q, z_seg)
             bp = frame_vis[ROOT]["blades"][f"blade_{k:02d}"]
             for s in range(len(z_seg)):
@@ -663,7 +725,7 @@ def ods_scene(result, index: int | None = None, frequency_hz: float | None = Non
             bp["platform"].set_transform(_rigid(scale * up[0], scale * pp[0], p_platform))
         if has_damper:
             for j in range(n_dampers):
-                x = sector_state(ks[j], tau)
+                x = sector_state_at(ks[j], tau)
                 uD = x[nm:nm + 6]
                 frame_vis[ROOT]["dampers"][f"damper_{ks[j]:02d}"]["body"].set_transform(
                     _rigid(scale * uD[:3], scale * uD[3:], np.zeros(3)))
@@ -674,9 +736,9 @@ def ods_scene(result, index: int | None = None, frequency_hz: float | None = Non
         anim = meshcat.animation.Animation(default_framerate=fps)
         for f, tau in enumerate(taus):
             with anim.at_frame(vis, f) as frame:
-                pose(frame, tau)
+                pose(frame, tau, True)
     else:
-        pose(vis, phase)
+        pose(vis, phase, False)
 
     # contact maps
     map_origin = np.array([0.04, 0.0, z_p + 0.06])
@@ -684,7 +746,7 @@ def ods_scene(result, index: int | None = None, frequency_hz: float | None = Non
     if layout == "disk":
         # beside the disk, right of the blade tips' circle (centre (0, 0, -r_root)), in front of
         # the blades: the maps and the legend cross no blade
-        r_tip = r_root + g.total_length
+        r_tip = r_root + blade_length
         map_origin = np.array([r_tip + 0.03, -0.02, -r_root + 0.09])
     if contact_maps and has_damper:
         samples = _add_contact_maps(scene, data, map_origin, n_frames)

@@ -9,15 +9,12 @@ Two kinds of callbacks:
 * the point contact and the friction oscillator (notebook 01): closed forms and cheap AFT
   evaluations (tens of milliseconds), the oscillator's FRF with time integration at a few
   frequencies (a few tenths of a second, memoised);
-* the reference bladed disk (notebooks 02, 03): a frequency response per slider move. A
-  continuation run over the 1F window takes 1-2 s; :class:`DiskFRFCache` answers in 0.1-0.5 s
-  (2-core machine) instead by Newton's method on a fixed frequency grid, each frequency started
-  from the cached solution of the nearest parameter value already computed (the *warm start*:
-  nearest mass, or nearest platform angle), or from the previous frequencies on a cold start
-  (about 1 s), with the peak refined on finer grids. Where Newton does not converge (a light
-  damper in gross slip) it falls back to the continuation solver (1-2 s). Results are
-  memoised, so moving a slider back is instant. Peaks agree with
-  :func:`bladedamp.studies.peak_response` to 0.1 % (tests).
+* the reference bladed disk (notebooks 02, 03): a frequency response per slider move, the
+  library's own (:func:`bladedamp.studies.peak_response`, i.e. ``TunedDisk.frequency_response``
+  with the studies' peak refinement), with a continuation step of 0.2 (0.4-1.2 s per new value
+  on the loaded 2-core machine, 1-2 s at the studies' 0.05; :class:`DiskFRFCache`). Results are
+  memoised, so moving a slider back is instant; the contact state at resonance (Eq. 27) is
+  :func:`bladedamp.studies.contact_state` itself, memoised.
 
 Units: SI inside; the arguments of the ``*_figure`` callbacks carry their slider units in their
 names (``mass_g``, ``amplitude_mm``, ``gamma_right_deg``).
@@ -35,7 +32,6 @@ import numpy as np
 from ..contact.laws import LinearNormalLaw
 from ..contact.patch import ContactPatch
 from ..contact.point import SEPARATED, SLIP, STICK, point_contact_forces
-from ..hbm.continuation import Branch, newton
 from ..hbm.fourier import HarmonicBasis
 from ..oscillator import FrictionOscillator
 
@@ -305,76 +301,85 @@ def oscillator_figure(normal_load=3.0, forcing=2.0, damping=2.0, **kwargs):
 
 
 # ---------------------------------------------------------------------------------------
-# 3. the reference disk: warm-started frequency responses
+# 3. the reference disk: the library's frequency responses, memoised
 # ---------------------------------------------------------------------------------------
 @dataclass
 class DiskFRF:
-    """A frequency response of the reference disk on a frequency grid.
+    """A frequency response of the reference disk, as a slider callback shows it.
 
-    frequency_hz : (n,) [Hz]; tip_amplitude : (n, 3) first-harmonic tip amplitude u_x, u_y, u_z [m];
-    x : (n, N) harmonic balance unknowns; peak_amplitude [m] and peak_frequency_hz [Hz] of u_x (refined);
-    peak_x : unknowns at the refined peak; method : "linear", "warm", "cold" or "continuation";
-    seconds : compute time [s]; disk : the TunedDisk; system : its HarmonicBalanceSystem.
+    response : the :class:`~bladedamp.disk.DiskResponse` of ``TunedDisk.frequency_response`` (via
+    :func:`bladedamp.studies.peak_response`); frequency_hz : (n,) [Hz] and tip_amplitude : (n, 3)
+    first-harmonic tip amplitude u_x, u_y, u_z [m] along its branch; peak_amplitude [m] and
+    peak_frequency_hz [Hz] of u_x (parabola-refined, as ``peak_response``); method : "linear"
+    (no damper), "continuation", or "incomplete" (the branch stopped early, ``response.message``
+    says why; the peak is the largest converged point, a lower bound); seconds : compute time [s];
+    disk : the TunedDisk.
     """
 
-    frequency_hz: np.ndarray
-    tip_amplitude: np.ndarray
-    x: np.ndarray
+    response: object
     peak_amplitude: float
     peak_frequency_hz: float
-    peak_x: np.ndarray
     method: str
     seconds: float
     disk: object
-    system: object
+
+    @property
+    def frequency_hz(self) -> np.ndarray:
+        """(n,) excitation frequency of the branch's points [Hz]."""
+        return self.response.frequency_hz
+
+    @property
+    def tip_amplitude(self) -> np.ndarray:
+        """(n, 3) first-harmonic tip amplitude u_x, u_y, u_z [m] of the branch's points."""
+        return self.response.tip_amplitude
 
     def reduction(self, undamped: "DiskFRF") -> float:
         """1 - peak / undamped peak."""
         return 1.0 - self.peak_amplitude / undamped.peak_amplitude
 
 
-def _tip(disk, system, X) -> np.ndarray:
-    basis = system.basis
-    C, n = basis.n_coeffs, system.n_dof
-    nm = disk.blade.n_modes
-    j = basis.cos_index(1)
-    X = np.asarray(X).reshape(-1, C, n)
-    q1 = X[:, j, :nm] - 1j * X[:, j + 1, :nm]
-    return np.abs(q1 @ disk.blade.shape("tip")[:3].T)
+# half-width of the window of the contact state at resonance [Hz]: the coarse branch's peak is
+# within 0.01 Hz of the fine one; measured on the 1 g cylinder at gamma_R = 85 deg, contact_state
+# took 2.0 / 1.2 s on a +-1 / +-0.3 Hz window (loaded 2-core machine)
+CONTACT_STATE_WINDOW_HZ = 0.3
 
 
 class DiskFRFCache:
-    """Memoised, warm-started frequency responses of reference disks (see the module docstring).
+    """Memoised frequency responses of reference disks (see the module docstring).
+
+    Each response is the library's own: :func:`bladedamp.studies.peak_response` (the disk's
+    ``frequency_response``, the range widened when the peak sits at an end, the peak refined
+    by a parabola), so a slider shows exactly what a study computes.
 
     Parameters
     ----------
-    f_range_hz : frequency window [Hz]; widened (once per side, by its width) when the peak
-        sits at an end
-    n_points : frequencies of the grid
-    refine_points : frequencies of each finer grid around the largest point
-    refine_rounds : how many finer grids (each spans two steps of the previous one)
+    f_range_hz : frequency window [Hz]
+    max_step : the continuation's largest step (scaled units, the window is 1). Measured against
+        the studies' step 0.05 on 0.1-10 g cylinders and wedges (10 disks, one loaded run): at
+        0.2 the peaks agree within 0.055 % in amplitude and 0.008 Hz, 43-87 points, 0.37-1.22 s
+        per response; 0.3 is 16 % faster (32-61 points) but 0.115 % off on the 1 g cylinder at
+        gamma_R = 45 deg (tests/test_widgets.py holds 0.1 % and 0.02 Hz)
     max_entries : memoised responses kept (least recently used dropped)
     """
 
-    def __init__(self, f_range_hz=(92.0, 100.0), n_points=33, refine_points=7, refine_rounds=3, max_entries=256):
+    def __init__(self, f_range_hz=(92.0, 100.0), max_step=0.2, max_entries=256):
         self.f_range_hz = tuple(float(f) for f in f_range_hz)
-        self.n_points = int(n_points)
-        self.refine_points = int(refine_points)
-        self.refine_rounds = int(refine_rounds)
+        self.max_step = float(max_step)
         self.max_entries = int(max_entries)
         self._memo: "OrderedDict[tuple, DiskFRF]" = OrderedDict()
         self._base_disks: dict = {}
-        self.stats = {"memo": 0, "linear": 0, "warm": 0, "cold": 0, "continuation": 0}
+        self._states: dict = {}
+        self.stats = {"memo": 0, "linear": 0, "continuation": 0}
 
     # -- keys -------------------------------------------------------------------------
     @staticmethod
     def family(kind, engine_order=1, gamma_right_deg=35.0, excitation=None, harmonics=(1,)):
-        """Everything but the mass: responses of one family warm-start each other."""
+        """Everything but the mass (the blade's beam modes are built once per family)."""
         exc = None if excitation is None else tuple(float(v) for v in excitation)
         return (kind, int(engine_order), round(float(gamma_right_deg), 6), exc, tuple(harmonics))
 
     def _disk(self, family, mass):
-        """The family's reference disk with ``mass`` (the blade's beam modes are built once per family)."""
+        """The family's reference disk with ``mass`` [kg]."""
         from ..reference import reference_disk
 
         if family not in self._base_disks:
@@ -383,7 +388,7 @@ class DiskFRFCache:
             if exc is not None:
                 kw["excitation"] = np.array(exc)
             if eo == 0:
-                kw["rotor_speed"] = 2 * np.pi * 95.0      # EO = 0 needs a rotor speed: the 1F frequency
+                kw["rotor_speed_hz"] = 95.0      # EO = 0 needs a rotor speed: that of the EO = 1 resonance
             disk = reference_disk(kind, 1e-3, engine_order=eo, **kw)
             if gamma_r != 35.0:
                 disk = dataclasses.replace(disk, gamma_right=np.radians(gamma_r))
@@ -398,6 +403,8 @@ class DiskFRFCache:
                  harmonics=(1,)) -> DiskFRF:
         """Frequency response of the reference disk with a ``kind`` damper of ``mass`` [kg]
         (``kind=None``: no damper), at ``engine_order``, right platform angle [deg]."""
+        from ..studies.mass import IncompleteResponse, peak_response
+
         if kind not in (None, "cylinder", "wedge"):
             raise ValueError(f"kind must be None, 'cylinder' or 'wedge' (got {kind!r})")
         if kind is not None and not mass > 0:
@@ -411,136 +418,45 @@ class DiskFRFCache:
             return self._memo[key]
         t0 = time.perf_counter()
         disk = self._disk(fam, mass if kind is not None else 1e-3)
-        system = disk.hbm_system(harmonics)
-        result = self._solve(fam, mass, disk, system, t0)
+        method = "continuation" if disk.has_damper else "linear"
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            try:
+                peak, f_peak, r = peak_response(disk, self.f_range_hz, harmonics=tuple(harmonics),
+                                                max_step=self.max_step)
+            except IncompleteResponse as e:
+                if e.response is None or not len(e.response.omega):
+                    raise
+                # the branch stopped early: show what converged, its largest point a lower bound
+                r, method = e.response, "incomplete"
+                i = int(np.argmax(r.tip_amplitude[:, 0]))
+                peak, f_peak = float(r.tip_amplitude[i, 0]), float(r.frequency_hz[i])
+        self.stats[method] = self.stats.get(method, 0) + 1
+        result = DiskFRF(r, peak, f_peak, method, time.perf_counter() - t0, disk)
         self._memo[key] = result
         while len(self._memo) > self.max_entries:
             self._memo.popitem(last=False)
         return result
 
-    def clear(self):
-        self._memo.clear()
+    def contact_state(self, frf: DiskFRF):
+        """:func:`bladedamp.studies.contact_state` (Eq. 27 at the resonance) of ``frf``'s disk,
+        memoised; solved on a window of +-``CONTACT_STATE_WINDOW_HZ`` around ``frf``'s peak (the
+        study's resonance is the same peak, and a window that contains it gives it; the study's
+        own step on the narrow window places points 0.03 Hz apart there)."""
+        from ..studies.design import contact_state
 
-    # -- internals --------------------------------------------------------------------
-    def _neighbour(self, fam, mass):
-        """Cached damped response nearest in parameters, or None: same damper type, engine order,
-        excitation and harmonics; distance |log(m / m')| + |gamma_R - gamma_R'| / 20 deg."""
-        best, dist = None, np.inf
-        kind, eo, gamma_r, exc, harmonics = fam
-        for key, r in self._memo.items():
-            k_kind, k_eo, k_gamma, k_exc, k_harm, k_mass = key
-            if (k_kind, k_eo, k_exc, k_harm) == (kind, eo, exc, harmonics) and k_mass > 0 and r.method != "linear":
-                d = abs(np.log(k_mass / mass)) + abs(k_gamma - gamma_r) / 20.0
-                if d < dist:
-                    best, dist = r, d
-        return best
-
-    def _solve(self, fam, mass, disk, system, t0) -> DiskFRF:
-        lo, hi = self.f_range_hz
-        for _ in range(3):
-            r = self._solve_range(fam, mass, disk, system, lo, hi, t0)
-            i = int(np.argmax(r.tip_amplitude[:, 0]))
-            width = hi - lo
-            if 0 < i < len(r.frequency_hz) - 1:
-                return r
-            lo, hi = (max(lo - width, 0.5 * lo), hi) if i == 0 else (lo, hi + width)
-        return r
-
-    def _solve_range(self, fam, mass, disk, system, lo, hi, t0) -> DiskFRF:
-        w0, w1 = 2 * np.pi * lo, 2 * np.pi * hi
-        if not disk.has_damper:
-            fs = np.linspace(lo, hi, 8 * self.n_points)   # linear and sharp: a dense grid is cheap
-            # linear: one solve per frequency
-            X = np.array([disk._initial_guess(system, 2 * np.pi * f) for f in fs])
-            return self._finish(disk, system, fs, X, "linear", t0, lambda f, x: (disk._initial_guess(system, 2 * np.pi * f), True))
-        fs = np.linspace(lo, hi, self.n_points)
-        scales = disk._scales(system, w0, w1)
-        rscale = max(np.linalg.norm(system.residual(np.zeros(system.n_unknowns), w0)[0]), 1e-300)
-
-        def solve(f, x0, max_iter=30):
+        key = id(frf)
+        if key not in self._states or self._states[key][0] is not frf:
+            f = frf.peak_frequency_hz
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                res = newton(system.residual, x0, 2 * np.pi * f, scales, rscale, max_iter=max_iter)
-            return res.x, res.converged and np.all(np.isfinite(res.x))
+                window = (f - CONTACT_STATE_WINDOW_HZ, f + CONTACT_STATE_WINDOW_HZ)
+                self._states[key] = (frf, contact_state(frf.disk, window))
+        return self._states[key][1]
 
-        nb = self._neighbour(fam, mass)
-        guesses = None
-        if nb is not None and nb.x.shape[1] == system.n_unknowns:
-            guesses = np.array([np.interp(fs, nb.frequency_hz, nb.x[:, k]) for k in range(nb.x.shape[1])]).T
-        X, ok_all = np.zeros((fs.size, system.n_unknowns)), True
-        x_prev = disk._initial_guess(system, w0)
-        for i, f in enumerate(fs):
-            x, ok = solve(f, guesses[i], 10) if guesses is not None else (None, False)
-            if not ok and i >= 2:
-                # secant predictor along the frequency
-                x, ok = solve(f, 2 * X[i - 1] - X[i - 2], 10)
-            if not ok:
-                x, ok = solve(f, x_prev)
-            if not ok and i >= 1:
-                # sub-steps from the previous frequency, each with a secant predictor
-                xa, xb, fa = X[i - 1] if i < 2 else X[i - 2], X[i - 1], fs[i - 1]
-                df = (f - fa) / 8
-                for k in range(1, 9):
-                    pred = xb + (xb - xa) * (df / (fa - fs[i - 2] if i >= 2 and k == 1 else df))
-                    x, ok = solve(fa + k * df, pred, 15)
-                    if not ok:
-                        x, ok = solve(fa + k * df, xb, 30)
-                    if not ok:
-                        break
-                    xa, xb = xb, x
-            if not ok:
-                ok_all = False
-                break
-            X[i] = x_prev = x
-        if ok_all:
-            return self._finish(disk, system, fs, X, "warm" if guesses is not None else "cold", t0, solve)
-        # fallback: arc-length continuation, then the grid by interpolation of the branch
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            resp = disk.frequency_response(lo, hi, harmonics=system.basis.harmonics, max_step=0.05)
-        order = np.argsort(resp.omega)
-        fb, xb = resp.frequency_hz[order], resp.coefficients.reshape(len(resp.omega), -1)[order]
-        fb, idx = np.unique(fb, return_index=True)
-        xb = xb[idx]
-        X = np.array([np.interp(fs, fb, xb[:, k]) for k in range(xb.shape[1])]).T
-        tip_b = _tip(disk, system, xb)
-        i = int(np.argmax(tip_b[:, 0]))
-        out = self._finish(disk, system, fs, X, "continuation", t0, solve)
-        if tip_b[i, 0] > out.peak_amplitude:
-            out.peak_amplitude, out.peak_frequency_hz, out.peak_x = float(tip_b[i, 0]), float(fb[i]), xb[i]
-        out.frequency_hz, out.tip_amplitude, out.x = fb, tip_b, xb
-        return out
-
-    def _finish(self, disk, system, fs, X, method, t0, solve) -> DiskFRF:
-        tip = _tip(disk, system, X)
-        i = int(np.argmax(tip[:, 0]))
-        peak, f_peak, x_peak = float(tip[i, 0]), float(fs[i]), X[i]
-        extra_f, extra_x = [], []
-        # refine on finer and finer grids between the neighbours of the largest point
-        a, b, x = fs[max(i - 1, 0)], fs[min(i + 1, fs.size - 1)], X[max(i - 1, 0)]
-        for _ in range(self.refine_rounds):
-            grid = np.linspace(a, b, self.refine_points)
-            for f in grid:
-                x_new, ok = solve(f, x)
-                if not ok:
-                    continue
-                x = x_new
-                extra_f.append(float(f))
-                extra_x.append(x)
-                t = float(_tip(disk, system, x)[0, 0])
-                if t > peak:
-                    peak, f_peak, x_peak = t, float(f), x
-            step = grid[1] - grid[0]
-            a, b, x = f_peak - step, f_peak + step, x_peak
-        if extra_f:
-            # the refinement points sharpen the plotted peak too
-            fs = np.concatenate([fs, extra_f])
-            X = np.vstack([X, np.array(extra_x)])
-            fs, idx = np.unique(fs, return_index=True)
-            X = X[idx]
-            tip = _tip(disk, system, X)
-        self.stats[method] += 1
-        return DiskFRF(fs, tip, X, peak, f_peak, x_peak, method, time.perf_counter() - t0, disk, system)
+    def clear(self):
+        self._memo.clear()
+        self._states.clear()
 
 
 DEFAULT_CACHE = DiskFRFCache()
@@ -582,7 +498,7 @@ def disk_frf_figure(mass_g=1.0, kind="cylinder", engine_order=1, gamma_right_deg
 
 
 def mass_sweep_peaks(kind, masses_g, engine_order=1, gamma_right_deg=35.0, cache=None) -> dict:
-    """Peak tip amplitude [m] and reduction over damper masses [g], warm-started mass after mass.
+    """Peak tip amplitude [m] and reduction over damper masses [g], one memoised FRF per mass.
 
     Returns a dict ``mass_g``, ``peak_amplitude``, ``peak_frequency_hz``, ``undamped_peak_amplitude``, ``reduction``,
     and the best grid point ``best_mass_g``, ``best_reduction``."""
@@ -629,31 +545,13 @@ def engine_order_figure(engine_order=1, kind="cylinder", mass_g=1.0, cache=None)
     return disk_frf_figure(mass_g, kind, engine_order, 35.0, cache)
 
 
-def contact_state_at_peak(frf: DiskFRF):
-    """Eq. 27 at the refined resonance of ``frf``: a :class:`bladedamp.studies.ContactState`
-    (normalised first-harmonic xi motion and force of both contacts), from the cached solution,
-    the same definitions as :func:`bladedamp.studies.contact_state`."""
-    from ..disk import DiskResponse
-    from ..studies.design import ContactState
-
-    disk, system = frf.disk, frf.system
-    if not disk.has_damper:
+def contact_state_at_peak(frf: DiskFRF, cache: DiskFRFCache | None = None):
+    """Eq. 27 at the resonance of ``frf``: the :class:`bladedamp.studies.ContactState` of
+    :func:`bladedamp.studies.contact_state` (normalised first-harmonic xi motion and force of both
+    contacts) for ``frf``'s disk, memoised in ``cache``."""
+    if not frf.disk.has_damper:
         raise ValueError("contact_state_at_peak needs a damped response")
-    omega = 2 * np.pi * frf.peak_frequency_hz
-    branch = Branch(np.array([omega]), frf.peak_x[None, :], np.zeros(1, dtype=int), True, "peak")
-    r = DiskResponse.from_branch(disk, system, branch)
-    basis = r.basis
-    w1 = basis.to_complex(r.relative_motion[0])[1]
-    f1 = basis.to_complex(r.contact_force[0])[1]
-    w_xi, F_xi = w1[[0, 6]], f1[[0, 6]]
-    patches = disk.damper_geometry().patches
-    c_t = np.array([p.tangential_stiffness for p in patches])
-    mu = np.array([p.friction_coefficient for p in patches])
-    F_N = np.asarray(disk.static_normal_loads(frf.peak_frequency_hz), dtype=float)
-    state = ContactState(w_xi * c_t / (mu * F_N), F_xi / (mu * F_N), w_xi, F_xi, F_N, c_t, mu,
-                         float(frf.peak_frequency_hz), float(frf.peak_amplitude))
-    state.point_state = r.point_state[0]     # (2, P, 3) stick / slip / separated share per point
-    return state
+    return (DEFAULT_CACHE if cache is None else cache).contact_state(frf)
 
 
 def platform_angle_figure(gamma_right_deg=35.0, kind="cylinder", mass_g=1.0, cache=None):
@@ -662,7 +560,7 @@ def platform_angle_figure(gamma_right_deg=35.0, kind="cylinder", mass_g=1.0, cac
     ``fig.data = (damped FRF, undamped FRF, ContactState)``."""
     damped = disk_frf(kind, mass_g, 1, gamma_right_deg, cache=cache)
     free = undamped_frf(1, cache=cache)
-    state = contact_state_at_peak(damped)
+    state = contact_state_at_peak(damped, cache)
     fig, (ax, ax2) = _figure(1, 2, figsize=(11, 4.5), gridspec_kw={"width_ratios": [1.4, 1]})
     ax.plot(free.frequency_hz, 1e3 * free.tip_amplitude[:, 0], "k--", lw=1, label="no damper")
     ax.plot(damped.frequency_hz, 1e3 * damped.tip_amplitude[:, 0], label=f"{kind} {mass_g:.3g} g, gamma_R = {gamma_right_deg:g} deg")
