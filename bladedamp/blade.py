@@ -194,22 +194,6 @@ class RectangularSection:
         return torsion_constant_rectangle(self.thickness_x, self.chord_y)
 
 
-def excitation_omega(omega, f_hz, method: str):
-    """Omega = 2 pi ``f_hz`` [rad/s] of a blade method's excitation frequency ``f_hz`` [Hz]; the
-    deprecated angular ``omega`` [rad/s] is taken as given, with a DeprecationWarning. Exactly
-    one of them must be given."""
-    if (omega is None) == (f_hz is None):
-        raise ValueError(f"{method}: give the excitation frequency once, as f_hz [Hz] (the angular omega "
-                         "[rad/s] is deprecated)")
-    if f_hz is not None:
-        return 2.0 * np.pi * np.asarray(f_hz, dtype=float)
-    import warnings
-
-    warnings.warn(f"ModalBlade.{method}(omega) in rad/s is deprecated: give f_hz= in Hz (omega / (2 pi))",
-                  DeprecationWarning, stacklevel=3)
-    return omega
-
-
 # --------------------------------------------------------------------------------------
 # Modal blade (paper Eq. 1-5)
 # --------------------------------------------------------------------------------------
@@ -306,14 +290,13 @@ class ModalBlade:
         """omega_0j = 2 pi f_0j [rad/s], shape (n_m,)."""
         return 2.0 * np.pi * self.natural_frequencies_hz
 
-    def dynamic_stiffness(self, omega: float | None = None, *, f_hz: float | None = None) -> np.ndarray:
+    def dynamic_stiffness(self, f_hz: float) -> np.ndarray:
         """Diagonal of the modal dynamic stiffness S(Omega) [1/s^2], Eq. 5, at the excitation
         frequency ``f_hz`` [Hz] (Omega = 2 pi f_hz).
 
         S_j = omega_0j^2 - Omega^2 + 2 i D_j omega_0j Omega, shape (n_m,), complex.
-        ``omega`` [rad/s], positional: deprecated (a DeprecationWarning), give ``f_hz``.
         """
-        omega = check.finite("f_hz", excitation_omega(omega, f_hz, "dynamic_stiffness"))
+        omega = 2.0 * np.pi * check.finite("f_hz", f_hz)
         w0 = self.natural_angular_frequencies
         return w0**2 - omega**2 + 2j * self.damping_ratios * w0 * omega
 
@@ -601,27 +584,23 @@ class ModalBlade:
                    mode_shapes=shapes, points=positions, mode_names=mode_names)
 
     # -- linear reference solution -----------------------------------------------------
-    def linear_frf(self, omega: np.ndarray | None = None, force: np.ndarray | None = None, at: str = "excitation",
-                   response_at: str = "tip", *, f_hz: np.ndarray | None = None) -> np.ndarray:
+    def linear_frf(self, f_hz: np.ndarray, force: np.ndarray, at: str = "excitation",
+                   response_at: str = "tip") -> np.ndarray:
         """Linear (no damper) harmonic response, closed-form modal superposition (Eq. 4-5).
 
         u(Omega) = Phi_resp S(Omega)^-1 Phi_at^T f.
 
         Parameters
         ----------
-        f_hz : excitation frequencies [Hz], scalar or (n,) (keyword).
+        f_hz : excitation frequencies [Hz], scalar or (n,).
         force : (6,) complex amplitude (F_x, F_y, F_z [N], M_x, M_y, M_z [N m]) at ``at``.
         at, response_at : point names.
-        omega : deprecated, the excitation angular frequencies [rad/s] (first positional
-            argument, a DeprecationWarning); give ``f_hz``.
 
         Returns
         -------
         (n, 6) complex response amplitudes (u [m], phi [rad]) at ``response_at``.
         """
-        if force is None:
-            raise ValueError("force must be given: the (6,) load (F_x, F_y, F_z [N], M_x, M_y, M_z [N m]) at 'at'")
-        omega = np.atleast_1d(check.finite("f_hz", excitation_omega(omega, f_hz, "linear_frf")))
+        omega = 2.0 * np.pi * np.atleast_1d(check.finite("f_hz", f_hz))
         if omega.ndim != 1:
             raise ValueError(f"f_hz must be a scalar or 1-D array [Hz] (got shape {omega.shape})")
         modal_force = self.modal_force(force, at)                       # (n_m,)

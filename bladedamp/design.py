@@ -458,8 +458,7 @@ class Design:
         if the file's rotor speed is 'auto')."""
         from .studies.design import at_engine_order
 
-        base = dataclasses.replace(self.disk, engine_order=1, rotor_speed_hz=self.rotor_speed_hz,
-                                   rotor_speed=None)   # valid for n >= 2
+        base = dataclasses.replace(self.disk, engine_order=1, rotor_speed_hz=self.rotor_speed_hz)   # valid for n >= 2
         return at_engine_order(base, engine_order, self.rotor_speed_eo0_hz)
 
     def mistuned_disk(self):

@@ -276,23 +276,10 @@ class DamperContacts:
         return force, jac, domega
 
 
-def rotor_speed_in_hz(rotor_speed_hz, rotor_speed=None):
-    """The rotor speed [Hz, revolutions per second] of a disk given ``rotor_speed_hz`` [Hz] and/or
-    the deprecated ``rotor_speed`` [rad/s] (a DeprecationWarning when only that is given; both
-    must agree). None: the speed follows the excitation (Omega_E / EO). Validated: > 0, and a
-    :class:`~bladedamp._validate.PlausibilityWarning` outside 1-3000 Hz (60-180 000 rpm)."""
-    if rotor_speed is not None:
-        rotor_speed = _validate.positive("rotor_speed (rad/s, deprecated: use rotor_speed_hz)", rotor_speed)
-        from_rad = float(rotor_speed) / (2 * np.pi)
-        if rotor_speed_hz is None:
-            import warnings
-
-            warnings.warn("rotor_speed [rad/s] is deprecated: give rotor_speed_hz [Hz] = rotor_speed / (2 pi) "
-                          "(rpm / 60)", DeprecationWarning, stacklevel=4)
-            rotor_speed_hz = from_rad
-        elif not np.isclose(float(rotor_speed_hz), from_rad, rtol=1e-12, atol=0.0):
-            raise ValueError(f"rotor_speed_hz = {rotor_speed_hz!r} Hz and the deprecated rotor_speed = {rotor_speed!r} "
-                             "rad/s disagree: give rotor_speed_hz only (or rotor_speed=None with it)")
+def rotor_speed_in_hz(rotor_speed_hz):
+    """The rotor speed [Hz, revolutions per second] of a disk, validated: None (the speed follows
+    the excitation, Omega_E / EO), or > 0 with a :class:`~bladedamp._validate.PlausibilityWarning`
+    outside 1-3000 Hz (60-180 000 rpm)."""
     if rotor_speed_hz is None:
         return None
     _validate.positive("rotor_speed_hz (rotor revolutions per second)", rotor_speed_hz)
@@ -322,8 +309,6 @@ class TunedDisk:
     damper_inertia : include the damper's mass and rotary inertia in Eq. 12
     initial_gaps : (2, P) gaps of the OL and OR patch points before loading [m] (default: a
         perfect fit), e.g. :func:`bladedamp.geometry.misfit_gaps` of a damper that does not fit
-    rotor_speed : deprecated, the rotor speed in rad/s (use ``rotor_speed_hz``); kept equal to
-        2 pi ``rotor_speed_hz`` so that code written for it still reads and replaces it
     """
 
     blade: ModalBlade
@@ -337,11 +322,9 @@ class TunedDisk:
     rotor_speed_hz: float | None = None
     damper_inertia: bool = True
     initial_gaps: np.ndarray | None = None
-    rotor_speed: float | None = field(default=None, repr=False)
 
     def __post_init__(self):
-        self.rotor_speed_hz = rotor_speed_in_hz(self.rotor_speed_hz, self.rotor_speed)
-        self.rotor_speed = None if self.rotor_speed_hz is None else 2 * np.pi * self.rotor_speed_hz
+        self.rotor_speed_hz = rotor_speed_in_hz(self.rotor_speed_hz)
         _validate.integer("n_blades", self.n_blades, minimum=2)
         _validate.integer("engine_order (EO)", self.engine_order, minimum=0, maximum=self.n_blades // 2)
         _validate.in_range("gamma_left (platform angle, rad)", self.gamma_left, 0.0, np.pi / 2, closed="neither")

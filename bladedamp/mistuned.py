@@ -438,7 +438,6 @@ class MistunedDisk:
     engine_order, damper_radius, excitation, rotor_speed_hz, damper_inertia : as
         :class:`~bladedamp.disk.TunedDisk` (the same for every position; ``rotor_speed_hz`` in Hz,
         revolutions per second)
-    rotor_speed : deprecated, the rotor speed in rad/s (as :class:`~bladedamp.disk.TunedDisk`)
     """
 
     blades: Sequence[ModalBlade]
@@ -452,14 +451,12 @@ class MistunedDisk:
     rotor_speed_hz: float | None = None
     damper_inertia: bool = True
     initial_gaps: object = None
-    rotor_speed: float | None = field(default=None, repr=False)
     #: linear solver of the continuation (:attr:`AssemblySystem.linear_solver`); set it on an
     #: instance (``disk.linear_solver = "condensation"``) to change that disk's solver
     linear_solver: ClassVar[str] = "auto"
 
     def __post_init__(self):
-        self.rotor_speed_hz = rotor_speed_in_hz(self.rotor_speed_hz, self.rotor_speed)
-        self.rotor_speed = None if self.rotor_speed_hz is None else 2 * np.pi * self.rotor_speed_hz
+        self.rotor_speed_hz = rotor_speed_in_hz(self.rotor_speed_hz)
         if isinstance(self.blades, ModalBlade) or len(self.blades) == 0:
             raise ValueError("blades must be a non-empty sequence of ModalBlade (one per blade of the model)")
         self.blades = list(self.blades)

@@ -64,13 +64,13 @@ def test_public_frequency_arguments_are_named_in_hz():
         params = inspect.signature(cls).parameters
         assert "rotor_speed_hz" in params and params["rotor_speed_hz"].default is None, cls
     for method in (bd.ModalBlade.dynamic_stiffness, bd.ModalBlade.linear_frf):
-        assert inspect.signature(method).parameters["f_hz"].kind is inspect.Parameter.KEYWORD_ONLY, method
+        assert list(inspect.signature(method).parameters)[1] == "f_hz", method
 
 
 def test_blade_frequency_arguments_in_hz_are_eq5():
     """ModalBlade.dynamic_stiffness(f_hz=) is Eq. 5 at Omega = 2 pi f; linear_frf(f_hz=) peaks at the
-    1F natural frequency in Hz; the deprecated rad/s positional argument gives the same numbers
-    with a DeprecationWarning; neither or both is a ValueError naming f_hz."""
+    1F natural frequency in Hz; f_hz is the first argument (positional or keyword); a NaN is a
+    ValueError naming f_hz."""
     blade = bd.reference_blade()
     f = 100.0
     w0, w = blade.natural_angular_frequencies, 2 * np.pi * f
@@ -80,15 +80,9 @@ def test_blade_frequency_arguments_in_hz_are_eq5():
     grid = np.linspace(94.0, 96.0, 2001)
     f1 = blade.natural_frequencies_hz[0]
     assert grid[np.argmax(np.abs(blade.linear_frf(f_hz=grid, force=force)[:, 0]))] == pytest.approx(f1, abs=2e-3)
-    with pytest.warns(DeprecationWarning, match="f_hz"):
-        old = blade.linear_frf(2 * np.pi * grid, force)
-    np.testing.assert_array_equal(old, blade.linear_frf(f_hz=grid, force=force))
-    with pytest.warns(DeprecationWarning, match="f_hz"):
-        np.testing.assert_array_equal(blade.dynamic_stiffness(w), blade.dynamic_stiffness(f_hz=f))
-    for bad in (lambda: blade.dynamic_stiffness(), lambda: blade.dynamic_stiffness(w, f_hz=f),
-                lambda: blade.linear_frf(force=force)):
-        with pytest.raises(ValueError, match="f_hz"):
-            bad()
+    np.testing.assert_array_equal(blade.linear_frf(grid, force), blade.linear_frf(f_hz=grid, force=force))
+    with pytest.raises(ValueError, match="f_hz"):
+        blade.dynamic_stiffness(np.nan)
 
 
 def test_frequency_response_of_anything_else_is_a_type_error_naming_it():
@@ -167,8 +161,7 @@ def test_plausible_designs_and_no_damper_do_not_warn():
 
 def test_centrifugal_force_takes_hz():
     """damper.kinetics.centrifugal_force (Eq. 26) at f_hz [Hz]: m R (2 pi f)^2 / EO^2, and at a
-    fixed rotor_speed_hz [Hz] m R (2 pi n)^2; the former rad/s arguments give the same numbers
-    with a DeprecationWarning."""
+    fixed rotor_speed_hz [Hz] m R (2 pi n)^2; a missing argument is a ValueError naming it."""
     from bladedamp.damper import centrifugal_force
 
     m, R, f = 1.3e-3, 0.05, 95.0
@@ -176,8 +169,6 @@ def test_centrifugal_force_takes_hz():
         F, dF = centrifugal_force(m, R, f_hz=f, engine_order=eo)
         assert F == pytest.approx(m * R * (2 * np.pi * f) ** 2 / eo ** 2, rel=1e-14)
         assert dF == pytest.approx(2 * F / (2 * np.pi * f), rel=1e-14)          # per rad/s of Omega_E
-        with pytest.warns(DeprecationWarning, match="f_hz"):
-            assert centrifugal_force(m, R, 2 * np.pi * f, eo)[0] == pytest.approx(F, rel=1e-14)
     F0, dF0 = centrifugal_force(m, R, f_hz=f, engine_order=0, rotor_speed_hz=50.0)
     assert F0 == pytest.approx(m * R * (2 * np.pi * 50.0) ** 2, rel=1e-14) and dF0 == 0.0
     for bad, name in ((lambda: centrifugal_force(m, R, f_hz=f, engine_order=0), "rotor_speed_hz"),

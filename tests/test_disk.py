@@ -574,7 +574,6 @@ def test_merged_patch_evaluation_equals_separate_patches(kind, harmonics):
     (lambda: reference_disk("cylinder", 1e-3, engine_order=0), "rotor_speed_hz"),
     (lambda: reference_disk("cylinder", 1e-3, engine_order=0, rotor_speed_hz=-5.0), "rotor_speed_hz"),
     (lambda: reference_disk("cylinder", 1e-3, engine_order=0, rotor_speed_hz=float("nan")), "rotor_speed_hz"),
-    (lambda: reference_disk("cylinder", 1e-3, engine_order=0, rotor_speed_hz=50.0, rotor_speed=100.0), "rotor_speed"),
     (lambda: reference_disk("cylinder", excitation=[0.1, 0.0]), "excitation"),
     (lambda: reference_disk("cylinder").frequency_response(92.0, 92.0), "f_end_hz"),
     (lambda: reference_disk("cylinder").frequency_response(-1.0, 92.0), "f_start_hz"),
@@ -595,8 +594,8 @@ def test_rotor_speed_in_hz_at_omega_e_over_eo_is_the_automatic_preload(engine_or
     """``rotor_speed_hz`` is the rotor's revolutions per second: given at f / EO it is the speed
     the automatic law (Omega_R = Omega_E / EO, Eq. 3, 26) takes at the excitation frequency f, so
     F_CG, the seating loads and the one-harmonic residual at f are those of the automatic disk
-    (only dF_CG / dOmega differs: a fixed speed does not follow the excitation). The deprecated
-    rad/s argument gives the same disk; a speed in rpm (60 times too large) is flagged."""
+    (only dF_CG / dOmega differs: a fixed speed does not follow the excitation); a speed in rpm
+    (60 times too large) is flagged."""
     import warnings
 
     from bladedamp._validate import PlausibilityWarning
@@ -612,9 +611,6 @@ def test_rotor_speed_in_hz_at_omega_e_over_eo_is_the_automatic_preload(engine_or
     R_auto = auto.hbm_system((1,)).residual(x, 2 * np.pi * f, False)[0]
     R_fixed = fixed.hbm_system((1,)).residual(x, 2 * np.pi * f, False)[0]
     np.testing.assert_allclose(R_fixed, R_auto, rtol=0, atol=1e-12 * np.abs(R_auto).max())
-    with pytest.warns(DeprecationWarning, match="rotor_speed_hz"):
-        old = reference_disk("cylinder", 1e-3, engine_order=engine_order, rotor_speed=2 * np.pi * f / engine_order)
-    assert old.rotor_speed_hz == pytest.approx(fixed.rotor_speed_hz, rel=1e-15)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert dataclasses.replace(fixed, engine_order=1).rotor_speed_hz == fixed.rotor_speed_hz

@@ -53,7 +53,7 @@ def test_no_damper_is_the_closed_form_linear_response():
     f = np.array([90.0, 95.0, 100.0])
     tr = disk.time_response(f, tol=1e-7)
     assert tr.periodic.all(), tr.message
-    ref = np.abs(disk.blade.linear_frf(2 * np.pi * f, disk.excitation))[:, :3]
+    ref = np.abs(disk.blade.linear_frf(f, disk.excitation))[:, :3]
     err = np.abs(tr.tip_amplitude / ref[:, None, :] - 1)[:, :, 0]
     print("rel err per frequency (max over blades):", err.max(axis=1))
     assert err.max() < 1e-3
@@ -156,7 +156,7 @@ def test_engine_order_0_cylinder_does_not_damp():
     tr = disk.time_response(95.0)
     assert tr.periodic[0] and tr.status[0] == "periodic", tr.message
     assert np.all(tr.point_state[0, :, 0] == 1.0) and tr.dissipated_energy[0] == 0.0
-    free = np.abs(disk.blade.linear_frf(2 * np.pi * 95.0, disk.excitation))[0, 0]
+    free = np.abs(disk.blade.linear_frf(95.0, disk.excitation))[0, 0]
     assert 0.9 < tr.tip_amplitude[0, :, 0].min() / free < 1.0
 
 

@@ -12,9 +12,8 @@ from .. import _validate
 from .geometry import DamperGeometry
 
 
-def centrifugal_force(mass: float, radius: float, omega_excitation: float | None = None,
-                      engine_order: int | None = None, rotor_speed: float | None = None, *,
-                      f_hz: float | None = None, rotor_speed_hz: float | None = None) -> tuple[float, float]:
+def centrifugal_force(mass: float, radius: float, f_hz: float | None = None, engine_order: int | None = None,
+                      rotor_speed_hz: float | None = None) -> tuple[float, float]:
     """Centrifugal force on the damper and its derivative in the excitation frequency.
 
     F_CG = m R Omega_R^2 with Omega_R = Omega_E / EO (Eq. 3, 26): F = m R Omega_E^2 / EO^2, at
@@ -22,32 +21,21 @@ def centrifugal_force(mass: float, radius: float, omega_excitation: float | None
     cannot follow from the excitation frequency: give ``rotor_speed_hz`` [Hz, revolutions per
     second] explicitly (then dF/dOmega_E = 0). ``mass`` [kg], ``radius`` R [m].
 
-    ``omega_excitation`` and ``rotor_speed`` [rad/s] (the former positional arguments) are
-    deprecated (a DeprecationWarning); give ``f_hz`` and ``rotor_speed_hz``.
-
     Returns (F [N], dF/dOmega_E [N s/rad]).
     """
-    import warnings
-
     _validate.nonnegative("damper mass", mass)
     _validate.positive("damper radius R", radius)
     if engine_order is None:
         raise ValueError("engine_order must be given (an integer >= 0)")
-    if omega_excitation is not None or rotor_speed is not None:
-        warnings.warn("centrifugal_force(omega_excitation, rotor_speed) in rad/s is deprecated: give f_hz= and "
-                      "rotor_speed_hz= in Hz", DeprecationWarning, stacklevel=2)
     if rotor_speed_hz is not None:
-        rotor_speed = 2 * np.pi * _validate.positive("rotor_speed_hz", rotor_speed_hz)
-    if rotor_speed is not None:
-        _validate.positive("rotor_speed", rotor_speed)
-        return mass * radius * rotor_speed ** 2, 0.0
+        rotor_omega = 2 * np.pi * _validate.positive("rotor_speed_hz", rotor_speed_hz)
+        return mass * radius * rotor_omega ** 2, 0.0
     if engine_order == 0:
         raise ValueError("engine_order = 0 needs an explicit rotor_speed_hz (rotor revolutions per second, > 0): "
                          "Omega_R = Omega_E / EO is undefined")
-    if f_hz is not None:
-        omega_excitation = 2 * np.pi * float(f_hz)
-    if omega_excitation is None:
+    if f_hz is None:
         raise ValueError("give the excitation frequency f_hz [Hz]")
+    omega_excitation = 2 * np.pi * float(f_hz)
     return mass * radius * omega_excitation ** 2 / engine_order ** 2, 2 * mass * radius * omega_excitation / engine_order ** 2
 
 

@@ -110,7 +110,7 @@ def at_engine_order(disk: TunedDisk, engine_order: int, rotor_speed_eo0_hz: floa
     [Hz, revolutions per second] unless the disk has its own (the excitation does not fix the
     speed there)."""
     speed = disk.rotor_speed_hz if disk.rotor_speed_hz is not None or engine_order != 0 else rotor_speed_eo0_hz
-    return dataclasses.replace(disk, engine_order=int(engine_order), rotor_speed_hz=speed, rotor_speed=None)
+    return dataclasses.replace(disk, engine_order=int(engine_order), rotor_speed_hz=speed)
 
 
 def _engine_order_case(case):
