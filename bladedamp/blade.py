@@ -73,7 +73,7 @@ import scipy.linalg
 import scipy.sparse
 import scipy.sparse.linalg
 
-from bladedamp import _validate as check
+from bladedamp import validation as check
 
 # Points every ModalBlade must carry.
 REQUIRED_POINTS = ("OL", "OR", "tip", "excitation")

@@ -575,23 +575,23 @@ def reproduce_command(args) -> int:
 # ---------------------------------------------------------------------------------------
 def _validate_flags(args) -> None:
     """UsageError naming the flag and its allowed range for zero, negative or NaN values."""
-    from . import _validate
+    from . import validation
 
     try:
         for flag in ("processes", "workers", "disks"):
             value = getattr(args, flag, None)
             if value is not None:
-                _validate.integer(f"--{flag}", value, minimum=1)
+                validation.integer(f"--{flag}", value, minimum=1)
         if getattr(args, "max_step", None) is not None:
-            _validate.in_range("--max-step", args.max_step, 0.0, 1.0, closed="right")
+            validation.in_range("--max-step", args.max_step, 0.0, 1.0, closed="right")
         if getattr(args, "tol", None) is not None:
-            _validate.in_range("--tol", args.tol, 0.0, 1.0, closed="neither")
+            validation.in_range("--tol", args.tol, 0.0, 1.0, closed="neither")
         if getattr(args, "std", None) is not None:
-            _validate.in_range("--std", args.std, 0.0, 0.2, closed="left")
+            validation.in_range("--std", args.std, 0.0, 0.2, closed="left")
         if getattr(args, "mass", None) is not None:
-            _validate.in_range("--mass (g)", args.mass, 0.0, 1000.0, closed="right")
+            validation.in_range("--mass (g)", args.mass, 0.0, 1000.0, closed="right")
         if getattr(args, "seed", None) is not None:
-            _validate.integer("--seed", args.seed, minimum=0)
+            validation.integer("--seed", args.seed, minimum=0)
     except ValueError as exc:
         raise UsageError(str(exc)) from None
 

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _validate
+from . import validation
 from .blade import ModalBlade
 from .contact.laws import LinearNormalLaw
 from .contact.patch import dof_jacobian
@@ -278,14 +278,14 @@ class DamperContacts:
 
 def rotor_speed_in_hz(rotor_speed_hz):
     """The rotor speed [Hz, revolutions per second] of a disk, validated: None (the speed follows
-    the excitation, Omega_E / EO), or > 0 with a :class:`~bladedamp._validate.PlausibilityWarning`
+    the excitation, Omega_E / EO), or > 0 with a :class:`~bladedamp.validation.PlausibilityWarning`
     outside 1-3000 Hz (60-180 000 rpm)."""
     if rotor_speed_hz is None:
         return None
-    _validate.positive("rotor_speed_hz (rotor revolutions per second)", rotor_speed_hz)
+    validation.positive("rotor_speed_hz (rotor revolutions per second)", rotor_speed_hz)
     # 60 rpm (a slow test rig) to 180 000 rpm (micro gas turbines); a value in rad/s is 2 pi times
     # too large, which only this range can catch at its top
-    _validate.plausible("rotor_speed_hz", rotor_speed_hz, 1.0, 3000.0, "Hz",
+    validation.plausible("rotor_speed_hz", rotor_speed_hz, 1.0, 3000.0, "Hz",
                         "rotor revolutions per second, 60 to 180 000 rpm; a speed in rad/s is 2 pi times larger")
     return float(rotor_speed_hz)
 
@@ -325,16 +325,16 @@ class TunedDisk:
 
     def __post_init__(self):
         self.rotor_speed_hz = rotor_speed_in_hz(self.rotor_speed_hz)
-        _validate.integer("n_blades", self.n_blades, minimum=2)
-        _validate.integer("engine_order (EO)", self.engine_order, minimum=0, maximum=self.n_blades // 2)
-        _validate.in_range("gamma_left (platform angle, rad)", self.gamma_left, 0.0, np.pi / 2, closed="neither")
-        _validate.in_range("gamma_right (platform angle, rad)", self.gamma_right, 0.0, np.pi / 2, closed="neither")
-        _validate.positive("damper_radius R", self.damper_radius)
+        validation.integer("n_blades", self.n_blades, minimum=2)
+        validation.integer("engine_order (EO)", self.engine_order, minimum=0, maximum=self.n_blades // 2)
+        validation.in_range("gamma_left (platform angle, rad)", self.gamma_left, 0.0, np.pi / 2, closed="neither")
+        validation.in_range("gamma_right (platform angle, rad)", self.gamma_right, 0.0, np.pi / 2, closed="neither")
+        validation.positive("damper_radius R", self.damper_radius)
         # R from a small test rig (the reference disk: 26 mm) to the largest fan and low-pressure
         # turbine disks (~1.5 m): 1 mm..5 m; outside, most likely a unit slip (26 meant as 26 mm)
-        _validate.plausible("damper_radius R", self.damper_radius, 1e-3, 5.0, "m",
+        validation.plausible("damper_radius R", self.damper_radius, 1e-3, 5.0, "m",
                             "the damper's distance to the rotor axis, 1 mm to 5 m")
-        self.excitation = np.asarray(_validate.finite("excitation", self.excitation), dtype=float)
+        self.excitation = np.asarray(validation.finite("excitation", self.excitation), dtype=float)
         if self.excitation.shape != (6,):
             raise ValueError("excitation must be a 6-vector (F_x, F_y, F_z, M_x, M_y, M_z) in N and N m")
         if self.engine_order == 0 and self.has_damper and self.rotor_speed_hz is None:
@@ -359,7 +359,7 @@ class TunedDisk:
     def damper_geometry(self) -> DamperGeometry:
         geometry = self.damper.geometry(self.gamma_left, self.gamma_right)
         if self.initial_gaps is not None:
-            gaps = np.asarray(_validate.finite("initial_gaps", self.initial_gaps), dtype=float)
+            gaps = np.asarray(validation.finite("initial_gaps", self.initial_gaps), dtype=float)
             P = geometry.patches[0].n_points
             if gaps.shape != (2, P):
                 raise ValueError(f"initial_gaps must have shape (2, {P}) (OL, OR points) in m")
@@ -550,8 +550,8 @@ class TunedDisk:
         error estimate; ``self.point_map(basis, "tip")`` gives a blade point's map), added to
         the sector with :meth:`HarmonicBalanceSystem.add` (README, "Your own nonlinear element").
         """
-        _validate.positive("f_start_hz", f_start_hz)
-        _validate.positive("f_end_hz", f_end_hz)
+        validation.positive("f_start_hz", f_start_hz)
+        validation.positive("f_end_hz", f_end_hz)
         if f_start_hz == f_end_hz:
             raise ValueError("f_end_hz must differ from f_start_hz")
         w0, w1 = 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz

@@ -46,7 +46,7 @@ from typing import ClassVar, Sequence
 import numpy as np
 import scipy.sparse as sp
 
-from . import _validate
+from . import validation
 from .blade import ModalBlade
 from .contact.laws import LinearNormalLaw
 from .contact.point import damper_contact_forces, normal_law_parameters
@@ -463,7 +463,7 @@ class MistunedDisk:
         s = len(self.blades)
         if self.n_blades is None:
             self.n_blades = s
-        self.n_blades = _validate.integer("n_blades", self.n_blades, minimum=2)
+        self.n_blades = validation.integer("n_blades", self.n_blades, minimum=2)
         if self.n_blades % s:
             raise ValueError(f"n_blades ({self.n_blades}) must be a multiple of len(blades) ({s})")
         nm = self.blades[0].n_modes
@@ -500,10 +500,10 @@ class MistunedDisk:
         ``kappa``: None (tuned) or n_sector values > 0; ``dampers``: "same" (the disk's damper
         everywhere), None (no dampers), one damper or a list; ``n_sector``: blades in the model
         (default ``disk.n_blades``, the full assembly)."""
-        s = disk.n_blades if n_sector is None else _validate.integer("n_sector", n_sector, minimum=1)
+        s = disk.n_blades if n_sector is None else validation.integer("n_sector", n_sector, minimum=1)
         if kappa is None:
             kappa = np.ones(s)
-        kappa = np.asarray(_validate.positive("kappa (mistuning factors)", kappa), dtype=float)
+        kappa = np.asarray(validation.positive("kappa (mistuning factors)", kappa), dtype=float)
         if kappa.shape != (s,):
             raise ValueError(f"kappa (mistuning factors) must have {s} entries, one per blade (got shape {kappa.shape})")
         blades = [disk.blade.scaled(k) for k in kappa]
@@ -710,8 +710,8 @@ class MistunedDisk:
         peak, kept for amplification factors. ``n_samples``: AFT samples per period; None
         (default): :meth:`default_samples`, and once ``AUTO_SAMPLES_GROWTH`` times more if that
         branch fails (:func:`bladedamp.response.sampled_response`, as the tuned disk)."""
-        _validate.positive("f_start_hz", f_start_hz)
-        _validate.positive("f_end_hz", f_end_hz)
+        validation.positive("f_start_hz", f_start_hz)
+        validation.positive("f_end_hz", f_end_hz)
         if f_start_hz == f_end_hz:
             raise ValueError("f_end_hz must differ from f_start_hz")
         w0, w1 = 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz
@@ -754,7 +754,7 @@ class MistunedDisk:
         as :meth:`TunedDisk.point_map`; add an element with ``system.add(element, map, name)``."""
         from .disk import blade_point_map
 
-        blade = _validate.integer("blade", blade, minimum=0, maximum=self.n_sector - 1)
+        blade = validation.integer("blade", blade, minimum=0, maximum=self.n_sector - 1)
         return blade_point_map(self.blades[blade], basis, point, directions, self.n_dof, self.blade_slice(blade))
 
     def unknown_scales(self, system: HarmonicBalanceSystem, omega_start: float, omega_end: float) -> np.ndarray:
@@ -768,7 +768,7 @@ class MistunedDisk:
         range it covers, as one response: the wider range without recomputing the part known.
         The continuation starts from the stored solution at that end (same harmonics and
         samples); its scales are those of the whole new range."""
-        _validate.positive("f_end_hz", f_end_hz)
+        validation.positive("f_end_hz", f_end_hz)
         w_new = 2 * np.pi * f_end_hz
         w_first, w_last = float(response.omega[0]), float(response.omega[-1])
         forward = np.sign(w_last - w_first)
@@ -885,7 +885,7 @@ class MistunedResponse(FrequencyResponse):
         ref = self.tuned_peak_amplitude if tuned_peak_amplitude is None else tuned_peak_amplitude
         if ref is None:
             raise ValueError("tuned_peak_amplitude is needed for amplification factors (give it here or to frequency_response)")
-        return self.peak_amplitude / _validate.positive("tuned_peak_amplitude", ref)
+        return self.peak_amplitude / validation.positive("tuned_peak_amplitude", ref)
 
     def energy_balance_error(self) -> np.ndarray:
         """|W_exc - W_visc - W_friction| / W_exc at every point (whole model)."""

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _validate
+from . import validation
 from .contact.laws import LinearNormalLaw
 from .contact.point import PointContactElement
 from .hbm.accuracy import HARMONIC_TOLERANCE, converged_response
@@ -67,18 +67,18 @@ class FrictionOscillator:
     cubic_stiffness: float = 0.0
 
     def __post_init__(self):
-        _validate.positive("mass", self.mass)
-        _validate.positive("stiffness", self.stiffness)
-        _validate.nonnegative("damping", self.damping)
-        _validate.positive("contact_stiffness (k_T)", self.contact_stiffness)
-        _validate.nonnegative("friction_coefficient (mu)", self.friction_coefficient)
-        _validate.nonnegative("normal_load", self.normal_load)
-        _validate.finite("forcing", self.forcing)
-        _validate.in_range("contact_angle", self.contact_angle, 0.0, np.pi / 2, closed="left")
+        validation.positive("mass", self.mass)
+        validation.positive("stiffness", self.stiffness)
+        validation.nonnegative("damping", self.damping)
+        validation.positive("contact_stiffness (k_T)", self.contact_stiffness)
+        validation.nonnegative("friction_coefficient (mu)", self.friction_coefficient)
+        validation.nonnegative("normal_load", self.normal_load)
+        validation.finite("forcing", self.forcing)
+        validation.in_range("contact_angle", self.contact_angle, 0.0, np.pi / 2, closed="left")
         if self.normal_stiffness is None:
             self.normal_stiffness = self.contact_stiffness
-        _validate.positive("normal_stiffness (k_N)", self.normal_stiffness)
-        _validate.finite("cubic_stiffness", self.cubic_stiffness)
+        validation.positive("normal_stiffness (k_N)", self.normal_stiffness)
+        validation.finite("cubic_stiffness", self.cubic_stiffness)
 
     # ----- closed forms ---------------------------------------------------------------
     @property
@@ -139,8 +139,8 @@ class FrictionOscillator:
         The result is ``success`` only if the branch reached the end and passed
         :func:`bladedamp.response.physical_checks`.
         """
-        _validate.positive("f_start_hz", f_start_hz)
-        _validate.positive("f_end_hz", f_end_hz)
+        validation.positive("f_start_hz", f_start_hz)
+        validation.positive("f_end_hz", f_end_hz)
         if f_start_hz == f_end_hz:
             raise ValueError("f_end_hz must differ from f_start_hz")
         omega_start, omega_end = 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz
@@ -224,8 +224,8 @@ class FrictionOscillator:
         the step bound checked here (from the linear stiffnesses) does not cover it; a run that
         blows up returns ``converged`` False."""
         f_hz = np.atleast_1d(np.asarray(f_hz, dtype=float))
-        _validate.positive("f_hz (excitation frequency, Hz)", f_hz)
-        _validate.integer("steps_per_period", steps_per_period, minimum=16)
+        validation.positive("f_hz (excitation frequency, Hz)", f_hz)
+        validation.integer("steps_per_period", steps_per_period, minimum=16)
         omega = 2 * np.pi * f_hz
         dt_max = 2.0 / np.sqrt((self.stiffness + self.contact_stiffness + self.normal_stiffness) / self.mass)
         if np.any(2 * np.pi / omega / steps_per_period > 0.5 * dt_max):
@@ -233,8 +233,8 @@ class FrictionOscillator:
             need = int(np.ceil(2 * np.pi / (2 * np.pi * lowest) / (0.5 * dt_max)))
             raise ValueError(f"steps_per_period must be >= {need} for the explicit scheme at the lowest "
                              f"frequency {lowest:.6g} Hz (got {steps_per_period})")
-        _validate.finite("initial_displacement", initial_displacement)
-        _validate.finite("initial_velocity", initial_velocity)
+        validation.finite("initial_displacement", initial_displacement)
+        validation.finite("initial_velocity", initial_velocity)
         samples = np.zeros((omega.size, steps_per_period))
         periods = np.zeros(omega.size, dtype=int)
         converged = np.zeros(omega.size, dtype=bool)

@@ -106,7 +106,7 @@ import scipy.linalg
 import scipy.sparse
 import scipy.sparse.linalg
 
-from . import _validate as check
+from . import validation as check
 from .blade import SHIFT_INVERT_SIGMA, BeamBladeGeometry, ModalBlade, PAPER_MODE_ORDER, platform_section
 
 __all__ = ["FE_HINT", "SolidBladeGeometry", "SurfaceBladeGeometry", "PlaneRegion", "SurfacePatch", "SolidMesh",

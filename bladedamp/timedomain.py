@@ -709,18 +709,18 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
 
     Returns a :class:`DiskTimeResponse`.
     """
-    from . import _validate
+    from . import validation
 
-    f_hz = np.atleast_1d(np.asarray(_validate.positive("f_hz (excitation frequency, Hz)", f_hz), dtype=float))
+    f_hz = np.atleast_1d(np.asarray(validation.positive("f_hz (excitation frequency, Hz)", f_hz), dtype=float))
     if f_hz.ndim != 1:
         raise ValueError("f_hz must be a scalar or a 1-D array of frequencies in Hz")
-    _validate.in_range("tol", tol, 0.0, 0.1, closed="right")
-    min_periods = _validate.integer("min_periods", min_periods, minimum=1)
-    max_periods = _validate.integer("max_periods", max_periods, minimum=min_periods)
-    n_stable = _validate.integer("n_stable", n_stable, minimum=1)
-    drift_periods = _validate.integer("drift_periods", drift_periods, minimum=2)
-    _validate.in_range("stability_margin", stability_margin, 0.0, 1.0, closed="right")
-    _validate.in_range("fluctuation_tol", fluctuation_tol, 0.0, 0.1, closed="right")
+    validation.in_range("tol", tol, 0.0, 0.1, closed="right")
+    min_periods = validation.integer("min_periods", min_periods, minimum=1)
+    max_periods = validation.integer("max_periods", max_periods, minimum=min_periods)
+    n_stable = validation.integer("n_stable", n_stable, minimum=1)
+    drift_periods = validation.integer("drift_periods", drift_periods, minimum=2)
+    validation.in_range("stability_margin", stability_margin, 0.0, 1.0, closed="right")
+    validation.in_range("fluctuation_tol", fluctuation_tol, 0.0, 0.1, closed="right")
     if disk.n_sector != disk.n_blades:
         raise ValueError(f"time_response integrates the full assembly: len(blades) must equal n_blades "
                          f"({disk.n_blades}), got a cyclic sector of {disk.n_sector}")
@@ -741,7 +741,7 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
     if steps_per_period is None:
         steps = max(MIN_STEPS_PER_PERIOD, needed)
     else:
-        steps = _validate.integer("steps_per_period", steps_per_period, minimum=16)
+        steps = validation.integer("steps_per_period", steps_per_period, minimum=16)
         if 2 * np.pi / omega.min() / steps > dt_limit:
             raise ValueError(f"steps_per_period must be at least {int(np.ceil(2 * np.pi / omega.min() / dt_limit))} "
                              f"(stability limit of the explicit scheme, omega_max = {w_max:.4g} rad/s; got {steps})")
@@ -887,11 +887,11 @@ def hbm_tip_at(disk, f_hz, harmonics=(0, 1, 2, 3), pad_hz: float = 1.0, max_step
     """
     import warnings
 
-    from . import _validate
+    from . import validation
     from .disk import TunedDisk
 
-    f_hz = np.atleast_1d(np.asarray(_validate.positive("f_hz (excitation frequency, Hz)", f_hz), dtype=float))
-    _validate.positive("pad_hz", pad_hz)
+    f_hz = np.atleast_1d(np.asarray(validation.positive("f_hz (excitation frequency, Hz)", f_hz), dtype=float))
+    validation.positive("pad_hz", pad_hz)
     kw = {} if harmonics is None else {"harmonics": tuple(harmonics)}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import bladedamp as bd
-from bladedamp._validate import PlausibilityWarning
+from bladedamp.validation import PlausibilityWarning
 from bladedamp.mistuned import MistunedDisk, MistunedResponse
 from bladedamp.studies import design as sd
 from bladedamp.studies import mass as sm

@@ -598,7 +598,7 @@ def test_rotor_speed_in_hz_at_omega_e_over_eo_is_the_automatic_preload(engine_or
     (60 times too large) is flagged."""
     import warnings
 
-    from bladedamp._validate import PlausibilityWarning
+    from bladedamp.validation import PlausibilityWarning
 
     f = 95.3
     auto = reference_disk("cylinder", 1e-3, engine_order=engine_order)

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _validate
+from .. import validation
 
 
 @dataclass(frozen=True)
@@ -27,7 +27,7 @@ class LinearNormalLaw:
     stiffness: float
 
     def __post_init__(self):
-        _validate.positive("normal stiffness k_N", self.stiffness)
+        validation.positive("normal stiffness k_N", self.stiffness)
 
     def force(self, approach: np.ndarray, weight: np.ndarray):
         """Normal force [N] and its derivative in the approach [N/m], same shape as ``approach``."""
@@ -67,9 +67,9 @@ class RoughnessNormalLaw:
     exponent: float = 1.5
 
     def __post_init__(self):
-        _validate.positive("normal stiffness k_N", self.stiffness)
-        _validate.positive("reference_load", self.reference_load)
-        _validate.in_range("exponent", self.exponent, 1.0, 5.0)
+        validation.positive("normal stiffness k_N", self.stiffness)
+        validation.positive("reference_load", self.reference_load)
+        validation.in_range("exponent", self.exponent, 1.0, 5.0)
 
     @property
     def reference_approach(self) -> float:

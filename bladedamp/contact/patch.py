@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import _validate
+from .. import validation
 from .laws import LinearNormalLaw, RoughnessNormalLaw
 from .point import PointContactSamples, point_contact_forces
 
@@ -118,12 +118,12 @@ class ContactPatch:
     point_map: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self):
-        _validate.nonnegative("contact height h_C", self.height)
-        _validate.positive("contact length l_C", self.length)
-        _validate.positive("tangential stiffness k_T", self.tangential_stiffness)
-        _validate.nonnegative("friction coefficient mu", self.friction_coefficient)
-        _validate.integer("n_xi", self.n_xi, minimum=1)
-        _validate.integer("n_eta", self.n_eta, minimum=1)
+        validation.nonnegative("contact height h_C", self.height)
+        validation.positive("contact length l_C", self.length)
+        validation.positive("tangential stiffness k_T", self.tangential_stiffness)
+        validation.nonnegative("friction coefficient mu", self.friction_coefficient)
+        validation.integer("n_xi", self.n_xi, minimum=1)
+        validation.integer("n_eta", self.n_eta, minimum=1)
         if not isinstance(self.normal_law, (LinearNormalLaw, RoughnessNormalLaw)):
             raise ValueError("normal_law must be a LinearNormalLaw or RoughnessNormalLaw")
         cx = (np.arange(self.n_xi) + 0.5) / self.n_xi - 0.5
@@ -133,7 +133,7 @@ class ContactPatch:
         if self.weights is None:
             self.weights = np.full(self.n_points, 1.0 / self.n_points)
         else:
-            w = _validate.nonnegative("weights", self.weights)
+            w = validation.nonnegative("weights", self.weights)
             if w.shape != (self.n_points,) or not np.isclose(w.sum(), 1.0):
                 raise ValueError(f"weights must be {self.n_points} non-negative values summing to 1")
             self.weights = w
@@ -141,7 +141,7 @@ class ContactPatch:
         if self.initial_gap is None:
             self.initial_gap = np.zeros(self.n_points)
         else:
-            gap = np.asarray(_validate.finite("initial_gap", self.initial_gap), dtype=float)
+            gap = np.asarray(validation.finite("initial_gap", self.initial_gap), dtype=float)
             if gap.shape != (self.n_points,):
                 raise ValueError(f"initial_gap must have one value per point, shape ({self.n_points},) m")
             self.initial_gap = gap

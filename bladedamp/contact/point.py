@@ -816,14 +816,14 @@ class PointContactElement:
     approach_offset: np.ndarray
 
     def __post_init__(self):
-        from .. import _validate
-        self.tangential_stiffness = np.atleast_1d(_validate.positive("tangential stiffness k_T", self.tangential_stiffness))
+        from .. import validation
+        self.tangential_stiffness = np.atleast_1d(validation.positive("tangential stiffness k_T", self.tangential_stiffness))
         P = self.tangential_stiffness.size
         self.friction_coefficient = np.broadcast_to(np.atleast_1d(
-            _validate.nonnegative("friction coefficient mu", self.friction_coefficient)), (P,)).copy()
-        self.weight = np.broadcast_to(np.atleast_1d(_validate.positive("weight", self.weight)), (P,)).copy()
+            validation.nonnegative("friction coefficient mu", self.friction_coefficient)), (P,)).copy()
+        self.weight = np.broadcast_to(np.atleast_1d(validation.positive("weight", self.weight)), (P,)).copy()
         self.approach_offset = np.broadcast_to(np.atleast_1d(
-            _validate.finite("approach_offset", self.approach_offset)), (P,)).copy()
+            validation.finite("approach_offset", self.approach_offset)), (P,)).copy()
 
     @property
     def n_points(self) -> int:

@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import _validate
+from .. import validation
 from ..contact.laws import LinearNormalLaw, RoughnessNormalLaw
 from ..contact.patch import ContactPatch
 
@@ -85,13 +85,13 @@ class ContactProperties:
     points_across_height: int = 5
 
     def __post_init__(self):
-        _validate.nonnegative("friction_coefficient (mu)", self.friction_coefficient)
-        _validate.positive("tangential_stiffness_per_length", self.tangential_stiffness_per_length)
-        _validate.positive("normal_to_tangential_stiffness", self.normal_to_tangential_stiffness)
-        _validate.in_range("roughness_exponent", self.roughness_exponent, 1.0, 5.0)
-        _validate.positive("roughness_reference_load", self.roughness_reference_load)
-        _validate.integer("points_along_length", self.points_along_length, minimum=1)
-        _validate.integer("points_across_height", self.points_across_height, minimum=1)
+        validation.nonnegative("friction_coefficient (mu)", self.friction_coefficient)
+        validation.positive("tangential_stiffness_per_length", self.tangential_stiffness_per_length)
+        validation.positive("normal_to_tangential_stiffness", self.normal_to_tangential_stiffness)
+        validation.in_range("roughness_exponent", self.roughness_exponent, 1.0, 5.0)
+        validation.positive("roughness_reference_load", self.roughness_reference_load)
+        validation.integer("points_along_length", self.points_along_length, minimum=1)
+        validation.integer("points_across_height", self.points_across_height, minimum=1)
 
     def patch(self, height: float, length: float, n_xi: int) -> ContactPatch:
         k_t = self.tangential_stiffness_per_length * length
@@ -148,8 +148,8 @@ class DamperGeometry:
 
 
 def _check_angles(gamma_left, gamma_right):
-    _validate.in_range("gamma_left (platform angle, rad)", gamma_left, 0.0, np.pi / 2, closed="neither")
-    _validate.in_range("gamma_right (platform angle, rad)", gamma_right, 0.0, np.pi / 2, closed="neither")
+    validation.in_range("gamma_left (platform angle, rad)", gamma_left, 0.0, np.pi / 2, closed="neither")
+    validation.in_range("gamma_right (platform angle, rad)", gamma_right, 0.0, np.pi / 2, closed="neither")
 
 
 def _polygon_inertia(poly: np.ndarray, mass: float, length: float) -> tuple[np.ndarray, np.ndarray]:
@@ -188,9 +188,9 @@ DAMPER_LENGTH_RANGE = (1.0e-4, 0.1)      # m
 
 
 def _check_plausible_damper(mass: float, lengths: dict) -> None:
-    _validate.plausible("damper mass", mass, *DAMPER_MASS_RANGE, "kg", "underplatform dampers weigh 0.01 g to 100 g")
+    validation.plausible("damper mass", mass, *DAMPER_MASS_RANGE, "kg", "underplatform dampers weigh 0.01 g to 100 g")
     for name, value in lengths.items():
-        _validate.plausible(name, value, *DAMPER_LENGTH_RANGE, "m", "damper dimensions are 0.1 mm to 100 mm")
+        validation.plausible(name, value, *DAMPER_LENGTH_RANGE, "m", "damper dimensions are 0.1 mm to 100 mm")
 
 
 @dataclass
@@ -211,9 +211,9 @@ class CylinderDamper:
     contact: ContactProperties = field(default_factory=ContactProperties)
 
     def __post_init__(self):
-        _validate.nonnegative("damper mass", self.mass)
-        _validate.positive("cylinder radius", self.radius)
-        _validate.positive("damper length l_C", self.length)
+        validation.nonnegative("damper mass", self.mass)
+        validation.positive("cylinder radius", self.radius)
+        validation.positive("damper length l_C", self.length)
         _check_plausible_damper(self.mass, {"cylinder radius": self.radius, "damper length l_C": self.length})
 
     kind = "cylinder"
@@ -257,11 +257,11 @@ class WedgeDamper:
     kind = "wedge"
 
     def __post_init__(self):
-        _validate.nonnegative("damper mass", self.mass)
+        validation.nonnegative("damper mass", self.mass)
         if self.contact_height is None:
             raise ValueError("contact_height h_C of a wedge damper must be given, in (0, inf) m")
-        _validate.positive("contact_height h_C", self.contact_height)
-        _validate.positive("damper length l_C", self.length)
+        validation.positive("contact_height h_C", self.contact_height)
+        validation.positive("damper length l_C", self.length)
         _check_plausible_damper(self.mass, {"contact_height h_C": self.contact_height, "damper length l_C": self.length})
 
     def geometry(self, gamma_left: float, gamma_right: float) -> DamperGeometry:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate
+from .. import validation
 from .geometry import DamperGeometry
 
 
@@ -23,12 +23,12 @@ def centrifugal_force(mass: float, radius: float, f_hz: float | None = None, eng
 
     Returns (F [N], dF/dOmega_E [N s/rad]).
     """
-    _validate.nonnegative("damper mass", mass)
-    _validate.positive("damper radius R", radius)
+    validation.nonnegative("damper mass", mass)
+    validation.positive("damper radius R", radius)
     if engine_order is None:
         raise ValueError("engine_order must be given (an integer >= 0)")
     if rotor_speed_hz is not None:
-        rotor_omega = 2 * np.pi * _validate.positive("rotor_speed_hz", rotor_speed_hz)
+        rotor_omega = 2 * np.pi * validation.positive("rotor_speed_hz", rotor_speed_hz)
         return mass * radius * rotor_omega ** 2, 0.0
     if engine_order == 0:
         raise ValueError("engine_order = 0 needs an explicit rotor_speed_hz (rotor revolutions per second, > 0): "
@@ -51,7 +51,7 @@ def seat(geometry: DamperGeometry, radial_force: float, tol: float = 1e-12, max_
 
     Returns (u_D (6,), approach (2, P) per-point static approach [m], loads (2,) [N]).
     """
-    _validate.nonnegative("radial_force", radial_force)
+    validation.nonnegative("radial_force", radial_force)
     G = geometry.G_D.reshape(2, 6, 6)
     if radial_force == 0:
         return np.zeros(6), -np.array([p.initial_gap for p in geometry.patches]), np.zeros(2)

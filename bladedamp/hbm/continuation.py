@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from .. import _validate
+from .. import validation
 from .linsolve import factorize as lu_factorize
 
 
@@ -185,14 +185,14 @@ def branch_checks(omega, omega_start, omega_end, max_step) -> dict:
 
 def _validate_options(step, max_step, min_step, max_points, tol, max_corrector, target_iterations, leave_margin):
     """ValueError naming the option and its allowed range for zero, negative or NaN values."""
-    _validate.in_range("max_step", max_step, 0.0, 1.0, closed="right")
-    _validate.in_range("step", step, 0.0, max_step, closed="right")
-    _validate.in_range("min_step", min_step, 0.0, step, closed="right")
-    _validate.in_range("tol (Newton tolerance)", tol, 0.0, 1.0, closed="neither")
-    _validate.integer("max_points", max_points, minimum=2)
-    _validate.integer("max_corrector", max_corrector, minimum=1)
-    _validate.integer("target_iterations", target_iterations, minimum=1)
-    _validate.nonnegative("leave_margin", leave_margin)
+    validation.in_range("max_step", max_step, 0.0, 1.0, closed="right")
+    validation.in_range("step", step, 0.0, max_step, closed="right")
+    validation.in_range("min_step", min_step, 0.0, step, closed="right")
+    validation.in_range("tol (Newton tolerance)", tol, 0.0, 1.0, closed="neither")
+    validation.integer("max_points", max_points, minimum=2)
+    validation.integer("max_corrector", max_corrector, minimum=1)
+    validation.integer("target_iterations", target_iterations, minimum=1)
+    validation.nonnegative("leave_margin", leave_margin)
 
 
 def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=None,
@@ -241,12 +241,12 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
     (``corner_escape``); then the landing at either end of the range (``land_at_start``,
     ``land_at_end``) and the retrace guard (``retraced``).
     """
-    _validate.finite("omega_start", omega_start)
-    _validate.finite("omega_end", omega_end)
+    validation.finite("omega_start", omega_start)
+    validation.finite("omega_end", omega_end)
     if omega_start == omega_end:
         raise ValueError("omega_end must differ from omega_start")
     max_step = 0.02 if max_step is None else max_step
-    _validate.in_range("max_step", max_step, 0.0, 1.0, closed="right")
+    validation.in_range("max_step", max_step, 0.0, 1.0, closed="right")
     step = min(0.01, max_step) if step is None else step
     min_step = min(1e-7, step) if min_step is None else min_step
     _validate_options(step, max_step, min_step, max_points, tol, max_corrector, target_iterations, leave_margin)

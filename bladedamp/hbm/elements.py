@@ -44,7 +44,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from .. import _validate
+from .. import validation
 
 
 class TimeDomainElement:
@@ -111,7 +111,7 @@ class CubicSpring(TimeDomainElement):
     n_local: int = 1
 
     def __post_init__(self):
-        self.coefficient = _validate.finite("cubic_stiffness", self.coefficient)
+        self.coefficient = validation.finite("cubic_stiffness", self.coefficient)
         if self.n_local != 1:
             raise ValueError(f"CubicSpring has one local coordinate (n_local = 1, got {self.n_local})")
 
@@ -136,8 +136,8 @@ class GapSpring(TimeDomainElement):
     n_local: int = 1
 
     def __post_init__(self):
-        self.stiffness = _validate.positive("GapSpring stiffness [N/m]", self.stiffness)
-        self.gap = _validate.positive("GapSpring gap [m]", self.gap, allow_zero=True)
+        self.stiffness = validation.positive("GapSpring stiffness [N/m]", self.stiffness)
+        self.gap = validation.positive("GapSpring gap [m]", self.gap, allow_zero=True)
         if self.n_local != 1:
             raise ValueError(f"GapSpring has one local coordinate (n_local = 1, got {self.n_local})")
 

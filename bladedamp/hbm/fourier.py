@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import _validate
+from .. import validation
 
 
 @dataclass(frozen=True)
@@ -43,13 +43,13 @@ class HarmonicBasis:
         if len(harmonics) == 0:
             raise ValueError("harmonics must be a non-empty tuple of integers >= 0 (got ())")
         for h in harmonics:
-            _validate.integer("harmonics", h, minimum=0)
+            validation.integer("harmonics", h, minimum=0)
         harmonics = tuple(sorted(set(int(h) for h in harmonics)))
         if harmonics == (0,):
             raise ValueError("harmonics must contain at least one harmonic >= 1 (got (0,))")
         h_max = max(harmonics)
         n = self.n_samples if self.n_samples is not None else max(64, 16 * h_max)
-        n = _validate.integer("n_samples", n, minimum=2 * h_max + 1)
+        n = validation.integer("n_samples", n, minimum=2 * h_max + 1)
         object.__setattr__(self, "harmonics", harmonics)
         object.__setattr__(self, "n_samples", n)
         tau = 2 * np.pi * np.arange(n) / n

@@ -44,7 +44,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .. import _validate
+from .. import validation
 from ..contact.point import SEPARATED
 from ..timedomain import oscillator_step
 
@@ -105,7 +105,7 @@ def oscillator_monodromy(osc, coefficients, basis, omega: float, steps: int = ST
     (x_0, x_-1, s) (see the module docstring); returns (monodromy, z (3,), periodicity error:
     |P(z) - z| over the displacements (x_0, x_-1) / the orbit's largest |x|, the HBM solution's
     distance from a periodic orbit of the discrete map)."""
-    steps = _validate.integer("steps (per period)", steps, minimum=16)
+    steps = validation.integer("steps (per period)", steps, minimum=16)
     dt_max = 2.0 / np.sqrt((osc.stiffness + osc.contact_stiffness + osc.normal_stiffness) / osc.mass)
     if 2 * np.pi / omega / steps > 0.5 * dt_max:
         need = int(np.ceil(2 * np.pi / omega / (0.5 * dt_max)))

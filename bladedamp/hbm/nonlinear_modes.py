@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg
 
-from .. import _validate
+from .. import validation
 from ..io import Saveable
 from .fourier import HarmonicBasis
 
@@ -358,7 +358,7 @@ class NonlinearModeResponse(Saveable):
         from scipy.optimize import brentq
 
         F = self.excitation if force is None else np.asarray(force)
-        F = np.asarray(F, dtype=complex).ravel() * float(_validate.finite("scale", scale))
+        F = np.asarray(F, dtype=complex).ravel() * float(validation.finite("scale", scale))
         n_dof = self.coefficients.shape[2]
         if F.shape != (n_dof,):
             raise ValueError(f"force must have shape ({n_dof},) (one first-harmonic amplitude per DOF; got {F.shape})")
@@ -505,7 +505,7 @@ def nonlinear_mode(model, mode: int = 0, amplitudes=None, harmonics=(1,), n_samp
     """
     if not hasattr(model, "hbm_system"):
         raise TypeError(f"model must provide hbm_system(harmonics, n_samples) (got {type(model).__qualname__})")
-    mode = _validate.integer("mode", mode, minimum=0)
+    mode = validation.integer("mode", mode, minimum=0)
     try:
         harmonics = tuple(int(h) for h in (harmonics if np.ndim(harmonics) else (harmonics,)))
     except (TypeError, ValueError):
@@ -513,20 +513,20 @@ def nonlinear_mode(model, mode: int = 0, amplitudes=None, harmonics=(1,), n_samp
     if 1 not in harmonics:
         raise ValueError(f"harmonics must contain 1, the harmonic of the amplitude and phase normalisation "
                          f"(got {harmonics!r})")
-    _validate.in_range("tol", tol, 0.0, 1e-3, closed="right")
-    _validate.in_range("max_log_step (decades)", max_log_step, 0.0, 2.0, closed="right")
-    n_points = _validate.integer("n_points", n_points, minimum=2)
+    validation.in_range("tol", tol, 0.0, 1e-3, closed="right")
+    validation.in_range("max_log_step (decades)", max_log_step, 0.0, 2.0, closed="right")
+    n_points = validation.integer("n_points", n_points, minimum=2)
     resolve_peaks = np.atleast_1d(np.asarray(resolve_peaks, dtype=float))
     if resolve_peaks.ndim != 1:
         raise ValueError(f"resolve_peaks must be a 1-D sequence of excitation scales in (0, inf) "
                          f"(got shape {resolve_peaks.shape})")
     if resolve_peaks.size:
-        _validate.positive("resolve_peaks (excitation scales)", resolve_peaks)
+        validation.positive("resolve_peaks (excitation scales)", resolve_peaks)
     if amplitudes is not None:
         amps = np.atleast_1d(np.asarray(amplitudes, dtype=float))
         if amps.ndim != 1 or amps.size == 0:
             raise ValueError(f"amplitudes must be a non-empty 1-D array of modal amplitudes in (0, inf) (got shape {amps.shape})")
-        _validate.positive("amplitudes (modal amplitudes)", amps)
+        validation.positive("amplitudes (modal amplitudes)", amps)
         amps = np.unique(amps)
 
     system = model.hbm_system(harmonics, n_samples)
@@ -537,7 +537,7 @@ def nonlinear_mode(model, mode: int = 0, amplitudes=None, harmonics=(1,), n_samp
     if reference_dof is None:
         weight = np.abs(phi) * np.sqrt(np.clip(np.diag(M), 0, None))
         reference_dof = int(np.argmax(weight))
-    reference_dof = _validate.integer("reference_dof", reference_dof, minimum=0, maximum=n - 1)
+    reference_dof = validation.integer("reference_dof", reference_dof, minimum=0, maximum=n - 1)
     if abs(phi[reference_dof]) < 1e-12 * np.abs(phi).max():
         raise ValueError(f"reference_dof {reference_dof} does not move in mode {mode}; choose a DOF in [0, {n - 1}] "
                          "that does (default: the largest)")

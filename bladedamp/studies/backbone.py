@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from .. import _validate
+from .. import validation
 from ..io import Saveable
 from .mass import GRID_PER_DECADE, peak_response, with_mass
 
@@ -153,12 +153,12 @@ def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid
     levels = np.atleast_1d(np.asarray(excitation_levels, dtype=float))
     if levels.ndim != 1 or levels.size == 0:
         raise ValueError(f"excitation_levels must be a non-empty 1-D array of forces in (0, inf) N (got {excitation_levels!r})")
-    _validate.positive("excitation_levels", levels)
-    lo, hi = _validate.interval("bracket", bracket, "kg")
-    _validate.positive("bracket", np.array([lo, hi]))
-    _validate.positive("xatol", xatol)
-    _validate.positive("grid_per_decade", grid_per_decade)
-    direction = _validate.integer("direction", direction, minimum=0, maximum=2)
+    validation.positive("excitation_levels", levels)
+    lo, hi = validation.interval("bracket", bracket, "kg")
+    validation.positive("bracket", np.array([lo, hi]))
+    validation.positive("xatol", xatol)
+    validation.positive("grid_per_decade", grid_per_decade)
+    direction = validation.integer("direction", direction, minimum=0, maximum=2)
     ref = _force_scale(disk)
     scales = levels / ref
 

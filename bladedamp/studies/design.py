@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import _validate
+from .. import validation
 from ..damper.kinetics import seat
 from ..disk import TunedDisk
 from ..io import Saveable
@@ -41,11 +41,11 @@ ROLLING_TOLERANCE = 0.01   # an optimum less than 1 % below the undamped peak co
 # input checks
 # ---------------------------------------------------------------------------------------
 def _check_f_range(f_range_hz):
-    return _validate.interval("f_range_hz", f_range_hz, "Hz")
+    return validation.interval("f_range_hz", f_range_hz, "Hz")
 
 
 def _check_mass_bounds(mass_bounds):
-    return _validate.interval("mass_bounds", mass_bounds, "kg")
+    return validation.interval("mass_bounds", mass_bounds, "kg")
 
 
 def _check_disk(disk):
@@ -164,11 +164,11 @@ def engine_order_sweeps(disks, engine_orders=range(0, 9), mass_bounds=(1e-5, 2e-
     if eos.size == 0:
         raise ValueError(f"engine_orders must be a non-empty range of integers in [0, {n_max}]")
     for eo in eos:
-        _validate.integer("engine_orders", eo, minimum=0, maximum=n_max)
+        validation.integer("engine_orders", eo, minimum=0, maximum=n_max)
     bounds = _check_mass_bounds(mass_bounds)
-    _validate.positive("rotor_speed_eo0_hz", rotor_speed_eo0_hz)
+    validation.positive("rotor_speed_eo0_hz", rotor_speed_eo0_hz)
     f_range = _check_f_range(f_range_hz)
-    _validate.positive("xatol", xatol)
+    validation.positive("xatol", xatol)
     known = [dict(k or {}) for k in (known if known is not None else [None] * len(disks))]
     if len(known) != len(disks):
         raise ValueError(f"known must give one dict of optima per disk ({len(disks)}), got {len(known)}")
@@ -313,9 +313,9 @@ def platform_angle_study(disk: TunedDisk, gamma_right_deg, gamma_left_deg: float
     gr = np.atleast_1d(np.asarray(gamma_right_deg, dtype=float))
     if gr.size == 0:
         raise ValueError("gamma_right_deg must be a non-empty array of angles in (0, 90) deg")
-    _validate.in_range("gamma_right_deg", gr, 0.0, 90.0, closed="neither")
-    _validate.in_range("gamma_left_deg", gl, 0.0, 90.0, closed="neither")
-    _validate.positive("fixed_mass (kg)", fixed_mass)
+    validation.in_range("gamma_right_deg", gr, 0.0, 90.0, closed="neither")
+    validation.in_range("gamma_left_deg", gl, 0.0, 90.0, closed="neither")
+    validation.positive("fixed_mass (kg)", fixed_mass)
     bounds = _check_mass_bounds(mass_bounds)
     f_range = _check_f_range(f_range_hz)
 
@@ -573,14 +573,14 @@ def design_map(disk: TunedDisk, masses, gamma_right_deg, contact_height: float |
     gr = np.atleast_1d(np.asarray(gamma_right_deg, dtype=float))
     if masses.size == 0 or gr.size == 0:
         raise ValueError("masses and gamma_right_deg must be non-empty (masses in (0, inf) kg, angles in (0, 90) deg)")
-    _validate.positive("masses", masses)
-    _validate.in_range("gamma_right_deg", gr, 0.0, 90.0, closed="neither")
+    validation.positive("masses", masses)
+    validation.in_range("gamma_right_deg", gr, 0.0, 90.0, closed="neither")
     gl = float(np.degrees(disk.gamma_left)) if gamma_left_deg is None else gamma_left_deg
     if contact_height is not None:
         if disk.damper.kind != "wedge":
             raise ValueError("contact_height applies to a wedge damper only (the disk's is a "
                              f"{disk.damper.kind})")
-        _validate.positive("contact_height h_C", contact_height)
+        validation.positive("contact_height h_C", contact_height)
         disk = with_contact_height(disk, contact_height)
     f_range = _check_f_range(f_range_hz)
     harmonics = tuple(harmonics)
@@ -614,8 +614,8 @@ def liftoff_onset(disk: TunedDisk, contact_heights, forces, f_range_hz=(90.0, 10
     fs = np.atleast_1d(np.asarray(forces, dtype=float))
     if hs.size == 0 or fs.size == 0:
         raise ValueError("contact_heights (m, > 0) and forces (N, > 0) must be non-empty")
-    _validate.positive("contact_heights", hs)
-    _validate.positive("forces", fs)
+    validation.positive("contact_heights", hs)
+    validation.positive("forces", fs)
     f_range = _check_f_range(f_range_hz)
 
     def excited(d, force):

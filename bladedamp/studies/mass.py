@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from .. import _validate
+from .. import validation
 from ..disk import TunedDisk
 from ..io import Saveable
 from ..plotting import place_legend
@@ -31,7 +31,7 @@ def peak_response(disk: TunedDisk, f_range_hz=(90.0, 105.0), harmonics=(1,), max
     ``continuation_options`` (e.g. ``max_points``) go to ``disk.frequency_response``.
     Raises RuntimeError if the continuation does not cover the range (never a silent number).
     """
-    lo, hi = _validate.interval("f_range_hz", f_range_hz, "Hz")
+    lo, hi = validation.interval("f_range_hz", f_range_hz, "Hz")
     for _ in range(max_widenings + 1):
         r = disk.frequency_response(lo, hi, harmonics=harmonics, max_step=max_step, **continuation_options)
         if not r.success:
@@ -120,7 +120,7 @@ def robust_peak(disk: TunedDisk, f_range_hz=(90.0, 105.0), harmonics=(1,), direc
     a partial branch has reached above it (a minimiser that already has a lower peak needs no
     more of this mass than that bound).
     """
-    lo, hi = _validate.interval("f_range_hz", f_range_hz, "Hz")
+    lo, hi = validation.interval("f_range_hz", f_range_hz, "Hz")
     messages, bound, up, runs = [], np.nan, None, 0
     for options in attempts:
         runs += 1
@@ -226,7 +226,7 @@ def mass_sweep(disk: TunedDisk, masses, f_range_hz=(90.0, 105.0), harmonics=(1,)
     masses = np.atleast_1d(np.asarray(masses, dtype=float))
     if masses.size == 0:
         raise ValueError("masses must be a non-empty array of damper masses in (0, inf) kg")
-    _validate.positive("masses", masses)
+    validation.positive("masses", masses)
     cases = [(with_mass(disk, m), f_range_hz, harmonics) for m in masses]
     peaks, freqs = np.array(parallel_map(_peak_of, cases, processes, progress)).T
     undamped, _, _ = peak_response(dataclasses.replace(disk, damper=None), f_range_hz, harmonics)
@@ -330,9 +330,9 @@ def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0),
     """
     from .parallel import parallel_map
 
-    lo, hi = _validate.interval("mass bounds", bounds, "kg")
-    _validate.positive("xatol", xatol)
-    _validate.positive("grid_per_decade", grid_per_decade)
+    lo, hi = validation.interval("mass bounds", bounds, "kg")
+    validation.positive("xatol", xatol)
+    validation.positive("grid_per_decade", grid_per_decade)
     undamped, _, _ = peak_response(dataclasses.replace(disk, damper=None), f_range_hz, harmonics)
     evaluations = {}
 

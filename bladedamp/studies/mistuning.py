@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import _validate
+from .. import validation
 from ..disk import TunedDisk
 from ..io import Saveable, npz_path
 from ..plotting import place_legend
@@ -42,7 +42,7 @@ def check_kappa(kappa, n_blades: int | None = None) -> np.ndarray:
     k = np.asarray(kappa, dtype=float)
     if k.ndim != 1 or k.size == 0:
         raise ValueError(f"kappa (mistuning factors) must be a non-empty 1-D array (got shape {k.shape})")
-    _validate.positive("kappa (mistuning factors)", k)
+    validation.positive("kappa (mistuning factors)", k)
     if n_blades is not None and k.size != n_blades:
         raise ValueError(f"kappa (mistuning factors) must have n_blades = {n_blades} entries (got {k.size})")
     return k
@@ -50,8 +50,8 @@ def check_kappa(kappa, n_blades: int | None = None) -> np.ndarray:
 
 def random_kappa(n_blades: int, std: float = PAPER_STD, seed=None) -> np.ndarray:
     """Gaussian mistuning factors, mean 1, standard deviation ``std`` (paper: 0.02)."""
-    n = _validate.integer("n_blades", n_blades, minimum=1)
-    std = _validate.nonnegative("std (standard deviation of kappa)", std)
+    n = validation.integer("n_blades", n_blades, minimum=1)
+    std = validation.nonnegative("std (standard deviation of kappa)", std)
     if std >= 0.2:
         raise ValueError(f"std (standard deviation of kappa) must be in [0, 0.2) (got {std})")
     return 1.0 + std * np.random.default_rng(seed).standard_normal(n)
@@ -59,10 +59,10 @@ def random_kappa(n_blades: int, std: float = PAPER_STD, seed=None) -> np.ndarray
 
 def alternating(n_blades: int, amplitude: float = PAPER_STD) -> np.ndarray:
     """1 + amplitude, 1 - amplitude, ... (paper's case d); ``n_blades`` must be even."""
-    n = _validate.integer("n_blades", n_blades, minimum=2)
+    n = validation.integer("n_blades", n_blades, minimum=2)
     if n % 2:
         raise ValueError(f"n_blades must be even for alternating mistuning (got {n})")
-    a = _validate.in_range("amplitude (alternating mistuning)", amplitude, 0.0, 1.0, closed="left")
+    a = validation.in_range("amplitude (alternating mistuning)", amplitude, 0.0, 1.0, closed="left")
     return 1.0 + a * np.tile([1.0, -1.0], n // 2)
 
 
@@ -118,7 +118,7 @@ def pattern_kappa(pattern: str, n_blades: int, std: float = PAPER_STD, seed=PAPE
     if pattern not in PATTERNS:
         raise ValueError(f"pattern must be one of {PATTERNS} (got {pattern!r})")
     if pattern == "tuned":
-        return np.ones(_validate.integer("n_blades", n_blades, minimum=2))
+        return np.ones(validation.integer("n_blades", n_blades, minimum=2))
     if pattern == "alternating":
         return alternating(n_blades, std)
     k = random_kappa(n_blades, std, seed=seed)
@@ -563,13 +563,13 @@ def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f
     Kappa of disk i is ``random_kappa(n, std, seed=[seed, i])`` (reproducible, independent of the
     scheduling).
     """
-    n_disks = _validate.integer("n_disks", n_disks, minimum=1)
+    n_disks = validation.integer("n_disks", n_disks, minimum=1)
     n = disk.n_blades
     kappas = np.array([random_kappa(n, std, seed=[int(seed), i]) for i in range(n_disks)])
-    settings = dict(harmonics=tuple(harmonics), max_step=_validate.positive("max_step", max_step),
-                    tol=_validate.positive("tol", tol), n_samples=n_samples)
+    settings = dict(harmonics=tuple(harmonics), max_step=validation.positive("max_step", max_step),
+                    tol=validation.positive("tol", tol), n_samples=n_samples)
     if n_workers is not None:
-        _validate.integer("n_workers", n_workers, minimum=1)
+        validation.integer("n_workers", n_workers, minimum=1)
     t0 = time.perf_counter()
     if tuned_peak_amplitude is None:
         tuned_peak_amplitude = tuned_peak(disk, f_range_hz or auto_range(disk, [1.0], 0.05), harmonics)[0]
@@ -661,7 +661,7 @@ def optimise_arrangement(disk: TunedDisk, kappa, max_evaluations: int = 30, cand
     improves or after ``max_evaluations`` FRFs. The given order and the heuristic are evaluated too.
     """
     k = check_kappa(kappa, disk.n_blades)
-    max_evaluations = _validate.integer("max_evaluations", max_evaluations, minimum=2)
+    max_evaluations = validation.integer("max_evaluations", max_evaluations, minimum=2)
     if tuned_peak_amplitude is None:
         tuned_peak_amplitude = tuned_peak(disk, f_range_hz or auto_range(disk, [1.0], 0.05), max_step=max_step)[0]
     cache = {}

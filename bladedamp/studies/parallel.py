@@ -6,7 +6,7 @@ import os
 import warnings
 from concurrent.futures import ProcessPoolExecutor, as_completed
 
-from .. import _validate
+from .. import validation
 
 
 def _quiet(fn, item):
@@ -22,7 +22,7 @@ def parallel_map(fn, items, processes: int | None = None, progress=None) -> list
     1 runs in this process; anything else but an integer >= 1 raises ValueError. ``progress(done, total)`` is called as cases finish.
     """
     if processes is not None:
-        processes = _validate.integer("processes (worker processes; None: every core)", processes, minimum=1)
+        processes = validation.integer("processes (worker processes; None: every core)", processes, minimum=1)
     items = list(items)
     n = len(items)
     processes = min(processes or os.cpu_count() or 1, n) if n else 1
