@@ -52,7 +52,7 @@ from .contact.laws import LinearNormalLaw
 from .contact.point import damper_contact_forces, normal_law_parameters
 from .damper.kinetics import seat
 from .disk import (AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION, DAMPER_DOFS, DamperContacts, TunedDisk,
-                   contact_point_maps, contact_rows, point_map_forces, rotor_speed_in_hz)
+                   contact_point_maps, contact_rows, damper_weighted_scales, point_map_forces, rotor_speed_in_hz)
 from .hbm.accuracy import HARMONIC_TOLERANCE, converged_response
 from .hbm.continuation import Branch, continuation
 from .hbm.start import robust_start
@@ -727,7 +727,7 @@ class MistunedDisk:
             x0 = self.start_solution(system, w0, scales)
             branch = continuation(system.residual, x0, w0, w1, x_scale=scales, factorize=system.factorize,
                                   max_step=max_step, start_at_end=lambda: self.start_solution(system, w1, scales),
-                                  **continuation_options)
+                                  retry_x_scale=self.retry_scales(system, scales), **continuation_options)
             response = MistunedResponse.from_branch(self, system, branch, tuned_peak_amplitude)
             T = system.basis.n_samples
 
@@ -761,6 +761,14 @@ class MistunedDisk:
         """Scale of each unknown of ``system`` over omega_start..omega_end [rad/s] (:meth:`scales`)."""
         return self.scales(system, omega_start, omega_end)
 
+    def retry_scales(self, system: HarmonicBalanceSystem, scales: np.ndarray) -> np.ndarray | None:
+        """The continuation's ``retry_x_scale``: ``scales`` with every damper's unknowns weighing
+        less in the arc length, as the tuned disk's (:func:`bladedamp.disk.damper_weighted_scales`);
+        None without dampers."""
+        if not self.active_dampers:
+            return None
+        return damper_weighted_scales(scales, system.basis.n_coeffs, slice(self.n_sector * self.n_modes, None))
+
     @one_blas_thread
     def extend_response(self, response: "MistunedResponse", f_end_hz: float, max_step: float = 0.02,
                         **continuation_options) -> "MistunedResponse":
@@ -787,7 +795,7 @@ class MistunedDisk:
         lo, hi = sorted((w0, w_new))
         scales = np.maximum(self.scales(system, lo, hi), np.abs(response.coefficients).max(axis=0).ravel())
         piece = continuation(system.residual, x0, w0, w_new, x_scale=scales, factorize=system.factorize,
-                             max_step=max_step, **continuation_options)
+                             max_step=max_step, retry_x_scale=self.retry_scales(system, scales), **continuation_options)
         old = response.coefficients.reshape(len(response.omega), -1)
         n_old = len(response.omega)
         if end == -1:
