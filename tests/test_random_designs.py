@@ -30,7 +30,11 @@ from bladedamp import reference as ref
 SEED = 20261201
 N_DISKS = 160
 N_OSCILLATORS = 160
-# issue 12's target is 0.99; measured 296 of 320 = 0.925 on 2026-12-01, fourth session (disks
+# issue 12's target is 0.99; measured 301 of 320 = 0.941 on 2026-12-02, sixth session (disks 143 of
+# 160 with the retry of a failed branch with the damper's unknowns weighing less in the arc length,
+# bladedamp.disk.DAMPER_ARC_SCALE: random disks 16, 102 and 124; oscillators 158 of 160; the floor
+# leaves 3 designs for rounding: disk 55 failed in the fifth session's venv and passes in this
+# one); 296 of 320 = 0.925 on 2026-12-01, fourth session (disks
 # 138 of 160, oscillators 158 of 160: the interpolated touchdown seat, the automatic AFT sampling
 # and the branch from the end of the range where the one from the start fails); 277 = 0.866 in
 # the third (271 = 0.847 before the corner fallbacks of the continuation and the refined
@@ -39,7 +43,7 @@ N_OSCILLATORS = 160
 # clip). Until the target is met this is a regression floor, not the target: the share is
 # printed, and the failing designs with it.
 SHARE_TARGET = 0.99
-SHARE_REQUIRED = 0.92
+SHARE_REQUIRED = 0.93
 # Harmonics of the oscillators cross-checked by time integration. The one-harmonic HBM is
 # wrong for inclined contacts (the normal load varies: it needs the static term and higher
 # harmonics); switch this to None (the frequency_response default) once that default is chosen
