@@ -591,11 +591,9 @@ class TunedDisk:
             system = model.hbm_system(H, n_samples)
             scales = self.unknown_scales(system, w0, w1)
             x0 = self.start_solution(system, w0, scales)
-            retry = damper_weighted_scales(scales, system.basis.n_coeffs, slice(self.blade.n_modes, None)) \
-                if self.has_damper else None
             branch = continuation(system.residual, x0, w0, w1, x_scale=scales, max_step=max_step,
-                                  start_at_end=lambda: self.start_solution(system, w1, scales), retry_x_scale=retry,
-                                  **continuation_options)
+                                  start_at_end=lambda: self.start_solution(system, w1, scales),
+                                  retry_x_scale=self.retry_scales(system, scales), **continuation_options)
             response = DiskResponse.from_branch(self, system, branch)
             T = system.basis.n_samples
 
@@ -667,6 +665,14 @@ class TunedDisk:
         x = self.static_state(system, omega)
         R, J, _ = system.residual(x, omega)
         return x - np.linalg.solve(J, R)
+
+    def retry_scales(self, system: HarmonicBalanceSystem, scales: np.ndarray) -> np.ndarray | None:
+        """The continuation's ``retry_x_scale``: ``scales`` (from :meth:`unknown_scales`) with the
+        damper's unknowns weighing less in the arc length (:func:`damper_weighted_scales`); None
+        without a damper."""
+        if not self.has_damper:
+            return None
+        return damper_weighted_scales(scales, system.basis.n_coeffs, slice(self.blade.n_modes, None))
 
     def unknown_scales(self, system: HarmonicBalanceSystem, omega_start: float, omega_end: float) -> np.ndarray:
         """Scale (C * n_dof,) of each unknown of ``system`` over omega_start..omega_end [rad/s]

@@ -763,7 +763,7 @@ class MistunedDisk:
 
     def retry_scales(self, system: HarmonicBalanceSystem, scales: np.ndarray) -> np.ndarray | None:
         """The continuation's ``retry_x_scale``: ``scales`` with every damper's unknowns weighing
-        less in the arc length, as the tuned disk's (:func:`bladedamp.disk.damper_weighted_scales`);
+        less in the arc length, as :meth:`TunedDisk.retry_scales` (:func:`bladedamp.disk.damper_weighted_scales`);
         None without dampers."""
         if not self.active_dampers:
             return None

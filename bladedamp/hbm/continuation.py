@@ -279,7 +279,8 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
     if retry_x_scale is not None:
         with warnings.catch_warnings(record=True):
             warnings.simplefilter("always", ConvergenceWarning)
-            retry_options = (step, max_step, min_step, max(2, max_points // RETRY_POINTS_FRACTION)) + options[4:]
+            retry_options = (step, max_step, min_step, max(2, max_points // RETRY_POINTS_FRACTION), tol, max_corrector,
+                             target_iterations, factorize)
             retried = _both_ends(fun, x0, omega_start, omega_end, retry_x_scale, residual_scale, retry_options,
                                  start_at_end)
             if retried.success:
@@ -293,7 +294,8 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
 
 def _both_ends(fun, x0, omega_start, omega_end, x_scale, residual_scale, options, start_at_end):
     """The branch from ``omega_start``; if it fails and ``start_at_end`` is given, the one from
-    ``omega_end`` where that one succeeds (see :func:`continuation`). Warns as each branch stops."""
+    ``omega_end`` where that one succeeds (see :func:`continuation`). The branch from the start
+    warns as it stops; the one from the end does not (it is returned only if it succeeds)."""
     forward = ArcLengthContinuation(fun, x0, omega_start, omega_end, x_scale, residual_scale, *options).run()
     if forward.success or start_at_end is None:
         return forward
