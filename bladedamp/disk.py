@@ -67,6 +67,9 @@ AUTO_SAMPLES_GROWTH_DISSIPATION = 16
 # The oscillator has no such unknown.
 DAMPER_ARC_SCALE = 100.0
 
+STOP_CHECK_OFFSET_HZ = 0.05   # [Hz] stop_check's frequency beyond the furthest point (0.3 rad/s, as
+# measured on the failing random disks, see with_stop_note)
+
 
 def damper_weighted_scales(scales: np.ndarray, n_coeffs: int, damper_unknowns: slice) -> np.ndarray:
     """A disk's ``retry_x_scale`` for :func:`bladedamp.hbm.continuation.continuation`: ``scales``
@@ -608,7 +611,7 @@ class TunedDisk:
             return with_checks(response, physical_checks(branch.omega, (w0, w1), points_dissipation(response),
                                                          response.excitation_work, max_step, T, refine))
 
-        return converged_response(model, solve, harmonics, harmonic_tolerance, max_harmonic)
+        return with_stop_note(converged_response(model, solve, harmonics, harmonic_tolerance, max_harmonic))
 
     def point_map(self, basis: HarmonicBasis, point: str = "tip", directions=(0,)) -> np.ndarray:
         """Real-form map (C*k, C*n_dof) from the unknowns of :meth:`hbm_system` (``basis``'s
@@ -705,6 +708,45 @@ class TunedDisk:
         from .timedomain import disk_time_response
 
         return disk_time_response(MistunedDisk.from_tuned(self), f_hz, **options)
+
+    def stop_check(self, response: "DiskResponse", offset_hz: float = STOP_CHECK_OFFSET_HZ, **options):
+        """Whether a periodic motion exists just beyond where ``response`` (a failed branch of
+        :meth:`frequency_response`) got furthest: :meth:`time_response` at that frequency plus
+        ``offset_hz`` [Hz] in the branch's direction (``options`` go to it). Its ``periodic``
+        and ``status`` answer: "not settled" or "drifting" (the damper hops on the platforms or
+        keeps rolling) mean that no periodic response, so no harmonic-balance branch, exists
+        there; "periodic" means the branch lost a solution that exists. Costs one time
+        integration of the full assembly (30-210 s for the reference disk on 2 cores)."""
+        validation.positive("offset_hz", offset_hz)
+        if not len(response.omega):
+            raise ValueError("stop_check needs a response with at least one point")
+        o = response.omega
+        k = response.furthest_index()
+        direction = np.sign(o[k] - o[0]) or 1.0
+        return self.time_response(response.frequency_hz[k] + direction * offset_hz, **options)
+
+
+def with_stop_note(response: "DiskResponse") -> "DiskResponse":
+    """A failed ``response`` with what the damper did where its branch got furthest (the share
+    of the period its contact points stick, slip and are separated there) and how to tell
+    whether a periodic motion exists just beyond (:meth:`TunedDisk.stop_check`). Measured on
+    the 17 random disks of tests/test_random_designs.py whose branch does not reach the end
+    (dampers of 0.02-7 g at EO 3-8, stopping at the 1F resonance): 0.3 rad/s beyond (disk 2:
+    0.27; disk 105, which keeps no point, at its start), the full assembly's time integration
+    over 4000 periods is not periodic for 13 of them (the damper hops, separated
+    21-99.8 % of the period, or a cylinder keeps rolling), so no harmonic-balance branch can go
+    on; for 4 it is periodic with the damper separated 80-100 % of the period (brief impacts,
+    which (0, 1, 2, 3) cannot follow). A successful or empty response is returned unchanged."""
+    if response.success or not len(response.omega) or response.point_state is None:
+        return response
+    k = response.furthest_index()
+    stick, slip, separated = 100 * response.contact_state_shares()[k]
+    f = response.frequency_hz[k]
+    note = (f"; where the branch got furthest ({f:.4f} Hz, tip amplitude {1e3 * response.tip_amplitude[k, 0]:.4g} mm) "
+            f"the damper's contact points stick {stick:.0f} %, slip {slip:.0f} %, are separated {separated:.0f} % of "
+            "the period; TunedDisk.stop_check(result) tells by time integration whether a periodic motion exists just "
+            "beyond (a light damper may hop on the platforms or keep rolling: then none does)")
+    return dataclasses.replace(response, message=response.message + note)
 
 
 def blade_point_map(blade, basis, point, directions, n_dof, modes):
@@ -820,6 +862,20 @@ class DiskResponse(FrequencyResponse):
             out.update(dissipated_energy=np.zeros(npts))
         return cls(branch.omega, X, basis, disk.dof_names, branch.success, branch.message, branch.iterations,
                    branch.turning_points, disk=disk, **out)
+
+    def contact_state_shares(self) -> np.ndarray:
+        """(n, 3) share of the period the damper's contact points stick, slip, are separated, the
+        mean over every point of both contacts (zeros without a damper)."""
+        if self.point_state is None:
+            return np.zeros((len(self.omega), 3))
+        return self.point_state.mean(axis=(1, 2))
+
+    def furthest_index(self) -> int:
+        """Index of the point furthest from the branch's first point in frequency (where a branch
+        from the start of its range got furthest, also if it then turned back)."""
+        o = self.omega
+        direction = np.sign(o[np.argmax(np.abs(o - o[0]))] - o[0])
+        return int(np.argmax(direction * (o - o[0])))
 
     @property
     def peak_amplitude(self) -> float:

@@ -153,8 +153,7 @@ def refined_peak(frequency_hz, amplitude, i: int | None = None) -> tuple[float, 
 def only_sampling_failed(response) -> bool:
     """Whether ``response`` reached the end of its range and failed only the dissipation check
     (the AFT's sampling error, see :func:`physical_checks`)."""
-    return (set(response.failed_checks) == {"dissipation"}
-            and response.message.startswith("reached the end of the frequency range"))
+    return set(response.failed_checks) == {"dissipation"} and bool(response.reached_end)
 
 
 def with_checks(response, failed: dict):
@@ -162,7 +161,9 @@ def with_checks(response, failed: dict):
     if not failed:
         return response
     message = response.message + "; failed checks: " + "; ".join(f"{k}: {v}" for k, v in failed.items())
-    return dataclasses.replace(response, success=False, message=message, failed_checks=dict(failed))
+    reached = response.success if response.reached_end is None else response.reached_end
+    return dataclasses.replace(response, success=False, message=message, failed_checks=dict(failed),
+                               reached_end=bool(reached))
 
 
 def plot_branch(ax, x, y, stable=None, **kwargs):
@@ -205,6 +206,8 @@ class FrequencyResponse(Saveable):
     harmonics_converged : whether the estimate met the tolerance (None: not estimated)
     failed_checks : physical sanity checks the branch failed (name -> what was found); a
         branch that fails one is not ``success``
+    reached_end : whether the continuation reached the end of the range (its own checks
+        passing) before the physical checks were applied; None: as ``success`` (no check failed)
     stable : (n,) bool per point, or None when not computed (see
         :func:`bladedamp.hbm.stability.with_stability`); plots draw unstable parts dashed
     floquet_exponents : (n, k) resolved Floquet exponents per point [1/s] (Hill's method; width
@@ -226,6 +229,7 @@ class FrequencyResponse(Saveable):
     harmonic_tolerance: float = float("nan")
     harmonics_converged: bool | None = None
     failed_checks: dict = field(default_factory=dict)
+    reached_end: bool | None = None
     stable: np.ndarray | None = None
     floquet_exponents: np.ndarray | None = None
     bifurcations: dict = field(default_factory=dict)

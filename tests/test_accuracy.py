@@ -179,21 +179,20 @@ def test_automatic_sampling_grows_further_only_for_a_branch_that_failed_the_diss
     AFT's sampling error) may grow to ``most_for_dissipation``; a branch that stalled stops at
     ``most``; a success stops at once. A fake solve records the samples it is asked for."""
     from bladedamp.hbm.fourier import HarmonicBasis
-    from bladedamp.response import FrequencyResponse, sampled_response
+    from bladedamp.response import FrequencyResponse, sampled_response, with_checks
 
     def fake(passes_at, failure):
         asked = []
 
-        def solve(n):
+        def solve(n):     # a continuation that reached the end (or stalled), then the checks
             asked.append(n)
             ok = n >= passes_at
-            message = "reached the end of the frequency range" if ok or failure == "dissipation" else \
-                "continuation did not converge after omega = 1 rad/s"
-            checks = {} if ok or failure != "dissipation" else {"dissipation": "negative"}
-            if checks:
-                message += "; failed checks: dissipation: negative"
-            return FrequencyResponse(np.ones(3), np.zeros((3, 3, 1)), HarmonicBasis((1,), n), ("x",), ok, message,
-                                     failed_checks=checks)
+            reached = ok or failure == "dissipation"
+            message = "reached the end" if reached else "continuation did not converge after omega = 1 rad/s"
+            # a stalled branch may fail the dissipation check too: only reached_end tells them apart
+            checks = {} if ok else {"dissipation": "negative"}
+            branch = FrequencyResponse(np.ones(3), np.zeros((3, 3, 1)), HarmonicBasis((1,), n), ("x",), reached, message)
+            return with_checks(branch, checks)
         return solve, asked
 
     solve, asked = fake(1024, "dissipation")

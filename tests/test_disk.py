@@ -616,3 +616,49 @@ def test_rotor_speed_in_hz_at_omega_e_over_eo_is_the_automatic_preload(engine_or
         assert dataclasses.replace(fixed, engine_order=1).rotor_speed_hz == fixed.rotor_speed_hz
     with pytest.warns(PlausibilityWarning, match="rotor_speed_hz"):
         reference_disk("cylinder", 1e-3, engine_order=0, rotor_speed_hz=60 * 95.0)      # rpm given as Hz
+
+
+def test_a_failed_branch_says_what_the_damper_did_where_it_got_furthest():
+    """A branch that does not reach the end (here: stopped by max_points) names the frequency it
+    got furthest to and the contact points' stick / slip / separated shares there (which sum to
+    100 %), read from the response's own point states; a successful branch has no such note."""
+    disk = reference_disk("wedge", 0.3e-3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = disk.frequency_response(93.0, 97.0, harmonics=(1,), max_step=0.05, max_points=12)
+    assert not r.success
+    k = r.furthest_index()
+    assert k == int(np.argmax(r.omega))                       # an upward branch
+    shares = r.contact_state_shares()
+    assert shares.shape == (len(r.omega), 3) and np.allclose(shares.sum(axis=1), 1.0)
+    stick, slip, separated = 100 * shares[k]
+    assert (f"where the branch got furthest ({r.frequency_hz[k]:.4f} Hz" in r.message
+            and f"stick {stick:.0f} %, slip {slip:.0f} %, are separated {separated:.0f} %" in r.message)
+    assert "got furthest" not in frf("wedge", 0.3e-3, f_range=(93.0, 94.0)).message
+
+
+def test_furthest_index_of_a_branch_that_turned_back():
+    """The furthest point of a branch that went up to 10 and came back to 2 is the one at 10,
+    of a downward branch the lowest frequency."""
+    from bladedamp.disk import DiskResponse
+    from bladedamp.hbm.fourier import HarmonicBasis
+
+    def response(omega):
+        return DiskResponse(np.asarray(omega, dtype=float), np.zeros((len(omega), 3, 1)), HarmonicBasis((1,)),
+                            ("q",), False, "")
+    assert response([1.0, 5.0, 10.0, 6.0, 2.0]).furthest_index() == 2
+    assert response([10.0, 4.0, 3.0, 8.0]).furthest_index() == 2
+
+
+def test_stop_check_bad_input():
+    from bladedamp.disk import DiskResponse
+    from bladedamp.hbm.fourier import HarmonicBasis
+
+    disk = reference_disk("wedge", 0.3e-3)
+    empty = DiskResponse(np.zeros(0), np.zeros((0, 3, 1)), HarmonicBasis((1,)), ("q",), False, "")
+    with pytest.raises(ValueError, match="at least one point"):
+        disk.stop_check(empty)
+    one = DiskResponse(np.array([600.0]), np.zeros((1, 3, 1)), HarmonicBasis((1,)), ("q",), False, "")
+    for bad in (0.0, -1.0, float("nan")):
+        with pytest.raises(ValueError, match="offset_hz"):
+            disk.stop_check(one, offset_hz=bad)
