@@ -49,7 +49,10 @@ Every mode lists the same points, each once.  For example (two of the four requi
 [Hz], ``damping_ratios`` (n_m,) [-], ``point_names`` (n_p,) str, ``point_positions``
 (n_p, 3) [m], ``mode_shapes`` (n_p, 6, n_m) [m/sqrt(kg), rad/sqrt(kg)], rows (ux, uy, uz,
 phix, phiy, phiz); optional ``mode_names`` (n_m,) str and ``format`` (the string
-``bladedamp.ModalBlade/1``).  A bad file raises ValueError naming the file, the key or
+``bladedamp.ModalBlade/1``).  A solid FE blade (:class:`bladedamp.solid.SolidModalBlade`)
+writes the format ``bladedamp.SolidModalBlade/1``: these arrays plus its flexible platforms'
+FE field, surface and solid_info under ``solid/`` (:meth:`~bladedamp.solid.SolidModalBlade.npz_arrays`);
+it has no CSV form.  A bad file raises ValueError naming the file, the key or
 column (and line) and what was expected.
 
 Reduced FE matrices (:meth:`ModalBlade.from_matrices`): Craig-Bampton or Guyan exports with
@@ -82,6 +85,9 @@ PAPER_MODE_ORDER = ("1F", "2F", "1T", "1E")
 
 # Modal data files (format: module docstring).
 MODAL_NPZ_FORMAT = "bladedamp.ModalBlade/1"
+# A solid FE blade's file (bladedamp.solid.SolidModalBlade.save): the ModalBlade keys plus its
+# flexible platforms' FE field, contact-face samples, surface and solid_info.
+SOLID_NPZ_FORMAT = "bladedamp.SolidModalBlade/1"
 MODAL_NPZ_KEYS = ("format", "natural_frequencies_hz", "damping_ratios", "mode_names", "point_names",
                   "point_positions", "mode_shapes")
 MODAL_CSV_COLUMNS = ("mode", "mode_name", "frequency_hz", "damping_ratio", "point", "x", "y", "z",
@@ -425,13 +431,21 @@ class ModalBlade:
         mass-normalised 6-DOF shapes [m/sqrt(kg), rad/sqrt(kg)] at OL, OR, tip, excitation
         and any extra points) are described in the module docstring of :mod:`bladedamp.blade`.
         A file that breaks them raises ValueError naming the file, the key or column (and
-        the line) and what was expected; a missing file raises FileNotFoundError.
+        the line) and what was expected; a missing file raises FileNotFoundError. A solid FE
+        blade's ``.npz`` (format :data:`SOLID_NPZ_FORMAT`, :meth:`bladedamp.solid.SolidModalBlade.save`)
+        gives a :class:`bladedamp.solid.SolidModalBlade` with its flexible platforms and surface.
         """
         path = Path(path)
         kind = _modal_file_kind(path)
         if not path.is_file():
             raise FileNotFoundError(f"{path}: no such modal data file")
-        fields = _read_modal_npz(path) if kind == "npz" else _read_modal_csv(path)
+        if kind == "npz":
+            fields, tag, extra = read_modal_npz(path)
+            if tag == SOLID_NPZ_FORMAT:
+                from .solid import SolidModalBlade
+                return SolidModalBlade.from_npz_arrays(path, fields, extra)
+        else:
+            fields = _read_modal_csv(path)
         try:
             return cls(**fields)
         except ValueError as err:
@@ -441,22 +455,27 @@ class ModalBlade:
         """Write this blade to ``path``: ``.npz`` or ``.csv`` by its suffix (formats: module
         docstring of :mod:`bladedamp.blade`). Every value is written exactly (the CSV holds
         the shortest decimal that reads back to the same float), so ``from_file`` gives the
-        same arrays back. Returns the path."""
+        same arrays back (a solid FE blade: ``.npz`` only, :meth:`bladedamp.solid.SolidModalBlade.save`).
+        Returns the path."""
         path = Path(path)
         kind = _modal_file_kind(path)
         if kind == "npz":
-            names = list(self.points)
-            with open(path, "wb") as fh:   # a file object: np.savez would append .npz to ".NPZ"
-                np.savez(fh, format=np.array(MODAL_NPZ_FORMAT),
-                         natural_frequencies_hz=self.natural_frequencies_hz,
-                         damping_ratios=self.damping_ratios,
-                         mode_names=np.array(self.mode_names, dtype=str),
-                         point_names=np.array(names, dtype=str),
-                         point_positions=np.array([self.points[p] for p in names]),
-                         mode_shapes=np.array([self.mode_shapes[p] for p in names]))
+            with open(path, "wb") as fh:   # a file object: np.savez_compressed would append .npz to ".NPZ"
+                np.savez_compressed(fh, **self.npz_arrays())
         else:
             _write_modal_csv(self, path)
         return path
+
+    def npz_arrays(self) -> dict:
+        """The arrays of this blade's ``.npz`` file by key (the format of the module docstring:
+        ``format``, ``natural_frequencies_hz``, ``damping_ratios``, ``mode_names``,
+        ``point_names``, ``point_positions`` (n_p, 3), ``mode_shapes`` (n_p, 6, n_m))."""
+        names = list(self.points)
+        return dict(format=np.array(MODAL_NPZ_FORMAT), natural_frequencies_hz=self.natural_frequencies_hz,
+                    damping_ratios=self.damping_ratios, mode_names=np.array(self.mode_names, dtype=str),
+                    point_names=np.array(names, dtype=str),
+                    point_positions=np.array([self.points[p] for p in names]),
+                    mode_shapes=np.array([self.mode_shapes[p] for p in names]))
 
     @classmethod
     def from_matrices(cls, mass, stiffness, dof_map: dict, *, points: dict, n_modes: int,
@@ -620,8 +639,14 @@ def _modal_file_kind(path: Path) -> str:
     return kind
 
 
-def _read_modal_npz(path: Path) -> dict:
-    """ModalBlade fields from a .npz file (format: module docstring)."""
+def read_modal_npz(path) -> tuple[dict, str, dict]:
+    """(ModalBlade fields, format tag, other arrays) of a modal data ``.npz`` file (format:
+    module docstring): the fields as keyword arguments of :class:`ModalBlade`; the tag is the
+    file's ``format`` entry (:data:`MODAL_NPZ_FORMAT` when it has none, or
+    :data:`SOLID_NPZ_FORMAT`); the other arrays (key -> array, read without pickle) are those
+    beyond :data:`MODAL_NPZ_KEYS`, which only the solid format may have. ValueError naming the
+    file and the key for a file that breaks the format."""
+    path = Path(path)
     try:
         data = np.load(path, allow_pickle=False)
     except Exception as err:   # numpy raises several types for a file that is not an .npz
@@ -630,11 +655,6 @@ def _read_modal_npz(path: Path) -> dict:
         raise ValueError(f"{path}: expected an .npz archive of named arrays (got a single array)")
     with data:
         keys = set(data.files)
-        unknown = sorted(keys - set(MODAL_NPZ_KEYS))
-        missing = [k for k in MODAL_NPZ_KEYS if k not in keys and k not in ("mode_names", "format")]
-        if unknown or missing:
-            raise ValueError(f"{path}: keys {MODAL_NPZ_KEYS} expected ('mode_names', 'format' "
-                             f"optional); missing: {missing}, unknown: {unknown}")
 
         def array(key, kind):
             try:
@@ -649,9 +669,16 @@ def _read_modal_npz(path: Path) -> dict:
                 arr = arr.astype(float)
             return arr
 
-        if "format" in keys and str(array("format", "string")) != MODAL_NPZ_FORMAT:
-            raise ValueError(f"{path}: key 'format' must be {MODAL_NPZ_FORMAT!r} "
-                             f"(got {str(data['format'])!r})")
+        tag = str(array("format", "string")) if "format" in keys else MODAL_NPZ_FORMAT
+        if tag not in (MODAL_NPZ_FORMAT, SOLID_NPZ_FORMAT):
+            raise ValueError(f"{path}: key 'format' must be {MODAL_NPZ_FORMAT!r} (or {SOLID_NPZ_FORMAT!r}, "
+                             f"a solid FE blade's) (got {tag!r})")
+        unknown = sorted(keys - set(MODAL_NPZ_KEYS)) if tag == MODAL_NPZ_FORMAT else []
+        missing = [k for k in MODAL_NPZ_KEYS if k not in keys and k not in ("mode_names", "format")]
+        if unknown or missing:
+            raise ValueError(f"{path}: keys {MODAL_NPZ_KEYS} expected ('mode_names', 'format' "
+                             f"optional); missing: {missing}, unknown: {unknown}")
+        extra = {k: array(k, "numeric or string") for k in sorted(keys - set(MODAL_NPZ_KEYS))}
         freqs = array("natural_frequencies_hz", "float")
         if freqs.ndim != 1 or freqs.size == 0:
             raise ValueError(f"{path}: key 'natural_frequencies_hz' must be a non-empty (n_modes,) "
@@ -675,10 +702,11 @@ def _read_modal_npz(path: Path) -> dict:
         names = [str(p) for p in names]
         if len(set(names)) != len(names):
             raise ValueError(f"{path}: key 'point_names' must not repeat a name (got {names})")
-        return dict(natural_frequencies_hz=freqs, damping_ratios=arrays["damping_ratios"],
-                    mode_shapes=dict(zip(names, arrays["mode_shapes"])),
-                    points=dict(zip(names, arrays["point_positions"])),
-                    mode_names=tuple(str(m) for m in mode_names))
+        fields = dict(natural_frequencies_hz=freqs, damping_ratios=arrays["damping_ratios"],
+                      mode_shapes=dict(zip(names, arrays["mode_shapes"])),
+                      points=dict(zip(names, arrays["point_positions"])),
+                      mode_names=tuple(str(m) for m in mode_names))
+    return fields, tag, extra
 
 
 def _read_modal_csv(path: Path) -> dict:

@@ -8,6 +8,12 @@ is part of every key's name. Every key is optional: a missing key takes the refe
 so a file holding only ``[damper]`` / ``mass_g = 2.0`` is the reference disk with a 2 g damper.
 Unknown tables and keys are errors (a typo must not pass silently).
 
+A blade of your own is modal data (``[blade] modal_file``) or a closed surface mesh meshed as a
+solid FE blade (``[blade] model = "solid"``, ``surface_file``, ``surface_units`` and the named
+regions ``[blade.regions.clamp]``, ``[blade.regions.OL]``, ``[blade.regions.OR]``, optionally
+``[blade.regions.tip]``, each a plane or its own surface file; :class:`bladedamp.solid.SurfaceBladeGeometry`);
+its OL / OR faces then set the disk's platform angles.
+
 Inside, everything is SI (m, kg, s, rad, N), as in the rest of the package.
 """
 from __future__ import annotations
@@ -163,16 +169,83 @@ class Field:
 
 TABLES = {
     "blade": "The blade: the built-in beam model of the paper's blade (geometry in [blade.beam]), its solid FE "
-             "model (model = 'solid'), or modal data from a file (modal_file).",
+             "model (model = 'solid'), the solid FE model of your own surface mesh (model = 'solid' with "
+             "surface_file, surface_units and the [blade.regions.*] tables), or modal data from a file (modal_file).",
     "blade.beam": "Geometry and material of the built-in blade (clamped root, shank, platform, airfoil), for the "
                   "beam and the solid model; each key overrides the reference blade's value. Ignored when [blade] "
-                  "modal_file is given: remove this table then.",
+                  "modal_file is given: remove this table then. With [blade] surface_file only the material "
+                  "(youngs_modulus_gpa, poisson_ratio, density_kg_m3) and tip_point_mm / excitation_point_mm apply.",
+    "blade.regions.clamp": "surface_file only, required: the root faces clamped in the disk, as a plane "
+                           "(plane_point_mm, plane_normal, optionally box_mm) or as their own surface file (file). "
+                           "The examples are the reference blade's (its root plane z = 0).",
+    "blade.regions.OL": "surface_file only, required: the platform's underside contact face on the -x side (the "
+                        "damper's left contact), as a plane or a file; planar, its outward normal in the x-z plane "
+                        "(the disk's gamma_left_deg is read from it). The examples are the reference blade's.",
+    "blade.regions.OR": "surface_file only, required: the platform's underside contact face on the +x side, as a "
+                        "plane or a file; planar, its outward normal in the x-z plane (gamma_right_deg is read from "
+                        "it). The examples are the reference blade's.",
+    "blade.regions.tip": "surface_file only, optional: the tip face (mode names, the tip point), as a plane or a "
+                         "file; default the flat top face at the surface's largest z.",
     "damper": "The underplatform damper between neighbouring blades: kind, geometry, mass and contact.",
     "disk": "The tuned bladed disk: blades, engine order(s), platform angles, damper radius, excitation, speed.",
     "mistuning": "Blade frequency mistuning kappa (f_0 -> kappa f_0 for every mode of a blade); remove this table "
                  "for a tuned design. Used by `frf --mistuned` and `montecarlo`.",
     "analysis": "Harmonic balance and continuation settings of every command.",
 }
+
+
+# [blade] surface_units -> metres per unit of the surface files' coordinates
+SURFACE_UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "in": 0.0254}
+# The named regions of a surface_file blade (tables [blade.regions.<name>]) and the required ones
+REGIONS = ("clamp", "OL", "OR", "tip")
+REQUIRED_REGIONS = ("clamp", "OL", "OR")
+# [disk] gamma_left_deg / gamma_right_deg given with a surface_file blade may differ from its faces'
+# platform angles by this much [deg] (the faces' then count); a float32 STL in mm fixes them to ~1e-4 deg
+SURFACE_GAMMA_TOLERANCE_DEG = 0.01
+# [blade.regions.*] tolerance_mm when not given [mm] (bladedamp.solid.PlaneRegion's default, 1e-5 m)
+REGION_TOLERANCE_MM = 0.01
+# [blade.beam] keys that apply to a surface_file blade (the others are the built-in blade's geometry)
+SURFACE_BEAM_KEYS = ("youngs_modulus_gpa", "poisson_ratio", "density_kg_m3", "tip_point_mm", "excitation_point_mm")
+
+
+def _region_fields(g) -> list[Field]:
+    """The keys of the [blade.regions.<name>] tables (one set per region of :data:`REGIONS`, the same
+    keys, checks and reasons; examples from the reference blade ``g``, a BeamBladeGeometry)."""
+    from .damper.geometry import contact_normal
+    from .reference import PLATFORM_ANGLE
+
+    pts = {k: [round(1e3 * float(x), 6) + 0.0 for x in p] for k, p in g.points().items()}      # [mm]
+    examples = {"clamp": ([0.0, 0.0, 0.0], [0.0, 0.0, -1.0]), "tip": (pts["tip"], [0.0, 0.0, 1.0]),
+                **{side: (pts[side], [round(float(x), 9) + 0.0 for x in contact_normal(side, PLATFORM_ANGLE)])
+                   for side in ("OL", "OR")}}
+    point = List(Number(-1e4, 1e4), 3)
+    rows = []
+    for name in REGIONS:
+        table = f"blade.regions.{name}"
+        rows += [
+            Field(table, "plane_point_mm", None, point, "mm",
+                  "a point of the region's plane in the blade frame (with plane_normal: the surface's triangles on "
+                  "that plane facing that way)", example=examples[name][0]),
+            Field(table, "plane_normal", None, List(Number(-1e6, 1e6), 3), "-",
+                  "the region's outward normal (out of the blade, any length, not zero): its triangles face within "
+                  "1 deg of it", example=examples[name][1]),
+            Field(table, "box_mm", None, List(Number(-1e4, 1e4), 6), "mm",
+                  "optional with a plane: only the triangles inside this box (x_min, y_min, z_min, x_max, y_max, "
+                  "z_max), for a plane other faces share",
+                  example=[x - 100.0 for x in examples[name][0]] + [x + 100.0 for x in examples[name][0]]),
+            Field(table, "file", None, Text(), "-",
+                  "instead of a plane: the region as its own surface file exported from the same model, in "
+                  "surface_units; the triangles within tolerance_mm of it", example=f"{name}.stl"),
+            Field(table, "tolerance_mm", None, Number(0.0, 1e3, "right"), "mm",
+                  f"how far the region's triangle vertices may lie from its plane or file; default "
+                  f"{_num(REGION_TOLERANCE_MM)} mm (an STL stores float32 coordinates: 1e-5 mm at 200 mm)",
+                  example=REGION_TOLERANCE_MM),
+        ]
+        if name in ("OL", "OR"):
+            rows.append(Field(table, "control_point_mm", None, point, "mm",
+                              "the contact control point on the face (the damper's contact centre); default the "
+                              "face's area centroid", example=pts[name]))
+    return rows
 
 
 def _fields() -> list[Field]:
@@ -218,8 +291,16 @@ def _fields() -> list[Field]:
         Field("blade", "model", "beam", Choice(("beam", "solid")), "-",
               "beam: the paper's beam FE model, rigid platforms at OL / OR; solid: 3D quadratic tetrahedra of the "
               "same geometry ([blade.beam] sections and material, the platform faces at [disk] gamma_left_deg / "
-              "gamma_right_deg), flexible platforms at every contact point (needs the fe extra; 7-16 s at 6 mm "
-              "on 2 cores)"),
+              "gamma_right_deg) or of surface_file, flexible platforms at every contact point (needs the fe "
+              "extra; 7-16 s at 6 mm on 2 cores)"),
+        Field("blade", "surface_file", None, Text(), "-",
+              "solid model only: your blade, a closed surface mesh (STL) in the blade frame (x circumferential, "
+              "y axial, z radial); needs surface_units, [blade.regions.clamp], [blade.regions.OL] and "
+              "[blade.regions.OR]",
+              example="my_blade.stl"),
+        Field("blade", "surface_units", None, Choice(tuple(SURFACE_UNITS)), "-",
+              "surface_file only (then required): the unit of the coordinates in surface_file and in the regions' "
+              "files (CAD exports are often mm)", example="mm"),
         Field("blade", "solid_element_size_mm", _tidy(SOLID_ELEMENT_SIZE, 1e-3), Number(0.5, 100.0), "mm",
               "solid model only: gmsh's element size; 6 mm: 28 800 DOF, the damped 1F peak 0.06 % in amplitude "
               "and 0.11 % in frequency from the 4.5 mm mesh's (README, flexible platforms)"),
@@ -227,7 +308,7 @@ def _fields() -> list[Field]:
               "beam or solid model: 4 gives the paper's modes 1F, 2F, 1T, 1E; otherwise the lowest n by frequency"),
         Field("blade", "natural_frequencies_hz", list(freqs), Either((Choice(("model",)), List(Number(0.0, 1e6, "right")))),
               "Hz", "the paper's Table 1 (the beam or solid FE gives the shapes); 'model' keeps the model's or the "
-              "file's own frequencies; one per mode"),
+              "file's own frequencies (the default with modal_file or surface_file); one per mode"),
         Field("blade", "damping_ratio", _tidy(damping[0]) if len(set(damping)) == 1 else list(damping),
               Either((Number(0.0, 0.5), List(Number(0.0, 0.5)))), "-",
               "modal viscous damping D of every mode (paper: 0.001), or one per mode"),
@@ -236,6 +317,7 @@ def _fields() -> list[Field]:
               "where the tip amplitude is read; default on the axis at the tip", example=[0.0, 0.0, 200.0]),
         Field("blade.beam", "excitation_point_mm", None, List(Number(-1e4, 1e4), 3), "mm",
               "where the excitation acts; default the tip point", example=[0.0, 0.0, 200.0]),
+        *_region_fields(g),
         Field("damper", "kind", "cylinder", Choice(("cylinder", "wedge", "none")), "-",
               "cylinder (rolls at EO = 0) or wedge (flat faces of height h_C); none: no damper"),
         Field("damper", "mass_g", 1.0, Number(0.0, 1000.0, "right"), "g",
@@ -267,9 +349,9 @@ def _fields() -> list[Field]:
               Either((Number(0, 500, integer=True), List(Number(0, 500, integer=True), increasing=True))), "-",
               "EO in [0, n_blades / 2], or a list (frf and eo-sweep run each; the others the first)"),
         Field("disk", "gamma_left_deg", _tidy(np.degrees(ref.PLATFORM_ANGLE)), Number(0.0, 90.0, "neither"), "deg",
-              "platform angle at OL (paper: 35 deg)"),
+              "platform angle at OL (paper: 35 deg); a surface_file blade's OL face sets it"),
         Field("disk", "gamma_right_deg", _tidy(np.degrees(ref.PLATFORM_ANGLE)), Number(0.0, 90.0, "neither"), "deg",
-              "platform angle at OR (paper: 35 deg)"),
+              "platform angle at OR (paper: 35 deg); a surface_file blade's OR face sets it"),
         Field("disk", "damper_radius_mm", mm(ref.DAMPER_RADIUS), Number(0.0, 1e5, "right"), "mm",
               "distance of the damper's centre of gravity to the rotor axis; calibrated on the 1 g optimum"),
         Field("disk", "excitation_n_nm", [_tidy(v) for v in ref.EXCITATION_FX], List(exc_item, 6), "N and N m",
@@ -441,7 +523,7 @@ class Design:
     [Hz], None for 'auto' (Omega_E / EO);
     values : {table: {key: value}} in the file's units, every key (defaults filled in);
     path : the file (None: the reference design); blade_geometry : the BeamBladeGeometry of a
-    beam blade (None for modal data from a file)
+    beam or parametric solid blade (None for modal data from a file and a surface_file blade)
     """
     disk: object
     engine_orders: tuple
@@ -487,11 +569,13 @@ def _read_values(path: Path, raw: dict) -> tuple[dict, set]:
     given = set()
     values = {t: {k: None if f.value is None else f.check(f.value) for k, f in keys.items()}
               for t, keys in by_table.items()}
+    # tables that only hold tables (blade.regions holds blade.regions.clamp, ...)
+    containers = {t.rsplit(".", 1)[0] for t in by_table if "." in t} - set(by_table)
 
     def visit(prefix: str, table: dict):
         for key, value in table.items():
             name = f"{prefix}.{key}" if prefix else key
-            if name in by_table:
+            if name in by_table or name in containers:
                 if not isinstance(value, dict):
                     raise DesignError(f"{path}: {name} must be a table [{name}] (got {key} = {_toml(value)})")
                 visit(name, value)
@@ -499,6 +583,10 @@ def _read_values(path: Path, raw: dict) -> tuple[dict, set]:
             if not prefix:
                 raise DesignError(f"{path}: unknown table or key {name!r}{_suggest(name, by_table)}; allowed "
                                   f"tables: {', '.join(f'[{t}]' for t in by_table)}")
+            if prefix in containers:
+                inside = [t for t in by_table if t.startswith(f"{prefix}.")]
+                raise DesignError(f"{path}: unknown table [{name}]{_suggest(name, inside)}; allowed tables: "
+                                  f"{', '.join(f'[{t}]' for t in inside)}")
             if key not in by_table[prefix]:
                 raise DesignError(f"{path}: unknown key [{prefix}] {key}{_suggest(key, by_table[prefix])}; "
                                   f"allowed keys: {', '.join(by_table[prefix])}")
@@ -594,29 +682,159 @@ def reference_design() -> Design:
 
 
 def _solid_blade(path: Path, geometry, v: dict, n_modes: int, freqs, damping):
-    """The solid FE blade (:meth:`ModalBlade.from_solid`) of [blade.beam]'s geometry with the
-    platform faces at the disk's platform angles (the contact kinematics need them to agree)."""
-    from .blade import ModalBlade
+    """The solid FE blade (:meth:`ModalBlade.from_solid`) of ``geometry``: a BeamBladeGeometry
+    ([blade.beam]: the parametric solid with its platform faces at the disk's platform angles, which
+    the contact kinematics need to agree) or a SurfaceBladeGeometry ([blade] surface_file, whose
+    faces set the disk's angles: :func:`_surface_geometry`)."""
+    from .blade import BeamBladeGeometry, ModalBlade
     from .solid import SolidBladeGeometry
 
     d = v["disk"]
+    parametric = isinstance(geometry, BeamBladeGeometry)
+    where = "[blade] model = 'solid'" if parametric else f"[blade] surface_file = {_toml(v['blade']['surface_file'])}"
     try:
-        sg = SolidBladeGeometry(beam=geometry, gamma_left=np.radians(d["gamma_left_deg"]),
-                                gamma_right=np.radians(d["gamma_right_deg"]))
+        sg = (SolidBladeGeometry(beam=geometry, gamma_left=np.radians(d["gamma_left_deg"]),
+                                 gamma_right=np.radians(d["gamma_right_deg"])) if parametric else geometry)
         options = {} if damping is None else {"damping_ratios": damping}
         return ModalBlade.from_solid(sg, 1e-3 * v["blade"]["solid_element_size_mm"], n_modes,
                                      natural_frequencies_hz=freqs, **options)
     except (ImportError, ValueError, RuntimeError) as exc:     # ImportError: the fe extra's one-line hint
-        raise DesignError(f"{path}: [blade] model = 'solid': {exc}") from None
+        raise DesignError(f"{path}: {where}: {exc}") from None
+
+
+def _relative(path: Path, file: str) -> Path:
+    """``file`` (a key's value) as a path: relative to the design file ``path``'s folder unless absolute."""
+    f = Path(file)
+    return f if f.is_absolute() else path.parent / f
+
+
+def _surface_error_key(message: str, v: dict) -> str:
+    """The design key a :class:`~bladedamp.solid.SurfaceBladeGeometry` error ``message`` is about
+    (its messages start with the parameter's name)."""
+    import re
+
+    b = v["blade"]
+    m = re.match(r"(regions|points_given)\[['\"](\w+)['\"]\]", message)
+    if m and m.group(1) == "regions":
+        return f"[blade.regions.{m.group(2)}]"
+    if m:
+        return {"OL": "[blade.regions.OL] control_point_mm", "OR": "[blade.regions.OR] control_point_mm",
+                "tip": "[blade.beam] tip_point_mm", "excitation": "[blade.beam] excitation_point_mm"}.get(
+            m.group(2), "[blade.beam]")
+    if message.startswith("scale"):
+        return f"[blade] surface_units = {_toml(b['surface_units'])} ({SURFACE_UNITS[b['surface_units']]:g} m per unit)"
+    for name, key in (("youngs_modulus", "youngs_modulus_gpa"), ("poisson_ratio", "poisson_ratio"),
+                      ("density", "density_kg_m3")):
+        if message.startswith(name):
+            return f"[blade.beam] {key}"
+    return f"[blade] surface_file = {_toml(b['surface_file'])}"
+
+
+def _surface_geometry(path: Path, v: dict, given: set):
+    """The :class:`~bladedamp.solid.SurfaceBladeGeometry` of [blade] surface_file, surface_units, the
+    [blade.regions.*] tables and [blade.beam]'s material and points; DesignError naming the key."""
+    b, beam = v["blade"], v["blade.beam"]
+    if b["surface_units"] is None:
+        raise DesignError(f"{path}: [blade] surface_file needs surface_units, the unit of its coordinates: "
+                          f"{Choice(tuple(SURFACE_UNITS)).describe()}")
+    file = _relative(path, b["surface_file"])
+    if not file.is_file():
+        raise DesignError(f"{path}: [blade] surface_file = {_toml(b['surface_file'])}: no file {str(file)!r}")
+    tables = {name: sorted(k for t, k in given if t == f"blade.regions.{name}") for name in REGIONS}
+    missing = [f"[blade.regions.{name}]" for name in REQUIRED_REGIONS if not tables[name]]
+    if missing:
+        required = ", ".join(f"[blade.regions.{n}]" for n in REQUIRED_REGIONS)
+        raise DesignError(f"{path}: [blade] surface_file needs the tables {required} (missing: {', '.join(missing)}), "
+                          "each with plane_point_mm and plane_normal, or file")
+    try:
+        from .solid import PlaneRegion, SurfaceBladeGeometry, SurfacePatch
+    except ImportError as exc:
+        raise DesignError(f"{path}: [blade] surface_file: {exc}") from None
+    regions, points = {}, {}
+    for name, keys in tables.items():
+        if not keys:
+            continue
+        table, r = f"blade.regions.{name}", v[f"blade.regions.{name}"]
+        plane = sorted({"plane_point_mm", "plane_normal", "box_mm"} & set(keys))
+        tolerance = REGION_TOLERANCE_MM if r["tolerance_mm"] is None else r["tolerance_mm"]
+        if "file" in keys:
+            if plane:
+                raise DesignError(f"{path}: [{table}] file replaces the plane: give file or plane_point_mm and "
+                                  f"plane_normal, not both (remove {', '.join(plane)} or file)")
+            patch = _relative(path, r["file"])
+            if not patch.is_file():
+                raise DesignError(f"{path}: [{table}] file = {_toml(r['file'])}: no file {str(patch)!r}")
+            regions[name] = SurfacePatch(str(patch), tolerance=1e-3 * tolerance)
+        else:
+            if r["plane_point_mm"] is None or r["plane_normal"] is None:
+                raise DesignError(f"{path}: [{table}] needs plane_point_mm and plane_normal (the region's plane), "
+                                  f"or file (given: {', '.join(keys)})")
+            if not any(r["plane_normal"]):
+                raise _bad(path, table, "plane_normal", list(r["plane_normal"]),
+                           "3 numbers, not all zero (the region's outward normal)")
+            box = None
+            if r["box_mm"] is not None:
+                low, high = np.array(r["box_mm"][:3]), np.array(r["box_mm"][3:])
+                if np.any(low > high):
+                    raise _bad(path, table, "box_mm", list(r["box_mm"]),
+                               "6 numbers x_min, y_min, z_min, x_max, y_max, z_max with each min <= its max, in mm")
+                box = (tuple(1e-3 * low), tuple(1e-3 * high))
+            regions[name] = PlaneRegion(tuple(1e-3 * np.array(r["plane_point_mm"])), tuple(r["plane_normal"]),
+                                        1e-3 * tolerance, box)
+        if r.get("control_point_mm") is not None:
+            points[name] = 1e-3 * np.array(r["control_point_mm"])
+    for key, name in (("tip_point_mm", "tip"), ("excitation_point_mm", "excitation")):
+        if beam[key] is not None:
+            points[name] = 1e-3 * np.array(beam[key])
+    try:
+        return SurfaceBladeGeometry(str(file), regions, SURFACE_UNITS[b["surface_units"]],
+                                    youngs_modulus=1e9 * beam["youngs_modulus_gpa"],
+                                    poisson_ratio=beam["poisson_ratio"], density=beam["density_kg_m3"],
+                                    points_given=points or None)
+    except ImportError as exc:
+        raise DesignError(f"{path}: [blade] surface_file: {exc}") from None
+    except (ValueError, OSError) as exc:
+        units = str(exc).startswith("scale")
+        hint = ' (in a design file: surface_units = "mm" for a file in millimetres)' if units else ""
+        raise DesignError(f"{path}: {_surface_error_key(str(exc), v)}: {exc}{hint}") from None
+
+
+def _platform_angles_of(path: Path, v: dict, given: set, gammas: dict, what: str) -> None:
+    """A blade with its own platform faces (a surface_file blade, a solid blade's modal file; their
+    platform angles ``gammas`` "OL", "OR" -> [rad]) sets the disk's: v["disk"] gamma_left_deg /
+    gamma_right_deg become the faces' angles [deg]; DesignError if the file gives one that differs
+    by more than :data:`SURFACE_GAMMA_TOLERANCE_DEG` (``what`` names the blade's key)."""
+    for side, key in (("OL", "gamma_left_deg"), ("OR", "gamma_right_deg")):
+        face = float(np.degrees(gammas[side]))
+        if ("disk", key) in given and abs(v["disk"][key] - face) > SURFACE_GAMMA_TOLERANCE_DEG:
+            raise DesignError(f"{path}: [disk] {key} = {_toml(v['disk'][key])} is not the platform angle of the {side} "
+                              f"face of {what} ({face:.6g} deg): remove {key} (the disk takes the face's) or give "
+                              f"{face:.6g}")
+        v["disk"][key] = face
 
 
 def _build_blade(path: Path, v: dict, given: set):
-    """(ModalBlade, BeamBladeGeometry or None) of [blade] and [blade.beam]."""
+    """(ModalBlade, BeamBladeGeometry or None) of [blade] and [blade.beam] (and [blade.regions.*]
+    for a surface_file blade). A blade with its own platform faces sets v["disk"]'s platform angles
+    (:func:`_platform_angles_of`)."""
     from .blade import BeamBladeGeometry, ModalBlade
 
     b, beam = v["blade"], v["blade.beam"]
     freqs, damping = b["natural_frequencies_hz"], b["damping_ratio"]
     solid = b["model"] == "solid"
+    surface = b["surface_file"] is not None
+    if surface and b["modal_file"] is not None:
+        raise DesignError(f"{path}: [blade] surface_file and modal_file are two different blades: give one of them")
+    if surface and not solid:
+        raise DesignError(f"{path}: [blade] surface_file is meshed as a solid FE blade: add model = \"solid\" to "
+                          "[blade] (or remove surface_file)")
+    surface_keys = sorted((t, k) for t, k in given
+                          if t.startswith("blade.regions.") or (t, k) == ("blade", "surface_units"))
+    if surface_keys and not surface:
+        t, k = surface_keys[0]
+        raise DesignError(f"{path}: [{t}] {k} applies to a surface_file blade only: add [blade] surface_file "
+                          "(or remove it)")
+    geometry = None
     if b["modal_file"] is not None:
         if solid:
             raise DesignError(f"{path}: [blade] model = 'solid' builds the blade from [blade.beam]; with "
@@ -628,17 +846,28 @@ def _build_blade(path: Path, v: dict, given: set):
         if not hasattr(ModalBlade, "from_file"):
             raise DesignError(f"{path}: [blade] modal_file needs ModalBlade.from_file, which this bladedamp "
                               "version does not have")
-        file = Path(b["modal_file"])
-        file = file if file.is_absolute() else path.parent / file
+        file = _relative(path, b["modal_file"])
         try:
             blade = ModalBlade.from_file(file)
         except (OSError, ValueError, KeyError) as exc:
             raise DesignError(f"{path}: [blade] modal_file = {_toml(b['modal_file'])}: {exc}") from None
+        faces = getattr(blade, "face_fields", {})        # a solid blade's file: its flexible platforms
+        if faces:
+            _platform_angles_of(path, v, given, {side: f.gamma for side, f in faces.items()},
+                                f"[blade] modal_file = {_toml(b['modal_file'])}")
         n_modes = blade.n_modes
         if ("blade", "natural_frequencies_hz") not in given:
             freqs = "model"
         if ("blade", "damping_ratio") not in given:
             damping = None
+    elif surface:
+        n_modes = b["n_modes"]
+        if ("blade", "natural_frequencies_hz") not in given:
+            freqs = "model"                  # your own blade's: Table 1 is the paper's blade
+        shape_keys = sorted(k for t, k in given if t == "blade.beam" and k not in SURFACE_BEAM_KEYS)
+        if shape_keys:
+            raise DesignError(f"{path}: [blade.beam] {shape_keys[0]} is the built-in blade's geometry; with [blade] "
+                              f"surface_file only {', '.join(SURFACE_BEAM_KEYS)} apply: remove it")
     else:
         n_modes = b["n_modes"]
         if beam["platform_contact_z_offset_mm"] > beam["shank_length_mm"]:
@@ -663,6 +892,11 @@ def _build_blade(path: Path, v: dict, given: set):
                    f"'model' or {n_modes} numbers in (0, 1e6] Hz (one per mode, n_modes = {n_modes})")
     if not isinstance(damping, (float, type(None))) and len(damping) != n_modes:
         raise _bad(path, "blade", "damping_ratio", list(damping), f"a number or {n_modes} numbers in [0, 0.5]")
+    if surface:
+        sg = _surface_geometry(path, v, given)
+        _platform_angles_of(path, v, given, {"OL": sg.gamma_left, "OR": sg.gamma_right},
+                            f"[blade] surface_file = {_toml(b['surface_file'])}")
+        return _solid_blade(path, sg, v, n_modes, None if freqs == "model" else freqs, damping), None
     if solid:
         return _solid_blade(path, geometry, v, n_modes, None if freqs == "model" else freqs, damping), geometry
     if b["modal_file"] is None:

@@ -8,6 +8,9 @@ time-domain responses, the study results of :mod:`bladedamp.studies`) has ``.sav
     frf.save("results/frf")                 # writes results/frf.npz
     frf = bladedamp.load("results/frf.npz")
 
+:func:`load` also reads a blade's modal data file (``blade.save("blade.npz")``, see
+:mod:`bladedamp.blade`; a solid FE blade's comes back with its flexible platforms).
+
 File layout (readable with ``np.load(path, allow_pickle=False)`` and any npz reader):
 
 * each array field of the dataclass is one npz entry under its field name (an object array of
@@ -233,15 +236,25 @@ def save(result, path) -> Path:
 def load(path):
     """Read a result written by ``.save(path)`` / :func:`save` (``.npz``; ``path`` without the
     suffix works too); returns an object of the class stored in the file, with ``disk=None``.
+    A blade's modal data file (``ModalBlade.save``, a ``format`` entry naming a blade format) gives
+    the blade (:meth:`bladedamp.blade.ModalBlade.from_file`: a solid FE blade's a SolidModalBlade).
     Raises FileNotFoundError naming the file, ValueError for a file that is not a saved result."""
+    from .blade import MODAL_NPZ_FORMAT, SOLID_NPZ_FORMAT, ModalBlade
+
     path = npz_path(path)
     if not path.exists():
         raise FileNotFoundError(f"no saved result at {path}")
     with np.load(path, allow_pickle=False) as z:
-        if META_KEY not in z.files:
-            raise ValueError(f"{path} is not a saved bladedamp result (no {META_KEY} entry)")
-        meta = json.loads(str(z[META_KEY][()]))
-        if meta.get("format", 0) > FORMAT_VERSION:
-            raise ValueError(f"{path} has format {meta.get('format')}; this bladedamp reads up to {FORMAT_VERSION}")
-        arrays = {k: z[k] for k in z.files if k != META_KEY}
+        files = set(z.files)
+        if META_KEY in files:
+            meta = json.loads(str(z[META_KEY][()]))
+            if meta.get("format", 0) > FORMAT_VERSION:
+                raise ValueError(f"{path} has format {meta.get('format')}; this bladedamp reads up to {FORMAT_VERSION}")
+            arrays = {k: z[k] for k in z.files if k != META_KEY}
+        blade = META_KEY not in files and "format" in files and z["format"].dtype.kind == "U"
+        tag = str(z["format"]) if blade else None
+    if META_KEY not in files:
+        if tag in (MODAL_NPZ_FORMAT, SOLID_NPZ_FORMAT):          # a blade's modal data file
+            return ModalBlade.from_file(path)
+        raise ValueError(f"{path} is not a saved bladedamp result (no {META_KEY} entry)")
     return _rebuild(meta, "", arrays)

@@ -1,12 +1,20 @@
-"""Shared closed forms and independent numerical helpers of the engine tests.
+"""Shared closed forms and independent numerical helpers of the engine tests, and the shared
+solid-blade inputs.
 
 Nothing here calls the code under test to produce a reference value: the closed forms are
 written from the physics (Jenkins element, unilateral spring, Duffing + Jenkins describing
-function), and the finite differences only call the function whose derivative is checked.
+function), and the finite differences only call the function whose derivative is checked. The
+solid-blade fixtures (the coarse reference solid, its surface as an STL in millimetres and that
+STL's named regions) are inputs of tests/test_solid_blade.py and tests/test_design_file.py, built
+once per session.
 """
 from __future__ import annotations
 
 import numpy as np
+import pytest
+
+FE_REASON = "the solid blade needs the fe extra: pip install 'bladedamp[fe]'"
+COARSE_SOLID = 9e-3    # [m] element size of the coarse reference solid: 14 400 DOF, 1F 0.4 % above the 3 mm value
 
 
 # ---------------------------------------------------------------------------------------
@@ -106,3 +114,40 @@ def hbm_amplitudes(osc, omegas, harmonics, n_samples=None, return_solutions=Fals
     if return_solutions:
         return np.array(amps), np.array(sols), system
     return np.array(amps)
+
+
+# ---------------------------------------------------------------------------------------
+# shared solid-blade inputs
+# ---------------------------------------------------------------------------------------
+@pytest.fixture(scope="session")
+def coarse_modes():
+    """The reference solid's clamped-root modes on the coarse mesh (COARSE_SOLID)."""
+    pytest.importorskip("gmsh", reason=FE_REASON)
+    pytest.importorskip("skfem", reason=FE_REASON)
+    from bladedamp import solid
+    return solid.solid_modes(None, COARSE_SOLID)
+
+
+@pytest.fixture(scope="session")
+def reference_stl_mm(coarse_modes, tmp_path_factory):
+    """The parametric reference solid's boundary (the 9 mm tetrahedral mesh's outer triangles)
+    written as an STL in millimetres: an independent path to the same blade."""
+    trimesh = pytest.importorskip("trimesh")
+    from bladedamp import solid
+    m = coarse_modes.mesh
+    tri = solid.boundary_faces(m.tets, m.vertices)
+    path = tmp_path_factory.mktemp("stl") / "reference_mm.stl"
+    trimesh.Trimesh(1e3 * m.vertices.T, tri.T).export(path)
+    return path
+
+
+def reference_regions():
+    """Selectors [m] of the reference solid's named faces: the root plane z = 0 (outward -z) and the
+    platform undersides (planes through OL / OR, outward along the contact normals)."""
+    from bladedamp import solid
+    from bladedamp.damper.geometry import contact_normal
+    sg = solid.SolidBladeGeometry()
+    pts = sg.points()
+    return {"clamp": solid.PlaneRegion((0.0, 0.0, 0.0), (0.0, 0.0, -1.0)),
+            "OL": solid.PlaneRegion(pts["OL"], contact_normal("OL", sg.gamma_left)),
+            "OR": solid.PlaneRegion(pts["OR"], contact_normal("OR", sg.gamma_right))}

@@ -37,6 +37,7 @@ def test_npz_loads_without_pickle(tmp_path):
     with np.load(path, allow_pickle=False) as data:
         assert data["mode_shapes"].shape == (5, 6, 4)              # (points, DOF, modes)
         assert list(data["point_names"]) == ["OL", "OR", "platform", "tip", "excitation"]
+    assert_same_blade(bladedamp.load(path), reference_blade())     # the generic loader reads blades too
 
 
 @pytest.mark.filterwarnings("ignore::bladedamp.hbm.accuracy.AccuracyWarning")

@@ -226,3 +226,159 @@ def test_modal_file_blade(tmp_path):
         load_design(_write(tmp_path, "[blade]\nmodal_file = \"blade.npz\"\n[blade.beam]\nairfoil_length_mm = 1.0\n"))
     with pytest.raises(DesignError, match="modal_file"):
         load_design(_write(tmp_path, "[blade]\nmodal_file = \"missing.npz\"\n"))
+
+
+# ---------------------------------------------------------------------------------------
+# a user's blade as a surface mesh (STL): [blade] surface_file and [blade.regions.*]
+# ---------------------------------------------------------------------------------------
+SURFACE_ELEMENT_SIZE_MM = 12.0     # [mm] the STL blade's mesh here: 6 700 DOF, about 1.5 s per blade
+
+
+def _mm(v) -> str:
+    """A TOML list of numbers [mm] of a vector ``v`` [m]."""
+    return str([1e3 * float(x) for x in v])
+
+
+@pytest.fixture
+def stl_folder(reference_stl_mm, tmp_path):
+    """A folder with the reference solid's surface (blade.stl, mm) and its OL and OR faces as their
+    own files (OL.stl, OR.stl, mm): the inputs of a surface_file design."""
+    import shutil
+
+    import trimesh
+    from bladedamp.solid import SurfaceBladeGeometry
+    from conftest import reference_regions
+
+    shutil.copy(reference_stl_mm, tmp_path / "blade.stl")
+    ug = SurfaceBladeGeometry(reference_stl_mm, reference_regions(), scale=1e-3)
+    for side in ("OL", "OR"):
+        trimesh.Trimesh(ug.vertices / 1e-3, ug.faces[ug.region_faces[side]]).export(tmp_path / f"{side}.stl")
+    return tmp_path
+
+
+def _surface_text(regions=("clamp", "OL", "OR")) -> str:
+    """A design with the reference solid's STL: [blade] model = "solid", surface_file = "blade.stl"
+    in mm, and the ``regions`` of conftest.reference_regions as planes."""
+    from conftest import reference_regions
+
+    text = ('[blade]\nmodel = "solid"\nsurface_file = "blade.stl"\nsurface_units = "mm"\n'
+            f'solid_element_size_mm = {SURFACE_ELEMENT_SIZE_MM}\n')
+    for name, region in reference_regions().items():
+        if name not in regions:
+            continue
+        text += (f"[blade.regions.{name}]\nplane_point_mm = {_mm(region.point)}\n"
+                 f"plane_normal = {[float(x) for x in region.normal]}\n")
+    return text
+
+
+def test_surface_file_blade_is_the_direct_stl_blade(stl_folder):
+    """The README's design-file example (section "Your own blade geometry (STL)"; its STL here the
+    reference solid's surface in mm, its OR face as its own file, the mesh coarser) gives the blade of
+    ModalBlade.from_solid(SurfaceBladeGeometry(...)) at the same element size: the same frequencies
+    and shapes (the same mesh; rounding of the eigensolver only), flexible platforms, and the disk
+    takes the platform angles of the STL's OL / OR faces (35 deg)."""
+    from bladedamp.blade import ModalBlade
+    from bladedamp.solid import SolidModalBlade, SurfaceBladeGeometry
+    from conftest import reference_regions
+
+    import pathlib
+    import shutil
+
+    readme = (pathlib.Path(__file__).parents[1] / "README.md").read_text()
+    section = readme[readme.index("### Your own blade geometry (STL)"):]
+    example = section[section.index("```toml\n") + 8:section.index("```\n", section.index("```toml"))]
+    example = example.replace('surface_units = "mm"',
+                              f'surface_units = "mm"\nsolid_element_size_mm = {SURFACE_ELEMENT_SIZE_MM}')
+    shutil.copy(stl_folder / "blade.stl", stl_folder / "my_blade.stl")
+    shutil.copy(stl_folder / "OR.stl", stl_folder / "my_blade_OR.stl")
+    design = load_design(_write(stl_folder, example))
+    blade = design.disk.blade
+    assert isinstance(blade, SolidModalBlade) and blade.flexible_platform and design.blade_geometry is None
+    direct = ModalBlade.from_solid(SurfaceBladeGeometry(stl_folder / "blade.stl", reference_regions(), scale=1e-3),
+                                   1e-3 * SURFACE_ELEMENT_SIZE_MM)
+    assert blade.solid_info["n_dofs"] == direct.solid_info["n_dofs"]
+    np.testing.assert_allclose(blade.natural_frequencies_hz, direct.natural_frequencies_hz, rtol=1e-9)
+    assert blade.mode_names == direct.mode_names == ("1F", "2F", "1T", "1E")
+    for p in direct.points:
+        np.testing.assert_allclose(blade.points[p], direct.points[p], rtol=0, atol=1e-12)
+        scale = np.abs(direct.shape(p)).max(axis=0)
+        np.testing.assert_allclose(blade.shape(p) / scale, direct.shape(p) / scale, rtol=0, atol=1e-7)
+    for side, gamma in (("OL", design.disk.gamma_left), ("OR", design.disk.gamma_right)):
+        assert gamma == pytest.approx(np.radians(35.0), abs=1e-6)
+        np.testing.assert_allclose(blade.platform_displacements(side, blade.points[side][None],
+                                                                blade.face_fields[side].frame[2]).shape, (1, 3, 4))
+    assert design.values["disk"]["gamma_left_deg"] == pytest.approx(35.0, abs=1e-4)
+
+
+@pytest.mark.parametrize("change, match", [
+    (lambda t: t.replace('surface_units = "mm"', 'surface_units = "furlong"'),
+     r"\[blade\] surface_units = \"furlong\" is not allowed: must be one of 'm', 'mm', 'cm', 'in'"),
+    (lambda t: t.replace('surface_units = "mm"', 'surface_units = "m"'),
+     r"\[blade\] surface_units = \"m\" \(1 m per unit\): scale: the surface spans 200 m"),
+    (lambda t: t.replace('surface_units = "mm"\n', ""), r"\[blade\] surface_file needs surface_units.*'mm'"),
+    (lambda t: t.replace('"blade.stl"', '"absent.stl"'), r"\[blade\] surface_file = \"absent.stl\": no file"),
+    (lambda t: t.replace('"blade.stl"', '"holed.stl"'),
+     r"\[blade\] surface_file = \"holed.stl\": surface must be a closed \(watertight\)"),
+    (lambda t: t.split("[blade.regions.OR]")[0],
+     r"\[blade\] surface_file needs the tables .* \(missing: \[blade.regions.OR\]\)"),
+    (lambda t: t + "[blade.regions.hub]\nfile = \"OL.stl\"\n",
+     r"unknown table \[blade.regions.hub\].*allowed tables: \[blade.regions.clamp\], \[blade.regions.OL\]"),
+    (lambda t: t.replace("[blade.regions.OR]\n", "[blade.regions.OR]\nfile = \"OL.stl\"\n"),
+     r"\[blade.regions.OR\] file replaces the plane: .*remove plane_normal, plane_point_mm"),
+    (lambda t: t + "[blade.regions.tip]\ntolerance_mm = 0.1\n",
+     r"\[blade.regions.tip\] needs plane_point_mm and plane_normal .*or file \(given: tolerance_mm\)"),
+    (lambda t: t + "[blade.regions.tip]\nfile = \"tip.stl\"\n", r"\[blade.regions.tip\] file = \"tip.stl\": no file"),
+    (lambda t: t + "[blade.regions.tip]\nplane_point_mm = [0, 0, 500]\nplane_normal = [0, 0, 1]\n",
+     r"\[blade.regions.tip\]: regions\['tip'\] selects no triangle"),
+    (lambda t: t + "[blade.regions.tip]\nplane_point_mm = [0, 0, 200]\nplane_normal = [0, 0, 0]\n",
+     r"\[blade.regions.tip\] plane_normal = \[0.0, 0.0, 0.0\] is not allowed: must be 3 numbers, not all zero"),
+    (lambda t: t + "[disk]\ngamma_left_deg = 40.0\n",
+     r"\[disk\] gamma_left_deg = 40.0 is not the platform angle of the OL face of \[blade\] surface_file"),
+    (lambda t: t + "[blade.beam]\nshank_length_mm = 50.0\n",
+     r"\[blade.beam\] shank_length_mm is the built-in blade's geometry; with \[blade\] surface_file only"),
+    (lambda t: t.replace('model = "solid"\n', ""), r"\[blade\] surface_file is meshed as a solid FE blade"),
+    (lambda t: t.replace('model = "solid"\n', 'model = "solid"\nmodal_file = "blade.npz"\n'),
+     r"\[blade\] surface_file and modal_file are two different blades: give one of them"),
+    (lambda t: t.replace('surface_file = "blade.stl"\n', ""),
+     r"\[blade\] surface_units applies to a surface_file blade only"),
+], ids=["units-unknown", "units-wrong", "units-missing", "file-missing", "not-watertight", "region-missing",
+        "region-unknown", "plane-and-file", "plane-incomplete", "region-file-missing", "plane-off-the-blade",
+        "normal-zero", "gamma-differs", "beam-geometry-key", "model-beam", "and-modal-file",
+        "units-without-file"])
+def test_surface_file_bad_input_one_line_naming_the_key(stl_folder, change, match):
+    """Each mistake stops before meshing with one line naming the file and the key."""
+    import trimesh
+
+    mesh = trimesh.load(stl_folder / "blade.stl", force="mesh")
+    trimesh.Trimesh(mesh.vertices, mesh.faces[1:]).export(stl_folder / "holed.stl")     # one triangle missing
+    path = _write(stl_folder, change(_surface_text()))
+    with pytest.raises(DesignError, match=match) as err:
+        load_design(path)
+    assert "\n" not in str(err.value) and str(path) in str(err.value)
+
+
+def test_modal_file_of_a_solid_blade_keeps_its_flexible_platforms(coarse_modes, tmp_path):
+    """[blade] modal_file of a saved solid FE blade: the solid blade with its flexible platforms,
+    its own frequencies, and the disk at its faces' platform angles (another angle is refused)."""
+    from bladedamp.solid import SolidModalBlade, solid_blade
+
+    blade = solid_blade(modes=coarse_modes)
+    blade.save(tmp_path / "solid.npz")
+    design = load_design(_write(tmp_path, '[blade]\nmodal_file = "solid.npz"\n'))
+    back = design.disk.blade
+    assert isinstance(back, SolidModalBlade) and back.flexible_platform
+    assert np.array_equal(back.natural_frequencies_hz, blade.natural_frequencies_hz)
+    assert design.disk.gamma_left == pytest.approx(blade.face_fields["OL"].gamma, abs=1e-12)
+    with pytest.raises(DesignError, match=r"\[disk\] gamma_right_deg = 50.0 is not the platform angle of the OR "
+                                          r"face of \[blade\] modal_file = \"solid.npz\" \(35 deg\)"):
+        load_design(_write(tmp_path, '[blade]\nmodal_file = "solid.npz"\n[disk]\ngamma_right_deg = 50.0\n'))
+
+
+def test_surface_file_error_on_the_command_line(stl_folder, capsys):
+    """bladedamp frf with a region missing: exit code 2, one line naming the file and the tables."""
+    from bladedamp.cli import main
+
+    path = _write(stl_folder, _surface_text(regions=("clamp", "OL")))
+    assert main(["frf", str(path), "--out", str(stl_folder / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and str(path) in err and "(missing: [blade.regions.OR])" in err

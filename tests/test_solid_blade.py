@@ -2,10 +2,22 @@
 
 Checks that could fail: the FE solution itself (mass normalisation, orthogonality, eigen
 residual, exact mass of the meshed volume), the plain cantilever plate against closed-form
-beam theory (nu = 0: the Euler-Bernoulli limit to 0.3 %; nu = 0.3: between the beam and the
-plate bounds), the reference solid against the beam model (shapes at the named points, 2F;
-1F is 3.4 % above the beam for physical reasons, see test_1F_within_3_percent_of_beam), the
-rigid-platform limit of the contact-face fit, and a tuned-disk FRF with the solid blade.
+beam theory (issue 16 item 2, below), the reference solid against the beam model (shapes at
+the named points, 2F; 1F is 3.4 % above the beam for physical reasons, see
+test_1F_within_3_percent_of_beam), the rigid-platform limit of the contact-face fit, and a
+tuned-disk FRF with the solid blade.
+
+The plain plate (the reference section 4.57 x 45.5 mm over the 0.2 m span, no platform) against
+closed-form beam theory: Euler-Bernoulli bending and St. Venant torsion leave out shear
+deformation and rotary inertia (1E, L / chord 4.4: the solid is 3.2 % below) and the clamp's
+warping restraint (1T: 5 % above). The refined closed forms (solid.cantilever_frequencies_hz
+with theory="refined": Timoshenko bending with Cowper's kappa, Vlasov torsion with the solid
+rectangle's warping constant; each checked against its classical limit, C_w against
+sectionproperties' FE value) have both. With nu = 0 (no plate effect) the converged plate
+(3 mm, 88 000 DOF) is within 0.013 % of them in 1F, 2F and 1E and 0.16 % in 1T (the 12 mm
+mesh of the fast test: 0.21 % and 1.1 %). With nu = 0.3 1E and 1T stay within 0.34 %, and the
+wide section's plate effect puts 1F and 2F 1.2-1.4 % above the refined forms with E, 3.3-3.4 %
+below those with the plate modulus E / (1 - nu^2).
 
 Fast tests use coarse meshes (the reference solid at 9 mm, 14 400 DOF, 4 s; the plain plate at
 12 mm, 5 500 DOF, 1 s); the mesh-convergence table, the converged comparisons with the beam and
@@ -15,6 +27,7 @@ from __future__ import annotations
 
 import dataclasses
 import sys
+import warnings
 
 import numpy as np
 import pytest
@@ -26,8 +39,9 @@ import bladedamp as bd  # noqa: E402
 from bladedamp import solid  # noqa: E402
 from bladedamp.blade import REQUIRED_POINTS  # noqa: E402
 from bladedamp.reference import reference_blade_geometry  # noqa: E402
+from conftest import COARSE_SOLID, reference_regions as _reference_regions  # noqa: E402
 
-COARSE = 9e-3          # [m] reference solid: 14 400 DOF, 1F 0.4 % above the 3 mm value
+COARSE = COARSE_SOLID  # [m] reference solid: 14 400 DOF, 1F 0.4 % above the 3 mm value (fixture coarse_modes)
 PLATE = 12e-3          # [m] plain plate (no platform): 5 500 DOF, 1F within 0.02 % of nu = 0 theory
 CONVERGENCE_SIZES = (9e-3, 6e-3, 4.5e-3)   # [m] 14 400, 28 800, 54 100 DOF
 
@@ -36,11 +50,6 @@ CONVERGENCE_SIZES = (9e-3, 6e-3, 4.5e-3)   # [m] 14 400, 28 800, 54 100 DOF
 def beam():
     """The beam model of the reference geometry with its own FE frequencies (no Table 1)."""
     return bd.ModalBlade.from_beam(reference_blade_geometry())
-
-
-@pytest.fixture(scope="module")
-def coarse_modes():
-    return solid.solid_modes(None, COARSE)
 
 
 @pytest.fixture(scope="module")
@@ -137,26 +146,136 @@ def test_paper_modes_are_the_lowest_four_and_beam_like(coarse_modes):
         assert m.family_fractions[j, solid.FAMILIES.index(fam)] > 0.95
 
 
-def test_plain_plate_against_closed_form_beam_theory():
-    """The reference section as a plain cantilever over the 0.2 m span (no platform).
+def test_warping_constant_of_a_solid_rectangle():
+    """C_w = int psi^2 dA of the exact St. Venant warping function against sectionproperties 3.10's
+    finite-element warping analysis (Pilkey's method, quadratic triangles, 6 500 and 83 000 nodes):
+    a square 1.34403e-4 a^6, the reference airfoil 4.57 x 45.5 mm 59 700.330 mm^6; and the thin
+    limit t^3 c^3 / 144 (1 - 4.8 (t/c)^2): the series' own expansion."""
+    assert solid.warping_constant_rectangle(1.0, 1.0) == pytest.approx(1.3440262e-4, rel=1e-5)
+    ref = solid.warping_constant_rectangle(4.57e-3, 45.5e-3)
+    assert ref == pytest.approx(59700.330e-18, rel=1e-7)
+    assert ref == solid.warping_constant_rectangle(45.5e-3, 4.57e-3)
+    assert ref / (4.57e-3**3 * 45.5e-3**3 / 144) == pytest.approx(0.9562, abs=1e-4)
+    thin = solid.warping_constant_rectangle(1e-3, 1.0)
+    assert thin / (1e-9 / 144) == pytest.approx(1 - 4.8e-6, abs=1e-8)
+    assert solid.warping_constant_rectangle(2.0, 20.0) == pytest.approx(2.0**6 * solid.warping_constant_rectangle(1.0, 10.0),
+                                                                        rel=1e-12)
 
-    nu = 0: the solid is Euler-Bernoulli's beam in flatwise bending (no anticlastic plate effect),
-    so 1F and 2F agree with the closed form to 0.3 %. Edgewise (1E, chord 45.5 mm, L / chord 4.4)
-    the solid is 3 % below: shear deformation and rotary inertia (Timoshenko), which the beam
-    leaves out. 1T is 5-6 % above St. Venant: the clamped root holds the section's warping.
-    nu = 0.3: the wide section cannot curve anticlastically near the clamp, so 1F lies between the
-    beam (E) and the plate (E / (1 - nu^2), +4.9 % frequency) values.
+
+def _transfer_root_hz(system, free_rows, clamp_free_states, length, guess_hz):
+    """Root [Hz] near ``guess_hz`` of a clamped-free ODE y' = system(omega) y, solved by the transfer
+    matrix expm(A L) (independent of solid.py's closed-form basis): the free-end conditions
+    ``free_rows`` on the states the clamp leaves free."""
+    import scipy.linalg
+    from scipy.optimize import brentq
+
+    def det(f):
+        T = scipy.linalg.expm(system(2 * np.pi * f) * length)
+        return np.linalg.det(np.asarray(free_rows, dtype=float) @ T[:, clamp_free_states])
+    return brentq(det, 0.99 * guess_hz, 1.01 * guess_hz, xtol=1e-12 * guess_hz)
+
+
+def test_refined_closed_forms_reduce_to_the_classical_ones():
+    """Vlasov's torsion with C_w -> 0 is St. Venant's 1 / (4 L) sqrt(G J / (rho I_p)), with G J -> 0
+    the Euler-Bernoulli cantilever in E C_w; Timoshenko's bending without shear deformation
+    (kappa G A -> inf) and rotary inertia is Euler-Bernoulli's beta_n^2 / (2 pi L^2) sqrt(E I /
+    (rho A)) (beta_n the roots of cos b cosh b = -1), and shear and rotary inertia each lower it.
+    In between, at the reference plate's values (nu = 0), both agree with an independent solution
+    of their ODE (transfer matrix, expm) to 1e-6: the transfer matrix loses digits to
+    exp(alpha L) ~ 2e9 (measured 5.5e-8 in 1T; a 40-digit mpmath determinant agreed with solid.py's
+    1T, 930.15731258 Hz, to 1e-16). The default theory is unchanged."""
+    L, GJ, ECw, rhoIp = 0.2, 1000.0, 1.25e-2, 2.8e-4          # [m], [N m^2], [N m^4], [kg m]
+    st_venant = np.sqrt(GJ / rhoIp) / (4 * L)
+    assert solid.vlasov_cantilever_frequency_hz(L, GJ, 1e-12 * ECw, rhoIp) == pytest.approx(st_venant, rel=1e-7)
+    warping = 1.8751040687**2 / (2 * np.pi * L**2) * np.sqrt(ECw / rhoIp)
+    assert solid.vlasov_cantilever_frequency_hz(L, 0.0, ECw, rhoIp) == pytest.approx(warping, rel=1e-9)
+    assert solid.vlasov_cantilever_frequency_hz(L, GJ, ECw, rhoIp) > st_venant
+    EI, kGA, rhoA, rhoI = 7.6e3, 8e9, 1.6, 1.4e-5             # [N m^2], [N], [kg/m], [kg m]
+    for mode, beta in ((1, 1.8751040687), (2, 4.6940911330), (3, 7.8547574382)):
+        euler = beta**2 / (2 * np.pi * L**2) * np.sqrt(EI / rhoA)
+        assert solid.timoshenko_cantilever_frequency_hz(L, EI, np.inf, rhoA, 0.0, mode) == pytest.approx(euler, rel=1e-9)
+        rayleigh = solid.timoshenko_cantilever_frequency_hz(L, EI, np.inf, rhoA, rhoI, mode)
+        shear = solid.timoshenko_cantilever_frequency_hz(L, EI, kGA, rhoA, 0.0, mode)
+        full = solid.timoshenko_cantilever_frequency_hz(L, EI, kGA, rhoA, rhoI, mode)
+        assert full < min(rayleigh, shear) and max(rayleigh, shear) < euler
+
+    from bladedamp.blade import RectangularSection
+    g = dataclasses.replace(reference_blade_geometry(), poisson_ratio=0.0)
+    t, c, L, E, G, rho = (g.airfoil_thickness_x, g.airfoil_chord_y, g.total_length, g.youngs_modulus,
+                          g.shear_modulus, g.density)
+    sec = RectangularSection(t, c)
+    refined = solid.cantilever_frequencies_hz(g, theory="refined")
+    GJ, ECw, rhoIp = G * sec.torsion_constant, E * solid.warping_constant_rectangle(t, c), rho * sec.polar_moment
+
+    def torsion(omega):                       # state (phi, phi', phi'', phi''')
+        return np.array([[0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1], [rhoIp * omega**2 / ECw, 0, GJ / ECw, 0]])
+    root = _transfer_root_hz(torsion, [[0, 0, 1, 0], [0, GJ, 0, -ECw]], [2, 3], L, refined["1T"])
+    assert root == pytest.approx(refined["1T"], rel=1e-6)
+    kGA, rhoA = 10 / 12 * G * sec.area, rho * sec.area                # Cowper's kappa at nu = 0
+    for name, I in (("1E", sec.second_moment_edgewise), ("2F", sec.second_moment_flatwise)):
+        def bending(omega, I=I):              # state (w, w', psi, psi')
+            return np.array([[0, 1, 0, 0], [-rhoA * omega**2 / kGA, 0, 0, 1], [0, 0, 0, 1],
+                             [0, -kGA / (E * I), (kGA - rho * I * omega**2) / (E * I), 0]])
+        root = _transfer_root_hz(bending, [[0, 0, 0, 1], [0, 1, -1, 0]], [1, 3], L, refined[name])
+        assert root == pytest.approx(refined[name], rel=1e-6), name
+
+    ref = reference_blade_geometry()
+    assert solid.cantilever_frequencies_hz() == solid.cantilever_frequencies_hz(ref, "euler-bernoulli", plate=False)
+    assert solid.cantilever_frequencies_hz()["1F"] == pytest.approx(95.4578, rel=1e-6)
+    with pytest.raises(ValueError, match="theory must be one of"):
+        solid.cantilever_frequencies_hz(ref, "timoshenko")
+
+
+def test_plain_plate_against_closed_form_beam_theory():
+    """The reference section as a plain cantilever over the 0.2 m span (no platform), 12 mm mesh
+    (5 500 DOF), against the Euler-Bernoulli / St. Venant and the refined (Timoshenko / Vlasov)
+    closed forms [Hz]:
+
+    ==== ==== ======= ======= ======= =================================
+    nu   mode solid   EB / SV refined solid / refined - 1
+    ==== ==== ======= ======= ======= =================================
+    0    1F   95.453  95.458  95.425  +0.03 %
+    0    2F   598.04  598.22  596.79  +0.21 %
+    0    1E   920.06  950.40  919.90  +0.02 %
+    0    1T   940.80  884.35  930.16  +1.14 %
+    0.3  1F   97.013  95.458  95.419  +1.67 % (plate E: 100.02, -3.0 %)
+    0.3  2F   606.72  598.22  596.52  +1.71 % (plate E: 625.19, -3.0 %)
+    0.3  1E   918.97  950.40  914.31  +0.51 %
+    0.3  1T   835.03  775.63  822.02  +1.58 %
+    ==== ==== ======= ======= ======= =================================
+
+    nu = 0: flatwise (1F, 2F) the solid is Euler-Bernoulli's beam (no anticlastic plate effect):
+    0.3 % against either closed form. Edgewise (1E, chord 45.5 mm, L / chord 4.4) shear deformation
+    and rotary inertia put it 3.2 % below Euler-Bernoulli: Timoshenko's beam (Cowper's kappa 5/6)
+    has them, 0.02 %. 1T is 6.4 % above St. Venant: the clamped root holds the section's warping,
+    which Vlasov's torsion (C_w of the solid rectangle) has: +1.1 % on this mesh, the FE's
+    torsion converging slowest (+0.06 % at 4.5 mm, -0.16 % at 3 mm:
+    test_plain_plate_mesh_convergence_against_refined_closed_form). Each of the four is within
+    the issue's 3 % of the refined form; asserted tighter, as measured.
+    nu = 0.3: the wide section cannot curve anticlastically near the clamp, so 1F (and 2F) lies
+    between the beam (E) and the plate (E / (1 - nu^2), +4.8 % frequency) values; 1E and 1T keep
+    to the refined forms (the coarse mesh +0.5 % and +1.6 %; +0.34 % and +0.18 % at 3 mm).
     """
     g0, plate0 = _plate(0.0)
     cf = solid.cantilever_frequencies_hz(g0)
     f = _by_name(plate0)
     assert f["1F"] / cf["1F"] == pytest.approx(1.0, abs=3e-3)
     assert f["2F"] / cf["2F"] == pytest.approx(1.0, abs=3e-3)
-    assert 0.95 < f["1E"] / cf["1E"] < 1.0
-    assert 1.0 < f["1T"] / cf["1T"] < 1.10
+    assert 0.95 < f["1E"] / cf["1E"] < 0.975
+    assert 1.03 < f["1T"] / cf["1T"] < 1.10
+    refined = solid.cantilever_frequencies_hz(g0, theory="refined")
+    for mode, tol in (("1F", 1e-3), ("2F", 3e-3), ("1E", 1e-3), ("1T", 0.015)):
+        assert f[mode] / refined[mode] == pytest.approx(1.0, abs=tol), mode       # all within 3 %
     g3, plate3 = _plate(0.3)
     cf3, f3 = solid.cantilever_frequencies_hz(g3), _by_name(plate3)
     assert 1.005 < f3["1F"] / cf3["1F"] < 1.0 / np.sqrt(1 - 0.3**2)
+    refined3 = solid.cantilever_frequencies_hz(g3, theory="refined")
+    plate_bound = solid.cantilever_frequencies_hz(g3, theory="refined", plate=True)
+    assert plate_bound["1F"] / refined3["1F"] == pytest.approx(1.0 / np.sqrt(1 - 0.3**2), rel=1e-3)
+    for mode in ("1F", "2F"):
+        assert refined3[mode] < f3[mode] < plate_bound[mode]
+    for mode, tol in (("1E", 0.01), ("1T", 0.02)):
+        assert f3[mode] / refined3[mode] == pytest.approx(1.0, abs=tol), mode
 
 
 # --------------------------------------------------------------------------------------
@@ -200,11 +319,96 @@ def test_contact_faces_hold_the_raw_displacements(coarse_blade):
     np.testing.assert_allclose(scaled.natural_frequencies_hz, 1.02 * sb.natural_frequencies_hz)
 
 
-def test_saved_solid_blade_reads_back(coarse_blade, tmp_path):
-    back = bd.ModalBlade.from_file(coarse_blade.save(tmp_path / "solid.npz"))
+def test_contact_face_field_is_the_fe_field(coarse_modes, coarse_blade):
+    """What the flexible platforms evaluate (ContactFaceField: the P2 tetrahedra at each contact
+    face, kept without the rest of the model) is the FE field itself: against SolidModes'
+    interpolation (scikit-fem probes) at random points 0.1 um inside the faces, to rounding."""
+    rng = np.random.default_rng(5)
+    idx = list(coarse_blade.mode_indices)
+    for side in ("OL", "OR"):
+        field = coarse_blade.face_fields[side]
+        centre, frame, xi_r, eta_r = coarse_modes.geometry.contact_face(side)
+        np.testing.assert_array_equal(field.centre, centre)
+        np.testing.assert_array_equal(field.xi_range, xi_r)
+        x = (centre + rng.uniform(*xi_r, 300)[:, None] * frame[0] + rng.uniform(*eta_r, 300)[:, None] * frame[1]
+             - 1e-7 * frame[2])
+        expected = coarse_modes.displacements_at(x)[:, :, idx]
+        np.testing.assert_allclose(field.displacements_at(x), expected, rtol=0, atol=1e-13 * np.abs(expected).max())
+        # the face's own P2 nodes carry the FE vector's values there
+        assert field.tets.shape[1] == 10 and field.nodes.shape[0] == field.shapes.shape[0]
+
+
+def test_saved_solid_blade_keeps_flexible_platforms_and_surface(coarse_blade, tmp_path):
+    """save / from_file of a SolidModalBlade (.npz): everything but the whole FE model comes back,
+    equal to the bit; bladedamp.load reads it too. The file is small (measured 129 kB at 9 mm)."""
+    path = coarse_blade.save(tmp_path / "solid.npz")
+    assert path.stat().st_size < 300e3
+    back = bd.ModalBlade.from_file(path)
+    assert isinstance(back, solid.SolidModalBlade) and back.flexible_platform and back.modes is None
     for p in coarse_blade.points:
         np.testing.assert_array_equal(back.shape(p), coarse_blade.shape(p))
+        np.testing.assert_array_equal(back.points[p], coarse_blade.points[p])
     np.testing.assert_array_equal(back.natural_frequencies_hz, coarse_blade.natural_frequencies_hz)
+    assert back.mode_names == coarse_blade.mode_names and back.mode_indices == coarse_blade.mode_indices
+    for name in ("vertices", "faces", "shapes"):                # the 3D view's surface
+        a, b = getattr(back.surface, name), getattr(coarse_blade.surface, name)
+        assert a.dtype == b.dtype
+        np.testing.assert_array_equal(a, b)
+    for group, kind in (("face_fields", solid.ContactFaceField), ("contact_faces", solid.ContactFaceModes)):
+        for side in ("OL", "OR"):
+            a, b = getattr(back, group)[side], getattr(coarse_blade, group)[side]
+            assert a.side == side
+            for f in dataclasses.fields(kind):
+                np.testing.assert_array_equal(getattr(a, f.name), getattr(b, f.name))
+    assert set(back.fit_residuals) == set(coarse_blade.fit_residuals)
+    for p, r in coarse_blade.fit_residuals.items():
+        np.testing.assert_array_equal(back.fit_residuals[p], r)
+    assert set(back.solid_info) == set(coarse_blade.solid_info)
+    for key, value in coarse_blade.solid_info.items():
+        if isinstance(value, np.ndarray):
+            np.testing.assert_array_equal(back.solid_info[key], value)
+        else:
+            assert back.solid_info[key] == value, key
+    again = bd.load(path)                                       # the generic loader
+    assert isinstance(again, solid.SolidModalBlade) and again.flexible_platform
+    # the rigid-platform blade is a plain modal file
+    plain = bd.ModalBlade.from_file(coarse_blade.rigid_platform_blade().save(tmp_path / "rigid.npz"))
+    assert type(plain) is bd.ModalBlade and not plain.flexible_platform
+
+
+def test_saved_solid_blade_gives_the_same_disk_frf(coarse_blade, tmp_path):
+    """The tuned reference disk (1 g cylinder, EO = 1, harmonics (1,), Table 1's frequencies so the
+    resonance is at 95 Hz) with the read-back blade: the same FRF to the bit as the original, and
+    not the rigid-platform blade's (measured: peak 0.47568 against 0.47607 mm, -0.08 %), so the
+    flexible platforms survived the file."""
+    from bladedamp.hbm.accuracy import AccuracyWarning
+    from bladedamp.reference import TABLE1_FREQUENCIES_HZ
+    blade = coarse_blade.with_frequencies(TABLE1_FREQUENCIES_HZ)
+    back = bd.ModalBlade.from_file(blade.save(tmp_path / "solid.npz"))
+    ref = bd.reference_disk("cylinder", 1e-3)
+    runs = {}
+    for name, b in (("original", blade), ("read back", back), ("rigid", blade.rigid_platform_blade())):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", AccuracyWarning)       # harmonics (1,) on purpose
+            runs[name] = dataclasses.replace(ref, blade=b).frequency_response(94.5, 96.0, harmonics=(1,), max_step=0.05)
+        assert runs[name].success, (name, runs[name].message)
+    np.testing.assert_array_equal(runs["read back"].omega, runs["original"].omega)
+    np.testing.assert_array_equal(runs["read back"].coefficients, runs["original"].coefficients)
+    rigid, flexible = runs["rigid"].peak_amplitude, runs["original"].peak_amplitude
+    assert rigid / flexible - 1 > 3e-4
+
+
+def test_solid_blade_refuses_csv_and_a_broken_file_names_the_key(coarse_blade, tmp_path):
+    with pytest.raises(ValueError, match=r"solid.csv: a solid FE blade cannot be saved as .csv .* save it as .npz"):
+        coarse_blade.save(tmp_path / "solid.csv")
+    assert not (tmp_path / "solid.csv").exists()
+    arrays = coarse_blade.npz_arrays()
+    assert str(arrays["format"]) == solid.SOLID_NPZ_FORMAT == "bladedamp.SolidModalBlade/1"
+    del arrays["solid/face_fields/OR/nodes"]
+    broken = tmp_path / "broken.npz"
+    np.savez(broken, **arrays)
+    with pytest.raises(ValueError, match=r"broken.npz: key 'solid/face_fields/OR/nodes' missing"):
+        bd.ModalBlade.from_file(broken)
 
 
 def test_mirrored_mesh_gives_exactly_symmetric_modes(coarse_blade):
@@ -288,6 +492,10 @@ def convergence():
 
 @pytest.mark.slow
 def test_mesh_convergence_table(convergence, beam, capsys):
+    """The reference solid (its platform included) against the beam model and, for scale, the closed
+    forms of the plain plate without the platform (Euler-Bernoulli / St. Venant and refined:
+    Timoshenko / Vlasov; nu = 0.3). Their validation without a platform is
+    test_plain_plate_mesh_convergence_against_refined_closed_form."""
     cf = solid.cantilever_frequencies_hz()
     names = ("1F", "2F", "1T", "1E")
     rows = [f"{'element size':>14} {'DOF':>7} " + " ".join(f"{n:>9}" for n in names) + "   [Hz]"]
@@ -295,7 +503,9 @@ def test_mesh_convergence_table(convergence, beam, capsys):
         f = _by_name(m)
         rows.append(f"{1e3 * m.mesh.element_size:11.2f} mm {m.n_dofs:7d} " + " ".join(f"{f[n]:9.2f}" for n in names))
     rows.append(f"{'beam model':>22} " + " ".join(f"{v:9.2f}" for v in beam.natural_frequencies_hz))
-    rows.append(f"{'closed form (no platf.)':>22} " + " ".join(f"{cf[n]:9.2f}" for n in names))
+    rows.append(f"{'EB / SV (no platf.)':>22} " + " ".join(f"{cf[n]:9.2f}" for n in names))
+    refined = solid.cantilever_frequencies_hz(theory="refined")
+    rows.append(f"{'refined (no platf.)':>22} " + " ".join(f"{refined[n]:9.2f}" for n in names))
     with capsys.disabled():
         print("\nsolid reference blade, mesh convergence (quadratic tetrahedra):\n" + "\n".join(rows))
     fine, finer = _by_name(convergence[-2]), _by_name(convergence[-1])
@@ -310,6 +520,64 @@ def test_mesh_convergence_table(convergence, beam, capsys):
     assert finer["2F"] / beam_f["2F"] == pytest.approx(1.0, abs=0.03)
     # edgewise: shear and rotary inertia (the beam is Euler-Bernoulli) put the solid below
     assert 0.95 < finer["1E"] / beam_f["1E"] < 1.0
+
+
+@pytest.mark.slow
+def test_plain_plate_mesh_convergence_against_refined_closed_form(capsys):
+    """Issue 16 item 2, after mesh convergence: the plain plate (no platform) against the closed
+    forms, table printed. Measured [Hz]:
+
+    ============ ======= ======= ======= ======= =======
+    nu = 0       DOF     1F      2F      1T      1E
+    ============ ======= ======= ======= ======= =======
+    12 mm        5 529   95.453  598.04  940.80  920.06
+    6 mm         22 923  95.429  596.96  931.56  920.02
+    4.5 mm       44 043  95.426  596.85  929.59  920.02
+    3 mm         87 957  95.426  596.82  928.69  920.02
+    EB / SV              95.458  598.22  884.35  950.40
+    refined              95.425  596.79  930.16  919.90
+    ============ ======= ======= ======= ======= =======
+
+    At 4.5 mm the solid is within 0.013 % of the refined forms in 1F, 2F, 1E and -0.06 % in 1T
+    (at 3 mm -0.16 %: Vlasov's torsion of a solid, not thin-walled, section is itself approximate
+    at that level); Euler-Bernoulli / St. Venant miss 1E by -3.2 % and 1T by +5.1 %. nu = 0.3 at
+    4.5 mm: 1F 96.73, 2F 604.02, 1T 824.37, 1E 917.60 against refined 95.42, 596.52, 822.02,
+    914.31 (plate modulus 100.02, 625.19 in 1F, 2F): 1E and 1T +0.36 % and +0.29 %, 1F and 2F
+    between the two moduli.
+    """
+    names = ("1F", "2F", "1T", "1E")
+    rows = [f"{'nu  element size':>18} {'DOF':>7} " + " ".join(f"{n:>9}" for n in names) + "   [Hz]"]
+    runs = []
+    for nu, size in ((0.0, PLATE), (0.0, 6e-3), (0.0, 4.5e-3), (0.3, 4.5e-3)):
+        g, modes = _plate(nu, size)
+        runs.append((nu, _by_name(modes)))
+        rows.append(f"{nu:3.1f} {1e3 * size:11.2f} mm {modes.n_dofs:7d} "
+                    + " ".join(f"{runs[-1][1][n]:9.2f}" for n in names))
+    closed = {}
+    for nu in (0.0, 0.3):
+        g = dataclasses.replace(reference_blade_geometry(), poisson_ratio=nu)
+        closed[nu] = {label: solid.cantilever_frequencies_hz(g, theory, plate)
+                      for label, theory, plate in (("EB / SV", "euler-bernoulli", False),
+                                                   ("refined", "refined", False),
+                                                   ("refined, plate E", "refined", True))}
+        for label, cf in closed[nu].items():
+            if nu == 0.0 and label == "refined, plate E":      # = "refined" at nu = 0
+                continue
+            rows.append(f"{nu:3.1f} {label:>22} " + " ".join(f"{cf[n]:9.2f}" for n in names))
+    fine = runs[2][1]
+    rows.append(f"{'0.0 4.5 mm / refined - 1':>26} " + " ".join(f"{100 * (fine[n] / closed[0.0]['refined'][n] - 1):8.3f}%"
+                                                                 for n in names))
+    with capsys.disabled():
+        print("\nplain plate (no platform), mesh convergence against the closed forms:\n" + "\n".join(rows))
+    for n in names:                                        # converged from above
+        assert runs[0][1][n] >= runs[1][1][n] >= runs[2][1][n]
+        assert fine[n] / closed[0.0]["refined"][n] == pytest.approx(1.0, abs=5e-3), n     # the issue: 3 %
+    assert fine["1E"] / closed[0.0]["EB / SV"]["1E"] < 0.975 and fine["1T"] / closed[0.0]["EB / SV"]["1T"] > 1.03
+    nu3 = runs[3][1]
+    for n in ("1E", "1T"):
+        assert nu3[n] / closed[0.3]["refined"][n] == pytest.approx(1.0, abs=5e-3), n
+    for n in ("1F", "2F"):
+        assert closed[0.3]["refined"][n] < nu3[n] < closed[0.3]["refined, plate E"][n]
 
 
 @pytest.mark.slow
@@ -386,27 +654,7 @@ def test_tuned_disk_frf_with_the_solid_blade(beam, capsys):
 # --------------------------------------------------------------------------------------
 # a user's geometry: closed surface mesh (STL) with named regions
 # --------------------------------------------------------------------------------------
-def _reference_regions():
-    """Selectors of the reference solid's named faces: the root plane z = 0 (outward -z) and the
-    platform undersides (planes through OL / OR, outward along the contact normals)."""
-    from bladedamp.damper.geometry import contact_normal
-    sg = solid.SolidBladeGeometry()
-    pts = sg.points()
-    return {"clamp": solid.PlaneRegion((0.0, 0.0, 0.0), (0.0, 0.0, -1.0)),
-            "OL": solid.PlaneRegion(pts["OL"], contact_normal("OL", sg.gamma_left)),
-            "OR": solid.PlaneRegion(pts["OR"], contact_normal("OR", sg.gamma_right))}
-
-
-@pytest.fixture(scope="module")
-def reference_stl_mm(coarse_modes, tmp_path_factory):
-    """The parametric reference solid's boundary (the 9 mm tetrahedral mesh's outer triangles)
-    written as an STL in millimetres: an independent path to the same blade."""
-    trimesh = pytest.importorskip("trimesh")
-    m = coarse_modes.mesh
-    tri = solid.boundary_faces(m.tets, m.vertices)
-    path = tmp_path_factory.mktemp("stl") / "reference_mm.stl"
-    trimesh.Trimesh(1e3 * m.vertices.T, tri.T).export(path)
-    return path
+# the fixtures coarse_modes and reference_stl_mm and the regions (_reference_regions) are in conftest.py
 
 
 def test_boundary_faces_are_the_closed_outward_surface(coarse_modes):
