@@ -119,6 +119,12 @@ def make_disk(d: dict) -> TunedDisk:
                      rotor_speed_hz=ROTOR_SPEED_95_HZ if d["engine_order"] == 0 else None)
 
 
+def disk_response(disk: TunedDisk, d: dict) -> DiskResponse:
+    """The frequency response of random disk ``d`` (``disk`` = make_disk(d)) over its range, as the suite runs it."""
+    return disk.frequency_response(d["f_start"], d["f_end"], harmonics=d["harmonics"], max_step=d["max_step"],
+                                   max_points=MAX_POINTS)
+
+
 def branch_checks(omega, lo, hi, max_step) -> list[str]:
     """Violations of the branch contract (item 2 of issue 12), empty if none."""
     bad = []
@@ -155,8 +161,7 @@ def run_design(d: dict) -> dict:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         if d["kind"][0] == "disk":
-            r = make_disk(d).frequency_response(d["f_start"], d["f_end"], harmonics=d["harmonics"],
-                                                max_step=d["max_step"], max_points=MAX_POINTS)
+            r = disk_response(make_disk(d), d)
             lo, hi = sorted((2 * np.pi * d["f_start"], 2 * np.pi * d["f_end"]))
             work = np.abs(r.excitation_work)
             points = np.zeros((len(r.omega), 0)) if r.point_dissipation is None \
@@ -259,8 +264,7 @@ def test_a_failing_disk_has_no_periodic_motion_beyond_its_stop():
     disk = make_disk(d)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        r = disk.frequency_response(d["f_start"], d["f_end"], harmonics=d["harmonics"], max_step=d["max_step"],
-                                    max_points=MAX_POINTS)
+        r = disk_response(disk, d)
         assert not r.success and "where the branch got furthest" in r.message, r.message
         check = disk.stop_check(r)
     assert check.omega[0] > r.omega.max()
@@ -317,8 +321,7 @@ def stop_check_design(d: dict) -> str:
     disk = make_disk(d)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        r = disk.frequency_response(d["f_start"], d["f_end"], harmonics=d["harmonics"], max_step=d["max_step"],
-                                    max_points=MAX_POINTS)
+        r = disk_response(disk, d)
         check = disk.stop_check(r) if len(r.omega) else disk.time_response(d["f_start"])
     return (f"disk {d['kind'][1]}: {check.status[0]} at {check.frequency_hz[0]:.4f} Hz, separated "
             f"{100 * check.point_state[0][..., 2].mean():.0f} % of the period ({check.message[0][:120]})")
