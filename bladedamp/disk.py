@@ -554,7 +554,8 @@ class TunedDisk:
 
     def frequency_response(self, f_start_hz: float, f_end_hz: float, harmonics="auto", n_samples=None,
                            max_step: float = 0.02, harmonic_tolerance: float = HARMONIC_TOLERANCE,
-                           max_harmonic: int = 7, extra_couplings=None, **continuation_options) -> "DiskResponse":
+                           max_harmonic: int = 7, extra_couplings=None, stop_above: float | None = None,
+                           stop_direction: int = 0, **continuation_options) -> "DiskResponse":
         """Forced response from ``f_start_hz`` to ``f_end_hz`` [Hz] by continuation.
 
         ``harmonics``: ``"auto"`` (default) chooses the harmonic set whose first-harmonic tip
@@ -576,12 +577,20 @@ class TunedDisk:
         Coupling`` (called for every harmonic set, the solved ones and the enriched one of the
         error estimate; ``self.point_map(basis, "tip")`` gives a blade point's map), added to
         the sector with :meth:`HarmonicBalanceSystem.add` (README, "Your own nonlinear element").
+        ``stop_above`` [m]: end the branch at the first point whose first-harmonic tip amplitude in
+        ``stop_direction`` (0, 1, 2: x, y, z) exceeds it (None: never). The response is then not
+        ``success``, its ``stopped_by`` says so, and nothing is retried (no branch from the end, no
+        finer AFT, no richer harmonics, no error estimate): the peak is known to be above the
+        bound, which is all a search for the lowest peak needs (:func:`bladedamp.studies.optimal_mass`).
         """
         validation.positive("f_start_hz", f_start_hz)
         validation.positive("f_end_hz", f_end_hz)
         if f_start_hz == f_end_hz:
             raise ValueError("f_end_hz must differ from f_start_hz")
         w0, w1 = 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz
+        if stop_above is not None:
+            validation.positive("stop_above", stop_above)
+        validation.integer("stop_direction", stop_direction, minimum=0, maximum=2)
 
         model = self if extra_couplings is None else WithCouplings(self, extra_couplings)
 
@@ -596,7 +605,9 @@ class TunedDisk:
             x0 = self.start_solution(system, w0, scales)
             branch = continuation(system.residual, x0, w0, w1, x_scale=scales, max_step=max_step,
                                   start_at_end=lambda: self.start_solution(system, w1, scales),
-                                  retry_x_scale=self.retry_scales(system, scales), **continuation_options)
+                                  retry_x_scale=self.retry_scales(system, scales),
+                                  stop_when=self.amplitude_stop(system.basis, stop_above, stop_direction),
+                                  **continuation_options)
             response = DiskResponse.from_branch(self, system, branch)
             T = system.basis.n_samples
 
@@ -612,6 +623,19 @@ class TunedDisk:
                                                          response.excitation_work, max_step, T, refine))
 
         return with_stop_note(converged_response(model, solve, harmonics, harmonic_tolerance, max_harmonic))
+
+    def amplitude_stop(self, basis: HarmonicBasis, stop_above: float | None, direction: int = 0):
+        """The continuation's ``stop_when`` for ``stop_above`` [m] (None: None): a message once the
+        first-harmonic tip amplitude in ``direction`` of the unknowns x (C * n_dof,) exceeds it."""
+        if stop_above is None:
+            return None
+        shape = (1, basis.n_coeffs, -1)
+
+        def stop_when(x, omega):
+            a = self.output_amplitudes(x.reshape(shape), basis)[0, direction]
+            return f"tip amplitude {1e3 * a:.4g} mm above stop_above = {1e3 * stop_above:.4g} mm" \
+                if a > stop_above else None
+        return stop_when
 
     def point_map(self, basis: HarmonicBasis, point: str = "tip", directions=(0,)) -> np.ndarray:
         """Real-form map (C*k, C*n_dof) from the unknowns of :meth:`hbm_system` (``basis``'s
@@ -737,7 +761,7 @@ def with_stop_note(response: "DiskResponse") -> "DiskResponse":
     21-99.8 % of the period, or a cylinder keeps rolling), so no harmonic-balance branch can go
     on; for 4 it is periodic with the damper separated 80-100 % of the period (brief impacts,
     which (0, 1, 2, 3) cannot follow). A successful or empty response is returned unchanged."""
-    if response.success or not len(response.omega) or response.point_state is None:
+    if response.success or response.stopped_by or not len(response.omega) or response.point_state is None:
         return response
     k = response.furthest_index()
     stick, slip, separated = 100 * response.contact_state_shares()[k]
@@ -861,7 +885,7 @@ class DiskResponse(FrequencyResponse):
         else:
             out.update(dissipated_energy=np.zeros(npts))
         return cls(branch.omega, X, basis, disk.dof_names, branch.success, branch.message, branch.iterations,
-                   branch.turning_points, disk=disk, **out)
+                   branch.turning_points, disk=disk, stopped_by=branch.stopped_by, **out)
 
     def contact_state_shares(self) -> np.ndarray:
         """(n, 3) share of the period the damper's contact points stick, slip, are separated, the

@@ -117,6 +117,8 @@ def sampled_response(solve, n_samples, first: int, most: int, most_for_dissipati
             empty = n                                 # the coarser branch is kept
             break
         response = finer
+        if response.stopped_by:                       # stopped as the caller asked: no retry
+            break
         limit = most if most_for_dissipation is None or not only_sampling_failed(response) else most_for_dissipation
         if response.success or n * SAMPLES_GROWTH > limit:
             break
@@ -215,6 +217,9 @@ class FrequencyResponse(Saveable):
     bifurcations : {"fold": [...], "branch point": [...], "neimark-sacker": [...], ...}: indices
         i where the kind happens between points i and i + 1
     stability_method : "hill", "determinant sign", "monodromy" or "" (not computed)
+    stopped_by : why a stop condition the caller gave ended the branch (e.g. ``stop_above`` of
+        :meth:`TunedDisk.frequency_response`), '' if none did; such a response is not
+        ``success``, and is not retried or enriched
     """
 
     omega: np.ndarray
@@ -234,6 +239,7 @@ class FrequencyResponse(Saveable):
     floquet_exponents: np.ndarray | None = None
     bifurcations: dict = field(default_factory=dict)
     stability_method: str = ""
+    stopped_by: str = ""
 
     def reversed(self):
         """The same branch in the opposite order (a downward sweep as rising frequency): every

@@ -314,3 +314,31 @@ def test_a_corner_past_which_the_corrector_lands_off_the_tangent_is_passed():
     r = _random_design("disk", 6)
     assert r["success"] and r["reached"], r["message"]
     assert not r["bad"], r["bad"]
+
+
+def test_stop_when_ends_the_branch_at_the_first_point_it_names_and_nothing_is_retried():
+    """A terminal event: the branch of the s-curve from its unique solution at omega = 4 (x = -2.355)
+    upwards stops at the first kept point where x > -2.2 (omega = 5.9), unsuccessful, with the event's message;
+    neither the branch from the end nor the re-weighted retry is computed."""
+    fun, w0, w1 = s_curve(), 4.0, 7.9
+    calls = []
+
+    def start_at_end():
+        calls.append("end")
+        return root(w1, -2.0)
+
+    def stop_when(x, omega):
+        return f"x = {x[0]:.4f} above -2.2" if x[0] > -2.2 else None
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ConvergenceWarning)      # a requested stop warns nothing
+        b = continuation(fun, root(w0, -3.0), w0, w1, x_scale=2.0, residual_scale=1.0, max_step=0.05,
+                         start_at_end=start_at_end, retry_x_scale=1.0, stop_when=stop_when)
+    assert not b.success and b.stopped_by.startswith("x = ") and b.stopped_by in b.message
+    assert b.x[-1, 0] > -2.2 and np.all(b.x[:-1, 0] <= -2.2)
+    assert b.omega[-1] < w1 and not calls
+    free = continuation(fun, root(w0, -3.0), w0, w1, x_scale=2.0, residual_scale=1.0, max_step=0.05)
+    assert free.success and not free.stopped_by and free.x[-1, 0] > -2.2
+    np.testing.assert_array_equal(free.omega[:len(b.omega)], b.omega)   # the same points up to the stop
+    with pytest.raises(ValueError, match="stop_when"):
+        continuation(fun, root(w0, -3.0), w0, w1, stop_when=1.0)

@@ -662,3 +662,24 @@ def test_stop_check_bad_input():
     for bad in (0.0, -1.0, float("nan")):
         with pytest.raises(ValueError, match="offset_hz"):
             disk.stop_check(one, offset_hz=bad)
+
+
+def test_stop_above_ends_the_branch_at_the_first_point_above_it_and_retries_nothing():
+    """``stop_above`` (the mass search's branch and bound): the reference 1 g cylinder's branch
+    stops at its first point above 0.3 mm (the peak is 0.489 mm), with the points of the full
+    branch up to there, not success, no finer AFT, no error estimate and no stop-check note."""
+    disk = reference_disk("cylinder", 1e-3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        full = disk.frequency_response(*F_RANGE, harmonics=(1,), max_step=MAX_STEP)
+        cut = disk.frequency_response(*F_RANGE, harmonics=(1,), max_step=MAX_STEP, stop_above=3e-4)
+    assert full.success and not full.stopped_by
+    k = len(cut.omega)
+    assert not cut.success and "above stop_above = 0.3 mm" in cut.stopped_by and cut.stopped_by in cut.message
+    assert 1 < k < len(full.omega) and cut.tip_amplitude[-1, 0] > 3e-4 and np.all(cut.tip_amplitude[:-1, 0] <= 3e-4)
+    np.testing.assert_array_equal(cut.omega, full.omega[:k])
+    assert cut.basis.n_samples == full.basis.n_samples and "raised" not in cut.message
+    assert np.isnan(cut.harmonic_error) and "stop_check" not in cut.message
+    for bad, name in (({"stop_above": -1.0}, "stop_above"), ({"stop_direction": 3}, "stop_direction")):
+        with pytest.raises(ValueError, match=name):
+            disk.frequency_response(*F_RANGE, harmonics=(1,), **bad)

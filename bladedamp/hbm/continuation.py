@@ -143,6 +143,8 @@ class Branch:
     message : str, why it stopped
     turning_points : indices of the folds
     checks : {name: bool} of :func:`branch_checks` (empty for a branch not made by :func:`continuation`)
+    stopped_by : what ``stop_when`` said when it ended the branch ('' if it did not): the branch
+        is then not ``success`` but not a failure of the method either, and is never retried
     """
 
     omega: np.ndarray
@@ -152,18 +154,21 @@ class Branch:
     message: str
     turning_points: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))  # indices of folds
     checks: dict = field(default_factory=dict)   # name -> bool, see branch_checks
+    stopped_by: str = ""
 
     def reversed(self, message: str) -> "Branch":
         """This branch in the opposite order (a branch computed from the end of its range,
         returned from the start), with ``message``; its turning points renumbered."""
         n = len(self.omega)
         return Branch(self.omega[::-1].copy(), self.x[::-1].copy(), self.iterations[::-1].copy(), self.success,
-                      message, np.sort(n - 1 - np.asarray(self.turning_points, dtype=int)), dict(self.checks))
+                      message, np.sort(n - 1 - np.asarray(self.turning_points, dtype=int)), dict(self.checks),
+                      self.stopped_by)
 
     def take(self, indices) -> "Branch":
         """The points ``indices`` of this branch (for re-evaluating them, e.g. with a finer AFT)."""
         indices = np.asarray(indices, dtype=int)
-        return Branch(self.omega[indices], self.x[indices], self.iterations[indices], self.success, self.message)
+        return Branch(self.omega[indices], self.x[indices], self.iterations[indices], self.success, self.message,
+                      stopped_by=self.stopped_by)
 
 
 def branch_checks(omega, omega_start, omega_end, max_step) -> dict:
@@ -206,7 +211,7 @@ RETRY_POINTS_FRACTION = 4
 def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=None,
                  step=None, max_step=None, min_step=None, max_points=5000, tol=1e-10,
                  max_corrector=12, target_iterations=5, factorize=lu_factorize, leave_margin=0.0,
-                 start_at_end=None, retry_x_scale=None):
+                 start_at_end=None, retry_x_scale=None, stop_when=None):
     """Pseudo-arclength continuation of R(x, omega) = 0 from ``omega_start`` to ``omega_end``.
 
     Every branch it returns keeps the contract of :func:`branch_checks` (``Branch.checks``):
@@ -248,6 +253,12 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         ``max_points``. Its branch is returned if it succeeds, its message saying so; otherwise
         the first try's branch, with its warnings. A branch that succeeds at the first try is
         never recomputed, so the second try changes no such result.
+    stop_when : callable (x, omega) -> str or None, or None: called at every point kept (the
+        first included); a non-empty string ends the branch there, unsuccessful, with that
+        string as ``Branch.stopped_by`` and in the message (a terminal event, like
+        ``solve_ivp``'s). Such a branch is not retried from the end or with ``retry_x_scale``:
+        the caller asked for it to stop (e.g. a mass search that only needs to know a peak is
+        above the best one found, :func:`bladedamp.studies.mass.optimal_mass`).
 
     The steps are the methods of :class:`ArcLengthContinuation`, in the order they are tried
     from each point: the predictor-corrector along the tangent with shorter steps
@@ -268,19 +279,21 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
     x0 = np.asarray(x0, dtype=float)
     if not np.all(np.isfinite(x0)):
         raise ValueError("x0 (initial guess) must be finite")
-    options = (step, max_step, min_step, max_points, tol, max_corrector, target_iterations, factorize)
+    if stop_when is not None and not callable(stop_when):
+        raise ValueError(f"stop_when must be a callable (x, omega) -> str or None, or None (got {stop_when!r})")
+    options = (step, max_step, min_step, max_points, tol, max_corrector, target_iterations, factorize, stop_when)
     if start_at_end is None and retry_x_scale is None:
         return ArcLengthContinuation(fun, x0, omega_start, omega_end, x_scale, residual_scale, *options).run()
     with warnings.catch_warnings(record=True) as first_warnings:
         warnings.simplefilter("always", ConvergenceWarning)
         first = _both_ends(fun, x0, omega_start, omega_end, x_scale, residual_scale, options, start_at_end)
-    if first.success:
+    if first.success or first.stopped_by:
         return first
     if retry_x_scale is not None:
         with warnings.catch_warnings(record=True):
             warnings.simplefilter("always", ConvergenceWarning)
             retry_options = (step, max_step, min_step, max(2, max_points // RETRY_POINTS_FRACTION), tol, max_corrector,
-                             target_iterations, factorize)
+                             target_iterations, factorize, stop_when)
             retried = _both_ends(fun, x0, omega_start, omega_end, retry_x_scale, residual_scale, retry_options,
                                  start_at_end)
             if retried.success:
@@ -297,7 +310,7 @@ def _both_ends(fun, x0, omega_start, omega_end, x_scale, residual_scale, options
     ``omega_end`` where that one succeeds (see :func:`continuation`). The branch from the start
     warns as it stops; the one from the end does not (it is returned only if it succeeds)."""
     forward = ArcLengthContinuation(fun, x0, omega_start, omega_end, x_scale, residual_scale, *options).run()
-    if forward.success or start_at_end is None:
+    if forward.success or forward.stopped_by or start_at_end is None:
         return forward
     with warnings.catch_warnings(record=True):
         warnings.simplefilter("always", ConvergenceWarning)
@@ -340,8 +353,8 @@ class ArcLengthContinuation:
     range's width: ``y = (x / x_scale, omega / w_scale)``."""
 
     def __init__(self, fun, x0, omega_start, omega_end, x_scale, residual_scale, step, max_step, min_step,
-                 max_points, tol, max_corrector, target_iterations, factorize):
-        self.fun, self.factorize = fun, factorize
+                 max_points, tol, max_corrector, target_iterations, factorize, stop_when=None):
+        self.fun, self.factorize, self.stop_when = fun, factorize, stop_when
         self.omega_start, self.omega_end = omega_start, omega_end
         self.step, self.max_step, self.min_step, self.max_points = step, max_step, min_step, max_points
         self.tol, self.max_corrector, self.target_iterations = tol, max_corrector, target_iterations
@@ -357,6 +370,7 @@ class ArcLengthContinuation:
         self.n = x0.size
         self.max_dw = max_step * self.w_scale          # the longest step in omega (item 2 of issue 12)
         self.points, self.its = [], []
+        self.stopped_by = ""       # what stop_when said when it ended the branch
         # Orientation of the branch (Allgower & Georg): the sense of the tangent t keeps the sign of
         # det [dR/dy; t^T], which changes at no fold and no corner of a piecewise-smooth branch.
         # "t . previous tangent > 0" picks the wrong sense once the branch turns by more than 90
@@ -731,7 +745,16 @@ class ArcLengthContinuation:
         # turning points: where omega stops growing along the branch and turns back
         d = np.sign(np.diff(Y[:, n]))
         turning = np.flatnonzero(d[1:] * d[:-1] < 0) + 1
-        return Branch(Y[:, n], Y[:, :n], np.array(self.its, dtype=int), success, message, turning, checks)
+        return Branch(Y[:, n], Y[:, :n], np.array(self.its, dtype=int), success, message, turning, checks,
+                      self.stopped_by)
+
+    def stop_event(self) -> str:
+        """``stop_when`` at the last point kept ('' without it); records it as ``stopped_by``."""
+        if self.stop_when is None or not self.points:
+            return ""
+        last = self.points[-1]
+        self.stopped_by = str(self.stop_when(last[:self.n].copy(), float(last[self.n])) or "")
+        return self.stopped_by
 
     # ----- the run -----------------------------------------------------------------------
     def run(self) -> Branch:
@@ -746,6 +769,8 @@ class ArcLengthContinuation:
         points = self.points
         points.append(np.append(first.x, self.omega_start))
         self.its.append(first.iterations)
+        if self.stop_event():
+            return self.finish(False, f"stopped at the start, omega = {self.omega_start:.6g} rad/s: {self.stopped_by}")
         tangent_prev = None  # in unscaled units
         message, success = "", False
         h = self.step
@@ -803,6 +828,8 @@ class ArcLengthContinuation:
                     _warn(message, 3)
                     break
                 success, message = True, "reached the end of the frequency range"
+                if self.stop_event():
+                    success, message = False, f"stopped at omega_end = {self.omega_end:.6g} rad/s: {self.stopped_by}"
                 break
             tangent_prev = None if tangent is None else tangent * self.scale()
             next_tangent = None if next_tangent is None else next_tangent * self.scale()
@@ -810,6 +837,9 @@ class ArcLengthContinuation:
             revisited = self.retraced(new, h)
             points.append(new)
             self.its.append(it)
+            if self.stop_event():
+                message = f"stopped at omega = {new[n]:.6g} rad/s ({new[n] / (2 * np.pi):.6g} Hz): {self.stopped_by}"
+                break
             if revisited is not None:
                 revisits += 1
                 if revisits >= MAX_REVISITS:

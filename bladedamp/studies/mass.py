@@ -94,6 +94,8 @@ class PeakEvaluation(Saveable):
         branches (the true peak is at least this; NaN when no part converged)
     message : how the peak was obtained, or why every attempt failed
     attempts : number of continuation runs
+    stopped_above : the branch was stopped once above ``stop_above`` (not a failure: the peak is
+        known to exceed that bound, ``lower_bound``)
     """
 
     success: bool
@@ -102,11 +104,12 @@ class PeakEvaluation(Saveable):
     lower_bound: float
     message: str
     attempts: int
+    stopped_above: bool = False
 
 
 def robust_peak(disk: TunedDisk, f_range_hz=(90.0, 105.0), harmonics=(1,), direction: int = 0,
                 attempts=ROBUST_ATTEMPTS, max_points: int = ROBUST_MAX_POINTS, downward: bool = True,
-                give_up_above: float = np.inf) -> PeakEvaluation:
+                give_up_above: float = np.inf, stop_above: float = np.inf) -> PeakEvaluation:
     """:func:`peak_response` that retries a failed frequency response and never raises on one.
 
     Tries each settings dict of ``attempts`` (upward sweeps, ``peak_response`` options); if all
@@ -118,19 +121,26 @@ def robust_peak(disk: TunedDisk, f_range_hz=(90.0, 105.0), harmonics=(1,), direc
 
     ``downward=False`` skips the downward sweep. ``give_up_above`` [m]: stop retrying as soon as
     a partial branch has reached above it (a minimiser that already has a lower peak needs no
-    more of this mass than that bound).
+    more of this mass than that bound). ``stop_above`` [m]: stop each branch itself at the first
+    point above it (``TunedDisk.frequency_response(stop_above=...)``); with ``give_up_above`` at
+    or below it, such a mass costs only the branch up to that point.
     """
     lo, hi = validation.interval("f_range_hz", f_range_hz, "Hz")
+    stop = dict(stop_above=float(stop_above), stop_direction=direction) if np.isfinite(stop_above) else {}
     messages, bound, up, runs = [], np.nan, None, 0
     for options in attempts:
         runs += 1
         try:
-            p, f, _ = peak_response(disk, (lo, hi), harmonics, direction=direction, max_points=max_points, **options)
+            p, f, _ = peak_response(disk, (lo, hi), harmonics, direction=direction, max_points=max_points, **stop,
+                                    **options)
             note = "" if runs == 1 else f" (retry {options}; before: {'; '.join(messages)})"
             return PeakEvaluation(True, p, f, np.nan, "interior peak of a complete response" + note, runs)
         except IncompleteResponse as exc:
             messages.append(f"{options}: {exc}")
             bound = np.fmax(bound, exc.lower_bound)
+            if exc.response is not None and exc.response.stopped_by:
+                return PeakEvaluation(False, np.nan, np.nan, float(bound), f"stopped above the bound: {exc}", runs,
+                                      stopped_above=True)
             r = exc.response
             if _joinable(r) and r.frequency_hz[0] == lo and (up is None or r.frequency_hz.max() > up.frequency_hz.max()):
                 up = r
@@ -145,7 +155,7 @@ def robust_peak(disk: TunedDisk, f_range_hz=(90.0, 105.0), harmonics=(1,), direc
     # downward sweep, joined with the farthest-reaching upward branch
     runs += 1
     step = min((o.get("max_step", 0.05) for o in attempts), default=0.02)
-    down = disk.frequency_response(hi, lo, harmonics=harmonics, max_step=step, max_points=max_points)
+    down = disk.frequency_response(hi, lo, harmonics=harmonics, max_step=step, max_points=max_points, **stop)
     bound = np.fmax(bound, _lower_bound(down, direction))
     if down.success:
         branches = [down]
@@ -250,6 +260,9 @@ class MassOptimum(Saveable):
     failure_messages : (f,) why each failed
     grid_mass : (g,) [kg] the bracketing grid; grid_peak_amplitude : (g,) [m] (NaN where failed)
     bracket : (low, high) [kg] the grid interval of the local search
+    stopped_masses : (s,) [kg] grid masses whose branch was stopped once it was above the best
+        peak found before them (branch and bound: their peak is above it, so none is the optimum;
+        NaN in ``grid_peak_amplitude``); not counted as failed
     success : True when the optimum is certified global on the grid: every failed mass has a
         lower bound above the optimum peak (so it cannot hide a better mass)
     message : what was found, and which failed masses leave the claim open
@@ -267,6 +280,7 @@ class MassOptimum(Saveable):
     bracket: tuple = ()
     success: bool = True
     message: str = ""
+    stopped_masses: tuple = ()
 
     @property
     def reduction(self) -> float:
@@ -278,8 +292,9 @@ GRID_PER_DECADE = 4   # bracketing grid density; the narrowest valley measured (
 
 
 def _robust_peak_case(case):
-    disk, f_range, harmonics, attempts, downward, give_up_above = case
-    return robust_peak(disk, f_range, harmonics, attempts=attempts, downward=downward, give_up_above=give_up_above)
+    disk, f_range, harmonics, attempts, downward, give_up_above, stop_above = case
+    return robust_peak(disk, f_range, harmonics, attempts=attempts, downward=downward, give_up_above=give_up_above,
+                       stop_above=stop_above)
 
 
 def bracket_minimum(fun, grid, xatol: float, fail_value: float, processes: int | None = 1, evaluate_grid=None):
@@ -328,7 +343,7 @@ def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0),
     in the result with a lower bound of their peak, and ``success`` says whether they could
     hide a better optimum. ``processes``: worker processes over the grid (None: every core).
     """
-    from .parallel import parallel_map
+    from .parallel import parallel_map, workers
 
     lo, hi = validation.interval("mass bounds", bounds, "kg")
     validation.positive("xatol", xatol)
@@ -348,15 +363,23 @@ def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0),
         return record(m, robust_peak(with_mass(disk, m), f_range_hz, harmonics, give_up_above=best_so_far()))
 
     def evaluate_grid(loggrid):
-        # first the plain response of every grid mass, then the retries of those that failed,
+        # first the plain response of every grid mass, heaviest first, as many at a time as there
+        # are workers, each branch stopped once it is above the best peak found before it (that
+        # mass cannot be the optimum: branch and bound); then the retries of those that failed,
         # except where a partial branch is already above the best grid peak (no optimum there)
         masses = [float(m) for m in np.exp(loggrid)]
-        cases = [(with_mass(disk, m), f_range_hz, harmonics, ROBUST_ATTEMPTS[:1], False, np.inf) for m in masses]
-        for m, ev in zip(masses, parallel_map(_robust_peak_case, cases, processes, progress)):
-            record(m, ev)
+        wave = workers(processes, len(masses))
+        order = masses[::-1]
+        for k in range(0, len(order), wave):
+            chunk, best = order[k:k + wave], best_so_far()
+            cases = [(with_mass(disk, m), f_range_hz, harmonics, ROBUST_ATTEMPTS[:1], False, best, best) for m in chunk]
+            for m, ev in zip(chunk, parallel_map(_robust_peak_case, cases, processes)):
+                record(m, ev)
+            if progress:
+                progress(min(k + wave, len(order)), len(order))
         best = best_so_far()
         retry = [m for m in masses if not evaluations[m].success and not evaluations[m].lower_bound > best]
-        cases = [(with_mass(disk, m), f_range_hz, harmonics, ROBUST_ATTEMPTS[1:], True, best) for m in retry]
+        cases = [(with_mass(disk, m), f_range_hz, harmonics, ROBUST_ATTEMPTS[1:], True, best, np.inf) for m in retry]
         for m, ev in zip(retry, parallel_map(_robust_peak_case, cases, processes)):
             ev.attempts += evaluations[m].attempts
             record(m, ev)
@@ -367,7 +390,8 @@ def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0),
     logm, peak, _, (a, b) = bracket_minimum(fun, loggrid, xatol, 10 * undamped, evaluate_grid=evaluate_grid)
     grid_m = np.exp(loggrid)
     grid_p = np.array([evaluations[float(m)].peak_amplitude for m in grid_m])
-    failed = sorted(m for m, ev in evaluations.items() if not ev.success)
+    failed = sorted(m for m, ev in evaluations.items() if not ev.success and not ev.stopped_above)
+    stopped = tuple(sorted(m for m, ev in evaluations.items() if ev.stopped_above))
     bounds_f = tuple(evaluations[m].lower_bound for m in failed)
     msgs = tuple(evaluations[m].message for m in failed)
     if not np.isfinite(logm):
@@ -377,6 +401,8 @@ def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0),
     where = "at a bound of the search" if logm in (loggrid[0], loggrid[-1]) else "interior"
     text = (f"optimum {1e3 * best:.4g} g ({where}), peak {1e3 * peak:.4g} mm, from a {n}-point log grid and a "
             f"bounded search in {1e3 * np.exp(a):.4g}-{1e3 * np.exp(b):.4g} g")
+    if stopped:
+        text += f"; {len(stopped)} grid mass(es) stopped once above the best peak found before them"
     if failed:
         text += (f"; {len(failed)} mass(es) not solved ({', '.join(f'{1e3 * m:.4g}' for m in failed)} g)")
         if open_:
@@ -385,4 +411,4 @@ def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0),
         else:
             text += ", each with a partial branch already above the optimum peak: they cannot be the optimum"
     return MassOptimum(best, peak, undamped, len(evaluations), tuple(failed), bounds_f, msgs, grid_m, grid_p,
-                       (float(np.exp(a)), float(np.exp(b))), not open_, text)
+                       (float(np.exp(a)), float(np.exp(b))), not open_, text, stopped)

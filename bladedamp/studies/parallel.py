@@ -15,17 +15,23 @@ def _quiet(fn, item):
         return fn(item)
 
 
+def workers(processes: int | None, n: int) -> int:
+    """The number of worker processes :func:`parallel_map` uses for ``n`` items (``processes``
+    None: every core; at least 1)."""
+    if processes is not None:
+        processes = validation.integer("processes (worker processes; None: every core)", processes, minimum=1)
+    return max(1, min(processes or os.cpu_count() or 1, n))
+
+
 def parallel_map(fn, items, processes: int | None = None, progress=None) -> list:
     """``[fn(item) for item in items]``, in order, on ``processes`` worker processes.
 
     ``fn`` must be a module-level function (picklable). ``processes=None`` uses every core;
     1 runs in this process; anything else but an integer >= 1 raises ValueError. ``progress(done, total)`` is called as cases finish.
     """
-    if processes is not None:
-        processes = validation.integer("processes (worker processes; None: every core)", processes, minimum=1)
     items = list(items)
     n = len(items)
-    processes = min(processes or os.cpu_count() or 1, n) if n else 1
+    processes = workers(processes, n)
     if processes <= 1:
         out = []
         for k, item in enumerate(items):
