@@ -385,6 +385,36 @@ def _damped(design, command: str):
     return design.disk
 
 
+def _check_platform_angle_option(design, option: str, angles_deg) -> None:
+    """UsageError for a platform-angle option (``option``, its values ``angles_deg``; None or
+    empty: not given) with a blade whose flexible platforms fix the angles: a solid FE blade
+    ([blade] model = "solid", surface_file, or a solid blade's modal_file) has its contact faces
+    at its geometry's platform angles, and its FE field at a contact point holds only for the
+    disk at those angles (:meth:`bladedamp.solid.SolidModalBlade.platform_displacements`), so
+    a study at other angles would stop at its first frequency response."""
+    blade = design.disk.blade
+    if not angles_deg or not getattr(blade, "flexible_platform", False):
+        return
+    import json
+
+    import numpy as np
+
+    b = design.values.get("blade", {})
+    face = f"{np.degrees(blade.face_fields['OR'].gamma):.4g}"
+    if b.get("surface_file") is not None:
+        source = f"[blade] surface_file = {json.dumps(b['surface_file'])}, its OR face at {face} deg"
+        remedy = "another angle needs another STL"
+    elif b.get("modal_file") is not None:
+        source = f"[blade] modal_file = {json.dumps(b['modal_file'])}, its OR face at {face} deg"
+        remedy = "another angle needs another blade file"
+    else:
+        source = f"[blade] model = \"solid\", meshed at [disk] gamma_right_deg = {face}"
+        remedy = "set [disk] gamma_right_deg for another angle"
+    raise UsageError(f"{option}: a solid FE blade's platform angles come from its geometry ({design.path}: {source}), "
+                     f"and its flexible platforms hold at those angles only; remove {option} ({remedy}), or study "
+                     "the angles with the built-in beam blade")
+
+
 def _done(out: Path, t0: float, what: str) -> int:
     print(f"{what}; wrote {out / 'summary.md'}, results and figures in {out} ({time.perf_counter() - t0:.1f} s)",
           file=sys.stderr)
@@ -441,6 +471,7 @@ def optimize_command(args) -> int:
     for g in args.gamma_right_deg or ():
         if not 0 < g < 90:
             raise UsageError(f"--gamma-right-deg {g:g}: must be in (0, 90) deg")
+    _check_platform_angle_option(design, "--gamma-right-deg", args.gamma_right_deg)
     for h in args.contact_height_mm or ():
         if not 0 < h <= 100:
             raise UsageError(f"--contact-height-mm {h:g}: must be in (0, 100] mm")

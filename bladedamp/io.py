@@ -21,7 +21,9 @@ File layout (readable with ``np.load(path, allow_pickle=False)`` and any npz rea
   class (``module:qualname``, on which :func:`load` dispatches), every scalar, string, tuple,
   list and dict field (dicts as key-value pairs, so integer keys stay integers; complex
   numbers as [re, im]; NaN as JSON's NaN), and the
-  :class:`~bladedamp.hbm.fourier.HarmonicBasis` by its harmonics and n_samples.
+  :class:`~bladedamp.hbm.fourier.HarmonicBasis` by its harmonics and n_samples: the typed
+  JSON form of :func:`encode_value` / :func:`decode_value` (also used for a solid blade's
+  ``solid_info``, :meth:`bladedamp.solid.SolidModalBlade.npz_arrays`).
 
 The model is not saved: a ``disk`` (TunedDisk or MistunedDisk) or ``system`` field is
 stored as absent, and a loaded result has ``disk=None`` (``system=None``). Rebuilding a disk
@@ -74,8 +76,25 @@ def npz_path(path) -> Path:
 
 
 # ----- JSON values ----------------------------------------------------------------------
-def _encode(value, where: str):
-    """A JSON-able form of a scalar / string / container value (see :func:`_decode`)."""
+def encode_value(value, where: str = "value"):
+    """The JSON-able, typed form of ``value`` (``json.dumps`` of it, with NaN allowed, and
+    :func:`decode_value` of ``json.loads`` give ``value`` back, types included).
+
+    Round-trip exactly (value and type): None, bool, int, float (NaN and infinities too: dump
+    with ``allow_nan=True``, json's default), complex and str; numpy arrays of bool, integer,
+    unsigned, float, complex and unicode dtypes (dtype and shape kept, empty arrays included; an
+    object array is stored as the array numpy infers from its items); tuples, lists and dicts
+    (any hashable keys of these types: integer and tuple keys stay integers and tuples),
+    nested to any depth; and :class:`~bladedamp.hbm.fourier.HarmonicBasis`. Numpy scalars come
+    back as the Python scalar of their kind (``np.float64`` -> float, ``np.int64`` -> int,
+    ``np.bool_`` -> bool, ``np.complex128`` -> complex).
+
+    The form: None, bools, numbers and strings as themselves, lists as JSON lists, every other
+    value as a JSON object with one tag: ``{"__tuple__": [...]}``, ``{"__dict__": [[key, value],
+    ...]}``, ``{"__array__": nested lists, "dtype": str}`` (complex entries as [re, im] pairs;
+    ``"shape"`` too when the array is empty), ``{"__complex__": [re, im]}``, ``{"__basis__":
+    {"harmonics": [...], "n_samples": n}}``. ``where`` names the value in the TypeError raised
+    for any other type (e.g. ``"MassSweep.meta['x']"``)."""
     from .hbm.fourier import HarmonicBasis
 
     if value is None or isinstance(value, (bool, str)):
@@ -91,26 +110,35 @@ def _encode(value, where: str):
     if isinstance(value, HarmonicBasis):
         return {"__basis__": {"harmonics": [int(h) for h in value.harmonics], "n_samples": int(value.n_samples)}}
     if isinstance(value, np.ndarray):
-        if value.dtype.kind == "c":
-            return {"__array__": np.stack([value.real, value.imag], axis=-1).tolist(), "dtype": str(value.dtype)}
         if value.dtype.kind == "O":
             value = np.asarray(value.tolist())
-        return {"__array__": value.tolist(), "dtype": str(value.dtype)}
+        if value.dtype.kind not in "biufcU":
+            raise TypeError(f"cannot save {where}: an array of dtype {value.dtype}")
+        data = np.stack([value.real, value.imag], axis=-1) if value.dtype.kind == "c" else value
+        out = {"__array__": data.tolist(), "dtype": str(value.dtype)}
+        if value.size == 0:                       # nested lists lose the shape of an empty array
+            out["shape"] = list(value.shape)
+        return out
     if isinstance(value, tuple):
-        return {"__tuple__": [_encode(v, f"{where}[{i}]") for i, v in enumerate(value)]}
+        return {"__tuple__": [encode_value(v, f"{where}[{i}]") for i, v in enumerate(value)]}
     if isinstance(value, list):
-        return [_encode(v, f"{where}[{i}]") for i, v in enumerate(value)]
+        return [encode_value(v, f"{where}[{i}]") for i, v in enumerate(value)]
     if isinstance(value, dict):
-        return {"__dict__": [[_encode(k, where), _encode(v, f"{where}[{k!r}]")] for k, v in value.items()]}
+        return {"__dict__": [[encode_value(k, where), encode_value(v, f"{where}[{k!r}]")] for k, v in value.items()]}
     raise TypeError(f"cannot save {where}: a {type(value).__module__}.{type(value).__qualname__} "
-                    "(results hold arrays, numbers, strings, tuples, lists, dicts and results)")
+                    "(encode_value takes None, bools, numbers, strings, numpy arrays, tuples, lists, dicts "
+                    "and HarmonicBasis)")
 
 
-def _decode(value):
+def decode_value(value):
+    """The value whose :func:`encode_value` form is ``value`` (as ``json.loads`` gives it back),
+    with its type (see :func:`encode_value` for the types that round-trip). ValueError for a
+    JSON object that carries none of encode_value's tags (a plain JSON object is not an encoded
+    dict: dicts are encoded as ``{"__dict__": [[key, value], ...]}``)."""
     from .hbm.fourier import HarmonicBasis
 
     if isinstance(value, list):
-        return [_decode(v) for v in value]
+        return [decode_value(v) for v in value]
     if not isinstance(value, dict):
         return value
     if "__complex__" in value:
@@ -123,13 +151,15 @@ def _decode(value):
         dtype = np.dtype(value["dtype"])
         if dtype.kind == "c":
             a = np.asarray(value["__array__"], dtype=float)
-            return (a[..., 0] + 1j * a[..., 1]).astype(dtype)
-        return np.asarray(value["__array__"], dtype=dtype)
+            a = (a[..., 0] + 1j * a[..., 1]).astype(dtype) if a.size else a.astype(dtype)
+        else:
+            a = np.asarray(value["__array__"], dtype=dtype)
+        return a.reshape(value["shape"]) if "shape" in value else a
     if "__tuple__" in value:
-        return tuple(_decode(v) for v in value["__tuple__"])
+        return tuple(decode_value(v) for v in value["__tuple__"])
     if "__dict__" in value:
-        return {_hashable(_decode(k)): _decode(v) for k, v in value["__dict__"]}
-    raise ValueError(f"unknown JSON value {value!r} in a saved result")
+        return {_hashable(decode_value(k)): decode_value(v) for k, v in value["__dict__"]}
+    raise ValueError(f"not an encoded value (a JSON object without a bladedamp tag): {value!r}")
 
 
 def _hashable(key):
@@ -180,13 +210,13 @@ def _flatten(result, prefix: str, arrays: dict) -> dict:
         elif dataclasses.is_dataclass(value) and not isinstance(value, type):
             meta["results"][f.name] = _flatten(value, f"{key}/", arrays)
         else:
-            meta["fields"][f.name] = _encode(value, where)
+            meta["fields"][f.name] = encode_value(value, where)
     return meta
 
 
 def _rebuild(meta: dict, prefix: str, arrays):
     cls = _resolve(meta["class"])
-    kwargs = {name: _decode(v) for name, v in meta["fields"].items()}
+    kwargs = {name: decode_value(v) for name, v in meta["fields"].items()}
     for name in meta["arrays"]:
         kwargs[name] = np.asarray(arrays[f"{prefix}{name}"])
         if name in meta.get("object_arrays", ()):
@@ -239,7 +269,7 @@ def load(path):
     A blade's modal data file (``ModalBlade.save``, a ``format`` entry naming a blade format) gives
     the blade (:meth:`bladedamp.blade.ModalBlade.from_file`: a solid FE blade's a SolidModalBlade).
     Raises FileNotFoundError naming the file, ValueError for a file that is not a saved result."""
-    from .blade import MODAL_NPZ_FORMAT, SOLID_NPZ_FORMAT, ModalBlade
+    from .blade import MODAL_NPZ_FORMAT, SOLID_NPZ_FORMATS_READ, ModalBlade
 
     path = npz_path(path)
     if not path.exists():
@@ -254,7 +284,7 @@ def load(path):
         blade = META_KEY not in files and "format" in files and z["format"].dtype.kind == "U"
         tag = str(z["format"]) if blade else None
     if META_KEY not in files:
-        if tag in (MODAL_NPZ_FORMAT, SOLID_NPZ_FORMAT):          # a blade's modal data file
+        if tag in (MODAL_NPZ_FORMAT, *SOLID_NPZ_FORMATS_READ):   # a blade's modal data file
             return ModalBlade.from_file(path)
         raise ValueError(f"{path} is not a saved bladedamp result (no {META_KEY} entry)")
     return _rebuild(meta, "", arrays)

@@ -123,6 +123,7 @@ import scipy.sparse.linalg
 from . import validation as check
 from .blade import (SHIFT_INVERT_SIGMA, SOLID_NPZ_FORMAT, BeamBladeGeometry, ModalBlade, PAPER_MODE_ORDER,
                     platform_section)
+from .io import decode_value, encode_value
 
 __all__ = ["FE_HINT", "SOLID_NPZ_FORMAT", "SolidBladeGeometry", "SurfaceBladeGeometry", "PlaneRegion", "SurfacePatch",
            "SolidMesh", "SolidModes", "ContactFaceModes", "ContactFaceField", "BladeSurface", "SolidModalBlade",
@@ -551,13 +552,6 @@ def _mirrored(vertices, tets, platform, faces, axis: int, tol: float, renamed: d
         out_faces.setdefault(renamed.get(name, name), []).append(image[tri][[1, 0, 2]])
     return (vertices, np.hstack([tets, mirrored_tets]), np.concatenate([platform, platform]),
             {name: np.hstack(tris) for name, tris in out_faces.items()})
-
-
-def _json_value(value):
-    """A JSON-able form of a numpy value of ``solid_info`` (arrays as lists, numpy scalars as numbers)."""
-    if isinstance(value, (np.ndarray, np.generic)):
-        return value.tolist()
-    raise TypeError(f"solid_info: cannot write a {type(value).__name__} to JSON")
 
 
 def _solid_geometry(geometry):
@@ -1915,7 +1909,8 @@ class SolidModalBlade(ModalBlade):
     def npz_arrays(self) -> dict:
         """The arrays of this blade's ``.npz`` file by key: the ModalBlade's
         (:meth:`bladedamp.blade.ModalBlade.npz_arrays`, with ``format`` = :data:`SOLID_NPZ_FORMAT`)
-        and, under ``solid/``: ``mode_indices`` (n_m,), ``info`` (``solid_info`` as JSON),
+        and, under ``solid/``: ``mode_indices`` (n_m,), ``info`` (``solid_info`` as JSON, typed by
+        :func:`bladedamp.io.encode_value`: arrays keep their dtype, tuples stay tuples),
         ``fit_residual_names`` (k,) and ``fit_residuals`` (k, n_m), and the fields of
         ``face_fields["OL" / "OR"]`` (:class:`ContactFaceField`), ``contact_faces["OL" / "OR"]``
         (:class:`ContactFaceModes`) and ``surface`` (:class:`BladeSurface`) as
@@ -1925,7 +1920,7 @@ class SolidModalBlade(ModalBlade):
         out["format"] = np.array(SOLID_NPZ_FORMAT)
         names = list(self.fit_residuals)
         out.update({"solid/mode_indices": np.array(self.mode_indices, dtype=np.int64),
-                    "solid/info": np.array(json.dumps(self.solid_info, default=_json_value)),
+                    "solid/info": np.array(json.dumps(encode_value(dict(self.solid_info), "solid_info"))),
                     "solid/fit_residual_names": np.array(names, dtype=str),
                     "solid/fit_residuals": np.array([self.fit_residuals[n] for n in names], dtype=float)
                     .reshape(len(names), self.n_modes)})
@@ -1967,9 +1962,16 @@ class SolidModalBlade(ModalBlade):
             raise ValueError(f"{path}: key 'solid/info' must be JSON ({err})") from None
         if not isinstance(info, dict):
             raise ValueError(f"{path}: key 'solid/info' must be a JSON object (got {type(info).__name__})")
-        # JSON lists back to what solid_blade wrote: numbers -> float array, names -> tuple
-        info = {k: (np.array(v, dtype=float) if isinstance(v, list) and all(isinstance(x, (int, float)) for x in v)
-                    else tuple(v) if isinstance(v, list) else v) for k, v in info.items()}
+        # Format /2 (bladedamp.blade.SOLID_NPZ_FORMAT) writes the typed form of
+        # bladedamp.io.encode_value, an object with the one key "__dict__"; a /1 file (plain JSON,
+        # commit 402db23) has solid_blade's keys and goes through the old reading.
+        if "__dict__" in info:
+            try:
+                info = decode_value(info)
+            except (ValueError, TypeError, KeyError) as err:
+                raise ValueError(f"{path}: key 'solid/info': {err}") from None
+        else:
+            info = _legacy_solid_info(info)
         sides = {g: sorted({k.split("/")[2] for k in arrays if k.startswith(f"solid/{g}/")})
                  for g in ("face_fields", "contact_faces")}
         names = [str(n) for n in get("solid/fit_residual_names")]
@@ -1985,6 +1987,14 @@ class SolidModalBlade(ModalBlade):
                      contact_faces={s: part(ContactFaceModes, f"solid/contact_faces/{s}", side=s)
                                     for s in sides["contact_faces"]},
                      surface=part(BladeSurface, "solid/surface") if "solid/surface/vertices" in arrays else None)
+
+
+def _legacy_solid_info(info: dict) -> dict:
+    """``solid_info`` of a file written before it was stored typed (plain JSON: arrays and tuples as
+    lists, numpy scalars as numbers), as :func:`solid_blade` made it: a list of numbers becomes a
+    float array, any other list a tuple; numbers, strings and objects (``seconds``) stay."""
+    return {k: (np.array(v, dtype=float) if isinstance(v, list) and all(isinstance(x, (int, float)) for x in v)
+                else tuple(v) if isinstance(v, list) else v) for k, v in info.items()}
 
 
 def solid_blade(geometry: SolidBladeGeometry | BeamBladeGeometry | None = None,

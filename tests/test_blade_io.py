@@ -226,6 +226,21 @@ def test_from_matrices_reproduces_from_beam(solver, to_matrix):
         assert part[np.argmax(np.abs(part))] > 0
 
 
+def test_from_matrices_reproduces_the_refined_beam_with_its_warping_dof():
+    """The beam of the solid's geometry (platform block, Timoshenko, Vlasov: 7 DOF per node, the
+    rates of twist after the 6 n_nodes node DOF): its clamped matrices keep node n's DOF at
+    6 n - 6 ... 6 n - 1, so the same dof_map reproduces from_beam."""
+    from bladedamp.blade import solid_platform_beam
+    g = solid_platform_beam()
+    modes = beam_modes(g)
+    assert modes.n_dofs == 7 * modes.n_nodes and modes.stiffness.shape[0] == modes.n_dofs - 7 - 2  # root, 2 tied
+    expected = ModalBlade.from_beam(g, n_modes=6)
+    blade = ModalBlade.from_matrices(modes.mass, modes.stiffness, beam_dof_map(modes), points=g.points(), n_modes=6,
+                                     damping_ratios=0.001, rigid_links=LINKS, mode_names=expected.mode_names)
+    np.testing.assert_allclose(blade.natural_frequencies_hz, expected.natural_frequencies_hz, rtol=1e-8)
+    assert matched_up_to_sign(blade, expected) < 1e-8
+
+
 def test_from_matrices_keeps_per_mode_damping_and_refines_nothing_else():
     g = reference_blade_geometry()
     modes = beam_modes(g)

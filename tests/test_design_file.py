@@ -382,3 +382,35 @@ def test_surface_file_error_on_the_command_line(stl_folder, capsys):
     assert main(["frf", str(path), "--out", str(stl_folder / "out")]) == 2
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and str(path) in err and "(missing: [blade.regions.OR])" in err
+
+
+@pytest.mark.parametrize("blade", ["modal_file", "surface_file", "parametric"])
+def test_platform_angle_option_with_a_solid_blade_exits_2_before_computing(blade, coarse_modes, stl_folder, capsys):
+    """bladedamp optimize --gamma-right-deg with a solid FE blade (its saved file, an STL, the
+    parametric solid): exit code 2 and one line naming the option and why (the blade's geometry
+    sets the platform angles), right after the design is read: no mass optimisation, no output
+    folder (the platform-angle check of the flexible platforms used to stop the study's first FRF)."""
+    import time
+
+    from bladedamp.cli import main
+    from bladedamp.solid import solid_blade
+
+    if blade == "modal_file":
+        solid_blade(modes=coarse_modes).save(stl_folder / "solid.npz")
+        text, source = '[blade]\nmodal_file = "solid.npz"\n', '[blade] modal_file = "solid.npz", its OR face at 35 deg'
+    elif blade == "surface_file":
+        text, source = _surface_text(), '[blade] surface_file = "blade.stl", its OR face at 35 deg'
+    else:
+        text = f'[blade]\nmodel = "solid"\nsolid_element_size_mm = {SURFACE_ELEMENT_SIZE_MM}\n'
+        source = '[blade] model = "solid", meshed at [disk] gamma_right_deg = 35'
+    path = _write(stl_folder, text)
+    out = stl_folder / "out"
+    t0 = time.perf_counter()
+    assert main(["optimize", str(path), "--gamma-right-deg", "30", "40", "--out", str(out)]) == 2
+    assert time.perf_counter() - t0 < 30                      # reading the design (meshing a solid) only
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+    assert err.startswith("bladedamp optimize: error: --gamma-right-deg: a solid FE blade's platform angles come "
+                          f"from its geometry ({path}: {source})"), err
+    assert "remove --gamma-right-deg" in err
+    assert not out.exists()

@@ -244,6 +244,56 @@ def test_monte_carlo_where_some_disks_failed(tmp_path, monkeypatch):
     np.testing.assert_array_equal(back.amplification, res.amplification)
 
 
+# ----- the typed JSON values (io.encode_value / io.decode_value) ------------------------
+def same_typed(x, y) -> bool:
+    """same_value, with numpy arrays compared by type, dtype, shape and entries (NaN equal to NaN)."""
+    if isinstance(x, np.ndarray):
+        return (type(y) is np.ndarray and x.dtype == y.dtype and x.shape == y.shape
+                and np.array_equal(x, y, equal_nan=x.dtype.kind in "fc"))
+    if type(x) is not type(y):
+        return False
+    if isinstance(x, (tuple, list)):
+        return len(x) == len(y) and all(same_typed(u, v) for u, v in zip(x, y))
+    if isinstance(x, dict):
+        return list(x) == list(y) and all(same_typed(x[k], y[k]) for k in x)
+    return same_value(x, y)
+
+
+def test_encoded_values_round_trip_with_their_types():
+    """Every type encode_value documents comes back from json text with its type, dtype and shape;
+    numpy scalars come back as the Python scalar of their kind."""
+    value = {"float": 0.1, "nan": float("nan"), "inf": -float("inf"), "zero": -0.0, "int": 2 ** 62, "neg": -3,
+             "true": True, "false": False, "text": "1F", "none": None, "complex": 1 - 2j,
+             "tuple": (1, 2.5, "x", None, (True, ())), "list": [1, [2.0, "a"], ()],
+             "f64": np.array([[0.1, np.nan], [1e-300, -2.0]]), "f32": np.array([1.5, 2.25], dtype=np.float32),
+             "i64": np.arange(6, dtype=np.int64).reshape(2, 3), "i32": np.array([-1, 7], dtype=np.int32),
+             "u8": np.array([0, 255], dtype=np.uint8), "bool": np.array([True, False]),
+             "c128": np.array([1 + 2j, -0.5j]), "names": np.array(["1F", "2F", "1T"]), "0d": np.array(3.5),
+             "empty": np.zeros((0, 3)), "empty_c": np.zeros((2, 0), dtype=complex),
+             "basis": bd.HarmonicBasis((0, 1, 3), 32),
+             "nested": {1: {"a": (np.array([1, 2]),), (2, "b"): {"deep": [1.0]}}, None: 0.0}}
+    back = io.decode_value(json.loads(json.dumps(io.encode_value(value))))
+    basis = back.pop("basis")
+    assert basis.harmonics == (0, 1, 3) and basis.n_samples == 32
+    value.pop("basis")
+    assert same_typed(value, back), back
+    scalars = [np.float64(0.25), np.float32(0.5), np.int64(3), np.int8(-2), np.bool_(True), np.complex128(1j), np.str_("x")]
+    assert same_typed([0.25, 0.5, 3, -2, True, 1j, "x"],
+                      io.decode_value(json.loads(json.dumps(io.encode_value(scalars)))))
+    # an object array is stored as the array numpy infers from its items
+    assert same_typed(io.decode_value(io.encode_value(np.array(["ok", "failed"], dtype=object))),
+                      np.array(["ok", "failed"]))
+
+
+def test_encode_value_refuses_other_types_naming_the_value():
+    with pytest.raises(TypeError, match=r"cannot save info\['k'\]\[1\]: a builtins.object"):
+        io.encode_value({"k": [1, object()]}, "info")
+    with pytest.raises(TypeError, match="cannot save a: an array of dtype"):
+        io.encode_value(np.array([b"x"]), "a")
+    with pytest.raises(ValueError, match="not an encoded value"):
+        io.decode_value({"n_dofs": 3})                 # a plain JSON object is not an encoded dict
+
+
 # ----- the file ------------------------------------------------------------------------
 def test_load_rejects_what_is_not_a_result(tmp_path, oscillator_frf):
     np.savez(tmp_path / "plain.npz", x=np.zeros(3))
