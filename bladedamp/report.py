@@ -936,6 +936,9 @@ def montecarlo_outputs(out: Path, design, result, saved: list) -> dict:
     analysis = (f"Analysis per disk: full assembly, {f_range}, harmonics {tuple(meta.get('harmonics', ()))}, "
                 f"max_step {meta.get('max_step', float('nan')):g}, tolerance {meta.get('tol', float('nan')):g} "
                 "(peaks only; see bladedamp.studies.mistuning.MONTE_CARLO_MAX_STEP).")
+    error = meta.get("harmonic_error_first_disk")
+    analysis += (" Harmonic error estimate of the first disk (the one estimated, against an enriched "
+                 f"harmonic set): {'not estimated' if error is None else fmt_percent(error)} of its peak.")
     write_summary(out, "montecarlo", design, lines, ["montecarlo.png", *saved], analysis)
     return summary
 

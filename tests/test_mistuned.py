@@ -376,6 +376,29 @@ def test_monte_carlo_local_without_dask_and_saved_results(tmp_path):
     assert lo <= res.amplification.mean() <= hi
 
 
+def test_monte_carlo_estimates_the_harmonic_error_of_its_first_disk_only(monkeypatch):
+    """The estimate costs about as much as a disk's FRF (5 enriched Newton solves of the full
+    assembly): the Monte Carlo makes it for disk 0 and records it; every other disk's response is
+    the same branch without it ("not estimated"), and 'auto' cannot go without it."""
+    import bladedamp.hbm.accuracy as accuracy
+
+    td = tuned(4, 1)
+    calls = []
+    estimate = accuracy.harmonic_error
+    monkeypatch.setattr(accuracy, "harmonic_error", lambda *a, **k: calls.append(1) or estimate(*a, **k))
+    res = mt.monte_carlo(td, 3, std=0.02, seed=5, f_range_hz=(88.0, 104.0), scheduler="serial",
+                         tuned_peak_amplitude=1e-4)
+    assert len(calls) == 1 and 0 < res.meta["harmonic_error_first_disk"] < 0.2
+    kappa = res.kappa[1]
+    plain = mt.mistuned_response(td, kappa, (88.0, 104.0))
+    bare = mt.mistuned_response(td, kappa, (88.0, 104.0), estimate_harmonic_error=False)
+    assert np.isfinite(plain.harmonic_error) and np.isnan(bare.harmonic_error) and bare.harmonics_converged is None
+    np.testing.assert_array_equal(plain.omega, bare.omega)
+    md = MistunedDisk.from_tuned(td, kappa)
+    with pytest.raises(ValueError, match="estimate_harmonic_error"):
+        md.frequency_response(90.0, 100.0, harmonics="auto", estimate_harmonic_error=False)
+
+
 def test_monte_carlo_on_a_local_dask_cluster_matches_serial():
     """The same two disks on a one-worker local Dask cluster give the serial peaks exactly
     (kappa of disk i depends on (seed, i) only, not on the scheduling)."""

@@ -166,15 +166,20 @@ def annotate(response, check: HarmonicCheck, tolerance: float):
 
 @one_blas_thread
 def converged_response(model, solve, harmonics="auto", tolerance: float = HARMONIC_TOLERANCE,
-                       max_harmonic: int = 3, n_points: int = 5):
+                       max_harmonic: int = 3, n_points: int = 5, estimate: bool = True):
     """The branch of ``solve(harmonics) -> response`` with its harmonic error estimate.
 
     ``harmonics="auto"``: the sets of :func:`auto_sets` (``max_harmonic``) in turn until one meets
     ``tolerance``; otherwise the given set, checked once. A set whose branch fails (does not reach the end of the range) is
-    followed by the next richer one in the automatic choice."""
+    followed by the next richer one in the automatic choice. ``estimate=False`` (a given set
+    only): no estimate (``harmonic_error`` NaN, ``harmonics_converged`` None: "not estimated"),
+    for a study that estimates it on a representative case instead (the Monte Carlo's first disk)."""
     if isinstance(harmonics, str):
         if harmonics != "auto":
             raise ValueError(f"harmonics must be 'auto' or a tuple of integers >= 0 (got {harmonics!r})")
+        if not estimate:
+            raise ValueError("harmonics='auto' chooses the harmonics by their error estimate: it needs "
+                             "estimate_harmonic_error=True (or give the harmonics, e.g. (1,))")
         if not (np.isfinite(tolerance) and tolerance > 0):
             raise ValueError(f"harmonic_tolerance must be a finite number > 0 (got {tolerance!r})")
         best = None
@@ -195,6 +200,6 @@ def converged_response(model, solve, harmonics="auto", tolerance: float = HARMON
             return response
         return annotate(best[0], best[1], tolerance)
     response = solve(tuple(harmonics))
-    if not len(response.omega) or getattr(response, "stopped_by", ""):
+    if not estimate or not len(response.omega) or getattr(response, "stopped_by", ""):
         return response
     return annotate(response, harmonic_error(model, response, n_points=n_points), tolerance)

@@ -138,7 +138,8 @@ def auto_range(disk: TunedDisk, kappa, margin: float = 0.03) -> tuple[float, flo
 
 def mistuned_response(disk: TunedDisk, kappa, f_range_hz=None, harmonics=(1,), max_step: float = 0.05,
                       tuned_peak_amplitude: float | None = None, max_widenings: int = 3, n_sector: int | None = None,
-                      n_samples: int | None = None, tol: float = 1e-10) -> MistunedResponse:
+                      n_samples: int | None = None, tol: float = 1e-10,
+                      estimate_harmonic_error: bool = True) -> MistunedResponse:
     """Full-assembly response of ``disk`` with blade frequencies times ``kappa``; while some
     blade's largest amplitude is at an end of the range (default :func:`auto_range`), the branch
     is continued beyond that end by half the range's width (:meth:`MistunedDisk.extend_response`).
@@ -147,14 +148,16 @@ def mistuned_response(disk: TunedDisk, kappa, f_range_hz=None, harmonics=(1,), m
     rising frequency.
     ``n_sector``: a cyclic sector of that many blades (``kappa`` then has n_sector entries; e.g. 2
     for alternating mistuning, exact, see the tests). ``n_samples``, ``tol``: AFT samples and
-    continuation tolerance (defaults: the model's and the continuation's).
+    continuation tolerance (defaults: the model's and the continuation's);
+    ``estimate_harmonic_error``: as :meth:`MistunedDisk.frequency_response`.
     Raises RuntimeError if the continuation does not cover the range."""
     md = MistunedDisk.from_tuned(disk, kappa, n_sector=n_sector)
     if f_range_hz is None:
         f_range_hz = auto_range(disk, kappa)
     lo, hi = (float(f) for f in f_range_hz)
     # a sweep that turns back and leaves the range by 5 % of its width has left the curve (below)
-    common = dict(harmonics=harmonics, n_samples=n_samples, tuned_peak_amplitude=tuned_peak_amplitude, tol=tol, leave_margin=0.05)
+    common = dict(harmonics=harmonics, n_samples=n_samples, tuned_peak_amplitude=tuned_peak_amplitude, tol=tol,
+                  leave_margin=0.05, estimate_harmonic_error=estimate_harmonic_error)
 
     def sweep(lo, hi):
         # the upward sweep can leave the response curve at a branch point and follow another
@@ -431,14 +434,21 @@ MONTE_CARLO_TOL = 1e-6
 
 
 def _one_disk(disk, kappa, f_range_hz, settings):
-    """Peaks (n,) and their frequencies (n,) of one mistuned disk (runs on a worker)."""
+    """Peaks (n,) and their frequencies (n,) of one mistuned disk, the failure's message ('' if
+    none) and the harmonic error estimate (NaN if not estimated) (runs on a worker)."""
     try:
         r = mistuned_response(disk, kappa, f_range_hz, **settings)
         p, f = r.peaks()
-        return p, f, ""
+        return p, f, "", float(r.harmonic_error)
     except RuntimeError as e:  # keep the study going; the failure is recorded
         n = len(kappa)
-        return np.full(n, np.nan), np.full(n, np.nan), str(e)
+        return np.full(n, np.nan), np.full(n, np.nan), str(e), float("nan")
+
+
+def _disk_settings(settings: dict, i: int) -> dict:
+    """Disk i's settings: only the first disk gets the harmonic error estimate (it costs about as
+    much as the disk's FRF; the harmonics are the same for every disk of the study)."""
+    return dict(settings, estimate_harmonic_error=i == 0)
 
 
 @dataclass
@@ -449,6 +459,9 @@ class MonteCarloResult(Saveable):
     default Monte Carlo settings, accurate for the largest blade of each disk; see
     :data:`MONTE_CARLO_MAX_STEP` for the measured errors of the others);
     peak_frequency_hz : (N, n); tuned_peak_amplitude [m]; errors : per disk, '' if it converged.
+    meta : the settings, the executor, ``elapsed_s`` and ``harmonic_error_first_disk``: the harmonic
+        error estimate of disk 0 (relative to its peak; None if it could not be estimated), the one
+        disk estimated, for cost (see :meth:`bladedamp.MistunedDisk.frequency_response`).
     """
 
     kappa: np.ndarray
@@ -577,7 +590,7 @@ def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f
     used = "serial"
     if scheduler == "serial":
         for i, k in enumerate(kappas):
-            results[i] = _one_disk(disk, k, f_range_hz, settings)
+            results[i] = _one_disk(disk, k, f_range_hz, _disk_settings(settings, i))
             if progress:
                 progress(i + 1, n_disks)
     else:
@@ -596,8 +609,8 @@ def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f
             used = f"scheduler {scheduler}"
         try:
             disk_future = client.scatter(disk, broadcast=True)
-            futures = [client.submit(_one_disk, disk_future, k, f_range_hz, settings, pure=False)
-                       for k in kappas]
+            futures = [client.submit(_one_disk, disk_future, k, f_range_hz, _disk_settings(settings, i), pure=False)
+                       for i, k in enumerate(kappas)]
             index = {f.key: i for i, f in enumerate(futures)}
             for done, fut in enumerate(as_completed(futures), 1):
                 results[index[fut.key]] = fut.result()
@@ -612,7 +625,8 @@ def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f
                            float(tuned_peak_amplitude), [r[2] for r in results],
                            {"std": std, "seed": int(seed), "f_range_hz": None if f_range_hz is None else list(f_range_hz), "harmonics": list(harmonics),
                             "max_step": max_step, "tol": tol, "n_samples": n_samples, "executor": used,
-                            "elapsed_s": elapsed,
+                            "elapsed_s": elapsed, "harmonic_error_first_disk":
+                                None if not np.isfinite(results[0][3]) else results[0][3],
                             "disk": {"n_blades": n, "engine_order": disk.engine_order,
                                      "damper": None if disk.damper is None else disk.damper.kind,
                                      "mass_g": None if disk.damper is None else 1e3 * disk.damper.mass}})
