@@ -683,3 +683,19 @@ def test_stop_above_ends_the_branch_at_the_first_point_above_it_and_retries_noth
     for bad, name in (({"stop_above": -1.0}, "stop_above"), ({"stop_direction": 3}, "stop_direction")):
         with pytest.raises(ValueError, match=name):
             disk.frequency_response(*F_RANGE, harmonics=(1,), **bad)
+
+
+def test_a_response_without_the_harmonic_error_estimate_is_the_same_branch_and_says_so():
+    """``estimate_harmonic_error=False`` (the mass searches, whose harmonic setting is reported
+    once): the same branch, its estimate NaN and "not estimated" (harmonics_converged None);
+    'auto' chooses by the estimate, so it refuses to go without."""
+    disk = reference_disk("cylinder", 1e-3)
+    full = frf("cylinder", 1e-3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        bare = disk.frequency_response(*F_RANGE, harmonics=(1,), max_step=MAX_STEP, estimate_harmonic_error=False)
+    assert np.isfinite(full.harmonic_error) and np.isnan(bare.harmonic_error) and bare.harmonics_converged is None
+    np.testing.assert_array_equal(bare.omega, full.omega)
+    np.testing.assert_array_equal(bare.tip_amplitude, full.tip_amplitude)
+    with pytest.raises(ValueError, match="estimate_harmonic_error"):
+        disk.frequency_response(*F_RANGE, harmonics="auto", estimate_harmonic_error=False)
