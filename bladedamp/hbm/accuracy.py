@@ -196,7 +196,7 @@ def converged_response(model, solve, harmonics="auto", tolerance: float = HARMON
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", AccuracyWarning)
                 response = solve(tuple(H))
-                if getattr(response, "stopped_by", ""):
+                if response.stopped_by:
                     return response           # stopped as the caller asked: no estimate, no richer set
                 check = harmonic_error(model, response, n_points=n_points) if len(response.omega) else None
             if check is None:
@@ -209,6 +209,6 @@ def converged_response(model, solve, harmonics="auto", tolerance: float = HARMON
             return response
         return annotate(best[0], best[1], tolerance)
     response = solve(tuple(harmonics))
-    if not estimate or not len(response.omega) or getattr(response, "stopped_by", ""):
+    if not estimate or not len(response.omega) or response.stopped_by:
         return response
     return annotate(response, harmonic_error(model, response, n_points=n_points), tolerance)

@@ -107,6 +107,14 @@ class PeakEvaluation(Saveable):
     stopped_above: bool = False
 
 
+def peak_search_options(harmonics) -> dict:
+    """``TunedDisk.frequency_response`` options of the studies' peak searches: no harmonic error
+    estimate of each response (the peak is all a search needs; the studies' harmonic setting is
+    reported once, beside the converged one, in ``reproduce``'s harmonic accuracy), unless
+    ``harmonics`` is "auto", which chooses by the estimate."""
+    return {} if isinstance(harmonics, str) else {"estimate_harmonic_error": False}
+
+
 def robust_peak(disk: TunedDisk, f_range_hz=(90.0, 105.0), harmonics=(1,), direction: int = 0,
                 attempts=ROBUST_ATTEMPTS, max_points: int = ROBUST_MAX_POINTS, downward: bool = True,
                 give_up_above: float = np.inf, stop_above: float = np.inf) -> PeakEvaluation:
@@ -126,17 +134,15 @@ def robust_peak(disk: TunedDisk, f_range_hz=(90.0, 105.0), harmonics=(1,), direc
     or below it, such a mass costs only the branch up to that point.
     """
     lo, hi = validation.interval("f_range_hz", f_range_hz, "Hz")
-    # the peak is all a search needs: no harmonic error estimate of each response (the studies'
-    # harmonic setting is reported once, beside the converged one: reproduce's harmonic accuracy)
-    stop = dict(stop_above=float(stop_above), stop_direction=direction) if np.isfinite(stop_above) else {}
-    if not isinstance(harmonics, str):               # "auto" chooses by the estimate
-        stop["estimate_harmonic_error"] = False
+    frf_options = peak_search_options(harmonics)
+    if np.isfinite(stop_above):
+        frf_options.update(stop_above=float(stop_above), stop_direction=direction)
     messages, bound, up, runs = [], np.nan, None, 0
     for options in attempts:
         runs += 1
         try:
-            p, f, _ = peak_response(disk, (lo, hi), harmonics, direction=direction, max_points=max_points, **stop,
-                                    **options)
+            p, f, _ = peak_response(disk, (lo, hi), harmonics, direction=direction, max_points=max_points,
+                                    **frf_options, **options)
             note = "" if runs == 1 else f" (retry {options}; before: {'; '.join(messages)})"
             return PeakEvaluation(True, p, f, np.nan, "interior peak of a complete response" + note, runs)
         except IncompleteResponse as exc:
@@ -159,7 +165,7 @@ def robust_peak(disk: TunedDisk, f_range_hz=(90.0, 105.0), harmonics=(1,), direc
     # downward sweep, joined with the farthest-reaching upward branch
     runs += 1
     step = min((o.get("max_step", 0.05) for o in attempts), default=0.02)
-    down = disk.frequency_response(hi, lo, harmonics=harmonics, max_step=step, max_points=max_points, **stop)
+    down = disk.frequency_response(hi, lo, harmonics=harmonics, max_step=step, max_points=max_points, **frf_options)
     bound = np.fmax(bound, _lower_bound(down, direction))
     if down.success:
         branches = [down]
@@ -226,7 +232,7 @@ class MassSweep(Saveable):
 
 def _peak_of(case):
     disk, f_range, harmonics = case
-    p, f, _ = peak_response(disk, f_range, harmonics, estimate_harmonic_error=isinstance(harmonics, str))
+    p, f, _ = peak_response(disk, f_range, harmonics, **peak_search_options(harmonics))
     return p, f
 
 
