@@ -616,8 +616,8 @@ class TunedDisk:
             response = DiskResponse.from_branch(self, system, branch)
             T = system.basis.n_samples
 
-            def points_dissipation(r):       # every contact point's dissipation, (n, 2 P)
-                return r.point_dissipation.reshape(len(r.omega), -1) if self.has_damper and len(r.omega) \
+            def points_dissipation(r, field="point_dissipation"):   # every contact point's, (n, 2 P)
+                return getattr(r, field).reshape(len(r.omega), -1) if self.has_damper and len(r.omega) \
                     else np.zeros((len(r.omega), 0))
 
             def refine(indices):
@@ -625,7 +625,8 @@ class TunedDisk:
                 return points_dissipation(DiskResponse.from_branch(self, fine, branch.take(indices)))
 
             return with_checks(response, physical_checks(branch.omega, (w0, w1), points_dissipation(response),
-                                                         response.excitation_work, max_step, T, refine))
+                                                         response.excitation_work, max_step, T, refine,
+                                                         points_dissipation(response, "point_work_bound")))
 
         return with_stop_note(converged_response(model, solve, harmonics, harmonic_tolerance, max_harmonic,
                                                  estimate=estimate_harmonic_error))
@@ -832,6 +833,8 @@ class DiskResponse(FrequencyResponse):
     point_displacement : (n, C, 2, P, 3) relative displacement coefficients of every patch point
     point_state : (n, 2, P, 3) fraction of the period each point sticks, slips, is separated
     point_dissipation : (n, 2, P) energy dissipated per period at each point [J]
+    point_work_bound : (n, 2, P) each point's energy scale per period, the largest work its force
+        and motion harmonics could do (HarmonicBasis.work_bound) [J]
     dissipated_energy : (n,) friction dissipation per period, all contacts of one sector [J]
     excitation_work : (n,) work of the excitation per period [J]
     viscous_dissipation : (n,) blade modal damping dissipation per period [J]
@@ -845,6 +848,7 @@ class DiskResponse(FrequencyResponse):
     point_displacement: np.ndarray = None
     point_state: np.ndarray = None
     point_dissipation: np.ndarray = None
+    point_work_bound: np.ndarray = None
     dissipated_energy: np.ndarray = None
     excitation_work: np.ndarray = None
     viscous_dissipation: np.ndarray = None
@@ -872,6 +876,7 @@ class DiskResponse(FrequencyResponse):
             pdisp = np.zeros((npts, C, 2, P, 3))
             pstate = np.zeros((npts, 2, P, 3))
             pdiss = np.zeros((npts, 2, P))
+            pbound = np.zeros((npts, 2, P))
             load = np.zeros((npts, 2))
             for i, (x, w) in enumerate(zip(X, branch.omega)):
                 local = (coupling.matrix @ x.ravel()).reshape(C, element.n_local)
@@ -885,9 +890,11 @@ class DiskResponse(FrequencyResponse):
                         pstate[i, c, :, s] = (pts.state == s).mean(axis=1)
                     fcoef = basis.to_coeffs(np.moveaxis(pts.force, 1, 0))
                     pdiss[i, c] = basis.work_per_cycle(fcoef, pdisp[i, :, c]).sum(axis=-1)
+                    pbound[i, c] = basis.work_bound(fcoef, pdisp[i, :, c]).sum(axis=-1)
                     load[i, c] = pts.normal_load.sum(axis=0).mean()
             out.update(contact_force=cf, relative_motion=rm, point_displacement=pdisp, point_state=pstate,
-                       point_dissipation=pdiss, dissipated_energy=pdiss.sum(axis=(1, 2)), normal_load=load)
+                       point_dissipation=pdiss, point_work_bound=pbound, dissipated_energy=pdiss.sum(axis=(1, 2)),
+                       normal_load=load)
         else:
             out.update(dissipated_energy=np.zeros(npts))
         return cls(branch.omega, X, basis, disk.dof_names, branch.success, branch.message, branch.iterations,

@@ -740,7 +740,8 @@ class MistunedDisk:
                 return MistunedResponse.from_branch(self, fine, branch.take(indices)).damper_dissipation
 
             return with_checks(response, physical_checks(branch.omega, (w0, w1), response.damper_dissipation,
-                                                         response.excitation_work, max_step, T, refine))
+                                                         response.excitation_work, max_step, T, refine,
+                                                         response.damper_work_bound))
 
         return converged_response(self, solve, harmonics, harmonic_tolerance, max_harmonic,
                                   estimate=estimate_harmonic_error)
@@ -836,6 +837,8 @@ class MistunedResponse(FrequencyResponse):
     tip_amplitude : (n_points, s, 3) first-harmonic tip amplitude of each blade in x, y, z [m]
     excitation_work, viscous_dissipation, dissipated_energy : (n_points,) per period, whole model [J]
     damper_dissipation : (n_points, n_active_dampers) friction dissipation of each damper [J]
+    damper_work_bound : (n_points, n_active_dampers) each damper's energy scale per period, the
+        largest work its force and motion harmonics could do (HarmonicBasis.work_bound) [J]
     tuned_peak_amplitude : the tuned disk's peak u_x [m] if given (amplification factors)
     """
 
@@ -844,6 +847,7 @@ class MistunedResponse(FrequencyResponse):
     viscous_dissipation: np.ndarray = None
     dissipated_energy: np.ndarray = None
     damper_dissipation: np.ndarray = None
+    damper_work_bound: np.ndarray = None
     tuned_peak_amplitude: float | None = None
     disk: MistunedDisk = None
 
@@ -854,7 +858,7 @@ class MistunedResponse(FrequencyResponse):
         X = branch.x.reshape(-1, C, N)
         tip = disk.output_amplitudes(X, basis).reshape(len(X), s, 3)
         nd = len(disk.active_dampers)
-        exc, visc, diss = [], [], np.zeros((len(branch.omega), nd))
+        exc, visc, diss, bound = [], [], np.zeros((len(branch.omega), nd)), np.zeros((len(branch.omega), nd))
         for i, (x, w) in enumerate(zip(branch.x, branch.omega)):
             exc.append(system.excitation_work(x, w))
             visc.append(system.viscous_dissipation(x, w))
@@ -863,9 +867,11 @@ class MistunedResponse(FrequencyResponse):
                 local = (c.matrix @ x).reshape(C, c.element.n_local)
                 force, _, _ = c.element.harmonic_forces(local, basis, w, False)
                 diss[i] = basis.work_per_cycle(force, local).reshape(nd, -1).sum(axis=1)
+                bound[i] = basis.work_bound(force, local).reshape(nd, -1).sum(axis=1)
         return cls(branch.omega, X, basis, disk.dof_names, branch.success, branch.message, branch.iterations,
                    branch.turning_points, tip_amplitude=tip, excitation_work=np.array(exc),
                    viscous_dissipation=np.array(visc), dissipated_energy=diss.sum(axis=1), damper_dissipation=diss,
+                   damper_work_bound=bound,
                    tuned_peak_amplitude=tuned_peak_amplitude, disk=disk)
 
     @property

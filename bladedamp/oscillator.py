@@ -168,9 +168,10 @@ class FrictionOscillator:
                 fine = self.hbm_system(system.basis.harmonics, REFINE_SAMPLES_FACTOR * T)
                 return np.array([fine.element_dissipation(branch.x[i], branch.omega[i]) for i in indices])
 
+            bound = np.array([sum(system.element_work_bound(x, w)) for x, w in zip(branch.x, branch.omega)])
             return with_checks(response, physical_checks(branch.omega, (omega_start, omega_end), energy[:, 2:],
                                                          energy[:, 0], continuation_options.get("max_step") or 0.02,
-                                                         T, refine))
+                                                         T, refine, bound.reshape(-1, 1)))
 
         return converged_response(self, solve, harmonics, harmonic_tolerance, max_harmonic)
 

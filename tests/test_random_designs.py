@@ -30,7 +30,13 @@ from bladedamp import reference as ref
 SEED = 20261201
 N_DISKS = 160
 N_OSCILLATORS = 160
-# issue 12's target is 0.99; measured 301 of 320 = 0.941 on 2026-12-02, sixth session (disks 143 of
+# issue 12's target is 0.99; measured 302 of 320 = 0.944 on 2026-12-03, tenth session (disks 143
+# of 160, oscillators 159 of 160: each contact's dissipation judged against its own energy scale,
+# max(excitation work, pi sum_h h |F_h||W_h|), so an off-resonance branch whose tiny negative
+# dissipation is AFT rounding no longer fails; inclined and time-checked oscillators run with
+# harmonics 'auto' and count only when harmonics_converged; the 17 disks left: 14 retrace, stall
+# or turn back near 94-95 Hz where the damper hops or rolls, 1 turns back at 90 Hz, 1 does not
+# start, 1 misses the harmonic tolerance); 301 of 320 = 0.941 on 2026-12-02, sixth session (disks 143 of
 # 160 with the retry of a failed branch with the damper's unknowns weighing less in the arc length,
 # bladedamp.disk.DAMPER_ARC_SCALE: random disks 16, 102 and 124; oscillators 158 of 160; the floor
 # leaves 3 designs for rounding: disk 55 failed in the fifth session's venv and passes in this
@@ -44,17 +50,15 @@ N_OSCILLATORS = 160
 # printed, and the failing designs with it.
 SHARE_TARGET = 0.99
 SHARE_REQUIRED = 0.93
-# Harmonics of the oscillators cross-checked by time integration. The one-harmonic HBM is
-# wrong for inclined contacts (the normal load varies: it needs the static term and higher
-# harmonics); switch this to None (the frequency_response default) once that default is chosen
-# automatically.
-TIME_CHECK_HARMONICS = (0, 1, 2, 3)
-# Inclined contacts (normal load varying with the motion, lifting off) need the static term, so
-# the random inclined oscillators use INCLINED_HARMONICS (switch to None, the default, with the
-# automatic choice). Their AFT samples are the product's automatic choice (None: at least 256 for
-# an inclined contact, four times more while the branch fails, see
-# bladedamp.response.sampled_response); 256 were set here by hand before.
-INCLINED_HARMONICS = (0, 1, 2, 3)
+# Harmonics of the oscillators cross-checked by time integration, and of the random inclined
+# oscillators (normal load varying with the motion, lifting off): the frequency_response default,
+# "auto" (the harmonics chosen by their error estimate, static term included; (0, 1, 2, 3) was
+# set here by hand before). A design run with "auto" that ends with harmonics_converged False
+# (the tolerance not met) is not counted as accurate. Their AFT samples are the product's
+# automatic choice too (None: at least 256 for an inclined contact, four times more while the
+# branch fails, see bladedamp.response.sampled_response).
+TIME_CHECK_HARMONICS = "auto"
+INCLINED_HARMONICS = "auto"
 INCLINED_N_SAMPLES = None
 # a branch that needs more points than this at the suite's max_step has stalled
 MAX_POINTS = 2000
@@ -163,33 +167,42 @@ def run_design(d: dict) -> dict:
         if d["kind"][0] == "disk":
             r = disk_response(make_disk(d), d)
             lo, hi = sorted((2 * np.pi * d["f_start"], 2 * np.pi * d["f_end"]))
-            work = np.abs(r.excitation_work)
+            work = np.abs(r.excitation_work)[:, None]
             points = np.zeros((len(r.omega), 0)) if r.point_dissipation is None \
                 else r.point_dissipation.reshape(len(r.omega), -1)
+            bound = np.zeros_like(points) if r.point_work_bound is None else r.point_work_bound.reshape(points.shape)
         else:
             osc = FrictionOscillator(**d["params"])
             r = osc.frequency_response(d["omega_start"] / (2 * np.pi), d["omega_end"] / (2 * np.pi), harmonics=d["harmonics"],
                                        n_samples=d["n_samples"], max_step=d["max_step"], max_points=MAX_POINTS)
             lo, hi = sorted((d["omega_start"], d["omega_end"]))
             e = osc.energy_balance(r) if len(r.omega) else np.zeros((0, 3))
-            work, points = np.abs(e[:, 0]), e[:, 2:]
+            work, points = np.abs(e[:, :1]), e[:, 2:]
+            system = osc.hbm_system(r.basis.harmonics, r.basis.n_samples)
+            bound = np.array([sum(system.element_work_bound(x.ravel(), w)) for x, w in zip(r.coefficients, r.omega)])
+            bound = bound.reshape(-1, 1)
         bad = branch_checks(r.omega, lo, hi, d["max_step"])
         # a friction contact cannot give energy back over a period, whatever the harmonic
         # truncation (bladedamp.response.physical_checks has the argument): a value below
-        # rounding (1e-9 of the excitation work) is the AFT's sampling error, re-evaluated with
-        # FINE_FACTOR x the samples, and fails if still below 1e-6 of the excitation work there
+        # rounding (1e-9 of the energy scale: the larger of the excitation work and the contact's
+        # work bound pi sum_h h |F_h||W_h|) is the AFT's sampling error, re-evaluated with
+        # FINE_FACTOR x the samples, and fails if still below 1e-6 of that scale there
         if len(r.omega):
-            relative = points.min(axis=1, initial=0.0) / work
+            scale = np.maximum(np.maximum(work, 1e-300), bound)
+            relative = (points / scale).min(axis=1, initial=0.0)
             suspect = np.flatnonzero(relative < -1e-9)
             if suspect.size:
-                relative[suspect] = resolved_dissipation(d, r, suspect).min(axis=1, initial=0.0) / work[suspect]
+                relative[suspect] = (resolved_dissipation(d, r, suspect) / scale[suspect]).min(axis=1, initial=0.0)
             if np.any(relative < -1e-6):
-                bad.append(f"negative dissipation {relative.min():.3g} of the excitation work "
+                bad.append(f"negative dissipation {relative.min():.3g} of the energy scale "
                            f"(with {FINE_FACTOR} x the AFT samples)")
     omega_end = 2 * np.pi * d["f_end"] if d["kind"][0] == "disk" else d["omega_end"]
     reached = bool(len(r.omega)) and abs(r.omega[-1] - omega_end) <= 1e-9 * abs(omega_end)
+    # a design whose harmonics were chosen automatically must meet the harmonic tolerance too
+    inaccurate = d["harmonics"] == "auto" and r.harmonics_converged is False
     return dict(kind=d["kind"], success=bool(r.success), reached=reached, message=r.message, bad=bad,
-                points=len(r.omega), seconds=time.perf_counter() - t0)
+                harmonics=r.basis.harmonics, inaccurate=inaccurate, points=len(r.omega),
+                seconds=time.perf_counter() - t0)
 
 
 def all_designs():
@@ -205,7 +218,7 @@ def run_all(designs, processes=None):
 
 
 def summary(results) -> tuple[float, str]:
-    good = [r for r in results if r["success"] and r["reached"] and not r["bad"]]
+    good = [r for r in results if r["success"] and r["reached"] and not r["bad"] and not r["inaccurate"]]
     lines = [f"random designs: {len(good)} of {len(results)} reach the end with every check passing "
              f"({100 * len(good) / len(results):.1f} %)"]
     for kind in ("disk", "oscillator"):
@@ -215,7 +228,8 @@ def summary(results) -> tuple[float, str]:
             lines.append(f"  {kind}s: {ok} of {len(rs)}, {sum(r['seconds'] for r in rs):.0f} s in all")
     for r in results:
         if r not in good:
-            lines.append(f"  FAILED {r['kind']}: {r['message']} {r['bad']}")
+            why = " (harmonic tolerance not met)" if r["inaccurate"] else ""
+            lines.append(f"  FAILED {r['kind']}{why}: harmonics {r['harmonics']}: {r['message']} {r['bad']}")
     return len(good) / len(results), "\n".join(lines)
 
 
@@ -283,12 +297,11 @@ def time_check_designs():
     return picked
 
 
-KNOWN_TIME_CHECK_FAILURES = {
-    # inclined contact with lift-off, gross slip: negative contact dissipation from the AFT's
-    # sampling at the lift-off kink (-14 % / +1.6 % / +0.1 % at 64 / 256 / 1024 samples with
-    # (0, 1, 2, 3); -2.6 % with 9 harmonics at 256) and a continuation that runs out of points
-    4: "inclined oscillator with lift-off: AFT sampling gives negative dissipation; branch incomplete",
-}
+# Oscillator 4 (inclined contact with lift-off, gross slip) was a known failure with (0, 1, 2, 3)
+# set by hand: negative contact dissipation from the AFT's sampling at the lift-off kink (-14 % /
+# +1.6 % / +0.1 % at 64 / 256 / 1024 samples) and a continuation that ran out of points. With the
+# default (automatic harmonics and samples) it passes, within 2 % of the time integration.
+KNOWN_TIME_CHECK_FAILURES = {}
 
 
 def _time_check_param(d):
@@ -306,7 +319,7 @@ def test_random_oscillator_peak_against_time_integration(design):
         warnings.simplefilter("ignore")
         r = osc.frequency_response(design["omega_start"] / (2 * np.pi), design["omega_end"] / (2 * np.pi), harmonics=TIME_CHECK_HARMONICS,
                                    n_samples=design["n_samples"], max_step=0.02)
-    assert r.success, r.message
+    assert r.success and r.harmonics_converged is not False, r.message
     j1 = r.basis.cos_index(1)
     a = np.hypot(r.coefficients[:, j1, 0], r.coefficients[:, j1 + 1, 0])
     k = int(np.argmax(a))

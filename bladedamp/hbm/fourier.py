@@ -146,6 +146,22 @@ class HarmonicBasis:
         weights = np.where(self.order == 0, 2 * np.pi, np.pi)
         return np.tensordot(weights, force * velocity, axes=(0, 0))
 
+    def work_bound(self, force: np.ndarray, displacement: np.ndarray) -> np.ndarray:
+        """The largest work per period that harmonics of these amplitudes can do, pi sum_h h
+        |F_h| |W_h| [J] (harmonic h does pi h |F_h| |W_h| sin(phase lag); the static term none).
+
+        The energy scale of :meth:`work_per_cycle` on the same arrays (C, ...), summed over the
+        coefficient axis only: an error eps |F_h| in the force harmonics (the AFT's time sampling)
+        changes the work by at most eps times this bound.
+        """
+        force, displacement = np.asarray(force), np.asarray(displacement)
+        out = np.zeros(np.broadcast_shapes(force.shape[1:], displacement.shape[1:]))
+        for h in self.harmonics:
+            if h > 0:
+                j = self.cos_index(h)
+                out = out + np.pi * h * np.hypot(force[j], force[j + 1]) * np.hypot(displacement[j], displacement[j + 1])
+        return out
+
     # ----- matrices ------------------------------------------------------------------
     def real_form(self, per_harmonic) -> np.ndarray:
         """Real (C*n_out, C*n_in) matrix of a linear map given per harmonic as complex matrices.

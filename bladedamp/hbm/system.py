@@ -184,12 +184,21 @@ class HarmonicBalanceSystem:
 
     def element_dissipation(self, x: np.ndarray, omega: float) -> list[float]:
         """Energy absorbed by each nonlinear element per period [J] (oint f . dw)."""
+        return self._per_element(x, omega, self.basis.work_per_cycle)
+
+    def element_work_bound(self, x: np.ndarray, omega: float) -> list[float]:
+        """Each nonlinear element's energy scale per period [J]: the largest work its force and
+        motion harmonics could do (:meth:`HarmonicBasis.work_bound`)."""
+        return self._per_element(x, omega, self.basis.work_bound)
+
+    def _per_element(self, x: np.ndarray, omega: float, measure) -> list[float]:
+        """``measure(force, local motion)`` (coefficient arrays) summed, for each element."""
         C = self.basis.n_coeffs
         out = []
         for c in self.couplings:
             local = (c.matrix @ x).reshape(C, c.element.n_local)
             force, _, _ = c.element.harmonic_forces(local, self.basis, omega, False)
-            out.append(float(np.sum(self.basis.work_per_cycle(force, local))))
+            out.append(float(np.sum(measure(force, local))))
         return out
 
 
