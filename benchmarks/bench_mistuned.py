@@ -83,11 +83,24 @@ def accuracy(n_disks):
     t = time.perf_counter()
     fast = mt.monte_carlo(disk, n_disks, seed=11, scheduler="serial", tuned_peak_amplitude=1.0)
     t_fast = time.perf_counter() - t
-    worst_max, worst_blade, t_fine = 0.0, 0.0, 0.0
+    worst_max, worst_blade, worst_old, t_fine, t_old, t_new = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     for i, kappa in enumerate(fast.kappa):
         t = time.perf_counter()
         fine = mt.mistuned_response(disk, kappa, max_step=0.05, tol=1e-10, estimate_harmonic_error=False)
         t_fine += time.perf_counter() - t
+        # the same disk the way monte_carlo did it before issue 15 item 4 (Newton corrector,
+        # max_step 0.1, 3 % range margin, parabola peaks), and the new way, both without the
+        # harmonic error estimate (the study's disk 0 only)
+        t = time.perf_counter()
+        old = mt.mistuned_response(disk, kappa, max_step=0.1, tol=1e-6, estimate_harmonic_error=False).peaks()[0]
+        t_old += time.perf_counter() - t
+        t = time.perf_counter()
+        mt.mistuned_response(disk, kappa, max_step=mt.MONTE_CARLO_MAX_STEP, tol=mt.MONTE_CARLO_TOL, chord=True,
+                             target_iterations=mt.MONTE_CARLO_TARGET_ITERATIONS,
+                             range_margin=mt.MONTE_CARLO_RANGE_MARGIN,
+                             estimate_harmonic_error=False).peaks(solve_within=mt.MONTE_CARLO_PEAK_MARGIN)
+        t_new += time.perf_counter() - t
+        worst_old = max(worst_old, abs(old.max() / fine.peak_amplitude.max() - 1))
         worst_max = max(worst_max, abs(fast.peak_amplitude[i].max() / fine.peak_amplitude.max() - 1))
         worst_blade = max(worst_blade, np.abs(fast.peak_amplitude[i] / fine.peak_amplitude - 1).max())
     print(f"Monte Carlo settings (max_step {mt.MONTE_CARLO_MAX_STEP}, tol {mt.MONTE_CARLO_TOL:g}, peaks solved "
@@ -95,6 +108,8 @@ def accuracy(n_disks):
           f"{int((~fast.valid).sum())}: largest peak per disk within {worst_max:.1e}, every blade's peak within "
           f"{worst_blade:.1e}; {t_fast / n_disks:.3f} (disk 0 with the harmonic error estimate) vs "
           f"{t_fine / n_disks:.3f} s per disk (serial)")
+    print(f"per disk, serial, same disks: before {t_old / n_disks:.3f} s (largest peak within {worst_old:.1e}), "
+          f"now {t_new / n_disks:.3f} s: {t_old / t_new:.2f}x less")
     return worst_max
 
 
