@@ -12,9 +12,10 @@ Run from the repository root::
    as the tuned full 16-blade MistunedDisk (same configuration, 16x the unknowns), best of
    ``--repeat`` runs after a warm-up, in the same process. Also a 2 % randomly mistuned
    assembly (seed 2) over its own range, for reference. Ratios per FRF and per branch point.
-2. Accuracy of the Monte Carlo settings (MONTE_CARLO_MAX_STEP, MONTE_CARLO_TOL) against fine
-   FRFs (max_step 0.05, tol 1e-10) on ``--accuracy`` random disks (2 %, seed 11): the largest
-   blade peak (what the amplification uses) and every blade's peak; time per disk of both.
+2. Accuracy of the Monte Carlo (its coarse branch, MONTE_CARLO_MAX_STEP, MONTE_CARLO_TOL, and
+   the peaks solved within MONTE_CARLO_PEAK_MARGIN, run as ``monte_carlo(scheduler="serial")``)
+   against fine FRFs (max_step 0.05, tol 1e-10) on ``--accuracy`` random disks (2 %, seed 11):
+   the largest blade peak (what the amplification uses) and every blade's peak; time per disk.
 3. Monte Carlo throughput (target speed-up >= 1.7 on 2 cores): the same ``--disks`` random
    disks (2 %, seed 0) on a local Dask cluster with 1 and 2 worker processes (one thread each).
    Each cluster is started and its workers warmed up (one disk each: imports, numba caches)
@@ -75,21 +76,40 @@ def cost_ratio(repeat):
 
 
 def accuracy(n_disks):
+    """The Monte Carlo's peaks (coarse branch + solved peaks, exactly as ``monte_carlo``) against
+    fine FRFs (max_step 0.05, tol 1e-10, parabola-refined peaks) on the random disks of seed 11."""
     disk = reference_disk("cylinder", 1e-3)
-    worst_max, worst_blade, t_fast, t_fine = 0.0, 0.0, 0.0, 0.0
-    for i in range(n_disks):
-        kappa = mt.random_kappa(16, 0.02, seed=[11, i])
+    mt.monte_carlo(disk, 1, seed=99, scheduler="serial", tuned_peak_amplitude=1.0)         # warm-up
+    t = time.perf_counter()
+    fast = mt.monte_carlo(disk, n_disks, seed=11, scheduler="serial", tuned_peak_amplitude=1.0)
+    t_fast = time.perf_counter() - t
+    worst_max, worst_blade, worst_old, t_fine, t_old, t_new = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    for i, kappa in enumerate(fast.kappa):
         t = time.perf_counter()
-        fast = mt.mistuned_response(disk, kappa, max_step=mt.MONTE_CARLO_MAX_STEP, tol=mt.MONTE_CARLO_TOL)
-        t_fast += time.perf_counter() - t
-        t = time.perf_counter()
-        fine = mt.mistuned_response(disk, kappa, max_step=0.05, tol=1e-10)
+        fine = mt.mistuned_response(disk, kappa, max_step=0.05, tol=1e-10, estimate_harmonic_error=False)
         t_fine += time.perf_counter() - t
-        worst_max = max(worst_max, abs(fast.peak_amplitude.max() / fine.peak_amplitude.max() - 1))
-        worst_blade = max(worst_blade, np.abs(fast.peak_amplitude / fine.peak_amplitude - 1).max())
-    print(f"Monte Carlo settings (max_step {mt.MONTE_CARLO_MAX_STEP}, tol {mt.MONTE_CARLO_TOL:g}) vs fine FRFs "
-          f"(0.05, 1e-10), {n_disks} disks: largest peak per disk within {worst_max:.1e}, every blade's "
-          f"peak within {worst_blade:.1e}; {t_fast / n_disks:.2f} vs {t_fine / n_disks:.2f} s per disk")
+        # the same disk the way monte_carlo did it before issue 15 item 4 (Newton corrector,
+        # max_step 0.1, 3 % range margin, parabola peaks), and the new way, both without the
+        # harmonic error estimate (the study's disk 0 only)
+        t = time.perf_counter()
+        old = mt.mistuned_response(disk, kappa, max_step=0.1, tol=1e-6, estimate_harmonic_error=False).peaks()[0]
+        t_old += time.perf_counter() - t
+        t = time.perf_counter()
+        mt.mistuned_response(disk, kappa, max_step=mt.MONTE_CARLO_MAX_STEP, tol=mt.MONTE_CARLO_TOL, chord=True,
+                             target_iterations=mt.MONTE_CARLO_TARGET_ITERATIONS,
+                             range_margin=mt.MONTE_CARLO_RANGE_MARGIN,
+                             estimate_harmonic_error=False).peaks(solve_within=mt.MONTE_CARLO_PEAK_MARGIN)
+        t_new += time.perf_counter() - t
+        worst_old = max(worst_old, abs(old.max() / fine.peak_amplitude.max() - 1))
+        worst_max = max(worst_max, abs(fast.peak_amplitude[i].max() / fine.peak_amplitude.max() - 1))
+        worst_blade = max(worst_blade, np.abs(fast.peak_amplitude[i] / fine.peak_amplitude - 1).max())
+    print(f"Monte Carlo settings (max_step {mt.MONTE_CARLO_MAX_STEP}, tol {mt.MONTE_CARLO_TOL:g}, peaks solved "
+          f"within {mt.MONTE_CARLO_PEAK_MARGIN:g}) vs fine FRFs (0.05, 1e-10), {n_disks} disks, failed "
+          f"{int((~fast.valid).sum())}: largest peak per disk within {worst_max:.1e}, every blade's peak within "
+          f"{worst_blade:.1e}; {t_fast / n_disks:.3f} (disk 0 with the harmonic error estimate) vs "
+          f"{t_fine / n_disks:.3f} s per disk (serial)")
+    print(f"per disk, serial, same disks: before {t_old / n_disks:.3f} s (largest peak within {worst_old:.1e}), "
+          f"now {t_new / n_disks:.3f} s: {t_old / t_new:.2f}x less")
     return worst_max
 
 
@@ -100,11 +120,13 @@ def throughput(n_disks):
     tuned = mt.tuned_peak(disk, mt.auto_range(disk, [1.0], 0.05))[0]
     times = {}
     for workers in (1, 2):
-        with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
-                Client(cluster) as client:
-            warm = [client.submit(mt._one_disk, disk, mt.random_kappa(16, 0.02, seed=[99, w]), None,
-                                  dict(max_step=mt.MONTE_CARLO_MAX_STEP, tol=mt.MONTE_CARLO_TOL), pure=False,
-                                  workers=[addr]) for w, addr in enumerate(client.scheduler_info()["workers"])]
+        with mt.local_worker_config():      # the workers monte_carlo's own local cluster starts
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
+        with cluster, Client(cluster) as client:
+            warm = [client.submit(mt.mistuned_response, disk, mt.random_kappa(16, 0.02, seed=[99, w]),
+                                  max_step=mt.MONTE_CARLO_MAX_STEP, tol=mt.MONTE_CARLO_TOL, chord=True,
+                                  estimate_harmonic_error=False, pure=False, workers=[addr])
+                    for w, addr in enumerate(client.scheduler_info()["workers"])]
             client.gather(warm)
             t = time.perf_counter()
             res = mt.monte_carlo(disk, n_disks, seed=0, scheduler=cluster.scheduler_address, tuned_peak_amplitude=tuned)
@@ -124,7 +146,7 @@ def main(argv=None):
     parser.add_argument("--quick", action="store_true", help="cost ratio only, one repetition")
     parser.add_argument("--repeat", type=int, default=2)
     parser.add_argument("--disks", type=int, default=24, help="Monte Carlo disks per worker count")
-    parser.add_argument("--accuracy", type=int, default=8, help="disks for the accuracy check (0: skip)")
+    parser.add_argument("--accuracy", type=int, default=16, help="disks for the accuracy check (0: skip)")
     args = parser.parse_args(argv)
     print(f"# bench_mistuned {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC, "
           f"{platform.processor() or platform.machine()}, {os.cpu_count()} CPUs, Python {platform.python_version()}")

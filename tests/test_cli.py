@@ -82,7 +82,11 @@ def test_montecarlo_command_writes_results_loadable_without_pickle(tmp_path):
     assert result.kappa.shape == (2, 16) and np.all(np.isfinite(result.peak_amplitude))
     # the largest blade of a 2 % mistuned disk at the tuned optimum stays within +-50 % of the tuned peak
     assert np.all((result.amplification > 0.5) & (result.amplification < 1.5)), result.amplification
-    assert result.meta["max_step"] == 0.1 and result.meta["tol"] == 1e-6   # the peak-only defaults
+    from bladedamp.studies import mistuning as mt
+
+    # the peak-only defaults: a coarse branch, its largest peaks solved by the peak condition
+    assert result.meta["max_step"] == mt.MONTE_CARLO_MAX_STEP and result.meta["tol"] == mt.MONTE_CARLO_TOL
+    assert result.meta["peak_margin"] == mt.MONTE_CARLO_PEAK_MARGIN and result.meta["chord"]
 
 
 def test_montecarlo_command_rejects_a_bad_step(tmp_path, capsys):

@@ -322,3 +322,30 @@ def test_absurd_settings_fail_gracefully():
         frf = osc.frequency_response(90.0 / (2 * np.pi), 140.0 / (2 * np.pi), max_points=10)
     assert not frf.success and frf.omega.size == 10 and f"{frf.omega[-1]:.6g}" in frf.message
     assert np.all(np.diff(frf.omega) > 0)
+
+
+def test_chord_corrector_follows_the_same_branch():
+    """continuation(chord=True) keeps the corrector's factorisation while its updates contract:
+    the same branch (every point a solution to the tolerance, the same peak) with fewer
+    Jacobians; a residual that ignores ``jacobian=False`` is never asked for one without it."""
+    osc = FrictionOscillator(damping=2.0, normal_load=3.0, forcing=2.0)
+    system = osc.hbm_system((1, 3))
+    calls = {"jacobian": 0, "residual only": 0}
+
+    def fun(x, w, jacobian=True):
+        calls["jacobian" if jacobian else "residual only"] += 1
+        return system.residual(x, w, jacobian)
+
+    x0 = system.linear_solution(90.0)
+    newton_branch = continuation(system.residual, x0, 90.0, 140.0, x_scale=1e-3, max_step=0.05, tol=1e-10)
+    chord_branch = continuation(fun, x0, 90.0, 140.0, x_scale=1e-3, max_step=0.05, tol=1e-10, chord=True,
+                                target_iterations=10)
+    assert newton_branch.success and chord_branch.success
+    assert calls["residual only"] > 0
+    scale = np.abs(newton_branch.x).max()
+    for x, w in zip(chord_branch.x, chord_branch.omega):
+        assert np.linalg.norm(system.residual(x, w, False)[0]) < 1e-6 * np.linalg.norm(
+            system.residual(np.zeros_like(x), w, False)[0])
+    a_newton = np.abs(newton_branch.x).max(axis=1).max()
+    a_chord = np.abs(chord_branch.x).max(axis=1).max()
+    assert abs(a_chord / a_newton - 1) < 2e-2 and scale > 0

@@ -139,25 +139,29 @@ def auto_range(disk: TunedDisk, kappa, margin: float = 0.03) -> tuple[float, flo
 def mistuned_response(disk: TunedDisk, kappa, f_range_hz=None, harmonics=(1,), max_step: float = 0.05,
                       tuned_peak_amplitude: float | None = None, max_widenings: int = 3, n_sector: int | None = None,
                       n_samples: int | None = None, tol: float = 1e-10,
-                      estimate_harmonic_error: bool = True) -> MistunedResponse:
+                      estimate_harmonic_error: bool = True, chord: bool = False,
+                      target_iterations: int = 5, range_margin: float = 0.03) -> MistunedResponse:
     """Full-assembly response of ``disk`` with blade frequencies times ``kappa``; while some
     blade's largest amplitude is at an end of the range (default :func:`auto_range`), the branch
-    is continued beyond that end by half the range's width (:meth:`MistunedDisk.extend_response`).
+    is continued beyond that end by half the range's width (:meth:`MistunedDisk.extend_response`);
+    ``range_margin``: :func:`auto_range`'s margin.
     If the upward sweep fails (it can leave the response curve at a branch point), the range is
     swept downwards, then both ways at half the step; the first complete sweep is returned in
     rising frequency.
     ``n_sector``: a cyclic sector of that many blades (``kappa`` then has n_sector entries; e.g. 2
     for alternating mistuning, exact, see the tests). ``n_samples``, ``tol``: AFT samples and
     continuation tolerance (defaults: the model's and the continuation's);
-    ``estimate_harmonic_error``: as :meth:`MistunedDisk.frequency_response`.
+    ``estimate_harmonic_error``: as :meth:`MistunedDisk.frequency_response`. ``chord``,
+    ``target_iterations``: the continuation's corrector (:func:`bladedamp.hbm.continuation.continuation`).
     Raises RuntimeError if the continuation does not cover the range."""
     md = MistunedDisk.from_tuned(disk, kappa, n_sector=n_sector)
     if f_range_hz is None:
-        f_range_hz = auto_range(disk, kappa)
+        f_range_hz = auto_range(disk, kappa, range_margin)
     lo, hi = (float(f) for f in f_range_hz)
     # a sweep that turns back and leaves the range by 5 % of its width has left the curve (below)
     common = dict(harmonics=harmonics, n_samples=n_samples, tuned_peak_amplitude=tuned_peak_amplitude, tol=tol,
-                  leave_margin=0.05, estimate_harmonic_error=estimate_harmonic_error)
+                  leave_margin=0.05, estimate_harmonic_error=estimate_harmonic_error, chord=chord,
+                  target_iterations=target_iterations)
 
     def sweep(lo, hi):
         # the upward sweep can leave the response curve at a branch point and follow another
@@ -177,7 +181,8 @@ def mistuned_response(disk: TunedDisk, kappa, f_range_hz=None, harmonics=(1,), m
         # continue the branch; if that leaves the curve too (3 of 1000 disks), at half the step,
         # then a new sweep over the whole widened range
         for step in (max_step, max_step / 2):
-            longer = md.extend_response(r, f_end, max_step=step, tol=tol, leave_margin=0.05)
+            longer = md.extend_response(r, f_end, max_step=step, tol=tol, leave_margin=0.05, chord=chord,
+                                        target_iterations=target_iterations)
             if longer.success:
                 return longer
         return sweep(lo, hi)
@@ -424,21 +429,44 @@ def plot_cases(cases: dict[str, MistuningCase], path=None):
 # ---------------------------------------------------------------------------------------
 # Monte Carlo on Dask
 # ---------------------------------------------------------------------------------------
-#: Monte Carlo per-disk continuation: only the peaks are kept, so the branch is coarser and the
-#: tolerance looser than an FRF's (0.05, 1e-10): about half the points and 1.7x less time per
-#: disk. Measured against those on 16 random 2 % reference disks (benchmarks/bench_mistuned.py):
-#: the largest blade peak of each disk (the amplification) within 1.6e-3 relative; the peaks of
-#: weakly responding blades (a third of the largest, on sharp local modes) within 5e-2 only.
-MONTE_CARLO_MAX_STEP = 0.1
+#: Monte Carlo per-disk continuation: only the peaks are kept, so the branch is coarse (max_step
+#: 0.4, tolerance 1e-6, chord corrector) and only brackets the peaks; the largest blade peaks are
+#: then solved on the response curve by the peak condition d|u|/dOmega = 0 (Newton at 1e-10,
+#: :meth:`bladedamp.MistunedDisk.solve_peaks`), every local maximum within
+#: MONTE_CARLO_PEAK_MARGIN of the largest. Measured against fine FRFs (max_step 0.05, tol 1e-10)
+#: on random 2 % reference disks (benchmarks/bench_mistuned.py, benchmarks/README.md): the largest
+#: blade peak within 5.7e-4 relative (parabola through the coarse branch alone: 5.8e-3, 1.4e-2 on
+#: one disk); above max_step 0.4 the points do not get fewer (57-81 per disk at 0.4 and at 1.0:
+#: the corrector's iterations limit the step); the other blades' peaks are parabola-refined on the
+#: coarse branch (weak blades on sharp local modes up to 1.9e-1 off on 16 disks).
+MONTE_CARLO_MAX_STEP = 0.4
 MONTE_CARLO_TOL = 1e-6
+#: local maxima solved by the peak condition: within this fraction of the largest blade peak
+#: (parabola-refined). The parabola's error on the largest peak was at most 1.4e-2 on the coarse
+#: branch; at 2 % 3-4 maxima are solved per disk (25-35 ms), at 5 % 6-10 (40-120 ms)
+MONTE_CARLO_PEAK_MARGIN = 0.02
+#: the chord corrector (continuation(chord=True)) and its step control: with chord steps a
+#: corrector takes more, cheaper iterations, so the step is kept up to 10 of them (measured on
+#: 8 random disks: 0.43-0.44 s per disk at 10, 0.45 at 12, and twice the points at the Newton
+#: corrector's 5)
+MONTE_CARLO_TARGET_ITERATIONS = 10
+#: :func:`auto_range`'s margin for the Monte Carlo's disks: 1 % (FRFs: 3 %). The peaks lie above
+#: f_01 min(kappa) (the damper stiffens the blades: 93-100 Hz for f_01 kappa in 90-99 Hz on
+#: random disks), so the wider range's first 3 Hz only cost points; a blade whose largest
+#: amplitude is at an end still widens the range. Measured on 16 random disks (seed 11): 0.37
+#: against 0.44 s per disk, the same largest peaks to 3e-4, none widened in vain or failed
+MONTE_CARLO_RANGE_MARGIN = 0.01
 
 
 def _one_disk(disk, kappa, f_range_hz, settings):
     """Peaks (n,) and their frequencies (n,) of one mistuned disk, the failure's message ('' if
-    none) and the harmonic error estimate (NaN if not estimated) (runs on a worker)."""
+    none) and the harmonic error estimate (NaN if not estimated) (runs on a worker). ``settings``:
+    :func:`mistuned_response`'s options, and ``solve_within`` for :meth:`MistunedResponse.peaks`."""
+    options = dict(settings)
+    solve_within = options.pop("solve_within", None)
     try:
-        r = mistuned_response(disk, kappa, f_range_hz, **settings)
-        p, f = r.peaks()
+        r = mistuned_response(disk, kappa, f_range_hz, **options)
+        p, f = r.peaks(solve_within=solve_within)
         return p, f, "", float(r.harmonic_error)
     except RuntimeError as e:  # keep the study going; the failure is recorded
         n = len(kappa)
@@ -543,33 +571,46 @@ class MonteCarloResult(Saveable):
         return ax
 
 
-def _without_malloc_trim():
+#: glibc's mmap threshold of local Dask workers [bytes]: above the 16-blade assembly's dense
+#: Jacobians and bordered matrices (321 x 321 doubles, 0.8 MB)
+WORKER_MMAP_THRESHOLD = 16 * 2 ** 20
+
+
+def local_worker_config():
     """Dask config context for local workers without Dask's MALLOC_TRIM_THRESHOLD_ (65536).
 
     With it glibc returns every freed large block to the system at once, so the dense Jacobians
     (~0.8 MB each, several per residual) are mapped and zero-filled anew each time: measured
     1.34x the time of a serial disk (0.94 of 4.4 s in the kernel), and more with two workers
-    faulting pages at once. The other settings (one BLAS thread per worker) are kept."""
+    faulting pages at once. The other settings (one BLAS thread per worker) are kept. And with
+    glibc's mmap threshold fixed at WORKER_MMAP_THRESHOLD those blocks always come from the heap
+    (measured serially: 0.40 s per disk against 0.45 s with glibc's default, the same 8 disks)."""
     import dask
 
     environ = dict(dask.config.get("distributed.nanny.pre-spawn-environ", default={}) or {})
     environ.pop("MALLOC_TRIM_THRESHOLD_", None)
+    environ["MALLOC_MMAP_THRESHOLD_"] = str(WORKER_MMAP_THRESHOLD)
     return dask.config.set({"distributed.nanny.pre-spawn-environ": environ})
 
 
 def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f_range_hz=None,
                 harmonics=(1,), max_step: float = MONTE_CARLO_MAX_STEP, scheduler=None, n_workers: int | None = None,
                 progress=None, out=None, tuned_peak_amplitude: float | None = None, tol: float = MONTE_CARLO_TOL,
-                n_samples: int | None = None) -> MonteCarloResult:
+                n_samples: int | None = None, peak_margin: float | None = MONTE_CARLO_PEAK_MARGIN,
+                chord: bool = True, target_iterations: int = MONTE_CARLO_TARGET_ITERATIONS) -> MonteCarloResult:
     """Peak amplification of ``n_disks`` randomly mistuned copies of ``disk`` (full assemblies).
 
     max_step, tol, n_samples : continuation step, tolerance and AFT samples of each disk
         (see :data:`MONTE_CARLO_MAX_STEP`); the tuned peak (unless given) is an FRF at the
         default accuracy of :func:`tuned_peak`.
+    peak_margin : local maxima within this fraction of each disk's largest blade peak are solved
+        by the peak condition (:meth:`MistunedResponse.peaks` ``solve_within``; None: the
+        parabola through the branch only). chord, target_iterations : the continuation's
+        corrector (see :data:`MONTE_CARLO_TARGET_ITERATIONS`).
 
     scheduler : None -> a local Dask cluster (``n_workers`` processes, one thread each; default
         the CPU count; started without Dask's MALLOC_TRIM_THRESHOLD_, see
-        :func:`_without_malloc_trim`), no set-up needed; an address ("tcp://host:8786") -> that
+        :func:`local_worker_config`), no set-up needed; an address ("tcp://host:8786") -> that
         Dask cluster (start its workers with MALLOC_TRIM_THRESHOLD_ unset for the same speed);
         "serial" -> in this process, without Dask.
     progress : callable (done, total) after every disk.  out : path stem for npz/json results.
@@ -580,7 +621,9 @@ def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f
     n = disk.n_blades
     kappas = np.array([random_kappa(n, std, seed=[int(seed), i]) for i in range(n_disks)])
     settings = dict(harmonics=tuple(harmonics), max_step=validation.positive("max_step", max_step),
-                    tol=validation.positive("tol", tol), n_samples=n_samples)
+                    tol=validation.positive("tol", tol), n_samples=n_samples, chord=bool(chord),
+                    target_iterations=validation.integer("target_iterations", target_iterations, minimum=1),
+                    solve_within=peak_margin, range_margin=MONTE_CARLO_RANGE_MARGIN)
     if n_workers is not None:
         validation.integer("n_workers", n_workers, minimum=1)
     t0 = time.perf_counter()
@@ -599,7 +642,7 @@ def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f
         cluster = None
         if scheduler is None:
             workers = n_workers or os.cpu_count() or 1
-            with _without_malloc_trim():
+            with local_worker_config():
                 cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                        dashboard_address=None)
             client = Client(cluster)
@@ -624,7 +667,9 @@ def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f
     res = MonteCarloResult(kappas, np.array([r[0] for r in results]), np.array([r[1] for r in results]),
                            float(tuned_peak_amplitude), [r[2] for r in results],
                            {"std": std, "seed": int(seed), "f_range_hz": None if f_range_hz is None else list(f_range_hz), "harmonics": list(harmonics),
-                            "max_step": max_step, "tol": tol, "n_samples": n_samples, "executor": used,
+                            "max_step": max_step, "tol": tol, "n_samples": n_samples, "peak_margin": peak_margin,
+                            "chord": bool(chord), "target_iterations": target_iterations,
+                            "range_margin": None if f_range_hz is not None else MONTE_CARLO_RANGE_MARGIN, "executor": used,
                             "elapsed_s": elapsed, "harmonic_error_first_disk":
                                 None if not np.isfinite(results[0][3]) else results[0][3],
                             "disk": {"n_blades": n, "engine_order": disk.engine_order,
