@@ -27,6 +27,7 @@ _LAZY = {
     "load": "io", "save": "io",
     "load_design": "design",
     "nonlinear_mode": "hbm.nonlinear_modes",
+    "precompile": "compilation",
 }
 __all__ = sorted(_LAZY) + ["frequency_response"]
 

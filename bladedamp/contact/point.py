@@ -341,7 +341,7 @@ def _iterate_passes(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s0,
                 ds_begin[1, j] = ds[1, j]
             # (no transfer tracking: ds_begin only stands in for the unused transfer array)
             s0, s1, moved, work, _, _ = _derivative_pass(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s0, s1, f_out,
-                                                         df_out, state_out, ds, ds_begin, False)
+                                                         df_out, state_out, ds, ds_begin, np.bool_(False))
         else:
             s0, s1, moved, work = _slider_pass(ut, normal, seat, kt, mu, s0, s1, f_out, state_out)
         if not moved:
@@ -441,7 +441,7 @@ def _point_return_map(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s
             s1 = start1
             for it in range(passes - 1):
                 s0, s1, moved, work, _, _ = _derivative_pass(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s0, s1, f_out,
-                                                             df_out, state_out, ds, transfer, False)
+                                                             df_out, state_out, ds, transfer, np.bool_(False))
             s0, s1, moved, work = _slider_pass(ut, normal, seat, kt, mu, s0, s1, f_out, state_out)
         ds0 = ds[0]
         ds1 = ds[1]
@@ -459,14 +459,14 @@ def _point_return_map(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s
         # the slider position did not repeat within max_passes: no periodic state to
         # linearise about; the derivative of the passes made, as before
         work, jp = _iterate_passes(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, start0, start1, static_index,
-                                   max_passes, tol, True, f_out, df_out, state_out, ds, ds_begin)
+                                   max_passes, tol, np.bool_(True), f_out, df_out, state_out, ds, ds_begin)
         return work, passes, jp
     # one more pass, with the derivative from ds_begin = 0 and the transfers M_t
     ds[:, :] = 0.0
     b0 = s0
     b1 = s1
     s0, s1, moved, work, gw0, gw1 = _derivative_pass(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, b0, b1, f_out,
-                                                     df_out, state_out, ds, transfer, True)
+                                                     df_out, state_out, ds, transfer, np.bool_(True))
     a = 1.0 - transfer[T - 1, 0]           # I - Phi = [[a, b], [c, d]]
     b = -transfer[T - 1, 1]
     c = -transfer[T - 1, 2]
@@ -474,7 +474,7 @@ def _point_return_map(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s
     det = a * d - b * c
     if abs(det) < SINGULAR_DET:
         work, jp = _iterate_passes(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, start0, start1, static_index,
-                                   max_passes, tol, True, f_out, df_out, state_out, ds, ds_begin)
+                                   max_passes, tol, np.bool_(True), f_out, df_out, state_out, ds, ds_begin)
         return work, passes, 1 + jp
     ia = a / det                           # (I - Phi)^{-1} = [[id_, -ib], [-ic, ia]]
     ib = b / det

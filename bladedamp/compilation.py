@@ -1,0 +1,82 @@
+"""Compile every numba kernel of bladedamp ahead of the user's first call.
+
+The kernels (the contact return map and its Jacobian, the ring solver of the full assembly, the
+time integrators, the monodromy period map) are compiled by numba on their first call and kept
+in the per-user cache (:mod:`bladedamp._numba_cache`). On a cold cache that compilation is most
+of the first call: measured in ``benchmarks/bench_startup.py`` (the reference FRF's first call
+in a fresh process with an empty cache against one with the cache filled). :func:`precompile`
+moves it out of that first call: run it once after installing (``bladedamp precompile``, e.g.
+in a Docker image or a lab machine's set-up), and every later process loads the compiled code.
+
+It compiles by running the public paths on tiny problems, so the kernels get exactly the
+argument types of real use (numba compiles one version per type signature): a flat and an
+inclined friction oscillator (with and without the Jacobian, the closed-form and the iterated
+slider derivative), the reference disk's residual, a 4-blade full assembly (the ring solver),
+the time integration of both, and the oscillator's monodromy. A kernel already in the cache is
+only loaded. ``tests/test_compilation.py`` checks that after it, in a new process, the
+reference disk's FRF, a mistuned FRF and the time integrations compile nothing.
+"""
+from __future__ import annotations
+
+import time
+import warnings
+
+
+def _oscillator_paths():
+    from .hbm.stability import with_stability
+    from .oscillator import FrictionOscillator
+
+    flat = FrictionOscillator(mass=1.0, stiffness=1.0, damping=0.02, contact_stiffness=1.0,
+                              friction_coefficient=1.0, normal_load=0.3, forcing=0.2)
+    r = flat.frequency_response(0.12, 0.2, harmonics=(1, 3), max_step=0.2)
+    with_stability(flat, r, method="monodromy")
+    inclined = FrictionOscillator(mass=1.0, stiffness=1.0, damping=0.02, contact_stiffness=1.0,
+                                  friction_coefficient=0.5, normal_load=0.05, forcing=0.1, contact_angle=0.5)
+    inclined.frequency_response(0.12, 0.2, max_step=0.2)
+    flat.time_response([0.15], max_periods=30)
+
+
+def _disk_paths():
+    import dataclasses
+
+    import numpy as np
+
+    from .hbm.linsolve import permutation_sign
+    from .mistuned import AssemblySystem, MistunedDisk
+    from .reference import reference_disk
+
+    disk = reference_disk("cylinder", 1e-3)
+    disk.frequency_response(94.0, 94.5, harmonics=(1,), max_step=0.5)
+    def small():
+        return MistunedDisk.from_tuned(dataclasses.replace(disk, n_blades=4, engine_order=1),
+                                       kappa=np.array([1.0, 1.01, 0.99, 1.0]))
+
+    small().frequency_response(94.0, 94.2, harmonics=(1,), max_step=0.5)
+    small().time_response([94.0], max_periods=2, min_periods=1)
+    dense_limit = AssemblySystem.dense_limit
+    try:              # the sparse Jacobian of large assemblies (its ring gather and sparse LU's sign)
+        AssemblySystem.dense_limit = 0
+        small().frequency_response(94.0, 94.2, harmonics=(1,), max_step=0.5)
+    finally:
+        AssemblySystem.dense_limit = dense_limit
+    for dtype in (np.int32, np.int64):          # scipy's sparse LU permutations, and numpy's
+        permutation_sign(np.arange(3, dtype=dtype))
+
+
+GROUPS = {"oscillator": _oscillator_paths, "disk": _disk_paths}
+
+
+def precompile(progress=print) -> dict:
+    """Compile (or load from the cache) every numba kernel of bladedamp; returns the seconds
+    per group {"oscillator": s, "disk": s}. ``progress`` is called with one line per group
+    (None: quiet). Harmless to run again: a second run only loads the cache (about 1-2 s)."""
+    seconds = {}
+    for name, run in GROUPS.items():
+        start = time.perf_counter()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")          # tiny problems: accuracy warnings are irrelevant
+            run()
+        seconds[name] = time.perf_counter() - start
+        if progress is not None:
+            progress(f"{name} kernels ready in {seconds[name]:.1f} s")
+    return seconds
