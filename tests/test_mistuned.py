@@ -276,18 +276,22 @@ def test_extended_response_equals_a_fresh_one_over_the_wider_range():
         md.extend_response(part, 95.0)
 
 
-@pytest.mark.slow
 def test_monte_carlo_settings_keep_the_amplification_of_fine_frfs():
-    """The Monte Carlo's coarse continuation (MONTE_CARLO_MAX_STEP, MONTE_CARLO_TOL) against fine
-    FRFs (max_step 0.05, tol 1e-10) on 6 random 16-blade reference disks: the largest blade peak
-    of each disk agrees to 2e-3 relative (measured: see benchmarks/README.md)."""
+    """The Monte Carlo's own per-disk path (its coarse continuation, MONTE_CARLO_MAX_STEP and
+    MONTE_CARLO_TOL with the chord corrector, then the largest peaks solved by the peak
+    condition) against fine FRFs (max_step 0.05, tol 1e-10) on 6 random 16-blade reference
+    disks: the largest blade peak of each disk agrees to 2e-3 relative (measured 5.7e-4 at most
+    on 16 disks: benchmarks/README.md). The coarse branch alone (no peak solve) misses by up to
+    2.3e-2 on these disks (disk 3: a parabola through unevenly spaced samples overshoots), so the
+    test fails without the peak condition, and did when the peak search's margin was taken from
+    that parabola (measured after the fix: 4.3e-4 at most)."""
     disk = reference_disk("cylinder", 1e-3)
+    mc = mt.monte_carlo(disk, 6, std=0.02, seed=7, scheduler="serial")
+    assert not any(mc.errors), mc.errors
     worst = 0.0
-    for i in range(6):
-        kappa = mt.random_kappa(16, 0.02, seed=[7, i])
-        fast = mt.mistuned_response(disk, kappa, max_step=mt.MONTE_CARLO_MAX_STEP, tol=mt.MONTE_CARLO_TOL)
-        fine = mt.mistuned_response(disk, kappa, max_step=0.05, tol=1e-10)
-        worst = max(worst, abs(fast.peak_amplitude.max() / fine.peak_amplitude.max() - 1))
+    for kappa, peaks in zip(mc.kappa, mc.peak_amplitude):
+        fine = mt.mistuned_response(disk, kappa, max_step=0.05, tol=1e-10, estimate_harmonic_error=False)
+        worst = max(worst, abs(peaks.max() / fine.peak_amplitude.max() - 1))
     print(f"\n[monte carlo settings] largest peak of 6 disks: worst relative error {worst:.1e}")
     assert worst < 2e-3, f"largest peak differs by {worst:.2e}"
 
