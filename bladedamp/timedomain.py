@@ -174,7 +174,7 @@ def _normal_force(law_kind, p0, p1, p2, weight, approach):
 
 
 @njit(cache=True)
-def _disk_period(steps, dt, n_q, m_q, c_q, k_q, minv, f_static, f_cos, f_sin,
+def disk_period(steps, dt, n_q, m_q, c_q, k_q, minv, f_static, f_cos, f_sin,
                  Tb, idx, pt_local, B, k_t, mu, weight, offset, law_kind, law_par, t_nnz, t_col, b_nnz, b_col,
                  tip, x, x_prev, slider,
                  tip_samples, tip_dft, damper_mean, damper_dft, damper_work, point_states, energies):
@@ -322,9 +322,17 @@ def _disk_period(steps, dt, n_q, m_q, c_q, k_q, minv, f_static, f_cos, f_sin,
 
 
 @dataclass
-class _AssemblyArrays:
+class AssemblyArrays:
     """The HBM model of a full assembly as arrays of the time integration (see
-    :func:`_assembly_arrays`)."""
+    :func:`assembly_arrays`): used by :func:`disk_time_response` and by the monodromy matrix of
+    the disk (:mod:`bladedamp.hbm.monodromy`), which integrate the same :func:`disk_period`.
+
+    n_q blade modal coordinates first (m_q, c_q, k_q (n_q,) modal mass, damping, stiffness), then
+    6 per damper (minv (n_d, 6, 6) inverse inertia); the contact map per damper Tb (n_d, 12, m)
+    on the columns idx (n_d, m); P contact points (pt_local (P,) the first local row of the
+    point's patch, B (P, 3, 6) point maps, k_t [N/m], mu, weight, offset (approach at zero
+    displacement, m), law_kind, law_par (P, 3) the normal law); tip (s, 3, n_m) each blade's tip
+    translation shape; point_map (3P, N) sparse x -> point displacements (xi, eta, zeta)."""
 
     system: object
     n_q: int
@@ -349,7 +357,7 @@ class _AssemblyArrays:
     mass: object               # scipy.sparse (N, N)
 
 
-def _assembly_arrays(disk) -> _AssemblyArrays:
+def assembly_arrays(disk) -> AssemblyArrays:
     """Arrays of the time integration, taken from the HBM model of ``disk`` (a full-assembly
     :class:`~bladedamp.mistuned.MistunedDisk`), so that both solve the same equations.
 
@@ -401,7 +409,7 @@ def _assembly_arrays(disk) -> _AssemblyArrays:
     tip = np.stack([b.shape("tip")[:3] for b in disk.blades])          # (s, 3, nm)
     if nd == 0:
         e = np.zeros
-        return _AssemblyArrays(system, n_q, M.diagonal()[:n_q], D.diagonal()[:n_q], K.diagonal()[:n_q], minv,
+        return AssemblyArrays(system, n_q, M.diagonal()[:n_q], D.diagonal()[:n_q], K.diagonal()[:n_q], minv,
                                e((0, 12, 1)), np.zeros((0, 1), dtype=np.int64), np.zeros(0, dtype=np.int64),
                                e((0, 3, 6)), e(0), e(0), e(0), e(0), np.zeros(0, dtype=np.int64), e((0, 3)), tip,
                                sp.csr_matrix((0, N)), [], K, M)
@@ -446,12 +454,12 @@ def _assembly_arrays(disk) -> _AssemblyArrays:
     rows = (3 * np.arange(P)[:, None, None] + np.arange(3)[None, :, None]) * np.ones((1, 1, 6))
     cols = arr["pt_local"][:, None, None] + np.arange(6)[None, None, :] * np.ones((1, 3, 1))
     Bs = sp.csr_matrix((arr["B"].ravel(), (rows.ravel().astype(int), cols.ravel().astype(int))), shape=(3 * P, n_local))
-    return _AssemblyArrays(system, n_q, M.diagonal()[:n_q].copy(), D.diagonal()[:n_q].copy(), K.diagonal()[:n_q].copy(),
+    return AssemblyArrays(system, n_q, M.diagonal()[:n_q].copy(), D.diagonal()[:n_q].copy(), K.diagonal()[:n_q].copy(),
                            minv, Tb, idx, tip=tip, point_map=(Bs @ T).tocsr(), geometries=geometries, stiffness=K,
                            mass=M, **arr)
 
 
-def _normal_law_numpy(arrays: _AssemblyArrays, approach: np.ndarray):
+def _normal_law_numpy(arrays: AssemblyArrays, approach: np.ndarray):
     """(N, dN/da) of every point (numpy version of :func:`_normal_force`)."""
     a = np.maximum(approach, 0.0)
     p0, p1, p2 = arrays.law_par.T
@@ -465,7 +473,7 @@ def _normal_law_numpy(arrays: _AssemblyArrays, approach: np.ndarray):
     return normal, stiff
 
 
-def _static_state(arrays: _AssemblyArrays, f_static: np.ndarray, tol: float = 1e-12, max_iter: int = 60):
+def _static_state(arrays: AssemblyArrays, f_static: np.ndarray, tol: float = 1e-12, max_iter: int = 60):
     """Static equilibrium under the centrifugal load F_CG (Eq. 26) with frictionless contacts:
     K x - Z^T N(offset - Z x) = f_static, Z the normal displacement of every point. Newton
     from every damper seated on rigid platforms (:func:`~bladedamp.damper.kinetics.seat`); the
@@ -506,8 +514,8 @@ def _static_state(arrays: _AssemblyArrays, f_static: np.ndarray, tol: float = 1e
     return x
 
 
-def _highest_frequency(arrays: _AssemblyArrays, x_static: np.ndarray) -> float:
-    """Highest natural frequency [rad/s] of the assembly linearised about the static state with
+def highest_frequency(arrays: AssemblyArrays, x_static: np.ndarray) -> float:
+    """Highest natural frequency omega_max [rad/s] of the assembly linearised about the static state with
     every contact point stuck (k_T tangential, dN/da normal; the power law's stiffness at twice
     the static approach): the stability limit of the central differences is dt < 2 / omega_max."""
     import scipy.sparse as sp
@@ -658,8 +666,9 @@ def _drift_verdict(means, scale, tol):
     return int(d), int(a), float(rate[d, a])
 
 
-def _row_nonzeros(A):
-    """(nnz (n, r) int64, columns (n, r, c) int64) of the rows of a stack of matrices (n, r, c)."""
+def row_nonzeros(A):
+    """(nnz (n, r) int64, columns (n, r, c) int64) of the rows of a stack of matrices (n, r, c):
+    the sparsity arguments (t_nnz, t_col of ``Tb``; b_nnz, b_col of ``B``) of :func:`disk_period`."""
     nz = A != 0
     nnz = nz.sum(axis=2).astype(np.int64)
     cols = np.zeros(A.shape, dtype=np.int64)
@@ -680,7 +689,7 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
     at its point's tangential displacement, so no tangential force), then the harmonic
     excitation of the HBM (blade k's tip load f cos(Omega t + k dphi), dphi = 2 pi EO / n, as
     :meth:`MistunedDisk.hbm_system`) is switched on at t = 0. Central differences
-    (:func:`_disk_period`), ``steps_per_period`` steps, the same for every frequency of the
+    (:func:`disk_period`), ``steps_per_period`` steps, the same for every frequency of the
     call (default: the more of MIN_STEPS_PER_PERIOD = 512, for accuracy, and the steps at
     ``stability_margin`` x the stability limit 2 / omega_max of the stuck linearised assembly;
     a given value below that limit is a ValueError).
@@ -726,7 +735,7 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
     if disk.n_sector != disk.n_blades:
         raise ValueError(f"time_response integrates the full assembly: len(blades) must equal n_blades "
                          f"({disk.n_blades}), got a cyclic sector of {disk.n_sector}")
-    arrays = _assembly_arrays(disk)
+    arrays = assembly_arrays(disk)
     system = arrays.system
     N, C = system.n_dof, system.basis.n_coeffs
     omega = 2 * np.pi * f_hz
@@ -737,7 +746,7 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
         loads.append(f)
         x0 = _static_state(arrays, f[0])
         statics.append(x0)
-        w_max = max(w_max, _highest_frequency(arrays, x0))
+        w_max = max(w_max, highest_frequency(arrays, x0))
     dt_limit = 2.0 / w_max
     needed = int(np.ceil(2 * np.pi / omega.min() / (stability_margin * dt_limit)))
     if steps_per_period is None:
@@ -756,8 +765,8 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
                damper_mean=np.zeros((n, nd, 6)), damper_drift=np.zeros((n, nd, 6)), point_state=np.zeros((n, P, 3)),
                time_step=2 * np.pi / omega / steps, static_state=np.array(statics), tip_history=[],
                damper_history=[])
-    t_nnz, t_col = _row_nonzeros(arrays.Tb)
-    b_nnz, b_col = _row_nonzeros(arrays.B)
+    t_nnz, t_col = row_nonzeros(arrays.Tb)
+    b_nnz, b_col = row_nonzeros(arrays.B)
     tip_dft = np.zeros((s, 3, 2))
     damper_mean = np.zeros((nd, 6))
     damper_dft = np.zeros((nd, 6, 2))
@@ -778,7 +787,7 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
         tip_hist, mean_hist, work_hist = [], [], []
         window = None                    # periods the reported values are the mean over (None: the last one)
         for period in range(max_periods):
-            _disk_period(steps, dt, arrays.n_q, arrays.m_q, arrays.c_q, arrays.k_q, arrays.minv, f[0], f[1], f[2],
+            disk_period(steps, dt, arrays.n_q, arrays.m_q, arrays.c_q, arrays.k_q, arrays.minv, f[0], f[1], f[2],
                          arrays.Tb, arrays.idx, arrays.pt_local, arrays.B, arrays.k_t, arrays.mu, arrays.weight,
                          arrays.offset, arrays.law_kind, arrays.law_par, t_nnz, t_col, b_nnz, b_col, arrays.tip,
                          x, x_prev, slider,
@@ -928,3 +937,6 @@ def hbm_tip_at(disk, f_hz, harmonics=(0, 1, 2, 3), pad_hz: float = 1.0, max_step
         out.append(disk.output_amplitudes(sol.x.reshape(1, basis.n_coeffs, -1), basis)[0])
     out = np.array(out)                                              # (n, 3 s)
     return out if isinstance(disk, TunedDisk) else out.reshape(len(f_hz), -1, 3)
+
+
+_assembly_arrays = assembly_arrays      # the former private name (tests/test_timedomain_disk.py)

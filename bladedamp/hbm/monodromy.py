@@ -37,7 +37,35 @@ The discrete map's multipliers converge to the continuous ones at second order i
 (``steps`` per period; ``STEPS_PER_PERIOD`` = 2048 by default: a relative error of order
 (2 pi / 2048)^2 = 1e-5 in the exponents). Models: :class:`~bladedamp.oscillator.FrictionOscillator`
 (the period map below is its equation of motion, the same as
-:meth:`FrictionOscillator.time_response`'s).
+:meth:`FrictionOscillator.time_response`'s), and the bladed disk (:func:`disk_monodromy`).
+
+The bladed disk. :class:`~bladedamp.mistuned.MistunedDisk` (a full assembly, every blade in
+the model) and :class:`~bladedamp.disk.TunedDisk` (a cyclic sector: its solution is written
+out on the full assembly, blade k's and damper k's harmonic h turned by e^{i h k dphi}, dphi =
+2 pi EO / n, Eq. 24-25, so the perturbations are those of every nodal diameter, not only of
+the engine order's travelling wave). The period map is one period of the time integration of
+the whole assembly, :func:`bladedamp.timedomain.disk_period` (central differences, the AFT's
+return-map step at every contact point, the HBM model's own M, D, K, contact maps, patches
+and loads: :func:`bladedamp.timedomain.assembly_arrays`), of the state z = (x_0 (N,), x_-1
+(N,), s (P, 2)): N unknowns (modal coordinates of the blades, 6 per damper), P contact points
+of all dampers, state dimension m = 2 N + 2 P. The orbit's state: x(0), x(-dt) from the
+Fourier series, every slider at t = 0 from the AFT's return map of its patch
+(``PointContactElement.samples``, as the oscillator's). The solution must carry the static
+harmonic (the time integration seats the dampers under F_CG; without h = 0 the HBM uses a
+pre-computed rigid seating the time domain does not have). The finite-difference step of each
+state component is ``FD_STEP`` x the vibration amplitude of its kind on the orbit (blade modal
+coordinates, damper translations, damper rotations, slider positions: the pooled largest
+|x_i(t) - mean x_i|), and the 2 m + 1 states are integrated as one batch
+(:func:`disk_period_map`). Steps per period: the more of
+:data:`bladedamp.timedomain.MIN_STEPS_PER_PERIOD` = 512 and 1 / 0.8 of the explicit scheme's
+stability limit 2 / omega_max of the stuck linearised assembly (as
+:func:`~bladedamp.timedomain.disk_time_response`); the exponents of a mode of frequency omega
+are then off by (omega dt)^2 / 24 relative: ~6e-6 for 1F, but of order 1 for the stiff contact
+modes near the stability limit (their multipliers are the discrete scheme's, with its own
+frequency; their moduli stay those of a lightly damped mode).
+
+Cost (one run each on the 2-core box, another job running; ``benchmarks``-style command in
+tests/test_monodromy_disk.py's module docstring): COST_NOTE.
 """
 from __future__ import annotations
 
@@ -46,7 +74,7 @@ from numba import njit
 
 from .. import validation
 from ..contact.point import SEPARATED
-from ..timedomain import oscillator_step
+from ..timedomain import disk_period, oscillator_step
 
 STEPS_PER_PERIOD = 2048       # central-difference steps per period of the period map
 FD_STEP = 1e-6                # finite-difference step of the monodromy matrix, relative to the state's scale
@@ -125,19 +153,217 @@ def oscillator_monodromy(osc, coefficients, basis, omega: float, steps: int = ST
     return mono, z, float(np.linalg.norm(out[0, :2] - z[:2]) / scale)
 
 
+# ----- the bladed disk ------------------------------------------------------------------
+
+@njit(cache=True)
+def disk_period_map(states, steps, dt, n_q, m_q, c_q, k_q, minv, f_static, f_cos, f_sin, Tb, idx, pt_local, B,
+                    k_t, mu, weight, offset, law_kind, law_par, t_nnz, t_col, b_nnz, b_col, tip):
+    """One period of the full assembly's central-difference integration
+    (:func:`bladedamp.timedomain.disk_period`, its arguments those of
+    :class:`~bladedamp.timedomain.AssemblyArrays`, ``steps`` steps of ``dt`` [s] from t = 0)
+    for each of the B states ``states`` (B, 2 N + 2 P) = (x_0 (N,), x_-1 (N,), slider positions
+    (P, 2) row-major) [modal coordinates, m, rad; sliders m]; returns the states (B, 2 N + 2 P)
+    at t = T, the same triple."""
+    n_b = states.shape[0]
+    N = f_static.shape[0]
+    P = B.shape[0]
+    nd = Tb.shape[0]
+    s_bl = tip.shape[0]
+    out = np.empty_like(states)
+    tip_samples = np.empty((s_bl, 3, steps))
+    tip_dft = np.empty((s_bl, 3, 2))
+    damper_mean = np.empty((nd, 6))
+    damper_dft = np.empty((nd, 6, 2))
+    damper_work = np.empty(nd)
+    point_states = np.empty((P, 3), dtype=np.int64)
+    energies = np.empty(2)
+    for b in range(n_b):
+        x = states[b, :N].copy()
+        x_prev = states[b, N:2 * N].copy()
+        slider = states[b, 2 * N:].copy().reshape(P, 2)
+        disk_period(steps, dt, n_q, m_q, c_q, k_q, minv, f_static, f_cos, f_sin, Tb, idx, pt_local, B, k_t, mu,
+                    weight, offset, law_kind, law_par, t_nnz, t_col, b_nnz, b_col, tip, x, x_prev, slider,
+                    tip_samples, tip_dft, damper_mean, damper_dft, damper_work, point_states, energies)
+        out[b, :N] = x
+        out[b, N:2 * N] = x_prev
+        out[b, 2 * N:] = slider.ravel()
+    return out
+
+
+_ASSEMBLY_CACHE = {}      # id(model) -> (weak reference to the model, full assembly, its arrays): the last model
+
+
+def _disk_assembly(model):
+    """(the full-assembly MistunedDisk of ``model``, its :class:`~bladedamp.timedomain.AssemblyArrays`),
+    built once per model (a branch calls this at every point)."""
+    import weakref
+
+    from ..disk import TunedDisk
+    from ..mistuned import MistunedDisk
+    from ..timedomain import assembly_arrays, row_nonzeros
+
+    hit = _ASSEMBLY_CACHE.get(id(model))
+    if hit is not None and hit[0]() is model:
+        return hit[1], hit[2], hit[3]
+    full = MistunedDisk.from_tuned(model) if isinstance(model, TunedDisk) else model
+    arrays = assembly_arrays(full)
+    nonzeros = row_nonzeros(arrays.Tb) + row_nonzeros(arrays.B)
+    _ASSEMBLY_CACHE.clear()
+    _ASSEMBLY_CACHE[id(model)] = (weakref.ref(model), full, arrays, nonzeros)
+    return full, arrays, nonzeros
+
+
+def assembly_coefficients(model, full, coefficients, basis) -> np.ndarray:
+    """The harmonic coefficients (C, N) of the full assembly ``full`` of ``model``'s solution
+    ``coefficients`` (C * n,) or (C, n): unchanged for a MistunedDisk; for a TunedDisk's sector
+    (n = n_m blade modes + 6 damper coordinates) blade k's and damper k's harmonic h are the
+    sector's turned by e^{i h k dphi} (X = a - i b; the static term the same), Eq. 24-25."""
+    from ..disk import TunedDisk
+
+    C = basis.n_coeffs
+    if not isinstance(model, TunedDisk):
+        return np.asarray(coefficients, dtype=float).reshape(C, full.n_dof)
+    X = np.asarray(coefficients, dtype=float).reshape(C, -1)
+    nm = full.n_modes
+    out = np.zeros((C, full.n_dof))
+    blocks = [(full.blade_slice(k), slice(0, nm), k) for k in range(full.n_sector)]
+    if model.has_damper:
+        blocks += [(full.damper_slice(d), slice(nm, nm + 6), k) for d, k in enumerate(full.active_dampers)]
+    for target, source, k in blocks:
+        for h in basis.harmonics:
+            j = basis.cos_index(h)
+            if h == 0:
+                out[j, target] = X[j, source]
+                continue
+            z = (X[j, source] - 1j * X[j + 1, source]) * np.exp(1j * h * k * full.interblade_phase)
+            out[j, target], out[j + 1, target] = z.real, -z.imag
+    return out
+
+
+def _evaluate(X, basis, tau):
+    """x (N,) of the coefficients X (C, N) at the phase tau = Omega t [rad]."""
+    x = np.zeros(X.shape[1])
+    for h in basis.harmonics:
+        j = basis.cos_index(h)
+        x += X[j] if h == 0 else X[j] * np.cos(h * tau) + X[j + 1] * np.sin(h * tau)
+    return x
+
+
+def _disk_sliders(arrays, X, basis):
+    """(sliders (P, 2) [m] at t = 0, the tangential point motion's amplitude [m]) of the
+    assembly's solution X (C, N): each patch's points through the AFT's periodic return map
+    (:meth:`~bladedamp.contact.point.PointContactElement.samples`, the patch's k_T x weight, mu,
+    normal law, weights and approach -initial gap, as :func:`~bladedamp.timedomain.assembly_arrays`
+    and the HBM with the static harmonic), s = u - f / k_T at the first sample (t = 0), u when
+    separated."""
+    from ..contact.point import PointContactElement
+
+    C = basis.n_coeffs
+    P = arrays.B.shape[0]
+    coeffs = (arrays.point_map @ X.T).T.reshape(C, P, 3)
+    sliders = np.zeros((P, 2))
+    amplitude = 0.0
+    start = 0
+    for geometry in arrays.geometries:
+        for patch in geometry.patches:
+            sl = slice(start, start + patch.n_points)
+            start += patch.n_points
+            k_t = patch.tangential_stiffness * patch.weights
+            element = PointContactElement(k_t, patch.friction_coefficient, patch.normal_law, patch.weights,
+                                          -np.asarray(patch.initial_gap, dtype=float) * np.ones(patch.n_points))
+            pts = element.samples(np.ascontiguousarray(coeffs[:, sl]).reshape(C, -1), basis)
+            u, f = pts.displacement[:, 0, :2], pts.force[:, 0, :2]
+            separated = pts.state[:, 0] == SEPARATED
+            sliders[sl] = np.where(separated[:, None], u, u - f / k_t[:, None])
+            ut = pts.displacement[:, :, :2]
+            amplitude = max(amplitude, float(np.abs(ut - ut.mean(axis=1, keepdims=True)).max()))
+    return sliders, amplitude
+
+
+def disk_monodromy(model, coefficients, basis, omega: float, steps: int | None = None):
+    """Monodromy matrix (m, m), m = 2 N + 2 P, of a bladed disk's HBM solution (see the module
+    docstring): ``model`` a TunedDisk (its sector solution written out on the full assembly) or
+    a full-assembly MistunedDisk, ``coefficients`` (C * n,) or (C, n) in ``basis`` (with the
+    static harmonic) at ``omega`` [rad/s]; ``steps`` per period (default: the more of
+    MIN_STEPS_PER_PERIOD and 1 / 0.8 of the stability limit; fewer than the limit is a
+    ValueError). Returns (monodromy (m, m) in the state (x_0, x_-1, s) of the full assembly,
+    z (m,), periodicity error: max |P(z) - z| over x_0 and x_-1, each component relative to the
+    orbit's vibration amplitude of its kind (blade modal coordinates, damper translations,
+    damper rotations), steps)."""
+    from ..timedomain import MIN_STEPS_PER_PERIOD, highest_frequency
+
+    if not basis.has_static:
+        raise ValueError("method 'monodromy' of a bladed disk needs a solution with the static harmonic 0 "
+                         f"(harmonics {tuple(basis.harmonics)}): the time integration seats the dampers under "
+                         "F_CG, the HBM without h = 0 on a pre-computed rigid seating")
+    full, arrays, (t_nnz, t_col, b_nnz, b_col) = _disk_assembly(model)
+    X = assembly_coefficients(model, full, coefficients, basis)
+    N, P, n_q = X.shape[1], arrays.B.shape[0], arrays.n_q
+    T = 2 * np.pi / omega
+    w_max = highest_frequency(arrays, X[basis.cos_index(0)])
+    limit = int(np.ceil(T / (2.0 / w_max)))
+    if steps is None:
+        steps = max(MIN_STEPS_PER_PERIOD, int(np.ceil(T / (0.8 * 2.0 / w_max))))
+    steps = validation.integer("steps (per period)", steps, minimum=16)
+    if steps < limit:
+        raise ValueError(f"steps (per period) must be >= {limit} for the explicit scheme at {omega / (2 * np.pi):.6g} Hz "
+                         f"(omega_max = {w_max:.4g} rad/s; got {steps})")
+    dt = T / steps
+    sliders, slider_amp = _disk_sliders(arrays, X, basis)
+    z = np.concatenate([_evaluate(X, basis, 0.0), _evaluate(X, basis, -omega * dt), sliders.ravel()])
+    # the FD step of each component: FD_STEP x its kind's vibration amplitude on the orbit
+    samples = basis.synthesis @ X                                   # (T, N)
+    amp = np.abs(samples - samples.mean(axis=0)).max(axis=0)
+    kinds = np.zeros(N, dtype=int)
+    kinds[n_q:] = 1 + (np.arange(N - n_q) % 6 >= 3)                 # damper translations 1, rotations 2
+    kind_amp = np.array([amp[kinds == k].max(initial=0.0) for k in range(3)])
+    floor = 1e-6 * max(kind_amp.max(), slider_amp, 1e-300)
+    kind_amp = np.maximum(kind_amp, floor)
+    x_scale = kind_amp[kinds]
+    scale = np.concatenate([x_scale, x_scale, np.full(2 * P, max(slider_amp, floor))])
+    m = z.size
+    h = FD_STEP * scale
+    batch = np.tile(z, (2 * m + 1, 1))
+    j = np.arange(m)
+    batch[1 + 2 * j, j] += h
+    batch[2 + 2 * j, j] -= h
+    f = arrays.system.excitation(omega)[0].reshape(arrays.system.basis.n_coeffs, N)   # static, cos, sin
+    out = disk_period_map(batch, steps, dt, arrays.n_q, arrays.m_q, arrays.c_q, arrays.k_q, arrays.minv,
+                          np.ascontiguousarray(f[0]), np.ascontiguousarray(f[1]), np.ascontiguousarray(f[2]),
+                          arrays.Tb, arrays.idx, arrays.pt_local, arrays.B, arrays.k_t, arrays.mu, arrays.weight,
+                          arrays.offset, arrays.law_kind, arrays.law_par, t_nnz, t_col, b_nnz, b_col, arrays.tip)
+    mono = ((out[1::2] - out[2::2]) / (2 * h[:, None])).T
+    error = float(np.max(np.abs(out[0, :2 * N] - z[:2 * N]) / scale[:2 * N]))
+    return mono, z, error, steps
+
+
 def supports(model) -> bool:
-    """Whether the monodromy method has a period map for ``model``."""
+    """Whether the monodromy method has a period map for ``model``: a FrictionOscillator, a
+    TunedDisk or a full-assembly MistunedDisk (every blade in the model)."""
+    from ..disk import TunedDisk
+    from ..mistuned import MistunedDisk
     from ..oscillator import FrictionOscillator
 
-    return isinstance(model, FrictionOscillator)
+    if isinstance(model, MistunedDisk):
+        return model.n_sector == model.n_blades
+    return isinstance(model, (FrictionOscillator, TunedDisk))
 
 
-def monodromy_multipliers(model, coefficients, basis, omega: float, steps: int = STEPS_PER_PERIOD):
-    """(multipliers (3,) complex, largest modulus first; periodicity error) of ``model``'s HBM
-    solution ``coefficients`` at ``omega`` [rad/s] (see :func:`oscillator_monodromy`)."""
+def monodromy_multipliers(model, coefficients, basis, omega: float, steps: int | None = None):
+    """(multipliers (m,) complex, largest modulus first; periodicity error) of ``model``'s HBM
+    solution ``coefficients`` at ``omega`` [rad/s] (see :func:`oscillator_monodromy`, m = 3,
+    and :func:`disk_monodromy`, m = 2 N + 2 P); ``steps`` per period (default STEPS_PER_PERIOD
+    for the oscillator, the disk's own rule for a disk)."""
+    from ..oscillator import FrictionOscillator
+
     if not supports(model):
-        raise ValueError(f"method 'monodromy' has a period map for the FrictionOscillator only (got "
-                         f"{type(model).__qualname__}); use method 'auto' (Hill or determinant sign)")
-    mono, _, error = oscillator_monodromy(model, coefficients, basis, omega, steps)
+        raise ValueError("method 'monodromy' has a period map for the FrictionOscillator, the TunedDisk and the "
+                         f"full-assembly MistunedDisk only (got {type(model).__qualname__}); use method 'auto' "
+                         "(Hill or determinant sign)")
+    if isinstance(model, FrictionOscillator):
+        mono, _, error = oscillator_monodromy(model, coefficients, basis, omega,
+                                              STEPS_PER_PERIOD if steps is None else steps)
+    else:
+        mono, _, error, _ = disk_monodromy(model, coefficients, basis, omega, steps)
     mu = np.linalg.eigvals(mono).astype(complex)
     return mu[np.argsort(-np.abs(mu))], error

@@ -323,8 +323,9 @@ def _check_method(method, model):
         from .monodromy import supports
 
         if model is None or not supports(model):
-            raise ValueError(f"method 'monodromy' needs the model and has a period map for the FrictionOscillator "
-                             f"only (got model={type(model).__qualname__}); use method 'auto'")
+            raise ValueError(f"method 'monodromy' needs the model and has a period map for the FrictionOscillator, "
+                             f"the TunedDisk and the full-assembly MistunedDisk only "
+                             f"(got model={type(model).__qualname__}); use method 'auto'")
 
 
 def _floquet_from_jacobian(system, J, omega, tolerance, n_near, method, x=None, model=None) -> FloquetResult:
