@@ -1,0 +1,222 @@
+"""The monodromy matrix of a bladed disk with friction dampers (issue 14, :func:`bladedamp.hbm.
+monodromy.disk_monodromy`): the Floquet multipliers from the period map of the full assembly's
+time integration, started on the HBM solution.
+
+* stuck limit: contacts that cannot slip make the assembly linear; its multipliers are checked
+  against the eigenvalues of the stuck linear system, taken from the HBM Jacobian (M, D and
+  K + contact stiffness of the first-harmonic block), not from the time-domain code: both the
+  exact multipliers of the linear central-difference recurrence (to the finite differences'
+  accuracy) and the continuous exp(lambda T) to the scheme's second-order error;
+* the reference cylinder damper on a 4-blade disk, points across the 1F FRF: stable, as the
+  determinant sign says, and the HBM orbit returns onto itself after one period;
+* a TunedDisk (sector written out) and the equivalent tuned MistunedDisk (its own solution)
+  give the same multipliers;
+* models without a period map and solutions without the static harmonic are refused.
+
+Cost: ``nice python benchmarks/bench_monodromy_disk.py 4 16`` (see :mod:`bladedamp.hbm.monodromy`).
+"""
+from __future__ import annotations
+
+import dataclasses
+import warnings
+
+import numpy as np
+import pytest
+import scipy.linalg
+
+import bladedamp as bd
+from bladedamp.blade import reference_blade
+from bladedamp.damper.geometry import CylinderDamper
+from bladedamp.disk import TunedDisk
+from bladedamp.hbm.monodromy import assembly_coefficients, disk_monodromy, monodromy_multipliers
+from bladedamp.hbm.stability import floquet_exponents
+from bladedamp.mistuned import MistunedDisk
+from bladedamp.reference import DAMPER_RADIUS, EXCITATION_FX, PLATFORM_ANGLE, reference_contact
+
+
+def small_disk(damper, n_blades=4, blade=None, excitation=EXCITATION_FX):
+    return TunedDisk(blade or reference_blade(), damper, n_blades, 1, PLATFORM_ANGLE, PLATFORM_ANGLE, DAMPER_RADIUS,
+                     np.asarray(excitation, dtype=float))
+
+
+def quiet_frf(disk, f0, f1, **kw):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = disk.frequency_response(f0, f1, **kw)
+    assert r.success, r.message
+    return r
+
+
+# ----- stuck limit --------------------------------------------------------------------------
+
+def stuck_linear_system(system, x, omega):
+    """(M, D, K_stuck) (N, N) of the assembly from its HBM Jacobian at the stuck solution x:
+    the first-harmonic block of dR/dx is [[K - w^2 M, w D], [-w D, K - w^2 M]] (the contacts'
+    AFT Jacobian there is their stick stiffness)."""
+    N = system.n_dof
+    _, J, _ = system.residual(x, omega, True)
+    J = J.toarray() if hasattr(J, "toarray") else np.asarray(J)
+    j = system.basis.cos_index(1)
+    c, s = slice(j * N, (j + 1) * N), slice((j + 1) * N, (j + 2) * N)
+    M = system.mass.toarray() if hasattr(system.mass, "toarray") else np.asarray(system.mass)
+    K = J[c, c] + omega ** 2 * M
+    D = J[c, s] / omega
+    assert np.abs(J[s, c] + omega * D).max() <= 1e-9 * np.abs(omega * D).max()    # the block structure holds
+    assert np.abs(J[s, s] - J[c, c]).max() <= 1e-9 * np.abs(J[c, c]).max()
+    return M, D, K
+
+
+@pytest.fixture(scope="module")
+def stuck():
+    """A 4-blade tuned full assembly with a 1 g cylinder of mu = 1e3 (every point sticks) and
+    blades of 0.5 % modal damping, harmonics (0, 1), at 92 Hz (off the 95 Hz stuck resonance)."""
+    blade = dataclasses.replace(reference_blade(), damping_ratios=0.005)
+    damper = CylinderDamper(1e-3, 2e-3, 20e-3, reference_contact(friction_coefficient=1e3))
+    full = MistunedDisk.from_tuned(small_disk(damper, blade=blade))
+    r = quiet_frf(full, 92.0, 92.3, harmonics=(0, 1))
+    i = len(r.omega) // 2
+    return full, r, i
+
+
+def test_stuck_contacts_give_the_multipliers_of_the_stuck_linear_system(stuck):
+    """Contacts that cannot slip: the period map is linear (x, x_-1) -> (x, x_-1) with the sliders
+    held (2 P multipliers exactly 1: a stuck contact keeps any offset). The other 2 N are
+
+    * those of the linear central-difference recurrence of M x'' + D x' + K_stuck x = f
+      (M, D, K_stuck from the HBM Jacobian, the recurrence's (2N, 2N) matrix to the power
+      ``steps``): to 1e-5 (finite differences of a linear map: rounding only; measured 2.9e-7);
+    * exp(lambda T) of the continuous system's eigenvalues lambda (lambda^2 M + lambda D + K_stuck
+      = 0) to the scheme's error: central differences advance a mode of frequency w with
+      (2 / dt) arcsin(w dt / 2) = w (1 + (w dt)^2 / 24 + ...), so its multiplier is off by
+      |mu| w T (w dt)^2 / 24 (1F at 512 steps: 4.2e-5; measured equal to that to 1 %). Checked
+      for every mode where that bound is below 0.05 (the stiff contact modes, w dt up to 1.6,
+      are the discrete scheme's own: checked by the recurrence above).
+    """
+    full, r, i = stuck
+    w = float(r.omega[i])
+    system = full.hbm_system(r.basis.harmonics, r.basis.n_samples)
+    x = r.coefficients[i].ravel()
+    mono, z, error, steps = disk_monodromy(full, x, r.basis, w)
+    N = full.n_dof
+    P = (z.size - 2 * N) // 2
+    assert P == 4 * 2 * 5 and mono.shape == (2 * N + 2 * P,) * 2
+    mu = np.linalg.eigvals(mono)
+    ones = np.abs(mu - 1) < 1e-9
+    assert ones.sum() == 2 * P, np.sort(np.abs(mu - 1))[:2 * P + 2]
+    mu_x = mu[~ones]
+
+    M, D, K = stuck_linear_system(system, x, w)
+    T = 2 * np.pi / w
+    dt = T / steps
+    L = np.linalg.inv(M / dt ** 2 + D / (2 * dt))
+    recurrence = np.block([[L @ (2 * M / dt ** 2 - K), L @ (-M / dt ** 2 + D / (2 * dt))],
+                           [np.eye(N), np.zeros((N, N))]])
+    discrete = np.linalg.eigvals(recurrence) ** steps
+    mismatch = max(np.abs(mu_x - d).min() for d in discrete)
+    print(f"discrete recurrence: max mismatch {mismatch:.2e} ({steps} steps)")
+    assert mismatch < 1e-5
+
+    lam = scipy.linalg.eigvals(np.block([[np.zeros((N, N)), np.eye(N)], [-K, -D]]),
+                               np.block([[np.eye(N), np.zeros((N, N))], [np.zeros((N, N)), M]]))
+    print("largest Re lambda [1/s]:", lam.real.max())
+    assert lam.size == 2 * N and np.all(lam.real < 1e-9 * np.abs(lam))
+    continuous = np.exp(lam * T)
+    w_mode = np.abs(lam)
+    bound = np.abs(continuous) * w_mode * T * (w_mode * dt) ** 2 / 24
+    resolved = bound < 0.05
+    err = np.array([np.abs(mu_x - c).min() for c in continuous])
+    print("resolved modes [rad/s]:", np.round(w_mode[resolved]), "error / bound:", np.round(err[resolved] / bound[resolved], 3))
+    assert resolved.sum() >= 16                                  # the blade modes at least
+    assert np.all(err[resolved] <= 1.2 * bound[resolved] + 1e-6)
+    # the 1F mode itself, ~6e-5 off at 512 steps: 1e-4 absolute
+    one_f = np.argmin(np.abs(w_mode - 2 * np.pi * 95))
+    assert err[one_f] < 1e-4
+    # a stuck linear orbit: the HBM solution is the continuous orbit (exact for a linear system)
+    print(f"periodicity error {error:.2e}")
+    assert error < 5e-3
+    res = floquet_exponents(system, x, w, method="monodromy", model=full)
+    assert res.method == "monodromy" and res.stable
+
+
+# ----- the reference damper on a 4-blade disk ----------------------------------------------
+
+FRF_POINTS_HZ = (92.0, 94.0, 95.3, 96.5, 98.0)
+
+
+@pytest.fixture(scope="module")
+def reference4():
+    """The reference 1 g cylinder and blade on a 4-blade disk (EO = 1), harmonics (0, 1, 2, 3)."""
+    disk = dataclasses.replace(bd.reference_disk("cylinder", 1e-3), n_blades=4)
+    return disk, quiet_frf(disk, 90.0, 100.0, harmonics=(0, 1, 2, 3))
+
+
+def test_reference_cylinder_on_four_blades_is_stable_across_the_1f_frf(reference4):
+    """Points below, at and above the 1F peak (slip at the peak): every point stable by the
+    multipliers (largest modulus at most 1 + 1e-6: the undamped damper-on-contact modes sit on
+    the unit circle), as the determinant sign says, and the HBM orbit returns to itself after
+    one period (periodicity error below 5e-3 of each kind's vibration amplitude; measured
+    0.4-1.6e-3, most of it the HBM's static retention spring on the damper's mean position,
+    1e-4 of the normal stiffness, which the time integration does not have)."""
+    disk, r = reference4
+    system = disk.hbm_system(r.basis.harmonics, r.basis.n_samples)
+    for f in FRF_POINTS_HZ:
+        i = int(np.argmin(np.abs(r.frequency_hz - f)))
+        x, w = r.coefficients[i].ravel(), float(r.omega[i])
+        mono = floquet_exponents(system, x, w, method="monodromy", model=disk)
+        det = floquet_exponents(system, x, w)
+        lead = np.abs(mono.multipliers[0])
+        print(f"{r.frequency_hz[i]:.2f} Hz: max |mu| - 1 = {lead - 1:.1e}, periodicity error "
+              f"{mono.periodicity_error:.2e}, det sign {det.jacobian_sign}")
+        assert det.method == "determinant sign" and det.stable
+        assert mono.method == "monodromy" and mono.stable == det.stable
+        assert lead < 1 + 1e-6
+        assert mono.periodicity_error < 5e-3
+        # friction or blade damping: most multipliers strictly inside the circle
+        assert np.sum(np.abs(mono.multipliers) < 0.99) >= 16
+
+
+# ----- the tuned sector against the tuned full assembly ---------------------------------------
+
+def test_tuned_sector_and_tuned_assembly_give_the_same_multipliers(reference4):
+    """The sector solution (TunedDisk) written out on the full assembly is a solution of the
+    assembly's own harmonic balance (residual < 1e-8 of the excitation), and the MistunedDisk's
+    own Newton solution there (started 1 % off) gives the same multipliers as the TunedDisk path
+    (each within 1e-6; measured ~1e-9)."""
+    from bladedamp.hbm.continuation import newton
+
+    disk, r = reference4
+    full = MistunedDisk.from_tuned(disk)
+    i = int(np.argmin(np.abs(r.frequency_hz - 95.3)))
+    w = float(r.omega[i])
+    system = full.hbm_system(r.basis.harmonics, r.basis.n_samples)
+    X = assembly_coefficients(disk, full, r.coefficients[i], r.basis).ravel()
+    scale = max(np.linalg.norm(system.residual(np.zeros_like(X), w, False)[0]), 1e-300)
+    assert np.linalg.norm(system.residual(X, w, False)[0]) < 1e-8 * scale
+    start = X * (1 + 0.01 * np.cos(np.arange(X.size)))
+    sol = newton(system.residual, start, w, full.unknown_scales(system, w, w), scale, tol=1e-12, max_iter=40,
+                 factorize=system.factorize)
+    assert sol.converged
+    mu_tuned, err_tuned = monodromy_multipliers(disk, r.coefficients[i], r.basis, w)
+    mu_full, err_full = monodromy_multipliers(full, sol.x, system.basis, w)
+    mismatch = max(np.abs(mu_full - a).min() for a in mu_tuned)
+    print(f"max mismatch {mismatch:.1e}, periodicity errors {err_tuned:.2e} / {err_full:.2e}")
+    assert mu_tuned.size == mu_full.size == 2 * full.n_dof + 2 * 4 * 2 * 5
+    assert mismatch < 1e-6 and abs(err_tuned - err_full) < 1e-6
+
+
+# ----- bad input -------------------------------------------------------------------------------
+
+def test_models_without_a_period_map_and_solutions_without_the_static_harmonic_are_refused(reference4):
+    disk, r = reference4
+    system = disk.hbm_system(r.basis.harmonics, r.basis.n_samples)
+    x, w = r.coefficients[0].ravel(), float(r.omega[0])
+    sector = MistunedDisk.from_tuned(disk, n_sector=2)                 # a cyclic sector of 2 blades
+    with pytest.raises(ValueError, match="full-assembly MistunedDisk"):
+        floquet_exponents(system, x, w, method="monodromy", model=sector)
+    with pytest.raises(ValueError, match="period map"):
+        monodromy_multipliers(object(), x, r.basis, w)
+    one = disk.hbm_system((1,))
+    with pytest.raises(ValueError, match="static harmonic"):
+        monodromy_multipliers(disk, np.zeros(one.n_unknowns), one.basis, w)
+    with pytest.raises(ValueError, match="steps .per period. must be >="):
+        disk_monodromy(disk, x, r.basis, w, steps=64)
