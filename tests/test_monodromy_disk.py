@@ -220,3 +220,33 @@ def test_models_without_a_period_map_and_solutions_without_the_static_harmonic_a
         monodromy_multipliers(disk, np.zeros(one.n_unknowns), one.basis, w)
     with pytest.raises(ValueError, match="steps .per period. must be >="):
         disk_monodromy(disk, x, r.basis, w, steps=64)
+
+
+# ----- the reference 16-blade disk: a stuck point, and the rolling cylinder -------------------
+
+def test_reference_disk_stuck_point_stable_and_rolling_cylinder_reported():
+    """The reference disk (16 blades, 1 g cylinder, (0, 1, 2, 3)). At 92 Hz (contacts stick) the
+    HBM orbit is periodic in the time integration (error < 5e-3; measured 3.9e-4) and stable by
+    the multipliers, as by det J. At 95.3 Hz (slip) the time integration of this disk does not
+    reach a periodic state: the cylinder keeps rolling, phi_y growing by mrad per period
+    (tests/test_timedomain_disk.py::test_cylinder_hbm_against_time_integration, slow); the HBM
+    holds its mean roll angle only by the static retention spring. The monodromy sees that: one
+    period from the HBM state moves phi_y by ~0.01 rad (periodicity error ~0.7 of the rotations'
+    vibration amplitude), with an AccuracyWarning naming phi_y."""
+    from bladedamp.hbm.accuracy import AccuracyWarning
+
+    disk = bd.reference_disk("cylinder", 1e-3)
+    r = quiet_frf(disk, 91.5, 95.6, harmonics=(0, 1, 2, 3))
+    system = disk.hbm_system(r.basis.harmonics, r.basis.n_samples)
+    i = int(np.argmin(np.abs(r.frequency_hz - 92.0)))
+    x, w = r.coefficients[i].ravel(), float(r.omega[i])
+    mono = floquet_exponents(system, x, w, method="monodromy", model=disk)
+    print(f"16 blades {r.frequency_hz[i]:.2f} Hz: max |mu| - 1 = {abs(mono.multipliers[0]) - 1:.1e}, "
+          f"periodicity error {mono.periodicity_error:.2e}")
+    assert mono.stable and floquet_exponents(system, x, w).stable
+    assert mono.multipliers.size == 2 * 160 + 2 * 160 and mono.periodicity_error < 5e-3
+    i = int(np.argmin(np.abs(r.frequency_hz - 95.3)))
+    with pytest.warns(AccuracyWarning, match="phi_y"):
+        _, error = monodromy_multipliers(disk, r.coefficients[i], r.basis, float(r.omega[i]))
+    print(f"16 blades {r.frequency_hz[i]:.2f} Hz: periodicity error {error:.2f}")
+    assert error > 0.1

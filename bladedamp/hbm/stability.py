@@ -68,7 +68,10 @@ neighbour: stable where the branch starts from the linear limit and keeps det J 
 Neimark-Sacker bifurcation (or a period doubling) of a friction-damped system cannot be found
 this way; ``method="monodromy"`` (:mod:`bladedamp.hbm.monodromy`: the Floquet multipliers of
 the period map of a time integration started on the HBM solution, the slider positions part of
-the state) finds all three, for the models it has a period map for (the FrictionOscillator).
+the state) finds all three, for the models it has a period map for (the FrictionOscillator, and
+the bladed disk: a TunedDisk's sector solution written out on the full assembly, or a
+full-assembly MistunedDisk, by the time domain's integrator of the assembly; its cost is
+~100-1600 x the HBM solve per point, see that module).
 The result says which method was used (``method``: "hill", "determinant sign" or "monodromy").
 The default ("auto") stays Hill / determinant sign: the monodromy integrates 7 trajectories
 over one period per point, 4.3 times the cost (measured on the friction-fold branch of
