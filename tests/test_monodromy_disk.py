@@ -250,3 +250,19 @@ def test_reference_disk_stuck_point_stable_and_rolling_cylinder_reported():
         _, error = monodromy_multipliers(disk, r.coefficients[i], r.basis, float(r.omega[i]))
     print(f"16 blades {r.frequency_hz[i]:.2f} Hz: periodicity error {error:.2f}")
     assert error > 0.1
+
+
+def test_with_stability_takes_method_monodromy_on_a_disk(reference4):
+    """The stability API on a disk FRF: ``with_stability(disk, response, method="monodromy")``
+    (a short stretch of the 4-blade reference FRF at the peak): every point stable, as by the
+    determinant sign, and ``stability_method`` says which method decided."""
+    from bladedamp.hbm.stability import with_stability
+
+    disk, r = reference4
+    short = quiet_frf(disk, 95.28, 95.34, harmonics=(0, 1, 2, 3))
+    assert 3 <= len(short.omega) <= 60
+    mono = with_stability(disk, short, method="monodromy")
+    det = with_stability(disk, short)
+    assert mono.stability_method == "monodromy" and det.stability_method == "determinant sign"
+    assert mono.stable.all() and det.stable.all()
+    assert mono.floquet_exponents.shape[0] == len(short.omega)
