@@ -25,7 +25,7 @@ subspace), and the assembly has more: other nodal diameters.
 The reference friction disk is not such a case: it keeps det J > 0 and no fold on 90-105 Hz
 (tests/test_stability.py::test_reference_disk_has_no_fold_and_keeps_det_j_positive); its
 determinant sign cannot see a Neimark-Sacker crossing, for which Hill's method on friction is
-not valid and the monodromy matrix has no period map of the disk yet.
+not valid; the monodromy matrix of the disk (tests/test_monodromy_disk.py) has the period map.
 """
 from __future__ import annotations
 
