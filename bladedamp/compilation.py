@@ -12,7 +12,7 @@ It compiles by running the public paths on tiny problems, so the kernels get exa
 argument types of real use (numba compiles one version per type signature): a flat and an
 inclined friction oscillator (with and without the Jacobian, the closed-form and the iterated
 slider derivative), the reference disk's residual, a 4-blade full assembly (the ring solver),
-the time integration of both, and the oscillator's monodromy. A kernel already in the cache is
+the time integration of both, and the monodromy of both. A kernel already in the cache is
 only loaded. ``tests/test_compilation.py`` checks that after it, in a new process, the
 reference disk's FRF, a mistuned FRF and the time integrations compile nothing.
 """
@@ -42,6 +42,7 @@ def _disk_paths():
     import numpy as np
 
     from .hbm.linsolve import permutation_sign
+    from .hbm.monodromy import monodromy_multipliers
     from .mistuned import AssemblySystem, MistunedDisk
     from .reference import reference_disk
 
@@ -53,6 +54,9 @@ def _disk_paths():
 
     small().frequency_response(94.0, 94.2, harmonics=(1,), max_step=0.5)
     small().time_response([94.0], max_periods=2, min_periods=1)
+    four = dataclasses.replace(disk, n_blades=4, engine_order=1)      # the disk's monodromy (static term)
+    r = four.frequency_response(92.0, 92.1, harmonics=(0, 1), max_step=0.5)
+    monodromy_multipliers(four, r.coefficients[0], r.basis, float(r.omega[0]))
     dense_limit = AssemblySystem.dense_limit
     try:              # the sparse Jacobian of large assemblies (its ring gather and sparse LU's sign)
         AssemblySystem.dense_limit = 0

@@ -3,7 +3,7 @@
 The slow test is the claim itself: on an empty cache, after ``precompile`` in one process, a
 new process running the real workloads (the reference FRFs of both dampers with the default
 harmonics, a 16-blade mistuned FRF on its sparse Jacobian, the time integrations, the
-oscillator's monodromy) compiles no kernel of bladedamp: numba's own counters of every
+monodromy of the oscillator and of a disk) compiles no kernel of bladedamp: numba's own counters of every
 dispatcher (``stats.cache_misses``) stay empty. Without precompile the same process misses
 (checked in the same test, so the counter is shown able to fail).
 """
@@ -43,6 +43,11 @@ m = bd.MistunedDisk.from_tuned(disk, kappa=1 + 0.02 * np.random.default_rng(0).s
 r = m.frequency_response(94.5, 95, harmonics=(0, 1, 2, 3, 4, 5), max_step=0.2)
 assert not m.hbm_system((0, 1, 2, 3, 4, 5)).dense          # the sparse path was taken
 m.time_response([95.0], max_periods=2, min_periods=1)
+from bladedamp.hbm.monodromy import monodromy_multipliers
+import dataclasses
+four = dataclasses.replace(bd.reference_disk("cylinder", 1e-3), n_blades=4)
+r = four.frequency_response(93, 93.5, harmonics=(0, 1, 2, 3))
+monodromy_multipliers(four, r.coefficients[-1], r.basis, float(r.omega[-1]))
 """
 MISSES = """
 from numba.core.registry import CPUDispatcher
