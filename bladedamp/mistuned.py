@@ -1030,7 +1030,7 @@ class MistunedResponse(FrequencyResponse):
                 interior[highest[k] - 1, k] = True
         f = self.frequency_hz
         candidates = [(int(k), int(i) + 1) for i, k in zip(*np.nonzero(interior))]
-        best = {k: [] if 0 < np.argmax(a[:, k]) < len(f) - 1 else [(peak[k], freq[k])] for k, _ in candidates}
+        best = {k: [] if 0 < highest[k] < len(f) - 1 else [(peak[k], freq[k])] for k, _ in candidates}
         for (k, i), solved in zip(candidates, self.disk.solve_peaks(self, candidates, direction, tol)):
             # the sampled maximum is one of the local maxima unless it lies at an end of the range
             best[k].append(solved if solved is not None else refined_peak(f, a[:, k], i))

@@ -161,17 +161,19 @@ class FrictionOscillator:
             C = system.basis.n_coeffs
             response = FrequencyResponse(branch.omega, branch.x.reshape(-1, C, 1), system.basis, ("x",),
                                          branch.success, branch.message, branch.iterations, branch.turning_points)
-            energy = self.energy_balance(response) if len(branch.omega) else np.zeros((0, 3))
+            # per point: the excitation work, and the contact's dissipation and energy scale (one AFT)
+            work = np.array([system.excitation_work(x, w) for x, w in zip(branch.x, branch.omega)])
+            energies = np.array([[sum(e) for e in system.element_energies(x, w)]
+                                 for x, w in zip(branch.x, branch.omega)]).reshape(-1, 2)
             T = system.basis.n_samples
 
             def refine(indices):
                 fine = self.hbm_system(system.basis.harmonics, REFINE_SAMPLES_FACTOR * T)
                 return np.array([fine.element_dissipation(branch.x[i], branch.omega[i]) for i in indices])
 
-            bound = np.array([sum(system.element_work_bound(x, w)) for x, w in zip(branch.x, branch.omega)])
-            return with_checks(response, physical_checks(branch.omega, (omega_start, omega_end), energy[:, 2:],
-                                                         energy[:, 0], continuation_options.get("max_step") or 0.02,
-                                                         T, refine, bound.reshape(-1, 1)))
+            return with_checks(response, physical_checks(branch.omega, (omega_start, omega_end), energies[:, :1],
+                                                         work, continuation_options.get("max_step") or 0.02,
+                                                         T, refine, energies[:, 1:]))
 
         return converged_response(self, solve, harmonics, harmonic_tolerance, max_harmonic)
 

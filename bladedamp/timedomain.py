@@ -15,6 +15,7 @@ frequencies for comparison.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numba import njit
@@ -355,6 +356,12 @@ class AssemblyArrays:
     geometries: list
     stiffness: object          # scipy.sparse (N, N)
     mass: object               # scipy.sparse (N, N)
+
+    @cached_property
+    def sparsity(self):
+        """(t_nnz, t_col, b_nnz, b_col): the nonzeros of the rows of ``Tb`` and ``B``
+        (:func:`row_nonzeros`), the sparsity arguments of :func:`disk_period`."""
+        return (*row_nonzeros(self.Tb), *row_nonzeros(self.B))
 
 
 def assembly_arrays(disk) -> AssemblyArrays:
@@ -765,8 +772,7 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
                damper_mean=np.zeros((n, nd, 6)), damper_drift=np.zeros((n, nd, 6)), point_state=np.zeros((n, P, 3)),
                time_step=2 * np.pi / omega / steps, static_state=np.array(statics), tip_history=[],
                damper_history=[])
-    t_nnz, t_col = row_nonzeros(arrays.Tb)
-    b_nnz, b_col = row_nonzeros(arrays.B)
+    t_nnz, t_col, b_nnz, b_col = arrays.sparsity
     tip_dft = np.zeros((s, 3, 2))
     damper_mean = np.zeros((nd, 6))
     damper_dft = np.zeros((nd, 6, 2))
@@ -938,5 +944,3 @@ def hbm_tip_at(disk, f_hz, harmonics=(0, 1, 2, 3), pad_hz: float = 1.0, max_step
     out = np.array(out)                                              # (n, 3 s)
     return out if isinstance(disk, TunedDisk) else out.reshape(len(f_hz), -1, 3)
 
-
-_assembly_arrays = assembly_arrays      # the former private name (tests/test_timedomain_disk.py)

@@ -168,11 +168,11 @@ def test_static_state_with_a_misfit_is_the_seating():
     frictionless) carries the same per-point normal loads as the HBM's rigid-platform seating
     (kinetics.seat) to 1e-6, and leaves the same points open."""
     from bladedamp.damper.kinetics import seat
-    from bladedamp.timedomain import _assembly_arrays, _normal_law_numpy, _static_state
+    from bladedamp.timedomain import _normal_law_numpy, _static_state, assembly_arrays
 
     xi = np.repeat(np.linspace(-1.0, 1.0, 3), 3)                  # 3 x 3 points, xi-major
     disk = small_disk(small_wedge(), initial_gaps=np.array([5e-6 * (1 + xi), 5e-6 * (1 - xi)]))
-    arrays = _assembly_arrays(MistunedDisk.from_tuned(disk))
+    arrays = assembly_arrays(MistunedDisk.from_tuned(disk))
     w = 2 * np.pi * 97.0
     f = arrays.system.excitation(w)[0].reshape(3, -1)
     x0 = _static_state(arrays, f[0])

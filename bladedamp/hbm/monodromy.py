@@ -119,6 +119,15 @@ def oscillator_period_map(states, omega, m, c, k, k3, k_t, mu, n0, k_n, sin_a, c
     return out
 
 
+def _evaluate(X, basis, tau):
+    """x (N,) of the coefficients X (C, N) at the phase tau = Omega t [rad]."""
+    x = np.zeros(X.shape[1])
+    for h in basis.harmonics:
+        j = basis.cos_index(h)
+        x += X[j] if h == 0 else X[j] * np.cos(h * tau) + X[j + 1] * np.sin(h * tau)
+    return x
+
+
 def _oscillator_orbit_state(osc, coefficients, basis, omega, steps):
     """(z (3,), scale) of the HBM solution ``coefficients`` (C*1,) of ``osc`` at ``omega``:
     x(0), x(-dt) from the Fourier series and the slider from the AFT's periodic return map at
@@ -131,21 +140,14 @@ def _oscillator_orbit_state(osc, coefficients, basis, omega, steps):
     c = np.asarray(coefficients, dtype=float).ravel()
     dt = 2 * np.pi / omega / steps
 
-    def x_at(t):
-        tau = omega * t
-        value = 0.0
-        for h in basis.harmonics:
-            j = basis.cos_index(h)
-            value += c[j] if h == 0 else c[j] * np.cos(h * tau) + c[j + 1] * np.sin(h * tau)
-        return value
-
     system = osc.hbm_system(basis.harmonics, basis.n_samples)
     contact = next(cp for cp in system.couplings if isinstance(cp.element, PointContactElement))
     pts = contact.element.samples(contact.matrix @ c, basis)
     u, f = pts.displacement[0, 0, 0], pts.force[0, 0, 0]
     s = u if pts.state[0, 0] == SEPARATED else u - f / osc.contact_stiffness
     scale = max(float(np.abs(basis.synthesis @ c).max()), 1e-300)
-    return np.array([x_at(0.0), x_at(-dt), s]), scale
+    X = c.reshape(-1, 1)
+    return np.array([_evaluate(X, basis, 0.0)[0], _evaluate(X, basis, -omega * dt)[0], s]), scale
 
 
 def oscillator_monodromy(osc, coefficients, basis, omega: float, steps: int = STEPS_PER_PERIOD):
@@ -221,17 +223,16 @@ def _disk_assembly(model):
 
     from ..disk import TunedDisk
     from ..mistuned import MistunedDisk
-    from ..timedomain import assembly_arrays, row_nonzeros
+    from ..timedomain import assembly_arrays
 
     hit = _ASSEMBLY_CACHE.get(id(model))
     if hit is not None and hit[0]() is model:
-        return hit[1], hit[2], hit[3]
+        return hit[1], hit[2]
     full = MistunedDisk.from_tuned(model) if isinstance(model, TunedDisk) else model
     arrays = assembly_arrays(full)
-    nonzeros = row_nonzeros(arrays.Tb) + row_nonzeros(arrays.B)
     _ASSEMBLY_CACHE.clear()
-    _ASSEMBLY_CACHE[id(model)] = (weakref.ref(model), full, arrays, nonzeros)
-    return full, arrays, nonzeros
+    _ASSEMBLY_CACHE[id(model)] = (weakref.ref(model), full, arrays)
+    return full, arrays
 
 
 def assembly_coefficients(model, full, coefficients, basis) -> np.ndarray:
@@ -259,15 +260,6 @@ def assembly_coefficients(model, full, coefficients, basis) -> np.ndarray:
             z = (X[j, source] - 1j * X[j + 1, source]) * np.exp(1j * h * k * full.interblade_phase)
             out[j, target], out[j + 1, target] = z.real, -z.imag
     return out
-
-
-def _evaluate(X, basis, tau):
-    """x (N,) of the coefficients X (C, N) at the phase tau = Omega t [rad]."""
-    x = np.zeros(X.shape[1])
-    for h in basis.harmonics:
-        j = basis.cos_index(h)
-        x += X[j] if h == 0 else X[j] * np.cos(h * tau) + X[j + 1] * np.sin(h * tau)
-    return x
 
 
 def _disk_sliders(arrays, X, basis):
@@ -318,7 +310,8 @@ def disk_monodromy(model, coefficients, basis, omega: float, steps: int | None =
         raise ValueError("method 'monodromy' of a bladed disk needs a solution with the static harmonic 0 "
                          f"(harmonics {tuple(basis.harmonics)}): the time integration seats the dampers under "
                          "F_CG, the HBM without h = 0 on a pre-computed rigid seating")
-    full, arrays, (t_nnz, t_col, b_nnz, b_col) = _disk_assembly(model)
+    full, arrays = _disk_assembly(model)
+    t_nnz, t_col, b_nnz, b_col = arrays.sparsity
     X = assembly_coefficients(model, full, coefficients, basis)
     N, P, n_q = X.shape[1], arrays.B.shape[0], arrays.n_q
     T = 2 * np.pi / omega

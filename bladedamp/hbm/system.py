@@ -184,22 +184,24 @@ class HarmonicBalanceSystem:
 
     def element_dissipation(self, x: np.ndarray, omega: float) -> list[float]:
         """Energy absorbed by each nonlinear element per period [J] (oint f . dw)."""
-        return self._per_element(x, omega, self.basis.work_per_cycle)
+        return self.element_energies(x, omega)[0]
 
     def element_work_bound(self, x: np.ndarray, omega: float) -> list[float]:
         """Each nonlinear element's energy scale per period [J]: the largest work its force and
         motion harmonics could do (:meth:`HarmonicBasis.work_bound`)."""
-        return self._per_element(x, omega, self.basis.work_bound)
+        return self.element_energies(x, omega)[1]
 
-    def _per_element(self, x: np.ndarray, omega: float, measure) -> list[float]:
-        """``measure(force, local motion)`` (coefficient arrays) summed, for each element."""
+    def element_energies(self, x: np.ndarray, omega: float) -> tuple[list[float], list[float]]:
+        """(dissipation, work bound) of each nonlinear element per period [J] (see
+        :meth:`element_dissipation`, :meth:`element_work_bound`), from one evaluation of its forces."""
         C = self.basis.n_coeffs
-        out = []
+        dissipation, bound = [], []
         for c in self.couplings:
             local = (c.matrix @ x).reshape(C, c.element.n_local)
             force, _, _ = c.element.harmonic_forces(local, self.basis, omega, False)
-            out.append(float(np.sum(measure(force, local))))
-        return out
+            dissipation.append(float(np.sum(self.basis.work_per_cycle(force, local))))
+            bound.append(float(np.sum(self.basis.work_bound(force, local))))
+        return dissipation, bound
 
 
 def with_element(system: HarmonicBalanceSystem, element: NonlinearElement, matrix, name: str = "") -> HarmonicBalanceSystem:
