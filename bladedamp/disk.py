@@ -32,11 +32,12 @@ from . import validation
 from .blade import ModalBlade
 from .contact.laws import LinearNormalLaw
 from .contact.patch import dof_jacobian
-from .contact.point import point_contact_forces
+from .contact.point import PointContactSamples, point_contact_forces
 from .damper.geometry import CylinderDamper, DamperGeometry, WedgeDamper
 from .damper.kinetics import centrifugal_force, seat
 from .hbm.accuracy import HARMONIC_TOLERANCE, converged_response
 from .hbm.continuation import continuation
+from .hbm.peaks import PeakSolver, first_harmonic_output
 from .hbm.start import robust_start
 from .hbm.fourier import HarmonicBasis
 from .hbm.system import Coupling, HarmonicBalanceSystem
@@ -277,6 +278,29 @@ class DamperContacts:
         maps = (None, None) if self.point_maps is None else self.point_maps
         return [patch.evaluate(local[:, m * c:m * c + m], basis, offsets[c], jacobian, point_map=maps[c])
                 for c, patch in enumerate(self.geometry.patches)]
+
+    def evaluate_states(self, local, basis, omegas):
+        """Forces (n, C, n_local) [N, N m] and the point samples (PointContactSamples, point axis
+        (n, 2, P) flattened) of both patches at n states ``local`` (n, C, n_local) at ``omegas``
+        (n,) [rad/s], without the Jacobian: every state in one call of the point-contact kernel
+        when the patches stack (:meth:`stacked_points`; the points are independent), else patch
+        by patch. The response's contact quantities at every point of a branch."""
+        local = np.asarray(local, dtype=float)
+        n, C, m = len(local), basis.n_coeffs, self.contact_local
+        offsets = np.stack([self.approach(w)[0] for w in omegas])                 # (n, 2, P)
+        stack = self.stacked_points()
+        if stack is not None:
+            _, B, k_t, mu, weights, law = stack
+            f, _, pts = point_map_forces(np.broadcast_to(B, (n,) + B.shape), np.moveaxis(local.reshape(n, C, 2, m), 0, 1),
+                                         basis, np.tile(k_t, n), np.tile(mu, n), law, np.tile(weights, n), offsets,
+                                         False)
+            return np.moveaxis(f, 1, 0).reshape(n, C, 2 * m), pts
+        evs = [ev for x, o in zip(local, offsets) for ev in self.evaluate_at(x, basis, o, False)]
+        force = np.stack([ev.force for ev in evs]).reshape(n, 2, C, m).transpose(0, 2, 1, 3).reshape(n, C, 2 * m)
+        pts = PointContactSamples(*(None if getattr(evs[0].points, f.name) is None else
+                                    np.concatenate([getattr(ev.points, f.name) for ev in evs])
+                                    for f in dataclasses.fields(PointContactSamples)))
+        return force, pts
 
     def harmonic_forces(self, local, basis, omega, jacobian=True):
         offsets, doffsets = self.approach(omega)
@@ -644,6 +668,24 @@ class TunedDisk:
                 if a > stop_above else None
         return stop_when
 
+    def solve_peak(self, response: "DiskResponse", index: int | None = None,
+                   direction: int = 0) -> tuple[float, float] | None:
+        """(peak first-harmonic tip amplitude u_``direction`` [m], its frequency [Hz]) of the local
+        maximum next to point ``index`` of ``response`` (default its largest amplitude), solved on
+        the response curve by the peak condition (:class:`bladedamp.hbm.peaks.PeakSolver`); None
+        where it is not solved (at an end of the branch, a fold next to the sample, a Newton solve
+        that does not converge). The branch only has to bracket the peak: measured on the
+        reference disks, a branch at max_step 0.2 gives the peak of one at 0.02 to 1e-6."""
+        validation.integer("direction", direction, minimum=0, maximum=2)
+        basis = response.basis
+        if index is None:
+            index = int(np.argmax(response.tip_amplitude[:, direction]))
+        system = self.hbm_system(basis.harmonics, basis.n_samples)
+        nm = self.blade.n_modes
+        tip = first_harmonic_output(basis, system.n_dof, np.arange(nm), self.blade.shape("tip")[direction])
+        solved = PeakSolver(system, response.omega, response.coefficients).solve(index, tip)
+        return None if solved is None else (solved[0], solved[1] / (2 * np.pi))
+
     def point_map(self, basis: HarmonicBasis, point: str = "tip", directions=(0,)) -> np.ndarray:
         """Real-form map (C*k, C*n_dof) from the unknowns of :meth:`hbm_system` (``basis``'s
         harmonics) to the motion of the reference blade's ``point`` in the k ``directions``
@@ -870,28 +912,18 @@ class DiskResponse(FrequencyResponse):
         if disk.has_damper and npts:
             coupling = system.couplings[0]
             element = coupling.element
-            P = element.geometry.patches[0].n_points
-            cf = np.zeros((npts, C, 12))
-            rm = np.zeros((npts, C, 12))
-            pdisp = np.zeros((npts, C, 2, P, 3))
-            pstate = np.zeros((npts, 2, P, 3))
-            pdiss = np.zeros((npts, 2, P))
-            pbound = np.zeros((npts, 2, P))
-            load = np.zeros((npts, 2))
-            for i, (x, w) in enumerate(zip(X, branch.omega)):
-                local = (coupling.matrix @ x.ravel()).reshape(C, element.n_local)
-                evs = element.evaluate(local, basis, w, jacobian=False)
-                rm[i] = element.relative_motion(local)
-                for c, ev in enumerate(evs):
-                    cf[i, :, 6 * c:6 * c + 6] = ev.force[:, :6]
-                    pts = ev.points
-                    pdisp[i, :, c] = basis.to_coeffs(np.moveaxis(pts.displacement, 1, 0))
-                    for s in range(3):
-                        pstate[i, c, :, s] = (pts.state == s).mean(axis=1)
-                    fcoef = basis.to_coeffs(np.moveaxis(pts.force, 1, 0))
-                    pdiss[i, c] = basis.work_per_cycle(fcoef, pdisp[i, :, c]).sum(axis=-1)
-                    pbound[i, c] = basis.work_bound(fcoef, pdisp[i, :, c]).sum(axis=-1)
-                    load[i, c] = pts.normal_load.sum(axis=0).mean()
+            P, T, m = element.geometry.patches[0].n_points, basis.n_samples, element.contact_local
+            local = (coupling.matrix @ X.reshape(npts, -1).T).T.reshape(npts, C, element.n_local)
+            force, pts = element.evaluate_states(local, basis, branch.omega)
+            cf = force.reshape(npts, C, 2, m)[..., :6].reshape(npts, C, 12)
+            rm = local.reshape(npts, C, 2, m)[..., :6].reshape(npts, C, 12)             # Eq. 7
+            disp = basis.to_coeffs(np.moveaxis(pts.displacement, 1, 0)).reshape(C, npts, 2, P, 3)
+            fcoef = basis.to_coeffs(np.moveaxis(pts.force, 1, 0)).reshape(C, npts, 2, P, 3)
+            pdisp = np.moveaxis(disp, 0, 1)
+            pstate = np.stack([(pts.state == s).mean(axis=1) for s in range(3)], axis=-1).reshape(npts, 2, P, 3)
+            pdiss = basis.work_per_cycle(fcoef, disp).sum(axis=-1)
+            pbound = basis.work_bound(fcoef, disp).sum(axis=-1)
+            load = pts.normal_load.reshape(npts, 2, P, T).sum(axis=2).mean(axis=-1)
             out.update(contact_force=cf, relative_motion=rm, point_displacement=pdisp, point_state=pstate,
                        point_dissipation=pdiss, point_work_bound=pbound, dissipated_energy=pdiss.sum(axis=(1, 2)),
                        normal_load=load)

@@ -54,10 +54,11 @@ from .damper.kinetics import seat
 from .disk import (AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION, DAMPER_DOFS, DamperContacts, TunedDisk,
                    contact_point_maps, contact_rows, damper_weighted_scales, point_map_forces, rotor_speed_in_hz)
 from .hbm.accuracy import HARMONIC_TOLERANCE, converged_response
-from .hbm.continuation import Branch, continuation, newton
+from .hbm.continuation import Branch, continuation
 from .hbm.start import robust_start
 from .hbm.linsolve import BlockCondensation, BlockRing, one_blas_thread
 from .hbm.linsolve import factorize as lu_factorize
+from .hbm.peaks import PEAK_MAX_ITERATIONS, PeakSolver, first_harmonic_output
 from .hbm.fourier import HarmonicBasis
 from .hbm.system import Coupling, HarmonicBalanceSystem
 from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, physical_checks, refined_peak, sampled_response,
@@ -415,26 +416,6 @@ def _as_list(name, value, n):
             raise ValueError(f"{name} must have one entry per blade of the model ({n}), got {len(value)}")
         return list(value)
     return [value] * n
-
-
-#: iterations of :meth:`MistunedDisk.solve_peaks` (each a Newton solve at fixed Omega); it stops
-#: earlier once the frequency settles (measured on random 2 % disks: 1-3)
-PEAK_MAX_ITERATIONS = 8
-
-
-def _hermite_maximum(a0, g0, a1, g1, h) -> float:
-    """Where in [0, 1] the cubic Hermite interpolant of values a0, a1 and slopes g0 > 0 > g1 (per
-    unit of the abscissa) over an interval of length h has its maximum: the root of its
-    derivative (a quadratic, positive at 0 and negative at 1, so one root lies between)."""
-    c2 = 6 * a0 + 3 * h * g0 - 6 * a1 + 3 * h * g1
-    c1 = -6 * a0 - 4 * h * g0 + 6 * a1 - 2 * h * g1
-    c0 = h * g0
-    if abs(c2) < 1e-14 * (abs(c1) + abs(c0)):
-        return float(np.clip(-c0 / c1, 0.0, 1.0))
-    roots = np.roots([c2, c1, c0])
-    roots = roots[np.isreal(roots)].real
-    inside = roots[(roots >= 0) & (roots <= 1)]
-    return float(inside[0]) if inside.size else 0.5
 
 
 @dataclass
@@ -866,83 +847,19 @@ class MistunedDisk:
         candidate ``(blade, index)``: blade ``blade``'s peak next to sample ``index`` of
         ``response`` (a local maximum of its sampled curve). Returns, per candidate, (peak [m],
         frequency [Hz]), or None where it is not solved (a fold next to the sample, a Newton
-        solve that does not converge).
-
-        The peak condition d|u|/dOmega = 0 is solved between the sample and the neighbour towards
-        which |u| still rises: the amplitude and its slope at both ends (dx/dOmega = -J^-1 dR/dOmega,
-        one back-substitution at each converged point, shared by all blades) give a cubic Hermite
-        interpolant whose maximum is the next frequency, solved there by Newton at fixed Omega
-        (``tol``, scaled as the continuation's) from the Taylor predictor of the nearer end; the
-        bracket shrinks to the side where the slope changes sign, until the frequency moves by
-        less than 1e-9 relative (measured: 2-3 iterations). The branch only has to bracket the
+        solve that does not converge): :class:`bladedamp.hbm.peaks.PeakSolver`, whose tangents
+        at the branch's points are shared by all blades. The branch only has to bracket the
         peak, so the continuation may take long steps there (the Monte Carlo's
         :data:`~bladedamp.studies.mistuning.MONTE_CARLO_MAX_STEP`)."""
         basis = response.basis
-        omega = response.omega
-        n_points = len(omega)
         system = self.hbm_system(basis.harmonics, basis.n_samples)
-        X = response.coefficients.reshape(n_points, -1)
-        x_scale = np.abs(X).max(axis=0)
-        x_scale = np.maximum(x_scale, 1e-3 * x_scale.max() + 1e-300)
-        j1, nm = basis.cos_index(1), self.n_modes
-        C, N = basis.n_coeffs, system.n_dof
-        derivatives = {}                                 # sample index -> dx/dOmega there
-
-        def solve_point(x, w):
-            """dx/dOmega (C * n_dof,) at the converged point x, w [rad/s]."""
-            _, J, Rw = system.residual(x, w)
-            return -system.factorize(J)(Rw)
-
-        def slope(blade, x, dx):
-            """(|u|, d|u|/dOmega) of the blade's tip at x with dx/dOmega = dx."""
-            tip = self.blades[blade].shape("tip")[direction]                        # (n_modes,)
-            cols = np.arange(nm) + blade * nm
-            Xc, dXc = x.reshape(C, N), dx.reshape(C, N)
-            u = tip @ (Xc[j1, cols] - 1j * Xc[j1 + 1, cols])
-            du = tip @ (dXc[j1, cols] - 1j * dXc[j1 + 1, cols])
-            return abs(u), float(np.real(np.conj(u) * du) / max(abs(u), 1e-300))
-
-        def sample(blade, k):
-            if k not in derivatives:
-                derivatives[k] = solve_point(X[k], float(omega[k]))
-            return (float(omega[k]), X[k], *slope(blade, X[k], derivatives[k]), derivatives[k])
-
-        residual_scale = None
-        out = []
+        solver = PeakSolver(system, response.omega, response.coefficients, tol, max_iter)
+        nm, out = self.n_modes, []
         for blade, index in candidates:
-            if not 0 < index < n_points - 1 or not (omega[index - 1] < omega[index] < omega[index + 1]):
-                out.append(None)                         # at an end, or a fold next to the peak
-                continue
-            if residual_scale is None:
-                residual_scale = max(np.linalg.norm(system.residual(np.zeros(system.n_unknowns), omega[index],
-                                                                    False)[0]), 1e-300)
-            middle = sample(blade, index)
-            # the peak lies towards the side where |u| still rises from the sample
-            (w0, x0, a0, g0, d0), (w1, x1, a1, g1, d1) = \
-                (middle, sample(blade, index + 1)) if middle[3] > 0 else (sample(blade, index - 1), middle)
-            best = max((a0, w0), (a1, w1))
-            if not (g0 > 0 > g1):
-                out.append(None)                         # the slopes do not bracket a maximum
-                continue
-            w_prev, solved = None, True
-            for _ in range(max_iter):
-                w = w0 + (w1 - w0) * _hermite_maximum(a0, g0, a1, g1, w1 - w0)
-                xp = x0 + d0 * (w - w0) if w - w0 <= w1 - w else x1 + d1 * (w - w1)
-                r = newton(system.residual, xp, w, x_scale, residual_scale, tol=tol, factorize=system.factorize)
-                if not r.converged:
-                    solved = False
-                    break
-                d = solve_point(r.x, w)
-                a, g = slope(blade, r.x, d)
-                best = max(best, (a, w))
-                if w_prev is not None and abs(w - w_prev) <= 1e-9 * w:
-                    break
-                w_prev = w
-                if g > 0:
-                    w0, x0, a0, g0, d0 = w, r.x, a, g, d
-                else:
-                    w1, x1, a1, g1, d1 = w, r.x, a, g, d
-            out.append((float(best[0]), float(best[1] / (2 * np.pi))) if solved else None)
+            tip = first_harmonic_output(basis, system.n_dof, np.arange(nm) + blade * nm,
+                                        self.blades[blade].shape("tip")[direction])
+            solved = solver.solve(index, tip)
+            out.append(None if solved is None else (solved[0], solved[1] / (2 * np.pi)))
         return out
 
     def time_response(self, f_hz, **options):

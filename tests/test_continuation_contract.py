@@ -291,6 +291,31 @@ def test_robust_start_finds_the_oscillator_solution_in_gross_slip():
     assert s.converged
 
 
+
+def test_damped_newton_gives_up_where_it_stagnates_and_not_where_it_converges_slowly():
+    """R(x) = x^2 + 1 has no real root: |R| cannot fall below 1, so damped Newton must stop as not
+    converged after about STAGNATION_WINDOW iterations, not max_iter. R(x) = x^3 (a triple root)
+    converges linearly, |R| falling by (2/3)^3 per iteration: it must converge, past that window."""
+    from bladedamp.hbm import start
+
+    calls = []
+
+    def no_root(x, jacobian):
+        calls.append(jacobian)
+        return np.array([x[0] ** 2 + 1]), np.array([[2 * x[0]]])
+    x, converged, rnorm = start.damped_newton(no_root, np.array([0.3]), 1.0, 1.0, max_iter=60)
+    newton_steps = sum(calls)
+    assert not converged and rnorm >= 1.0
+    assert start.STAGNATION_WINDOW < newton_steps <= start.STAGNATION_WINDOW + 2, newton_steps
+
+    calls.clear()
+
+    def triple_root(x, jacobian):
+        calls.append(jacobian)
+        return np.array([x[0] ** 3]), np.array([[3 * x[0] ** 2]])
+    x, converged, rnorm = start.damped_newton(triple_root, np.array([1.0]), 1.0, 1.0, tol=1e-12, max_iter=200)
+    assert converged and abs(x[0]) < 1e-3 and sum(calls) > start.STAGNATION_WINDOW
+
 @pytest.mark.slow   # 8-26 s: kept out of the default run (under 10 min); CI runs it
 def test_a_branch_retracing_itself_is_stopped_and_says_so():
     """Random disk 51 (a 7 g cylinder, (0, 1, 2, 3)): past a non-smooth fold at 94.18 Hz the

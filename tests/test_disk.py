@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 from conftest import central_difference, relative_matrix_error
 
-from bladedamp.disk import TunedDisk
-from bladedamp.hbm.continuation import newton
+from bladedamp.disk import DamperContacts, DiskResponse, TunedDisk
+from bladedamp.hbm.continuation import Branch, newton
 from bladedamp.reference import reference_disk
 
 F_RANGE = (92.0, 104.0)            # around the 1F resonance (95 Hz undamped)
@@ -559,6 +559,28 @@ def test_merged_patch_evaluation_equals_separate_patches(kind, harmonics):
         assert np.abs(domega - ref_dw).max() <= 1e-6 * np.abs(ref_dw).max()
     else:
         assert domega is None
+
+
+@pytest.mark.parametrize("kind", ["cylinder", "wedge"])
+@pytest.mark.parametrize("harmonics", HARMONICS)
+def test_response_contact_quantities_of_all_points_at_once_equal_point_by_point(kind, harmonics, monkeypatch):
+    """DiskResponse.from_branch evaluates the contacts of every branch point in one call of the
+    point-contact kernel (DamperContacts.evaluate_states); with the batch switched off it takes
+    two ContactPatch.evaluate calls per point. Forces, point motions, dissipation, work bound
+    and normal loads must agree to rounding; the stick/slip/separated shares to one sample
+    (a sample exactly at the slip limit may fall either way by rounding)."""
+    r = frf(kind, REFERENCE_MASS[kind], harmonics)
+    system = r.disk.hbm_system(harmonics, r.basis.n_samples)
+    branch = Branch(r.omega, r.coefficients.reshape(len(r.omega), -1), np.zeros(len(r.omega), dtype=int), True, "")
+    batched = DiskResponse.from_branch(r.disk, system, branch)
+    monkeypatch.setattr(DamperContacts, "stacked_points", lambda self: None)
+    separate = DiskResponse.from_branch(r.disk, r.disk.hbm_system(harmonics, r.basis.n_samples), branch)
+    for name in ("contact_force", "relative_motion", "point_displacement", "point_dissipation", "point_work_bound",
+                 "normal_load", "dissipated_energy"):
+        a, b = getattr(batched, name), getattr(separate, name)
+        assert np.abs(a - b).max() <= 1e-12 * np.abs(b).max(), name
+    assert np.abs(batched.point_state - separate.point_state).max() <= 1.0 / r.basis.n_samples + 1e-15
+    assert np.mean(batched.point_state != separate.point_state) < 1e-3
 
 
 # ---------------------------------------------------------------------------------------

@@ -10,6 +10,7 @@ generalised contact forces of Eq. 11 (on the platform).
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -38,6 +39,19 @@ def rigid_point_map(xi: np.ndarray, eta: np.ndarray) -> np.ndarray:
     return B
 
 
+@functools.lru_cache(maxsize=64)
+def _dof_jacobian_path(b_shape, j_shape):
+    """The einsum contraction order of :func:`dof_jacobian` for these operand shapes, found once
+    (numpy's optimiser searched it on every call: 9 % of a reference FRF's time, measured)."""
+    # m > 6 (a flexible platform's maps): numpy's optimiser would take one 8-loop einsum, 5 x slower
+    # than its own m = 6 path (B with B, then the point Jacobian), given here (measured, one BLAS
+    # thread, 2 x 25 points, 7 coefficients, m = 10: 6.3 against 1.3 ms)
+    if b_shape[-1] != 6:
+        return ["einsum_path", (0, 2), (0, 1)]
+    return np.einsum_path("lpim,lpaikb,lpkn->lambn", np.empty(b_shape), np.empty(j_shape), np.empty(b_shape),
+                          optimize=True)[0]
+
+
 def dof_jacobian(point_map: np.ndarray, point_jacobian: np.ndarray) -> np.ndarray:
     """The Jacobian of a patch's generalised forces from its points' (Eq. 11 differentiated):
     ``sum_p B_p^T (d f_p / d c_p) B_p`` per pair of harmonic coefficients.
@@ -54,11 +68,7 @@ def dof_jacobian(point_map: np.ndarray, point_jacobian: np.ndarray) -> np.ndarra
     L = int(np.prod(lead, dtype=int))
     B = point_map.reshape((L,) + point_map.shape[-3:])
     J = point_jacobian.reshape((L,) + point_jacobian.shape[-5:])
-    # m > 6 (a flexible platform's maps): numpy's optimiser would take one 8-loop einsum, 5 x slower
-    # than its own m = 6 path (B with B, then the point Jacobian), given here (measured, one BLAS
-    # thread, 2 x 25 points, 7 coefficients, m = 10: 6.3 against 1.3 ms)
-    path = True if B.shape[-1] == 6 else ["einsum_path", (0, 2), (0, 1)]
-    out = np.einsum("lpim,lpaikb,lpkn->lambn", B, J, B, optimize=path)
+    out = np.einsum("lpim,lpaikb,lpkn->lambn", B, J, B, optimize=_dof_jacobian_path(B.shape, J.shape))
     return out.reshape(lead + out.shape[1:])
 
 

@@ -387,8 +387,8 @@ class ContactState(Saveable):
 
 
 def _resonance(disk, f_range_hz):
-    """(response, index of the largest tip amplitude on the branch)."""
-    _, _, r = peak_response(disk, _check_f_range(f_range_hz))
+    """(response at max_step 0.05, index of the largest tip amplitude on the branch)."""
+    _, _, r = peak_response(disk, _check_f_range(f_range_hz), max_step=0.05)
     return r, int(np.argmax(r.tip_amplitude[:, 0]))
 
 
