@@ -741,7 +741,7 @@ def build_parser() -> argparse.ArgumentParser:
                 "reproduce the paper on the built-in reference configuration",
                 "Every result of the paper (Table 1, Figs. 4-17) computed on the reference configuration, beside\n"
                 "the paper's numbers, with a verdict per row. Writes summary.json, report.md and the figures.\n"
-                "About 3-4 min on two cores.")
+                "About 2 min on two cores.")
     out_arg(p, "results")
     processes_arg(p)
 

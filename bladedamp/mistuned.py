@@ -49,10 +49,10 @@ import scipy.sparse as sp
 from . import validation
 from .blade import ModalBlade
 from .contact.laws import LinearNormalLaw
-from .contact.point import damper_contact_forces, normal_law_parameters
 from .damper.kinetics import seat
-from .disk import (AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION, DAMPER_DOFS, DamperContacts, TunedDisk,
-                   contact_point_maps, contact_rows, damper_weighted_scales, point_map_forces, rotor_speed_in_hz)
+from .disk import (AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION, DAMPER_DOFS, RETURN_MAP_PASSES, RETURN_MAP_TOL,
+                   DamperContacts, TunedDisk, contact_point_maps, contact_rows, damper_weighted_scales,
+                   fused_point_map_forces, point_map_forces, rotor_speed_in_hz)
 from .hbm.accuracy import HARMONIC_TOLERANCE, converged_response
 from .hbm.continuation import Branch, continuation
 from .hbm.start import robust_start
@@ -106,10 +106,6 @@ class AssemblyContacts:
     _index: dict = field(default_factory=dict, init=False, repr=False)
     _last_approach: tuple | None = field(default=None, init=False, repr=False)
 
-    # return map of the point contacts: passes and tolerance (point_contact_forces' defaults)
-    _max_passes = 20
-    _tol = 1e-10
-
     def __post_init__(self):
         sizes = {c.n_local for c in self.contacts}
         if len(sizes) > 1:
@@ -153,22 +149,13 @@ class AssemblyContacts:
         """Forces (C, n_d, L) and Jacobian blocks (n_d, C, L, C, L) or None.
 
         Batched dampers with rigid platforms and a normal law the fused kernel knows go through
-        :func:`~bladedamp.contact.point.damper_contact_forces` (one numba call: point motion,
-        normal law, return map, AFT and the projections); otherwise (flexible platforms too,
+        :func:`~bladedamp.disk.fused_point_map_forces` (one numba call: point motion, normal
+        law, return map, AFT and the projections); otherwise (flexible platforms too,
         whose point maps the fused kernel does not take) :meth:`_forces_numpy`."""
         stack = self._stacked()
-        law = None if stack is None or self.damper_local != 12 else normal_law_parameters(stack[5])
-        if law is None:
-            return self._forces_numpy(local, basis, offsets, jacobian)
-        C, nd = basis.n_coeffs, self.n_dampers
-        _, B, k_t, mu, weights, _ = stack
-        force = np.empty((C, nd, 12))
-        blocks = np.empty((nd, C, 12, C, 12)) if jacobian else np.empty((1, 1, 1, 1, 1))
-        static_index = basis.cos_index(0) if basis.has_static else -1
-        damper_contact_forces(B, np.ascontiguousarray(local, dtype=float), basis.synthesis, basis.analysis,
-                              k_t, mu, weights, np.ascontiguousarray(offsets, dtype=float).ravel(), law[0], law[1],
-                              static_index, self._max_passes, self._tol, jacobian, force, blocks)
-        return force, blocks if jacobian else None
+        fused = None if stack is None else fused_point_map_forces(stack[1], local, basis, stack[2], stack[3], stack[5],
+                                                                  stack[4], offsets, jacobian)
+        return self._forces_numpy(local, basis, offsets, jacobian) if fused is None else fused
 
     def _forces_numpy(self, local, basis, offsets, jacobian):
         """:meth:`_forces` through :func:`~bladedamp.disk.point_map_forces` (the point-contact
@@ -188,7 +175,7 @@ class AssemblyContacts:
         _, B, k_t, mu, weights, law = stack                      # B (n_d, 2, P, 3, m)
         m = B.shape[-1]
         force, q_blocks, _ = point_map_forces(B, local.reshape(C, nd, 2, m), basis, k_t, mu, law, weights, offsets,
-                                              jacobian, max_passes=self._max_passes, tol=self._tol)
+                                              jacobian, max_passes=RETURN_MAP_PASSES, tol=RETURN_MAP_TOL)
         force = force.reshape(C, nd, L)
         if not jacobian:
             return force, None

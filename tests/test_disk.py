@@ -530,7 +530,7 @@ def test_omega_derivative_of_the_rotor_speed_dependent_preload(exponent):
 @pytest.mark.parametrize("kind", ["cylinder", "wedge"])
 @pytest.mark.parametrize("harmonics", HARMONICS)
 def test_merged_patch_evaluation_equals_separate_patches(kind, harmonics):
-    """DamperContacts.harmonic_forces evaluates both patches in one point-contact call (speed);
+    """DamperContacts.harmonic_forces evaluates both patches in one call of the fused kernel (speed);
     forces, Jacobian and omega-derivative must equal those of two ContactPatch.evaluate calls."""
     r = frf(kind, REFERENCE_MASS[kind], harmonics)
     _, _, i = peak(r)
