@@ -688,7 +688,7 @@ class TunedDisk:
                                                          points_dissipation(response, "point_work_bound")))
 
         return with_stop_note(converged_response(model, solve, harmonics, harmonic_tolerance, max_harmonic,
-                                                 estimate=estimate_harmonic_error))
+                                                 estimate=estimate_harmonic_error), f_start_hz)
 
     def amplitude_stop(self, basis: HarmonicBasis, stop_above: float | None, direction: int = 0):
         """The continuation's ``stop_when`` for ``stop_above`` [m] (None: None): a message once the
@@ -834,7 +834,7 @@ class TunedDisk:
         return self.time_response(response.frequency_hz[k] + direction * offset_hz, **options)
 
 
-def with_stop_note(response: "DiskResponse") -> "DiskResponse":
+def with_stop_note(response: "DiskResponse", f_start_hz: float | None = None) -> "DiskResponse":
     """A failed ``response`` with what the damper did where its branch got furthest (the share
     of the period its contact points stick, slip and are separated there) and how to tell
     whether a periodic motion exists just beyond (:meth:`TunedDisk.stop_check`). Measured on
@@ -844,8 +844,20 @@ def with_stop_note(response: "DiskResponse") -> "DiskResponse":
     over 4000 periods is not periodic for 13 of them (the damper hops, separated
     21-99.8 % of the period, or a cylinder keeps rolling), so no harmonic-balance branch can go
     on; for 4 it is periodic with the damper separated 80-100 % of the period (brief impacts,
-    which (0, 1, 2, 3) cannot follow). A successful or empty response is returned unchanged."""
-    if response.success or response.stopped_by or not len(response.omega) or response.point_state is None:
+    which (0, 1, 2, 3) cannot follow). A response that kept no point (the start failed) gets how to
+    tell at the start ``f_start_hz`` [Hz] (random disk 105, a 0.025 g wedge: periodic there by time
+    integration, separated 80 % of the period; the robust start finds no solution with (0, 1, 2, 3)
+    nor (0, ..., 5), one with (0, ..., 7)). A successful one is returned unchanged."""
+    if response.success or response.stopped_by:
+        return response
+    if not len(response.omega):
+        if f_start_hz is None:
+            return response
+        note = (f"; TunedDisk.time_response({f_start_hz:.6g}) tells by time integration whether a periodic motion "
+                "exists at the start (where one does with the damper separated most of the period, brief impacts, "
+                "a richer harmonic set may find it: harmonics='auto')")
+        return dataclasses.replace(response, message=response.message + note)
+    if response.point_state is None:
         return response
     k = response.furthest_index()
     stick, slip, separated = 100 * response.contact_state_shares()[k]

@@ -10,6 +10,7 @@ import pytest
 
 from bladedamp import FrictionOscillator
 from bladedamp.hbm.accuracy import (AccuracyWarning, auto_sets, check_points, enriched, harmonic_error)
+from bladedamp.hbm.continuation import NewtonResult
 from bladedamp.hbm.fourier import HarmonicBasis
 from bladedamp.response import physical_checks
 
@@ -93,7 +94,6 @@ def test_estimate_falls_back_on_the_damped_newton(monkeypatch):
     Newton of the robust start gives the estimate; without either it is NaN ("not verified").
     Here the plain Newton is made to fail on the inclined oscillator."""
     import bladedamp.hbm.accuracy as accuracy
-    from bladedamp.hbm.continuation import NewtonResult
 
     osc = FrictionOscillator(**INCLINED)
     with warnings.catch_warnings():
@@ -105,6 +105,37 @@ def test_estimate_falls_back_on_the_damped_newton(monkeypatch):
     assert np.isfinite(plain.error) and damped.error == pytest.approx(plain.error, rel=1e-6, abs=1e-9)
     monkeypatch.setattr(accuracy, "damped_newton", lambda fun, x0, *a, **k: (x0, False, 1.0))
     assert np.isnan(harmonic_error(osc, r).error)
+
+
+def test_estimate_retries_a_failed_point_with_more_samples(monkeypatch):
+    """Where neither Newton converges in the enriched set at its first sampling (random oscillator
+    154's peak: the lift-off instant between AFT samples), the point is solved once more with
+    ENRICHED_SAMPLES_GROWTH x the samples instead of leaving the estimate "not verified". Here both
+    Newtons are made to fail at the first sampling on the inclined oscillator."""
+    import bladedamp.hbm.accuracy as accuracy
+
+    osc = FrictionOscillator(**INCLINED)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = osc.frequency_response(*RANGE_HZ, harmonics=(0, 1, 2, 3))
+    first = max(HarmonicBasis(enriched(r.basis.harmonics)).n_samples, r.basis.n_samples)
+    plain = harmonic_error(osc, r)
+
+    def failing_at_first(solver, failed):
+        def solve(fun, x0, *args, **kwargs):            # the system is the one of its factorize
+            if kwargs["factorize"].__self__.basis.n_samples == first:
+                return failed(x0)
+            return solver(fun, x0, *args, **kwargs)
+        return solve
+
+    monkeypatch.setattr(accuracy, "newton", failing_at_first(accuracy.newton,
+                                                             lambda x0: NewtonResult(x0, False, 20, 1.0)))
+    monkeypatch.setattr(accuracy, "damped_newton", failing_at_first(accuracy.damped_newton,
+                                                                    lambda x0: (x0, False, 1.0)))
+    finer = harmonic_error(osc, r)
+    assert np.all(np.isfinite(finer.errors)), finer.errors
+    # the same estimate to within the sampling error of 4 x the samples
+    assert finer.error == pytest.approx(plain.error, rel=0.1, abs=1e-3)
 
 
 def test_physical_checks_flag_range_dissipation_and_step():

@@ -112,6 +112,40 @@ def test_a_failed_branch_is_tried_again_with_the_retry_scales():
     assert plain.success and np.array_equal(plain.x, retried.x) and plain.message == retried.message
 
 
+def test_a_failed_retry_that_got_further_is_returned():
+    """Both tries fail (too few points for either): the retry's branch, which got further into the
+    range, is returned, its message saying so and quoting the first try (random disk 127: the
+    first try retraced itself from 89.9 Hz to the start, the second stopped at 94.1 Hz)."""
+    fun, w0, w1 = wiggle(), 1.0, 3.0
+    x0 = np.array([w0, 10.0 * np.sin(20.0 * w0)])
+    options = dict(x_scale=np.array([1.0, 1.0]), residual_scale=1.0, max_step=0.05, max_points=40)
+    with pytest.warns(ConvergenceWarning, match="max_points"):
+        first = continuation(fun, x0, w0, w1, **options)
+    with pytest.warns(ConvergenceWarning, match="max_points"):
+        b = continuation(fun, x0, w0, w1, retry_x_scale=np.array([1.0, 1e4]), **options)
+    assert not b.success and len(b.omega) == 40 // 4 and b.omega.max() > first.omega.max()
+    assert "which got further than the first" in b.message and "first try: stopped after max_points" in b.message
+    assert all(b.checks.values())
+
+
+def test_a_branch_back_on_its_first_point_says_it_retraced_itself():
+    """A branch that comes back to the start of its range on its own first point (one solution
+    at every frequency: it reversed onto itself) does not claim a fold with a second solution;
+    the circle's turn back (the other half at the start) still does."""
+    from bladedamp.hbm.continuation import ArcLengthContinuation
+    from bladedamp.hbm.linsolve import factorize
+
+    def line(x, omega, jacobian=True):                   # x = omega - 10: one solution everywhere
+        return np.array([x[0] - (omega - 10.0)]), np.array([[1.0]]), np.array([-1.0])
+
+    run = ArcLengthContinuation(line, np.array([-1.0]), 9.0, 14.0, 1.0, 1.0, 0.01, 0.05, 1e-7, 100, 1e-10, 12, 5,
+                                factorize)
+    run.points = [np.array([-1.0, 9.0]), np.array([0.0, 10.0]), np.array([-0.5, 9.5])]   # back down its own path
+    message = run.land_at_start(np.array([-1.5, 8.5]))
+    assert "retraced its own path back to the start" in message and "not a second solution" in message
+    assert "turned back (fold" not in message and run.points[-1][1] == 9.0
+
+
 def test_the_turn_back_stops_whatever_the_leave_margin():
     """mistuned studies pass leave_margin=0.05: the branch still stops at the boundary."""
     fun = circle()

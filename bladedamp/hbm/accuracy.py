@@ -12,7 +12,8 @@ So every answer is checked against an enriched harmonic set:
   the plain Newton does not converge, by the damped Newton with a line search of the robust
   start: measured on the reference 1 g cylinder with (0, ..., 7), whose peak point the plain
   Newton could not solve with (0, ..., 9), so its estimate was "not verified"; damped it
-  converges there to 0.53 %). The
+  converges there to 0.53 %; where neither converges, once more with
+  :data:`ENRICHED_SAMPLES_GROWTH` x the AFT samples). The
   largest change of the first-harmonic output amplitudes (the blade tips, the oscillator's x),
   relative to the branch's peak amplitude, is the error estimate of ``H``. It is an
   a-posteriori estimate of the truncation error, not a bound: the first-harmonic amplitude of a
@@ -46,6 +47,9 @@ from .start import damped_newton
 HARMONIC_TOLERANCE = 0.01
 #: the harmonic sets ``harmonics="auto"`` may try, cheapest first (see :func:`auto_sets`)
 AUTO_HARMONIC_SETS = ((0, 1), (0, 1, 2, 3), (0, 1, 2, 3, 4, 5), tuple(range(8)), tuple(range(10)))
+#: AFT samples of the enriched set's second try at a point where its Newton fails, per sample
+#: of the first (see :func:`harmonic_error`)
+ENRICHED_SAMPLES_GROWTH = 4
 #: the paper's setting: the first harmonic only, static approach from frictionless seating
 PAPER_HARMONICS = (1,)
 
@@ -122,6 +126,22 @@ def lift(model, coefficients: np.ndarray, basis, system, omega: float) -> np.nda
     return X.ravel()
 
 
+def _enriched_amplitudes(model, coefficients, basis, system, omega, scales, tol):
+    """The first-harmonic output amplitudes (k,) of the solution of the enriched ``system`` at
+    ``omega`` [rad/s] from ``coefficients`` (C, n_dof) of ``basis`` lifted into it, or None if
+    neither the plain nor the damped Newton converges."""
+    x0 = lift(model, coefficients, basis, system, omega)
+    rs = max(np.linalg.norm(system.residual(np.zeros_like(x0), omega, False)[0]), 1e-300)
+    sol = newton(system.residual, x0, omega, scales, rs, tol=tol, max_iter=20, factorize=system.factorize)
+    x, converged = sol.x, sol.converged
+    if not converged:               # the plain Newton overshoots on a corner of the force map
+        x, converged, _ = damped_newton(lambda y, jacobian=True: system.residual(y, omega, jacobian)[:2],
+                                        x0, scales, rs, tol=tol, factorize=system.factorize)
+    if not converged:
+        return None
+    return model.output_amplitudes(x.reshape(1, system.basis.n_coeffs, -1), system.basis)[0]
+
+
 @one_blas_thread
 def harmonic_error(model, response, harmonics=None, n_points: int = 5, tol: float = 1e-10) -> HarmonicCheck:
     """Error estimate of ``response`` (computed by ``model``) against the enriched set
@@ -134,22 +154,25 @@ def harmonic_error(model, response, harmonics=None, n_points: int = 5, tol: floa
     if idx.size:
         # the enriched set with at least the response's AFT samples (the sampling is not the
         # question here: with fewer, a sampling error would pass for a harmonic one)
-        system = model.hbm_system(target, max(HarmonicBasis(target).n_samples, basis.n_samples))
+        n_samples = max(HarmonicBasis(target).n_samples, basis.n_samples)
+        system = model.hbm_system(target, n_samples)
         w = response.omega
         scales = model.unknown_scales(system, float(w.min()), float(w.max()))
         peak = max(float(amp.max()), 1e-300)
+        finer = None
         for k, i in enumerate(idx):
-            x0 = lift(model, response.coefficients[i], basis, system, float(w[i]))
-            rs = max(np.linalg.norm(system.residual(np.zeros_like(x0), float(w[i]), False)[0]), 1e-300)
-            sol = newton(system.residual, x0, float(w[i]), scales, rs, tol=tol, max_iter=20,
-                         factorize=system.factorize)
-            x, converged = sol.x, sol.converged
-            if not converged:               # the plain Newton overshoots on a corner of the force map
-                x, converged, _ = damped_newton(lambda y, jacobian=True, wi=float(w[i]): system.residual(y, wi, jacobian)[:2],
-                                                x0, scales, rs, tol=tol, factorize=system.factorize)
-            if converged:
-                X = x.reshape(1, system.basis.n_coeffs, -1)
-                errors[k] = np.abs(model.output_amplitudes(X, system.basis)[0] - amp[i]).max() / peak
+            a = _enriched_amplitudes(model, response.coefficients[i], basis, system, float(w[i]), scales, tol)
+            if a is None:
+                # Newton fails on the AFT's sampling of a contact event, not on the harmonics
+                # (random oscillator 154's (0..9) peak, 1024 samples: the lift-off instant between
+                # samples; it converges with 4096, 0.18 % off, as the time integration): once more
+                # with ENRICHED_SAMPLES_GROWTH x the samples (the change then includes the branch's
+                # own sampling error too)
+                if finer is None:
+                    finer = model.hbm_system(target, ENRICHED_SAMPLES_GROWTH * n_samples)
+                a = _enriched_amplitudes(model, response.coefficients[i], basis, finer, float(w[i]), scales, tol)
+            if a is not None:
+                errors[k] = np.abs(a - amp[i]).max() / peak
     finite = errors[np.isfinite(errors)]
     error = float(finite.max()) if finite.size and np.isfinite(errors[0]) else float("nan")
     return HarmonicCheck(basis.harmonics, target, error, response.omega[idx], errors, idx)

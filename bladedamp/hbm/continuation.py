@@ -257,8 +257,9 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         length measured by these scales (e.g. a disk's with the damper's unknowns weighing less,
         :func:`bladedamp.disk.damper_weighted_scales`), and with 1 / RETRY_POINTS_FRACTION of
         ``max_points``. Its branch is returned if it succeeds, its message saying so; otherwise
-        the first try's branch, with its warnings. A branch that succeeds at the first try is
-        never recomputed, so the second try changes no such result.
+        the one of the two failed branches that got further into the range (the first on a tie),
+        with its warnings. A branch that succeeds at the first try is never recomputed, so the
+        second try changes no such result.
     stop_when : callable (x, omega) -> str or None, or None: called at every point kept (the
         first included); a non-empty string ends the branch there, unsuccessful, with that
         string as ``Branch.stopped_by`` and in the message (a terminal event, like
@@ -304,7 +305,7 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
     if first.success or first.stopped_by:
         return first
     if retry_x_scale is not None:
-        with warnings.catch_warnings(record=True):
+        with warnings.catch_warnings(record=True) as retry_warnings:
             warnings.simplefilter("always", ConvergenceWarning)
             retry_options = (step, max_step, min_step, max(2, max_points // RETRY_POINTS_FRACTION), tol, max_corrector,
                              target_iterations, factorize, stop_when, bool(chord))
@@ -314,9 +315,23 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
                 retried.message += f" (second try, with the arc length weighted by retry_x_scale; first try: " \
                                    f"{first.message})"
                 return retried
+        # both failed: the branch that got further into the range is the better account of where
+        # the solutions end (random disk 127: the first try retraced itself from a fold at 89.9 Hz
+        # back to the start, the second passed that fold and stopped at 94.1 Hz)
+        if _reach(retried, omega_start, omega_end) > _reach(first, omega_start, omega_end):
+            retried.message += f" (second try, with the arc length weighted by retry_x_scale, which got further " \
+                               f"than the first; first try: {first.message})"
+            first, first_warnings = retried, retry_warnings
     for w in first_warnings:
         _warn(w.message, 2)
     return first
+
+
+def _reach(branch, omega_start, omega_end) -> float:
+    """How far ``branch`` got from ``omega_start`` towards ``omega_end`` [rad/s] (-inf: no point)."""
+    if not len(branch.omega):
+        return -np.inf
+    return float(np.max(np.sign(omega_end - omega_start) * (branch.omega - omega_start)))
 
 
 def _both_ends(fun, x0, omega_start, omega_end, x_scale, residual_scale, options, start_at_end):
@@ -738,7 +753,8 @@ class ArcLengthContinuation:
     def land_at_start(self, new):
         """The branch turned back and reached the start of the range: it stops there (never a
         point outside the range; an FRF never runs to zero or negative frequency). Returns the
-        message."""
+        message: a turn back at a fold (a second solution at the start), or a retrace if the
+        point reached there is the branch's first."""
         n, points, omega_start, direction = self.n, self.points, self.omega_start, self.direction
         last = points[-1]
         a = (last[n] - omega_start) / (last[n] - new[n])
@@ -746,6 +762,14 @@ class ArcLengthContinuation:
         if land is not None:
             points.append(np.append(land.x, omega_start))
             self.its.append(land.iterations)
+            # back on its own first point (within the Newton's resolution, 10 sqrt(tol) scaled):
+            # the branch reversed onto itself, there is no second solution at the start (random
+            # disk 127: 1.5e-13 after a reversal at 89.0 Hz, past a fold at 89.9 Hz)
+            if np.linalg.norm((land.x - points[0][:n]) / self.x_scale) < 10 * np.sqrt(self.tol):
+                return f"continuation retraced its own path back to the start of the range, omega = " \
+                       f"{omega_start:.6g} rad/s, where it came back to its first point (it reversed onto itself " \
+                       f"after getting up to omega = {max(p[n] * direction for p in points) * direction:.6g} rad/s: " \
+                       f"not a second solution); branch kept up to there"
         return f"continuation turned back (fold at omega = {max(p[n] * direction for p in points) * direction:.6g}" \
                f" rad/s) and returned to the start of the range, omega = {omega_start:.6g} rad/s; " \
                f"branch kept up to there"
