@@ -107,7 +107,7 @@ def test_liftoff_ratio_is_that_of_the_wedge_liftoff_map():
 
     disk = bd.reference_disk("wedge", 0.28e-3)
     reference = wedge_liftoff_map(disk)
-    _, _, frf = peak_response(disk, (90.0, 105.0))      # the response wedge_liftoff_map evaluates
+    _, _, frf = peak_response(disk, (90.0, 105.0), max_step=0.05)      # the response wedge_liftoff_map evaluates
     data = mv.cycle_data(frf)
     assert data.frequency_hz == pytest.approx(reference.peak_frequency_hz, rel=1e-9)
     np.testing.assert_allclose(data.liftoff_ratio, reference.ratio_time, rtol=1e-6, atol=1e-9)
