@@ -703,19 +703,22 @@ class TunedDisk:
                 if a > stop_above else None
         return stop_when
 
-    def solve_peak(self, response: "DiskResponse", index: int | None = None,
-                   direction: int = 0) -> tuple[float, float] | None:
+    def solve_peak(self, response: "DiskResponse", index: int | None = None, direction: int = 0,
+                   extra_couplings=None) -> tuple[float, float] | None:
         """(peak first-harmonic tip amplitude u_``direction`` [m], its frequency [Hz]) of the local
         maximum next to point ``index`` of ``response`` (default its largest amplitude), solved on
         the response curve by the peak condition (:class:`bladedamp.hbm.peaks.PeakSolver`); None
         where it is not solved (at an end of the branch, a fold next to the sample, a Newton solve
-        that does not converge). The branch only has to bracket the peak: measured on the
-        reference disks, a branch at max_step 0.2 gives the peak of one at 0.02 to 1e-6."""
+        that does not converge). ``extra_couplings``: those the response was computed with (see
+        :meth:`frequency_response`). The branch only has to bracket the peak: measured on the
+        reference disks at max_step 0.1, within 8.3e-6 of a dense branch's largest point
+        (:data:`bladedamp.studies.mass.PEAK_SEARCH_MAX_STEP`)."""
         validation.integer("direction", direction, minimum=0, maximum=2)
         basis = response.basis
         if index is None:
             index = int(np.argmax(response.tip_amplitude[:, direction]))
-        system = self.hbm_system(basis.harmonics, basis.n_samples)
+        model = self if extra_couplings is None else WithCouplings(self, extra_couplings)
+        system = model.hbm_system(basis.harmonics, basis.n_samples)
         nm = self.blade.n_modes
         tip = first_harmonic_output(basis, system.n_dof, np.arange(nm), self.blade.shape("tip")[direction])
         solved = PeakSolver(system, response.omega, response.coefficients).solve(index, tip)

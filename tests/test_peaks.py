@@ -113,3 +113,29 @@ def test_peak_search_falls_back_to_a_finer_branch_where_the_peak_is_not_solved(m
                                    estimate_harmonic_error=False)
     assert len(r.omega) == len(fine.omega)
     assert (peak, f_peak) == refined_peak(fine.frequency_hz, fine.tip_amplitude[:, 0])
+
+
+def test_peak_search_solves_on_the_system_with_the_users_elements():
+    """A zero-gap spring k max(0, u) at the tip of the bare blade, one harmonic: its fundamental is
+    k u / 2 exactly, so the tip FRF is the closed-form receptance of diag(omega_j^2) + (k/2) phi
+    phi^T with the modal damping. The peak search (extra_couplings passed through) solves the peak
+    on the system with the spring; on the bare blade's system the solve would not converge there."""
+    from bladedamp.hbm import Coupling, GapSpring
+
+    disk, k = dataclasses.replace(reference_disk("cylinder"), damper=None), 1e4
+    tip_stop = lambda basis: [Coupling(GapSpring(stiffness=k), disk.point_map(basis, "tip", (0,)), "tip stop")]
+    blade = disk.blade
+    w0, phi = blade.natural_angular_frequencies, blade.shape("tip")[0]
+    stiffness = np.diag(w0 ** 2) + 0.5 * k * np.outer(phi, phi)
+    modal_force = blade.shape("excitation").T @ disk.excitation
+
+    def tip(f_hz):
+        w = 2 * np.pi * f_hz
+        dynamic = stiffness - w ** 2 * np.eye(len(w0)) + 1j * w * np.diag(2 * blade.damping_ratios * w0)
+        return abs(phi @ np.linalg.solve(dynamic, modal_force))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        peak, f_peak, _ = peak_response(disk, (95.0, 110.0), extra_couplings=tip_stop)
+    exact = minimize_scalar(lambda f: -tip(f), bounds=(f_peak - 0.5, f_peak + 0.5), method="bounded",
+                            options={"xatol": 1e-10})
+    assert abs(peak / tip(exact.x) - 1) < 1e-8 and abs(f_peak - exact.x) < 1e-5

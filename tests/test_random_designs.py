@@ -266,6 +266,17 @@ def test_random_designs_share():
     assert share >= SHARE_REQUIRED, text
 
 
+def stopped_disk(i: int):
+    """(design, response, stop check) of random disk i: its branch as the suite runs it and
+    TunedDisk.stop_check, the time integration just beyond where it got furthest."""
+    d = disk_design(i)
+    disk = make_disk(d)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = disk_response(disk, d)
+        return d, r, disk.stop_check(r)
+
+
 @pytest.mark.slow
 def test_a_failing_disk_has_no_periodic_motion_beyond_its_stop():
     """Random disk 51 (a 7.1 g cylinder at EO 7, (0, 1, 2, 3)) does not reach the end: its branch
@@ -274,13 +285,8 @@ def test_a_failing_disk_has_no_periodic_motion_beyond_its_stop():
     "not settled" after 4000 periods, separated 69 % of the period, the first harmonics still
     changing by 0.33 % per period. So no harmonic-balance branch can go on there (13 of the 17
     failing random disks are like this one: bladedamp.disk.with_stop_note)."""
-    d = disk_design(51)
-    disk = make_disk(d)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        r = disk_response(disk, d)
-        assert not r.success and "where the branch got furthest" in r.message, r.message
-        check = disk.stop_check(r)
+    d, r, check = stopped_disk(51)
+    assert not r.success and "where the branch got furthest" in r.message, r.message
     assert check.omega[0] > r.omega.max()
     assert not check.periodic[0] and check.status[0] in ("not settled", "drifting"), check.message[0]
 
@@ -295,15 +301,10 @@ def test_random_disk_127_reports_the_branch_that_got_furthest():
     it retraced itself, and the time integration 0.05 Hz beyond finds no periodic motion (measured:
     "not settled" after 4000 periods, separated 74 % of the period, the first harmonics changing
     by 0.1 % per period), as for disk 51."""
-    d = disk_design(127)
-    disk = make_disk(d)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        r = disk_response(disk, d)
-        assert not r.success and "which got further than the first" in r.message, r.message
-        assert "retraced its own path back to the start" in r.message and "turned back (fold" not in r.message
-        assert r.frequency_hz.max() > 94.0 and r.frequency_hz[0] == pytest.approx(d["f_start"], rel=1e-12)
-        check = disk.stop_check(r)
+    d, r, check = stopped_disk(127)
+    assert not r.success and "which got further than the first" in r.message, r.message
+    assert "retraced its own path back to the start" in r.message and "turned back (fold" not in r.message
+    assert r.frequency_hz.max() > 94.0 and r.frequency_hz[0] == pytest.approx(d["f_start"], rel=1e-12)
     assert not check.periodic[0] and check.status[0] in ("not settled", "drifting"), check.message[0]
 
 

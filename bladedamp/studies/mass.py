@@ -64,7 +64,7 @@ def peak_response(disk: TunedDisk, f_range_hz=(90.0, 105.0), harmonics=(1,), max
         raise RuntimeError(f"no interior resonance peak found up to the range {lo:.4g}-{hi:.4g} Hz")
 
     r, i = interior(max_step)
-    solved = disk.solve_peak(r, i, direction)
+    solved = disk.solve_peak(r, i, direction, continuation_options.get("extra_couplings"))
     if solved is not None:
         return solved[0], solved[1], r
     if max_step > PEAK_FALLBACK_MAX_STEP:
