@@ -615,7 +615,7 @@ class TunedDisk:
                            max_step: float = 0.02, harmonic_tolerance: float = HARMONIC_TOLERANCE,
                            max_harmonic: int = 7, extra_couplings=None, stop_above: float | None = None,
                            stop_direction: int = 0, estimate_harmonic_error: bool = True,
-                           **continuation_options) -> "DiskResponse":
+                           check_stop: bool = False, **continuation_options) -> "DiskResponse":
         """Forced response from ``f_start_hz`` to ``f_end_hz`` [Hz] by continuation.
 
         ``harmonics``: ``"auto"`` (default) chooses the harmonic set whose first-harmonic tip
@@ -646,6 +646,15 @@ class TunedDisk:
         enriched Newton solves: 0.04-0.16 s of the reference disks' 0.5-0.75 s one-harmonic FRFs); the result then says "not
         estimated". For studies of many FRFs at one harmonic setting whose accuracy is reported
         once (the mass searches: ``reproduce``'s harmonic-accuracy section).
+        ``check_stop``: where the branch ends before the end of the range (not by ``stop_above``),
+        integrate the full assembly in time just beyond where it got furthest (:meth:`stop_check`;
+        at ``f_start_hz`` when no point was kept) and put the verdict in the result (its
+        ``stop_check`` and message, :func:`stop_verdict`): either no periodic motion exists there
+        (the damper hops on the platforms or keeps rolling, so no harmonic-balance branch can go on,
+        and the time integration's amplitude is the answer there) or one does, which the harmonic
+        set lost. One time integration (30-210 s for the reference disk on 2 cores), and only for
+        a branch that failed; rigid platforms and no ``extra_couplings`` (what ``time_response``
+        models).
         """
         validation.positive("f_start_hz", f_start_hz)
         validation.positive("f_end_hz", f_end_hz)
@@ -656,6 +665,13 @@ class TunedDisk:
             validation.positive("stop_above", stop_above)
         validation.integer("stop_direction", stop_direction, minimum=0, maximum=2)
 
+        if check_stop:
+            if extra_couplings is not None:
+                raise ValueError("check_stop integrates the disk in time, which has no extra_couplings: "
+                                 "give one or the other")
+            if self.blade.flexible_platform:
+                raise ValueError("check_stop integrates the disk in time, which models rigid platforms only: "
+                                 "use blade.rigid_platform_blade() or check_stop=False")
         model = self if extra_couplings is None else WithCouplings(self, extra_couplings)
 
         def solve(H):
@@ -687,8 +703,12 @@ class TunedDisk:
                                                          response.excitation_work, max_step, T, refine,
                                                          points_dissipation(response, "point_work_bound")))
 
-        return with_stop_note(converged_response(model, solve, harmonics, harmonic_tolerance, max_harmonic,
-                                                 estimate=estimate_harmonic_error), f_start_hz)
+        response = converged_response(model, solve, harmonics, harmonic_tolerance, max_harmonic,
+                                      estimate=estimate_harmonic_error)
+        stopped_early = not (response.stopped_by or (response.success if response.reached_end is None
+                                                      else response.reached_end))
+        check = self.stop_check(response, f_start_hz=f_start_hz) if check_stop and stopped_early else None
+        return with_stop_note(response, f_start_hz, check)
 
     def amplitude_stop(self, basis: HarmonicBasis, stop_above: float | None, direction: int = 0):
         """The continuation's ``stop_when`` for ``stop_above`` [m] (None: None): a message once the
@@ -820,24 +840,51 @@ class TunedDisk:
 
         return disk_time_response(MistunedDisk.from_tuned(self), f_hz, **options)
 
-    def stop_check(self, response: "DiskResponse", offset_hz: float = STOP_CHECK_OFFSET_HZ, **options):
+    def stop_check(self, response: "DiskResponse", offset_hz: float = STOP_CHECK_OFFSET_HZ,
+                   f_start_hz: float | None = None, **options):
         """Whether a periodic motion exists just beyond where ``response`` (a failed branch of
         :meth:`frequency_response`) got furthest: :meth:`time_response` at that frequency plus
-        ``offset_hz`` [Hz] in the branch's direction (``options`` go to it). Its ``periodic``
+        ``offset_hz`` [Hz] in the branch's direction (``options`` go to it); for a response that
+        kept no point, at ``f_start_hz`` [Hz], where its branch was to start. Its ``periodic``
         and ``status`` answer: "not settled" or "drifting" (the damper hops on the platforms or
         keeps rolling) mean that no periodic response, so no harmonic-balance branch, exists
-        there; "periodic" means the branch lost a solution that exists. Costs one time
-        integration of the full assembly (30-210 s for the reference disk on 2 cores)."""
+        there; "periodic" means the branch lost a solution that exists (:func:`stop_verdict`).
+        Costs one time integration of the full assembly (30-210 s for the reference disk on 2
+        cores)."""
         validation.positive("offset_hz", offset_hz)
         if not len(response.omega):
-            raise ValueError("stop_check needs a response with at least one point")
+            if f_start_hz is None:
+                raise ValueError("stop_check needs a response with at least one point, or f_start_hz "
+                                 "(where a branch that kept none was to start)")
+            return self.time_response(validation.positive("f_start_hz", f_start_hz), **options)
         o = response.omega
         k = response.furthest_index()
         direction = np.sign(o[k] - o[0]) or 1.0
         return self.time_response(response.frequency_hz[k] + direction * offset_hz, **options)
 
 
-def with_stop_note(response: "DiskResponse", f_start_hz: float | None = None) -> "DiskResponse":
+def stop_verdict(check, harmonics) -> str:
+    """What the time integration ``check`` (a one-frequency DiskTimeResponse of
+    :meth:`TunedDisk.stop_check`) says of a branch with ``harmonics`` that stopped before it:
+    no periodic motion exists there (no harmonic-balance branch can go on), or one does, which
+    the branch did not reach (cut by max_points, or lost by the harmonic set: a richer set may
+    follow it)."""
+    f = check.frequency_hz[0]
+    tip = 1e3 * check.tip_amplitude[0, :, 0].max()
+    separated = 100 * check.point_state[0][..., 2].mean()
+    if check.periodic[0]:
+        return (f"the time integration of the full assembly at {f:.4f} Hz settles on a periodic motion (largest tip "
+                f"amplitude {tip:.4g} mm, the damper's contact points separated {separated:.0f} % of the period): "
+                f"one exists there, which the branch with harmonics {tuple(harmonics)} did not reach (more points, "
+                "max_points, or a richer set, harmonics='auto', may follow it; with the damper separated most of the "
+                "period, brief impacts, only a richer set can)")
+    return (f"the time integration of the full assembly at {f:.4f} Hz finds no periodic motion ({check.status[0]}: "
+            f"{check.message[0]}; largest tip amplitude {tip:.4g} mm over its last periods, the damper's contact "
+            f"points separated {separated:.0f} % of the period): the damper hops on the platforms or keeps rolling, "
+            "a motion no harmonic-balance branch represents; the time integration is the answer there")
+
+
+def with_stop_note(response: "DiskResponse", f_start_hz: float | None = None, check=None) -> "DiskResponse":
     """A failed ``response`` with what the damper did where its branch got furthest (the share
     of the period its contact points stick, slip and are separated there) and how to tell
     whether a periodic motion exists just beyond (:meth:`TunedDisk.stop_check`). Measured on
@@ -850,15 +897,22 @@ def with_stop_note(response: "DiskResponse", f_start_hz: float | None = None) ->
     which (0, 1, 2, 3) cannot follow). A response that kept no point (the start failed) gets how to
     tell at the start ``f_start_hz`` [Hz] (random disk 105, a 0.025 g wedge: periodic there by time
     integration, separated 80 % of the period; the robust start finds no solution with (0, 1, 2, 3)
-    nor (0, ..., 5), one with (0, ..., 7)). A successful one is returned unchanged."""
+    nor (0, ..., 5), one with (0, ..., 7)). ``check``: the time integration there
+    (:meth:`TunedDisk.stop_check`), whose verdict (:func:`stop_verdict`) replaces how to tell, and
+    which the result keeps as its ``stop_check``. A successful one is returned unchanged."""
     if response.success or response.stopped_by:
         return response
+    if check is not None:
+        where = "at the start" if not len(response.omega) else "beyond where the branch got furthest"
+        note = f"; {where}, {stop_verdict(check, response.basis.harmonics)}"
+        return dataclasses.replace(response, message=response.message + note, stop_check=check)
     if not len(response.omega):
         if f_start_hz is None:
             return response
         note = (f"; TunedDisk.time_response({f_start_hz:.6g}) tells by time integration whether a periodic motion "
                 "exists at the start (where one does with the damper separated most of the period, brief impacts, "
-                "a richer harmonic set may find it: harmonics='auto')")
+                "a richer harmonic set may find it: harmonics='auto'; frequency_response(..., check_stop=True) "
+                "runs it)")
         return dataclasses.replace(response, message=response.message + note)
     if response.point_state is None:
         return response
@@ -868,7 +922,8 @@ def with_stop_note(response: "DiskResponse", f_start_hz: float | None = None) ->
     note = (f"; where the branch got furthest ({f:.4f} Hz, tip amplitude {1e3 * response.tip_amplitude[k, 0]:.4g} mm) "
             f"the damper's contact points stick {stick:.0f} %, slip {slip:.0f} %, are separated {separated:.0f} % of "
             "the period; TunedDisk.stop_check(result) tells by time integration whether a periodic motion exists just "
-            "beyond (a light damper may hop on the platforms or keep rolling: then none does)")
+            "beyond (a light damper may hop on the platforms or keep rolling: then none does; "
+            "frequency_response(..., check_stop=True) runs it)")
     return dataclasses.replace(response, message=response.message + note)
 
 
@@ -931,6 +986,10 @@ class DiskResponse(FrequencyResponse):
     excitation_work : (n,) work of the excitation per period [J]
     viscous_dissipation : (n,) blade modal damping dissipation per period [J]
     normal_load : (n, 2) mean normal load of OL, OR [N]
+    stop_check : for a branch that stopped before the end of its range, computed with
+        ``check_stop=True``: the time integration of the full assembly just beyond where it got
+        furthest (a one-frequency :class:`bladedamp.timedomain.DiskTimeResponse`; its ``periodic``
+        says whether a periodic motion exists there, :func:`stop_verdict`), else None
     """
 
     tip_amplitude: np.ndarray = None
@@ -945,6 +1004,7 @@ class DiskResponse(FrequencyResponse):
     excitation_work: np.ndarray = None
     viscous_dissipation: np.ndarray = None
     normal_load: np.ndarray = None
+    stop_check: object = None
     disk: TunedDisk = None
 
     @classmethod

@@ -194,6 +194,22 @@ def small_design(tmp_path_factory):
                           "frequency_range_hz = [92.0, 99.0]": "frequency_range_hz = [97.0, 106.0]"})
 
 
+def test_frf_checks_a_stopped_branch_by_time_integration_unless_told_not_to(small_design, tmp_path, monkeypatch):
+    """``bladedamp frf`` asks the tuned responses for ``check_stop`` (the time integration beyond a
+    branch that stops early, tested in test_disk.py); ``--no-stop-check`` turns it off."""
+    from bladedamp.disk import TunedDisk
+
+    asked, original = [], TunedDisk.frequency_response
+
+    def spy(self, *args, **options):
+        asked.append(options.get("check_stop"))
+        return original(self, *args, **options)
+    monkeypatch.setattr(TunedDisk, "frequency_response", spy)
+    assert main(["frf", str(small_design), "--out", str(tmp_path / "a")]) == 0
+    assert main(["frf", str(small_design), "--no-stop-check", "--out", str(tmp_path / "b")]) == 0
+    assert asked == [True, False]
+
+
 def test_frf_mistuned_with_unit_kappa_is_the_tuned_response(small_design, tmp_path):
     path = tmp_path / "design.toml"
     path.write_text(small_design.read_text().replace("# kappa = [1.02, 0.98]", "kappa = [1.0, 1.0, 1.0, 1.0]")

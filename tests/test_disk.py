@@ -672,6 +672,37 @@ def test_furthest_index_of_a_branch_that_turned_back():
     assert response([10.0, 4.0, 3.0, 8.0]).furthest_index() == 2
 
 
+def test_check_stop_keeps_the_time_integration_beyond_a_failed_branch_and_says_what_it_found(tmp_path):
+    """``check_stop=True``: a branch that stops before the end (here cut by max_points, a 4-blade
+    disk with the 1 g cylinder, (0, 1)) gets the full assembly's time integration 0.05 Hz beyond
+    its furthest point as ``stop_check``; its verdict is in the message, and it is right: there
+    the motion is periodic, with the first-harmonic tip amplitude of the complete HBM branch at
+    that frequency (independent: the HBM's own answer, interpolated, within 1 %). It survives
+    save / load. A branch that reaches the end, or is stopped by stop_above, runs no check."""
+    from bladedamp import load
+    from bladedamp.disk import STOP_CHECK_OFFSET_HZ
+
+    disk = dataclasses.replace(reference_disk("cylinder", 1e-3), n_blades=4)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cut = disk.frequency_response(90.0, 100.0, harmonics=(0, 1), max_points=15, check_stop=True)
+        full = disk.frequency_response(90.0, 100.0, harmonics=(0, 1), check_stop=True)
+        stopped = disk.frequency_response(90.0, 100.0, harmonics=(0, 1), stop_above=1e-5, check_stop=True)
+    assert full.success and full.stop_check is None and stopped.stop_check is None
+    check = cut.stop_check
+    f = check.frequency_hz[0]
+    assert not cut.success and f == pytest.approx(cut.frequency_hz.max() + STOP_CHECK_OFFSET_HZ, rel=1e-12)
+    assert check.periodic[0] and "settles on a periodic motion" in cut.message and f"{f:.4f} Hz" in cut.message
+    assert "check_stop=True) runs it" not in cut.message               # the verdict replaces how to tell
+    hbm = np.interp(f, full.frequency_hz, full.tip_amplitude[:, 0])
+    assert check.tip_amplitude[0, :, 0] == pytest.approx(hbm, rel=1e-2)
+    back = load(cut.save(tmp_path / "cut"))
+    assert back.message == cut.message and back.stop_check.periodic[0]
+    np.testing.assert_array_equal(back.stop_check.tip_amplitude, check.tip_amplitude)
+    with pytest.raises(ValueError, match="extra_couplings"):
+        disk.frequency_response(90.0, 100.0, check_stop=True, extra_couplings=lambda basis: [])
+
+
 def test_stop_check_bad_input():
     from bladedamp.disk import DiskResponse
     from bladedamp.hbm.fourier import HarmonicBasis
@@ -680,6 +711,8 @@ def test_stop_check_bad_input():
     empty = DiskResponse(np.zeros(0), np.zeros((0, 3, 1)), HarmonicBasis((1,)), ("q",), False, "")
     with pytest.raises(ValueError, match="at least one point"):
         disk.stop_check(empty)
+    with pytest.raises(ValueError, match="f_start_hz"):
+        disk.stop_check(empty, f_start_hz=-1.0)
     one = DiskResponse(np.array([600.0]), np.zeros((1, 3, 1)), HarmonicBasis((1,)), ("q",), False, "")
     for bad in (0.0, -1.0, float("nan")):
         with pytest.raises(ValueError, match="offset_hz"):
