@@ -878,10 +878,10 @@ def stop_verdict(check, harmonics) -> str:
                 f"one exists there, which the branch with harmonics {tuple(harmonics)} did not reach (more points, "
                 "max_points, or a richer set, harmonics='auto', may follow it; with the damper separated most of the "
                 "period, brief impacts, only a richer set can)")
-    return (f"the time integration of the full assembly at {f:.4f} Hz finds no periodic motion ({check.status[0]}: "
-            f"{check.message[0]}; largest tip amplitude {tip:.4g} mm over its last periods, the damper's contact "
-            f"points separated {separated:.0f} % of the period): the damper hops on the platforms or keeps rolling, "
-            "a motion no harmonic-balance branch represents; the time integration is the answer there")
+    return (f"the time integration of the full assembly at {f:.4f} Hz finds no periodic motion ({check.message[0]}; "
+            f"largest tip amplitude {tip:.4g} mm over its last periods, the damper's contact points separated "
+            f"{separated:.0f} % of the period): the damper hops on the platforms, keeps rolling or the vibration "
+            "does not settle, a motion no harmonic-balance branch represents; the time integration is the answer there")
 
 
 def with_stop_note(response: "DiskResponse", f_start_hz: float | None = None, check=None) -> "DiskResponse":

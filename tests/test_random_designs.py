@@ -50,6 +50,11 @@ N_OSCILLATORS = 160
 # printed, and the failing designs with it.
 SHARE_TARGET = 0.99
 SHARE_REQUIRED = 0.93
+# answered rightly: reached the end with every check passing, or stopped where the product's own
+# time integration (check_stop) finds no periodic motion and the result says so. Measured 316 of
+# 320 = 0.9875 on 2026-12-06 (the 4 others: periodic motions with brief impacts that (0, 1, 2, 3)
+# cannot follow, disks 63, 67, 154, 105); the floor leaves one design for rounding
+ANSWERED_REQUIRED = 0.984
 # Harmonics of the oscillators cross-checked by time integration, and of the random inclined
 # oscillators (normal load varying with the motion, lifting off): the frequency_response default,
 # "auto" (the harmonics chosen by their error estimate, static term included; (0, 1, 2, 3) was
@@ -306,7 +311,7 @@ def test_a_failing_disk_has_no_periodic_motion_beyond_its_stop():
     assert check.omega[0] > r.omega.max()
     assert not check.periodic[0] and check.status[0] in ("not settled", "drifting"), check.message[0]
     assert "beyond where the branch got furthest, the time integration" in r.message
-    assert "finds no periodic motion" in r.message and check.status[0] in r.message
+    assert "finds no periodic motion" in r.message and check.message[0] in r.message
 
 
 @pytest.mark.slow
