@@ -91,15 +91,23 @@ def test_real_form_is_complex_multiplication():
 
 def test_system_dynamic_stiffness_from_cached_parts_is_the_basis_one():
     """HarmonicBalanceSystem.dynamic_stiffness builds the Omega-independent parts once: at every
-    frequency it is bit-identical to HarmonicBasis.dynamic_stiffness of the matrices (with the
-    static stiffness on the static harmonic), and the cached parts are not changed by it."""
+    frequency it is bit-identical to K_0 - Omega^2 M_2 + Omega G of the parts (with the static
+    stiffness on the static harmonic) and to HarmonicBasis.dynamic_stiffness of the matrices,
+    returns new arrays, and the cached parts are not changed by it."""
     system = reference_disk("cylinder", 1e-3).hbm_system((0, 1, 2))
     n, j = system.n_dof, system.basis.cos_index(0)
+    K0, M2, G = (p.copy() for p in system.basis.dynamic_stiffness_parts(system.mass, system.damping, system.stiffness))
     for omega in (580.0, 600.0, 580.0):
         A, dA = system.dynamic_stiffness(omega)
-        A_ref, dA_ref = system.basis.dynamic_stiffness(omega, system.mass, system.damping, system.stiffness)
+        A_basis, dA_basis = system.basis.dynamic_stiffness(omega, system.mass, system.damping, system.stiffness)
+        A_ref, dA_ref = K0 - omega ** 2 * M2 + omega * G, -2 * omega * M2 + G
+        assert np.array_equal(A_basis, A_ref) and np.array_equal(dA_basis, dA_ref)
         A_ref[j * n:(j + 1) * n, j * n:(j + 1) * n] += system.static_stiffness
         assert np.array_equal(A, A_ref) and np.array_equal(dA, dA_ref)
+        A_only, none = system.dynamic_stiffness(omega, derivative=False)
+        assert none is None and np.array_equal(A_only, A_ref) and A_only is not A
+        A += 1.0                                    # the caller may change what it got
+    assert all(np.array_equal(a, b) for a, b in zip(system._dense_parts, (K0, M2, G)))
 
 
 def _maps_with_zero_rows_and_columns():

@@ -207,15 +207,18 @@ class HarmonicBasis:
         return kron(np.eye(C), stiffness), kron(np.diag(self.order.astype(float) ** 2), mass), \
             kron(self.derivative, damping)
 
-    def dynamic_stiffness(self, omega: float, mass, damping, stiffness, parts=None):
+    def dynamic_stiffness(self, omega: float, mass, damping, stiffness, parts=None, derivative=True):
         """Real-form dynamic stiffness and its derivative in omega.
 
         Harmonic h block: K - (h Omega)^2 M + i h Omega D (paper Eq. 5 in modal form).
         ``parts``: :meth:`dynamic_stiffness_parts` of the same matrices if already built.
-        Returns ``(A, dA_domega)``, each (C*n, C*n).
+        Returns ``(A, dA_domega)``, each (C*n, C*n) (``dA_domega`` None without ``derivative``).
         """
         stiffness_part, inertia, gyro = parts if parts is not None else \
             self.dynamic_stiffness_parts(mass, damping, stiffness)
-        A = stiffness_part - omega ** 2 * inertia + omega * gyro
-        dA = -2 * omega * inertia + gyro
+        # A = K_0 - Omega^2 M_2 + Omega G, the same operations in place (two arrays instead of four)
+        A = np.multiply(inertia, omega ** 2)
+        np.subtract(stiffness_part, A, out=A)
+        A += np.multiply(gyro, omega)
+        dA = -2 * omega * inertia + gyro if derivative else None
         return A, dA

@@ -170,15 +170,17 @@ class HarmonicBalanceSystem:
         K0, M2, G = self._sparse_parts
         return (K0 - omega ** 2 * M2 + omega * G).tocsc(), (-2 * omega * M2 + G).tocsc()
 
-    def dynamic_stiffness(self, omega: float):
+    def dynamic_stiffness(self, omega: float, derivative: bool = True):
         """(A, dA/domega) of the linear part at ``omega`` [rad/s] (the residual's variable): the
         harmonic dynamic stiffness of M, D, K with the static stiffness on the static harmonic;
-        dense (C*n, C*n) ndarrays, or scipy.sparse for a sparse system."""
+        dense (C*n, C*n) ndarrays (new arrays at each call; dA/domega None without
+        ``derivative``), or scipy.sparse for a sparse system."""
         if self.sparse:
             return self._sparse_dynamic_stiffness(omega)
         if self._dense_parts is None:      # the Omega-independent parts, built once
             self._dense_parts = self.basis.dynamic_stiffness_parts(self.mass, self.damping, self.stiffness)
-        A, dA = self.basis.dynamic_stiffness(omega, self.mass, self.damping, self.stiffness, self._dense_parts)
+        A, dA = self.basis.dynamic_stiffness(omega, self.mass, self.damping, self.stiffness, self._dense_parts,
+                                             derivative)
         if self.static_stiffness is not None and self.basis.has_static:
             n = self.n_dof
             j = self.basis.cos_index(0)
@@ -215,11 +217,11 @@ class HarmonicBalanceSystem:
         """``(R, dR/dx, dR/domega)``; the last two are None when ``jacobian`` is False."""
         basis = self.basis
         C = basis.n_coeffs
-        A, dA = self.dynamic_stiffness(omega)
+        A, dA = self.dynamic_stiffness(omega, jacobian)
         f, df = self.excitation(omega)
         R = A @ x - f
         sparse = sp.issparse(A)
-        J = A.copy() if jacobian else None
+        J = (A.copy() if sparse else A) if jacobian else None       # dense A is new at each call: J grows in it
         Rw = dA @ x - df if jacobian else None
         for c in self.couplings:
             local = (c.matrix @ x).reshape(C, c.element.n_local)
