@@ -589,8 +589,8 @@ def point_harmonics(c, synthesis, analysis, kt, mu, w, off, law_kind, law_params
     :func:`point_work` (T, C). Writes fc (C, 3): the force coefficients on the platform
     (tangential, then the normal force -N) [N]; with ``want_jac`` also
     jt (C, 2 n3p), jt[a, i n3p + k C + b] = d fc[a, i] / d c[b, k] for the tangential rows
-    i = 0, 1 (n3p: 3C rounded up to a multiple of 4, ``work[8].shape[2]``), and jn (C, C) = d fc[a, 2] / d c[b, 2] [N/m], the
-    normal row (its xi and eta columns are zero).
+    i = 0, 1 (n3p: 3C rounded up to a multiple of 4, ``work[8].shape[2]``), and
+    jn (C, C) = d fc[a, 2] / d c[b, 2] [N/m], the normal row (its xi and eta columns are zero).
     """
     ut, uz, normal, dnormal, approach, seats, seat_rates, f_t, df, df_flat, state, ds, ds_begin, transfer = work
     T, C = synthesis.shape[0], synthesis.shape[1]

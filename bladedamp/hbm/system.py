@@ -78,7 +78,8 @@ class Coupling:
                     # flat indices of the (rows, rows) block of dF/dw and the (cols, cols) block
                     # of the Jacobian: take / flat assignment are ~3x faster than np.ix_ indexing
                     structure = (rows, cols, np.ascontiguousarray(self.matrix[np.ix_(rows, cols)]),
-                                 (rows[:, None] * m + rows[None, :]).ravel(), (cols[:, None] * n + cols[None, :]).ravel())
+                                 (rows[:, None] * m + rows[None, :]).ravel(),
+                                 (cols[:, None] * n + cols[None, :]).ravel())
             self._support = (self.matrix, structure)
         return None if self._support[1] is None else self._support[1][:3]
 
