@@ -594,7 +594,7 @@ def profile(problem: Problem):
     shares(lambda: bd_frf(problem), [
         ("residual + Jacobian (HarmonicBalanceSystem.residual)", "system.py:residual"),
         ("  contact AFT + Jacobian (PointContactElement.harmonic_forces)", "harmonic_forces"),
-        ("    numba return map", "_return_map"),
+        ("    fused numba contact kernel (point_contact_harmonics)", "point_contact_harmonics"),
         ("  dynamic stiffness", "dynamic_stiffness"),
         ("linear solves (factorize)", "linsolve.py:factorize"),
     ])

@@ -11,6 +11,7 @@ from conftest import jenkins_dissipation, jenkins_first_harmonic, unilateral_spr
 
 from bladedamp.contact import SEPARATED, SLIP, STICK, LinearNormalLaw, point_contact_forces
 from bladedamp.contact.laws import RoughnessNormalLaw
+from bladedamp.contact.point import PointContactElement
 from bladedamp.hbm import HarmonicBasis
 
 K_T = 1.0e4      # N/m
@@ -434,3 +435,45 @@ def test_stuck_sliders_keep_the_iterated_jacobian(harmonics):
     assert np.sum(stuck & ~transient) > 0 and transient.sum() > 0, "want both: stuck from the start and after slipping"
     for field in ("force", "jacobian", "slip_work", "state"):
         assert np.array_equal(getattr(new, field), getattr(old, field)), field
+
+
+# ---------------------------------------------------------------------------------------
+# PointContactElement: the fused kernel against the analysis of the point samples
+# ---------------------------------------------------------------------------------------
+class ShiftedLinearLaw(LinearNormalLaw):
+    """A subclassed law: the fused kernel does not know it (normal_law_parameters gives None)."""
+
+
+@pytest.mark.parametrize("law_name", list(NORMAL_LAWS) + ["subclassed"])
+@pytest.mark.parametrize("harmonics", JACOBIAN_HARMONICS, ids=["h1", "h13", "h012"])
+def test_element_fused_kernel_equals_the_analysed_samples(harmonics, law_name):
+    """PointContactElement.harmonic_forces by the fused kernel (point_contact_harmonics) equals the
+    analysis of point_contact_forces' samples and Jacobian (the path it replaced, kept for other
+    laws) to rounding, 1e-13 of the largest force / Jacobian entry, with and without the
+    Jacobian, on random motions with stick, slip and lift-off and near-stick orbits, per point
+    k_T, mu, weights and preloads; a subclassed law takes the samples path."""
+    basis = HarmonicBasis(harmonics, 64)
+    law = ShiftedLinearLaw(K_N) if law_name == "subclassed" else NORMAL_LAWS[law_name]
+    c = np.concatenate([mixed_motion(basis, 7, P=24), near_stick_orbits(basis, 8, P=8)], axis=1)
+    C, P = basis.n_coeffs, c.shape[1]
+    rng = np.random.default_rng(9)
+    offset = N0 / K_N if isinstance(law, LinearNormalLaw) else law.reference_approach
+    element = PointContactElement(K_T * rng.uniform(0.5, 2, P), MU * rng.uniform(0.5, 2, P), law,
+                                  rng.uniform(0.5, 1.5, P), offset * rng.uniform(0.3, 1.5, P))
+    local = c.reshape(C, 3 * P)
+    force, jac, none = element.harmonic_forces(local, basis)
+    force_only, no_jac, _ = element.harmonic_forces(local, basis, jacobian=False)
+    ref_force, ref_jac, _ = element._harmonic_forces_from_samples(local, basis, True)
+    ref_only, _, _ = element._harmonic_forces_from_samples(local, basis, False)
+    counts = np.bincount(element.samples(local, basis).state.ravel(), minlength=3)
+    assert np.all(counts > 0), f"not all contact states covered: {counts}"
+    assert none is None and no_jac is None and jac.shape == (3 * C * P,) * 2
+    e_force = np.abs(force - ref_force).max() / np.abs(ref_force).max()
+    e_only = np.abs(force_only - ref_only).max() / np.abs(ref_only).max()
+    e_jac = np.abs(jac - ref_jac).max() / np.abs(ref_jac).max()
+    print(f"\n[{harmonics} {law_name}] stick/slip/lift-off {counts}: fused - samples: forces {e_force:.1e} "
+          f"(without Jacobian {e_only:.1e}), Jacobian {e_jac:.1e}")
+    assert e_force < 1e-13 and e_only < 1e-13 and e_jac < 1e-13
+    if law_name == "subclassed":
+        assert np.array_equal(force, ref_force) and np.array_equal(jac, ref_jac)
+        assert np.array_equal(force_only, ref_only)

@@ -10,7 +10,10 @@ from bladedamp import FrictionOscillator
 from bladedamp.contact import SEPARATED, SLIP, STICK
 from bladedamp.hbm import HarmonicBasis
 from bladedamp.hbm.continuation import ConvergenceWarning, continuation, newton
+from bladedamp.hbm import system as system_module
+from bladedamp.hbm.elements import CubicSpring, GapSpring
 from bladedamp.hbm.system import Coupling
+from bladedamp.reference import reference_disk
 
 
 # ---------------------------------------------------------------------------------------
@@ -84,6 +87,97 @@ def test_real_form_is_complex_multiplication():
     Xc, Yc = basis.to_complex(X), basis.to_complex(Y)
     for h in basis.harmonics:
         assert np.allclose(Yc[h], G[h] @ Xc[h], atol=1e-13)
+
+
+def test_system_dynamic_stiffness_from_cached_parts_is_the_basis_one():
+    """HarmonicBalanceSystem.dynamic_stiffness builds the Omega-independent parts once: at every
+    frequency it is bit-identical to K_0 - Omega^2 M_2 + Omega G of the parts (with the static
+    stiffness on the static harmonic) and to HarmonicBasis.dynamic_stiffness of the matrices,
+    returns new arrays, and the cached parts are not changed by it."""
+    system = reference_disk("cylinder", 1e-3).hbm_system((0, 1, 2))
+    n, j = system.n_dof, system.basis.cos_index(0)
+    K0, M2, G = (p.copy() for p in system.basis.dynamic_stiffness_parts(system.mass, system.damping, system.stiffness))
+    for omega in (580.0, 600.0, 580.0):
+        A, dA = system.dynamic_stiffness(omega)
+        A_basis, dA_basis = system.basis.dynamic_stiffness(omega, system.mass, system.damping, system.stiffness)
+        A_ref, dA_ref = K0 - omega ** 2 * M2 + omega * G, -2 * omega * M2 + G
+        assert np.array_equal(A_basis, A_ref) and np.array_equal(dA_basis, dA_ref)
+        A_ref[j * n:(j + 1) * n, j * n:(j + 1) * n] += system.static_stiffness
+        assert np.array_equal(A, A_ref) and np.array_equal(dA, dA_ref)
+        A_only, none = system.dynamic_stiffness(omega, derivative=False)
+        assert none is None and np.array_equal(A_only, A_ref) and A_only is not A
+        A += 1.0                                    # the caller may change what it got
+    assert all(np.array_equal(a, b) for a, b in zip(system._dense_parts, (K0, M2, G)))
+
+
+def _maps_with_zero_rows_and_columns():
+    """Random dense maps with zero rows and columns, and the reference disk's: its damper contacts'
+    sector map (no zero row or column) and the map to the blade tip (the damper's columns zero)."""
+    rng = np.random.default_rng(21)
+    maps = []
+    for m, n in ((192, 128), (30, 17), (6, 40)):
+        T = rng.standard_normal((m, n))
+        T[rng.random(m) < 0.5] = 0.0
+        T[:, rng.random(n) < 0.4] = 0.0
+        maps.append(T)
+    disk = reference_disk("cylinder", 1e-3)
+    system = disk.hbm_system((0, 1, 2, 3))
+    return maps + [system.couplings[0].matrix, disk.point_map(system.basis, "tip", (0, 1))]
+
+
+@pytest.mark.parametrize("layout", ["C", "F"])
+def test_coupling_projection_on_the_nonzero_rows_and_columns_equals_the_dense_one(monkeypatch, layout):
+    """Coupling.add_jacobian and add_forces, through the map restricted to its nonzero rows and
+    columns (Coupling.support), equal the dense T^T (dF/dw) T and T^T F to rounding (1e-13 of the
+    largest entry), on random maps and the disk's, into a C- or Fortran-ordered Jacobian."""
+    monkeypatch.setattr(system_module, "PRUNE_MIN_SAVING", 1)       # restrict every map with a zero row or column
+    rng = np.random.default_rng(22)
+    restricted = 0
+    for T in _maps_with_zero_rows_and_columns():
+        m, n = T.shape
+        coupling = Coupling(CubicSpring(1.0), T)
+        restricted += coupling.support() is not None
+        jac, f = rng.standard_normal((m, m)), rng.standard_normal(m)
+        J0, R0 = rng.standard_normal((n, n)), rng.standard_normal(n)
+        J = np.array(J0, order=layout)
+        out = coupling.add_jacobian(J, jac)
+        assert out is J
+        R = R0.copy()
+        coupling.add_forces(R, f)
+        assert relative_matrix_error(J - J0, T.T @ jac @ T) < 1e-13
+        assert np.abs(R - R0 - T.T @ f).max() <= 1e-13 * np.abs(T.T @ f).max()
+    assert restricted == 4          # all but the damper contacts' map
+
+
+@pytest.mark.parametrize("model", ["flat oscillator", "inclined oscillator", "disk with a tip stop"])
+def test_residual_through_the_restricted_maps_equals_the_dense_one(monkeypatch, model):
+    """The residual, its Jacobian and omega-derivative with every map restricted to its nonzero rows
+    and columns equal those through the dense maps to rounding (1e-13 of the largest entry)."""
+    if model == "disk with a tip stop":
+        disk = reference_disk("cylinder", 1e-3)
+        system = disk.hbm_system((0, 1, 2))
+        system = system.add(GapSpring(1e6, 0.0), disk.point_map(system.basis, "tip", (0,)), "tip stop")
+        omega = 2 * np.pi * 95.0
+    else:
+        osc = FrictionOscillator(damping=2.0, normal_load=3.0, forcing=2.0, normal_stiffness=1.5e4,
+                                 contact_angle=0.3 if model == "inclined oscillator" else 0.0)
+        system = osc.hbm_system((0, 1, 3))
+        omega = 117.0
+    x = np.random.default_rng(23).normal(scale=1e-4, size=system.n_unknowns)
+
+    def evaluate(threshold):
+        monkeypatch.setattr(system_module, "PRUNE_MIN_SAVING", threshold)
+        for c in system.couplings:
+            c._support = None
+        restricted = [c.support() is not None for c in system.couplings]
+        return system.residual(x, omega), restricted
+
+    (R, J, Rw), restricted = evaluate(1)
+    (R_d, J_d, Rw_d), dense = evaluate(np.inf)
+    assert any(restricted) and not any(dense)
+    assert np.abs(R - R_d).max() <= 1e-13 * np.abs(R_d).max()
+    assert relative_matrix_error(J, J_d) < 1e-13
+    assert np.abs(Rw - Rw_d).max() <= 1e-13 * np.abs(Rw_d).max()
 
 
 # ---------------------------------------------------------------------------------------

@@ -34,6 +34,8 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from .laws import LinearNormalLaw, RoughnessNormalLaw
+
 STICK, SLIP, SEPARATED = 0, 1, 2
 
 
@@ -72,6 +74,10 @@ SINGULAR_DET = 1e-6
 # applied to the forces and slip work as a linear correction (see _point_return_map): after
 # the position test the step is ~tol / det; a larger one is no small correction.
 NEWTON_STEP_MAX = 1e-6
+# the return map's defaults: at most MAX_PASSES periods, repeated until the slider position at
+# the period end repeats to PERIODIC_TOL of mu max N / k_T (point_contact_forces, PointContactElement)
+MAX_PASSES = 20
+PERIODIC_TOL = 1e-10
 
 
 @njit(cache=True)
@@ -551,7 +557,6 @@ def normal_law_parameters(law):
 
     LinearNormalLaw: (LAW_LINEAR, [k_N, 0, 0]); RoughnessNormalLaw: (LAW_POWER, [N_ref, a_ref, p]).
     Exact types only (a subclass may change ``force``)."""
-    from .laws import LinearNormalLaw, RoughnessNormalLaw
     if type(law) is LinearNormalLaw:
         return LAW_LINEAR, np.array([float(law.stiffness), 0.0, 0.0])
     if type(law) is RoughnessNormalLaw:
@@ -560,17 +565,123 @@ def normal_law_parameters(law):
 
 
 @njit(cache=True)
+def point_work(T, C):
+    """Work arrays of :func:`point_harmonics` for T samples and C coefficients (allocated once
+    per kernel call, reused for every point)."""
+    n3 = 3 * C
+    n3p = (n3 + 3) // 4 * 4          # padded to whole SIMD vectors
+    df = np.zeros((T, 2, n3p))       # d f_tangential / d c of the last pass; padding stays 0
+    return (np.empty((T, 2)), np.empty(T), np.empty(T), np.empty(T), np.empty((1, T)), np.empty((1, T)),
+            np.empty((1, T)), np.empty((T, 2)), df, df.reshape((T, 2 * n3p)), np.empty(T, dtype=np.int8),
+            np.zeros((2, n3)), np.zeros((2, n3)), np.zeros((T, 4)))
+
+
+@njit(cache=True)
+def point_harmonics(c, synthesis, analysis, kt, mu, w, off, law_kind, law_params, static_index, max_passes, tol,
+                    want_jac, closed_form, work, fc, jt, jn):
+    """AFT of one point contact from its harmonic coefficients: the per-point step of the fused
+    kernels (:func:`damper_contact_forces`, :func:`point_contact_harmonics`).
+
+    c (C, 3): coefficients of the relative displacement (xi, eta, zeta) [m]; synthesis (T, C),
+    analysis (C, T); kt [N/m], mu [-], w (weight [-]), off (approach offset [m]) of the point;
+    ``law_kind`` / ``law_params``: see :func:`normal_law_parameters`; the slider seated at the
+    mean if ``static_index`` >= 0, the periodic slider of :func:`_point_return_map`; ``work``:
+    :func:`point_work` (T, C). Writes fc (C, 3): the force coefficients on the platform
+    (tangential, then the normal force -N) [N]; with ``want_jac`` also
+    jt (C, 2 n3p), jt[a, i n3p + k C + b] = d fc[a, i] / d c[b, k] for the tangential rows
+    i = 0, 1 (n3p: 3C rounded up to a multiple of 4, ``work[8].shape[2]``), and
+    jn (C, C) = d fc[a, 2] / d c[b, 2] [N/m], the normal row (its xi and eta columns are zero).
+    """
+    ut, uz, normal, dnormal, approach, seats, seat_rates, f_t, df, df_flat, state, ds, ds_begin, transfer = work
+    T, C = synthesis.shape[0], synthesis.shape[1]
+    n3p = df.shape[2]
+    seat = seats[0]
+    seat_rate = seat_rates[0]
+    for t in range(T):
+        x0 = 0.0
+        x1 = 0.0
+        x2 = 0.0
+        for a in range(C):
+            sa = synthesis[t, a]
+            x0 += sa * c[a, 0]
+            x1 += sa * c[a, 1]
+            x2 += sa * c[a, 2]
+        ut[t, 0] = x0
+        ut[t, 1] = x1
+        uz[t] = x2
+    # normal law N(a), a = offset - u_zeta (as laws.py); dnormal = dN/du_zeta = -dN/da
+    k_law = law_params[0]
+    a_ref = law_params[1]
+    expo = law_params[2]
+    for t in range(T):
+        app = off - uz[t]
+        approach[0, t] = app
+        if app > 0.0:
+            if law_kind == LAW_LINEAR:
+                kw = k_law * w
+                normal[t] = kw * app
+                dnormal[t] = -kw
+            else:
+                ratio = app / a_ref
+                n_ref = k_law * w
+                normal[t] = n_ref * ratio ** expo
+                dnormal[t] = -(n_ref * expo / a_ref * ratio ** (expo - 1.0))
+        else:
+            normal[t] = 0.0
+            dnormal[t] = 0.0
+    touchdown_seats(approach, seats, seat_rates)
+    if static_index >= 0:
+        s0 = c[static_index, 0]
+        s1 = c[static_index, 1]
+    else:
+        s0 = 0.0
+        s1 = 0.0
+    _point_return_map(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s0, s1, static_index,
+                      max_passes, tol, want_jac, f_t, df, state, ds, ds_begin, transfer, closed_form)
+    # force coefficients of the point (normal force -N)
+    for a in range(C):
+        a0 = 0.0
+        a1 = 0.0
+        a2 = 0.0
+        for t in range(T):
+            an = analysis[a, t]
+            a0 += an * f_t[t, 0]
+            a1 += an * f_t[t, 1]
+            a2 -= an * normal[t]
+        fc[a, 0] = a0
+        fc[a, 1] = a1
+        fc[a, 2] = a2
+    if not want_jac:
+        return
+    # jt[a, i n3p + k C + b] = sum_t analysis[a, t] df[t, i, k C + b] (tangential rows i);
+    # jn[a, b] = sum_t analysis[a, t] dN/da E[t, b] (normal row, zeta columns only);
+    # separated samples carry no force and no derivative
+    jt[:, :] = 0.0
+    jn[:, :] = 0.0
+    for t in range(T):
+        if state[t] == SEPARATED:
+            continue
+        dnda = -dnormal[t]
+        for a in range(C):
+            an = analysis[a, t]
+            # (indexed, not row views: a view per sample costs reference counting)
+            for r in range(2 * n3p):
+                jt[a, r] += an * df_flat[t, r]
+            for b in range(C):
+                jn[a, b] += an * (dnda * synthesis[t, b])
+
+
+@njit(cache=True)
 def damper_contact_forces(B, local, synthesis, analysis, k_t, mu, weight, approach_offset, law_kind,
                           law_params, static_index, max_passes, tol, want_jac, force, blocks,
                           closed_form=True):
     """Fused AFT of the two contact patches of n_d dampers (the batched path of AssemblyContacts).
 
-    Per point (d, q, p): coefficients c = B[d, q, p] @ local[:, d, 6q:6q+6], samples
-    synthesis @ c, normal law (``law_kind``/``law_params``, see :func:`normal_law_parameters`)
-    with lift-off, the periodic slider (:func:`_point_return_map`, seated at the mean if
-    ``static_index`` >= 0), force coefficients analysis @ f projected back with B^T, and the
-    Jacobian B^T (analysis @ df/dc) B: the same numbers as :func:`point_contact_forces`
-    followed by those projections, without the (n_points, T, 3, 3C) intermediates.
+    Per point (d, q, p): coefficients c = B[d, q, p] @ local[:, d, 6q:6q+6], then
+    :func:`point_harmonics` (samples, normal law with lift-off, periodic slider, AFT), the force
+    coefficients projected back with B^T, and the Jacobian B^T (analysis @ df/dc) B: the same
+    numbers as :func:`point_contact_forces` followed by those projections, without the
+    (n_points, T, 3, 3C) intermediates.
 
     B (n_d,2,P,3,6); local (C,n_d,12); synthesis (T,C); analysis (C,T); k_t, mu, weight,
     approach_offset (n_d*2*P,) in (d, q, p) order; law_params float (3,). Outputs
@@ -581,25 +692,10 @@ def damper_contact_forces(B, local, synthesis, analysis, k_t, mu, weight, approa
     """
     nd, P = B.shape[0], B.shape[2]
     T, C = synthesis.shape[0], synthesis.shape[1]
-    n3 = 3 * C
-    n3p = (n3 + 3) // 4 * 4          # padded rows of the point derivative (whole SIMD vectors)
-    ut = np.empty((T, 2))
-    uz = np.empty(T)
-    normal = np.empty(T)
-    dnormal = np.empty(T)
-    approach = np.empty((1, T))      # one point at a time (touchdown_seats takes (P, T))
-    seats = np.empty((1, T))
-    seat_rates = np.empty((1, T))
-    seat = seats[0]
-    seat_rate = seat_rates[0]
-    f_t = np.empty((T, 2))
-    df = np.zeros((T, 2, n3p))       # d f_tangential / d c of the last pass; padding stays 0
-    df_flat = df.reshape((T, 2 * n3p))
-    state = np.empty(T, dtype=np.int8)
-    ds = np.zeros((2, n3))
-    ds_begin = np.zeros((2, n3))
-    transfer = np.zeros((T, 4))
+    work = point_work(T, C)
+    n3p = work[8].shape[2]
     c = np.empty((C, 3))
+    fc = np.empty((C, 3))
     jt = np.empty((C, 2 * n3p))
     jn = np.empty((C, C))
     bj = np.empty((C, 6, 3, C))      # sum_i B[i, m] jp[a, i, k, b]
@@ -607,9 +703,6 @@ def damper_contact_forces(B, local, synthesis, analysis, k_t, mu, weight, approa
     force[:, :, :] = 0.0
     if want_jac:
         blocks[:, :, :, :, :] = 0.0
-    k_law = law_params[0]
-    a_ref = law_params[1]
-    expo = law_params[2]
     for d in range(nd):
         for q in range(2):
             col = 6 * q
@@ -618,83 +711,24 @@ def damper_contact_forces(B, local, synthesis, analysis, k_t, mu, weight, approa
             for p in range(P):
                 g = (d * 2 + q) * P + p
                 Bp = B[d, q, p]
-                # point coefficients and samples
+                # point coefficients
                 for a in range(C):
                     for i in range(3):
                         s = 0.0
                         for j in range(6):
                             s += Bp[i, j] * local[a, d, col + j]
                         c[a, i] = s
-                for t in range(T):
-                    x0 = 0.0
-                    x1 = 0.0
-                    x2 = 0.0
-                    for a in range(C):
-                        sa = synthesis[t, a]
-                        x0 += sa * c[a, 0]
-                        x1 += sa * c[a, 1]
-                        x2 += sa * c[a, 2]
-                    ut[t, 0] = x0
-                    ut[t, 1] = x1
-                    uz[t] = x2
-                # normal law N(a), a = offset - u_zeta (as laws.py); dnormal = dN/du_zeta = -dN/da
-                w = weight[g]
-                off = approach_offset[g]
-                for t in range(T):
-                    app = off - uz[t]
-                    approach[0, t] = app
-                    if app > 0.0:
-                        if law_kind == LAW_LINEAR:
-                            kw = k_law * w
-                            normal[t] = kw * app
-                            dnormal[t] = -kw
-                        else:
-                            ratio = app / a_ref
-                            n_ref = k_law * w
-                            normal[t] = n_ref * ratio ** expo
-                            dnormal[t] = -(n_ref * expo / a_ref * ratio ** (expo - 1.0))
-                    else:
-                        normal[t] = 0.0
-                        dnormal[t] = 0.0
-                touchdown_seats(approach, seats, seat_rates)
-                if static_index >= 0:
-                    s0 = c[static_index, 0]
-                    s1 = c[static_index, 1]
-                else:
-                    s0 = 0.0
-                    s1 = 0.0
-                _point_return_map(ut, normal, dnormal, seat, seat_rate, synthesis, k_t[g], mu[g], s0, s1, static_index,
-                                  max_passes, tol, want_jac, f_t, df, state, ds, ds_begin, transfer, closed_form)
-                # force coefficients of the point (normal force -N), projected with B^T
+                point_harmonics(c, synthesis, analysis, k_t[g], mu[g], weight[g], approach_offset[g], law_kind,
+                                law_params, static_index, max_passes, tol, want_jac, closed_form, work, fc, jt, jn)
+                # force coefficients of the point projected with B^T
                 for a in range(C):
-                    a0 = 0.0
-                    a1 = 0.0
-                    a2 = 0.0
-                    for t in range(T):
-                        an = analysis[a, t]
-                        a0 += an * f_t[t, 0]
-                        a1 += an * f_t[t, 1]
-                        a2 -= an * normal[t]
+                    a0 = fc[a, 0]
+                    a1 = fc[a, 1]
+                    a2 = fc[a, 2]
                     for j in range(6):
                         force[a, d, col + j] += a0 * Bp[0, j] + a1 * Bp[1, j] + a2 * Bp[2, j]
                 if not want_jac:
                     continue
-                # jt[a, i n3p + k C + b] = sum_t analysis[a, t] df[t, i, k C + b] (tangential rows i);
-                # jn[a, b] = sum_t analysis[a, t] dN/da E[t, b] (normal row, zeta columns only);
-                # separated samples carry no force and no derivative
-                jt[:, :] = 0.0
-                jn[:, :] = 0.0
-                for t in range(T):
-                    if state[t] == SEPARATED:
-                        continue
-                    dnda = -dnormal[t]
-                    for a in range(C):
-                        an = analysis[a, t]
-                        # (indexed, not row views: a view per sample costs reference counting)
-                        for r in range(2 * n3p):
-                            jt[a, r] += an * df_flat[t, r]
-                        for b in range(C):
-                            jn[a, b] += an * (dnda * synthesis[t, b])
                 # acc[a, m, b, n] += sum_ik B[i, m] jp[a, i, k, b] B[k, n], jp the point block
                 # d f_coef[a, i] / d c[b, k] (normal row i = 2: zeta column k = 2 only)
                 for a in range(C):
@@ -724,6 +758,53 @@ def damper_contact_forces(B, local, synthesis, analysis, k_t, mu, weight, approa
                                 blocks[d, a, col + m, b, col + n] = acc[a, m, b, n]
 
 
+@njit(cache=True)
+def point_contact_harmonics(local, synthesis, analysis, k_t, mu, weight, approach_offset, law_kind, law_params,
+                            static_index, max_passes, tol, want_jac, closed_form, force, jac):
+    """Fused AFT of P independent point contacts (the path of :class:`PointContactElement`).
+
+    Per point p: :func:`point_harmonics` of its coefficients local[:, p, :] (samples, normal law
+    with lift-off, periodic slider, AFT and the point's Jacobian block): the same numbers as
+    :func:`point_contact_forces` followed by the analysis of its samples and Jacobian, to
+    rounding, without the (P, T, 3, 3C) intermediates.
+
+    local (C, P, 3) coefficients of the relative displacements [m]; synthesis (T, C), analysis
+    (C, T); k_t, mu, weight, approach_offset (P,) [N/m, -, -, m]; law_kind / law_params (3,)
+    see :func:`normal_law_parameters`; static_index: the mean's coefficient (slider seated at
+    the mean) or -1. Outputs (overwritten): force (C, P, 3) [N]; jac (C, P, 3, C, P, 3)
+    [N/m], d force / d local, block diagonal over the points, if ``want_jac`` (any array
+    otherwise).
+    """
+    P = local.shape[1]
+    T, C = synthesis.shape[0], synthesis.shape[1]
+    work = point_work(T, C)
+    n3p = work[8].shape[2]
+    c = np.empty((C, 3))
+    fc = np.empty((C, 3))
+    jt = np.empty((C, 2 * n3p))
+    jn = np.empty((C, C))
+    if want_jac:
+        jac[:, :, :, :, :, :] = 0.0
+    for p in range(P):
+        for a in range(C):
+            for i in range(3):
+                c[a, i] = local[a, p, i]
+        point_harmonics(c, synthesis, analysis, k_t[p], mu[p], weight[p], approach_offset[p], law_kind, law_params,
+                        static_index, max_passes, tol, want_jac, closed_form, work, fc, jt, jn)
+        for a in range(C):
+            for i in range(3):
+                force[a, p, i] = fc[a, i]
+        if not want_jac:
+            continue
+        for a in range(C):
+            for i in range(2):
+                for k in range(3):
+                    for b in range(C):
+                        jac[a, p, i, b, p, k] = jt[a, i * n3p + k * C + b]
+            for b in range(C):
+                jac[a, p, 2, b, p, 2] = jn[a, b]
+
+
 @dataclass
 class PointContactSamples:
     """Forces of P point contacts over one period (time samples T).
@@ -747,7 +828,8 @@ class PointContactSamples:
 
 
 def point_contact_forces(coeffs, basis, tangential_stiffness, friction_coefficient, normal_law,
-                         weight, approach_offset, jacobian=True, max_passes=20, tol=1e-10, closed_form=True):
+                         weight, approach_offset, jacobian=True, max_passes=MAX_PASSES, tol=PERIODIC_TOL,
+                         closed_form=True):
     """Periodic forces of P point contacts from their harmonic displacement coefficients.
 
     Parameters
@@ -846,7 +928,27 @@ class PointContactElement:
                                     self.weight, self.approach_offset, jacobian=jacobian)
 
     def harmonic_forces(self, local, basis, omega=None, jacobian=True):
-        """Force coefficients (C, 3P), Jacobian (C*3P, C*3P) (block diagonal over points), None."""
+        """Force coefficients (C, 3P) [N], Jacobian (C*3P, C*3P) [N/m] (block diagonal over
+        points) or None, and None (no explicit omega dependence), of ``local`` (C, 3P) [m].
+
+        For the normal laws the kernel evaluates itself (:func:`normal_law_parameters`) one call
+        of the fused kernel :func:`point_contact_harmonics`; otherwise (a subclassed law) the
+        samples of :meth:`samples` are analysed here. The two agree to rounding (tested).
+        """
+        C, P = basis.n_coeffs, self.n_points
+        law = normal_law_parameters(self.normal_law)
+        if law is None:
+            return self._harmonic_forces_from_samples(local, basis, jacobian)
+        force = np.empty((C, P, 3))
+        jac = np.empty((C, P, 3, C, P, 3)) if jacobian else np.empty((1, 1, 1, 1, 1, 1))
+        point_contact_harmonics(np.ascontiguousarray(np.reshape(local, (C, P, 3)), dtype=float), basis.synthesis,
+                                basis.analysis, self.tangential_stiffness, self.friction_coefficient, self.weight,
+                                self.approach_offset, law[0], law[1], basis.cos_index(0) if basis.has_static else -1,
+                                MAX_PASSES, PERIODIC_TOL, jacobian, True, force, jac)
+        return force.reshape(C, 3 * P), (jac.reshape(C * 3 * P, C * 3 * P) if jacobian else None), None
+
+    def _harmonic_forces_from_samples(self, local, basis, jacobian):
+        """:meth:`harmonic_forces` by the analysis of :meth:`samples` (any normal law)."""
         C, P = basis.n_coeffs, self.n_points
         pts = self.samples(local, basis, jacobian)
         force = basis.to_coeffs(np.moveaxis(pts.force, 1, 0)).reshape(C, 3 * P)

@@ -190,12 +190,11 @@ class HarmonicBasis:
             out[b_o, b_i] = gr
         return out
 
-    def dynamic_stiffness(self, omega: float, mass, damping, stiffness):
-        """Real-form dynamic stiffness and its derivative in omega.
-
-        Harmonic h block: K - (h Omega)^2 M + i h Omega D (paper Eq. 5 in modal form).
-        Returns ``(A, dA_domega)``, each (C*n, C*n).
-        """
+    def dynamic_stiffness_parts(self, mass, damping, stiffness):
+        """The parts of the real-form dynamic stiffness that do not depend on Omega:
+        ``(K_0, M_2, G)``, each (C*n, C*n) [N/m, kg, N s/m], with
+        ``A(Omega) = K_0 - Omega^2 M_2 + Omega G`` (:meth:`dynamic_stiffness`); a caller that
+        evaluates A at many frequencies builds them once."""
         mass, damping, stiffness = (np.atleast_2d(np.asarray(m, dtype=float)) for m in (mass, damping, stiffness))
         # same as real_form(h -> K - (h Omega)^2 M + i h Omega D), assembled as Kronecker
         # products (harmonic-major): the block of i h is [[0, h], [-h, 0]], the derivative
@@ -205,8 +204,21 @@ class HarmonicBasis:
         def kron(coeff_matrix, dof_matrix):
             return (coeff_matrix[:, None, :, None] * dof_matrix[None, :, None, :]).reshape(C * n, C * n)
 
-        inertia = kron(np.diag(self.order.astype(float) ** 2), mass)
-        gyro = kron(self.derivative, damping)
-        A = kron(np.eye(C), stiffness) - omega ** 2 * inertia + omega * gyro
-        dA = -2 * omega * inertia + gyro
+        return kron(np.eye(C), stiffness), kron(np.diag(self.order.astype(float) ** 2), mass), \
+            kron(self.derivative, damping)
+
+    def dynamic_stiffness(self, omega: float, mass, damping, stiffness, parts=None, derivative=True):
+        """Real-form dynamic stiffness and its derivative in omega.
+
+        Harmonic h block: K - (h Omega)^2 M + i h Omega D (paper Eq. 5 in modal form).
+        ``parts``: :meth:`dynamic_stiffness_parts` of the same matrices if already built.
+        Returns ``(A, dA_domega)``, each (C*n, C*n) (``dA_domega`` None without ``derivative``).
+        """
+        stiffness_part, inertia, gyro = parts if parts is not None else \
+            self.dynamic_stiffness_parts(mass, damping, stiffness)
+        # A = K_0 - Omega^2 M_2 + Omega G, the same operations in place (two arrays instead of four)
+        A = np.multiply(inertia, omega ** 2)
+        np.subtract(stiffness_part, A, out=A)
+        A += np.multiply(gyro, omega)
+        dA = -2 * omega * inertia + gyro if derivative else None
         return A, dA

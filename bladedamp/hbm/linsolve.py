@@ -18,13 +18,12 @@ with the sign of det A for the continuation's orientation.
 from __future__ import annotations
 
 import functools
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
 from numba import njit
-from scipy.linalg import LinAlgWarning, lu_factor, lu_solve
+from scipy.linalg import get_lapack_funcs
 from scipy.sparse.linalg import splu
 
 
@@ -51,22 +50,53 @@ def one_blas_thread(fn):
     return wrapper
 
 
+# LAPACK's LU (what scipy.linalg.lu_factor / lu_solve call, without their per-call dispatch:
+# 20-40 us on the 9 x 9 bordered matrix of a one-DOF oscillator, more than the LU itself)
+_GETRF, _GETRS = get_lapack_funcs(("getrf", "getrs"), dtype=np.float64)
+
+
+class DenseLU:
+    """``solve(b)`` of the LU factorisation of a dense matrix A (LAPACK ``getrf`` with partial
+    pivoting, as ``scipy.linalg.lu_factor``, the same numbers), for b (N,) or (N, k).
+
+    ``sign`` (+1 / -1) and ``logabsdet`` of det A come from the factors when asked (U's
+    diagonal and the row swaps: no second factorisation, as ``np.linalg.slogdet`` would be).
+    Raises ``np.linalg.LinAlgError`` if A is singular (a zero or
+    non-finite pivot)."""
+
+    def __init__(self, A):
+        lu, piv, info = _GETRF(np.asarray(A, dtype=float))
+        if info < 0:
+            raise ValueError(f"illegal value in argument {-info} of LAPACK getrf")
+        if info > 0 or not np.all(np.isfinite(lu)) or np.any(np.diag(lu) == 0):
+            raise np.linalg.LinAlgError("singular matrix")
+        self.lu, self.piv = lu, piv
+
+    def __call__(self, b):
+        x, info = _GETRS(self.lu, self.piv, np.asarray(b, dtype=float))
+        if info != 0:
+            raise ValueError(f"illegal value in argument {-info} of LAPACK getrs")
+        return x
+
+    @property
+    def sign(self) -> int:
+        swaps = np.count_nonzero(self.piv != np.arange(self.piv.size))
+        return int(np.prod(np.sign(np.diag(self.lu))) * (-1.0) ** swaps)
+
+    @property
+    def logabsdet(self) -> float:
+        return float(np.sum(np.log(np.abs(np.diag(self.lu)))))
+
+
 def factorize(A):
-    """LU factorisation of a dense ndarray or a scipy.sparse matrix (sparse LU, COLAMD
-    ordering); returns ``solve(b)`` for one or several right-hand sides (columns of b).
-    Raises ``np.linalg.LinAlgError`` (dense) or ``RuntimeError`` (sparse) if A is singular."""
+    """LU factorisation of a dense ndarray (:class:`DenseLU`, which also gives the sign of det A)
+    or a scipy.sparse matrix (sparse LU, COLAMD ordering); returns ``solve(b)`` for one or
+    several right-hand sides (columns of b). Raises ``np.linalg.LinAlgError`` (dense) or
+    ``RuntimeError`` (sparse) if A is singular."""
     if sp.issparse(A):
         lu = splu(sp.csc_matrix(A))
         return lambda b: lu.solve(np.asarray(b, dtype=float))
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", LinAlgWarning)
-        try:
-            lu = lu_factor(A, check_finite=False)
-        except LinAlgWarning as e:
-            raise np.linalg.LinAlgError(str(e)) from None
-    if not np.all(np.isfinite(lu[0])) or np.any(np.diag(lu[0]) == 0):
-        raise np.linalg.LinAlgError("singular matrix")
-    return lambda b: lu_solve(lu, np.asarray(b, dtype=float), check_finite=False)
+    return DenseLU(A)
 
 
 def solve(A, b):
@@ -269,31 +299,18 @@ def _condensed_back(r, xe, yq, q, pos, exterior, X):
 
 def _lu_signed(A):
     """:func:`factorize` whose ``solve`` also carries ``sign`` and ``logabsdet`` of det A (from the
-    LU factors: dense ``lu_factor``, or ``splu``'s U diagonal and row / column permutations) and
+    LU factors: :class:`DenseLU`, or ``splu``'s U diagonal and row / column permutations) and
     ``method = "lu"``. Raises as :func:`factorize` if A is singular."""
-    if sp.issparse(A):
-        lu = splu(sp.csc_matrix(A))
-        d = lu.U.diagonal()
-        sign = np.prod(np.sign(d)) * permutation_sign(lu.perm_r) * permutation_sign(lu.perm_c)
+    if not sp.issparse(A):
+        solve = DenseLU(A)
+        solve.method = "lu"
+        return solve
+    lu = splu(sp.csc_matrix(A))
+    d = lu.U.diagonal()
 
-        def solve(b):
-            return lu.solve(np.asarray(b, dtype=float))
-    else:
-        with warnings.catch_warnings():
-            warnings.simplefilter("error", LinAlgWarning)
-            try:
-                lu = lu_factor(A, check_finite=False)
-            except LinAlgWarning as e:
-                raise np.linalg.LinAlgError(str(e)) from None
-        d = np.diag(lu[0])
-        if not np.all(np.isfinite(lu[0])) or np.any(d == 0):
-            raise np.linalg.LinAlgError("singular matrix")
-        swaps = np.count_nonzero(lu[1] != np.arange(lu[1].size))
-        sign = np.prod(np.sign(d)) * (-1.0) ** swaps
-
-        def solve(b):
-            return lu_solve(lu, np.asarray(b, dtype=float), check_finite=False)
-    solve.sign = int(sign)
+    def solve(b):
+        return lu.solve(np.asarray(b, dtype=float))
+    solve.sign = int(np.prod(np.sign(d)) * permutation_sign(lu.perm_r) * permutation_sign(lu.perm_c))
     solve.logabsdet = float(np.sum(np.log(np.abs(d))))
     solve.method = "lu"
     return solve
