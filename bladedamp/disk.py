@@ -866,22 +866,27 @@ class TunedDisk:
 def stop_verdict(check, harmonics) -> str:
     """What the time integration ``check`` (a one-frequency DiskTimeResponse of
     :meth:`TunedDisk.stop_check`) says of a branch with ``harmonics`` that stopped before it:
-    no periodic motion exists there (no harmonic-balance branch can go on), or one does, which
-    the branch did not reach (cut by max_points, or lost by the harmonic set: a richer set may
-    follow it)."""
+    the motion there is not periodic (no harmonic-balance branch represents it), or it is
+    periodic, and the branch did not reach it (cut by max_points, or lost by the harmonic set: a
+    richer set may follow it). It is the motion reached from the static equilibrium, what a test
+    rig run up to that speed would see; a periodic solution may coexist with it (random disk
+    154: the time integration from rest is periodic at 94.85 Hz and not at 94.19 Hz, where the
+    (0, 1, 2, 3) branch went through)."""
     f = check.frequency_hz[0]
     tip = 1e3 * check.tip_amplitude[0, :, 0].max()
     separated = 100 * check.point_state[0][..., 2].mean()
     if check.periodic[0]:
-        return (f"the time integration of the full assembly at {f:.4f} Hz settles on a periodic motion (largest tip "
+        return (f"the time integration of the full assembly at {f:.4f} Hz (from the static equilibrium) settles on a "
+                f"periodic motion (largest tip "
                 f"amplitude {tip:.4g} mm, the damper's contact points separated {separated:.0f} % of the period): "
                 f"one exists there, which the branch with harmonics {tuple(harmonics)} did not reach (more points, "
                 "max_points, or a richer set, harmonics='auto', may follow it; with the damper separated most of the "
                 "period, brief impacts, only a richer set can)")
-    return (f"the time integration of the full assembly at {f:.4f} Hz finds no periodic motion ({check.message[0]}; "
-            f"largest tip amplitude {tip:.4g} mm over its last periods, the damper's contact points separated "
-            f"{separated:.0f} % of the period): the damper hops on the platforms, keeps rolling or the vibration "
-            "does not settle, a motion no harmonic-balance branch represents; the time integration is the answer there")
+    return (f"the time integration of the full assembly at {f:.4f} Hz (from the static equilibrium) finds no periodic "
+            f"motion ({check.message[0]}; largest tip amplitude {tip:.4g} mm over its last periods, the damper's "
+            f"contact points separated {separated:.0f} % of the period): the damper hops on the platforms, keeps "
+            "rolling or the vibration does not settle, a motion no harmonic-balance branch represents; the time "
+            "integration is the answer there")
 
 
 def with_stop_note(response: "DiskResponse", f_start_hz: float | None = None, check=None) -> "DiskResponse":

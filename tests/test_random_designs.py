@@ -7,7 +7,7 @@ random friction oscillators (forcing / slip force 0.1-10, k_T / k 0.1-10, dampin
 SEED and i. The slow part runs all of them and prints two shares: those that reach the end with
 every check passing, and those answered rightly, which adds the disks whose branch stops where
 the product's own time integration (``check_stop``) finds no periodic motion and whose result
-says so (no periodic branch exists there). The fast part runs a few of each kind; a subset of
+says so (the motion reached from rest is not periodic, so no harmonic-balance branch describes it). The fast part runs a few of each kind; a subset of
 oscillators is checked against time integration.
 
 Run the whole suite by hand with ``python tests/test_random_designs.py [processes]``.
@@ -214,7 +214,8 @@ def run_design(d: dict) -> dict:
     # a design whose harmonics were chosen automatically must meet the harmonic tolerance too
     inaccurate = d["harmonics"] == "auto" and r.harmonics_converged is False
     # a disk whose branch stopped where its time integration finds no periodic motion, and whose
-    # result says so (check_stop): the right answer, since no periodic branch exists there
+    # result says so (check_stop): the right answer for the motion reached from rest, which no periodic
+    # branch describes
     check = getattr(r, "stop_check", None)
     no_periodic_motion = (not reached and check is not None and not check.periodic[0]
                           and "finds no periodic motion" in r.message)
