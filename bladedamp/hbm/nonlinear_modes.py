@@ -275,6 +275,14 @@ def peak_bracket(h) -> int:
     return int(below[-1])
 
 
+def _peak_record(a: float, omega: float, zeta: float, output_amplitude) -> dict:
+    """:meth:`NonlinearModeResponse.forced_peak`'s record of the resonance at modal amplitude
+    ``a``, where the mode has omega [rad/s] and zeta: the excitation frequency of the peak is
+    Omega = omega sqrt(1 - 2 zeta^2); ``output_amplitude`` (k,) [m]."""
+    return {"modal_amplitude": a, "frequency_hz": omega * np.sqrt(max(1 - 2 * zeta ** 2, 0.0)) / (2 * np.pi),
+            "damping_ratio": zeta, "output_amplitude": output_amplitude, "found": True, "message": "peak found"}
+
+
 # ----- the result -------------------------------------------------------------------------
 @dataclass
 class NonlinearModeResponse(Saveable):
@@ -388,8 +396,7 @@ class NonlinearModeResponse(Saveable):
             out_amp = np.exp(CubicSpline(la, np.log(np.maximum(out / a[:, None], 1e-300)), axis=0)(s)) * ap
         else:
             out_amp = np.zeros(0)
-        return {"modal_amplitude": ap, "frequency_hz": wp * np.sqrt(max(1 - 2 * zp ** 2, 0.0)) / (2 * np.pi),
-                "damping_ratio": zp, "output_amplitude": out_amp, "found": True, "message": "peak found"}
+        return _peak_record(ap, wp, zp, out_amp)
 
     def plot(self, ax=None, *, label: str | None = None, **kwargs):
         """Frequency [Hz] (top) and damping ratio [%] (bottom) over the modal amplitude (log x).
@@ -414,6 +421,11 @@ class NonlinearModeResponse(Saveable):
 
 
 # ----- the driver --------------------------------------------------------------------------
+# the peak tracked from a neighbouring design (tracked_forced_peak): the secant's second point,
+# in log a (its first step is a difference quotient of h; 1e-3 as _resolve_peaks' 1e-3 of its
+# bracket, ~1e-3 in log a for 30 points), and its steps before giving up (the full mode then)
+TRACK_FIRST_STEP = 1e-3
+TRACK_MAXITER = 12
 def _local_force_norm(system, x, omega) -> float:
     """Norm of every element's local forces at ``x`` (e.g. the contacts' normal preload): the
     level of the rounding in the residual's element forces."""
@@ -805,6 +817,86 @@ def _resolve_peaks(problem, system, peak_scales, amps, ys, its, scales, tol):
 
 class _PeakNotResolved(Exception):
     """Newton did not converge inside a peak's bracket (the peak stays interpolated)."""
+
+
+def tracked_forced_peak(model, start: NonlinearModeResponse, scale: float = 1.0, amplitude: float | None = None,
+                        tol: float = 1e-10, maxiter: int = TRACK_MAXITER) -> dict:
+    """The resonance of ``model`` under ``scale`` times its own excitation by single-nonlinear-mode
+    synthesis, solved from a neighbouring design's EPMC solution instead of a continuation from the
+    stuck mode (a design parameter changed a little: the damper mass in a refinement search).
+
+    ``start``: a nonlinear mode of a model with the same degrees of freedom and harmonics (e.g. the
+    same disk with another damper mass): its point nearest ``amplitude`` (default: its own forced
+    peak at ``scale``, or its only point) is the first guess of an EPMC Newton solve of ``model``
+    at that modal amplitude, with ``start``'s mode number and phase DOF. From there the root of the
+    synthesis condition h(a) (:func:`peak_function`) is found as ``nonlinear_mode(...,
+    resolve_peaks=...)`` finds it (the same secant in log a to 1e-7, each step an EPMC Newton
+    solve, here from the secant line through the two nearest solutions), but without a bracket: a
+    Newton solve that does not converge, or no convergence in ``maxiter`` secant steps, returns
+    ``found`` False (compute the full :func:`nonlinear_mode` then). ``tol``: Newton tolerance.
+
+    The peak is the EPMC solution at the root, as the resolved peak of the full mode is: the two
+    agree to the root search's 1e-7 in log a (measured on the reference cylinder, tests/
+    test_backbone_design.py), at about a tenth of the cost (no amplitude range, no continuation).
+
+    Returns the record of :meth:`NonlinearModeResponse.forced_peak` ("modal_amplitude",
+    "frequency_hz", "output_amplitude" (k,) [m], "damping_ratio", "found", "message") and
+    "mode": the NonlinearModeResponse of the one solution at the root (a start for the next
+    design; None if not found), "solves": the number of EPMC Newton solves."""
+    if not isinstance(start, NonlinearModeResponse):
+        raise TypeError(f"start must be a NonlinearModeResponse (got {type(start).__qualname__})")
+    scale = float(validation.finite("scale", scale))
+    validation.positive("scale", scale)
+    maxiter = validation.integer("maxiter", maxiter, minimum=1)
+    a_start = np.asarray(start.modal_amplitude, dtype=float)
+    nan = {"modal_amplitude": np.nan, "frequency_hz": np.nan, "damping_ratio": np.nan,
+           "output_amplitude": np.full(np.shape(start.output_amplitude)[1:], np.nan), "found": False,
+           "mode": None, "solves": 0}
+    if a_start.size == 0:
+        return {**nan, "message": "the start mode has no points"}
+    if amplitude is None:
+        amplitude = a_start[0] if a_start.size == 1 else start.forced_peak(scale=scale)["modal_amplitude"]
+        if not np.isfinite(amplitude):
+            return {**nan, "message": "the start mode has no peak at this scale to start from"}
+    validation.positive("amplitude", amplitude)
+    i0 = int(np.argmin(np.abs(np.log(a_start / amplitude))))
+
+    setup = _EPMCStart(model, start.mode, start.basis.harmonics, start.basis.n_samples, start.reference_dof)
+    problem = setup.problem
+    if np.shape(start.coefficients)[1:] != (problem.C, problem.n):
+        raise ValueError(f"start has harmonic coefficients of shape {np.shape(start.coefficients)[1:]}, the model "
+                         f"({problem.C}, {problem.n}): not a mode of a neighbouring design")
+    N = problem.N
+    y_start = np.concatenate([np.ravel(start.coefficients[i0]), [start.omega[i0], start.damping_ratio[i0]]])
+
+    calls = []
+
+    def solve(la, found):
+        calls.append(la)
+        a = float(np.exp(la))
+        near = sorted(found, key=lambda x: abs(x - la))[:2]
+        if len(near) == 2 and near[0] != near[1]:
+            (l0, (_, y0, _)), (l1, (_, y1, _)) = ((x, found[x]) for x in near)
+            guess = y0 + (y1 - y0) * (la - l0) / (l1 - l0)
+        else:
+            guess = found[near[0]][1] if near else y_start
+        y, ok, it = _newton(problem, guess, a, *setup.scales(a), tol=tol)
+        if not ok:
+            raise _PeakNotResolved
+        return a, y, it
+
+    force = scale * _first_harmonic_force(problem, setup.omega_lin)
+    la0 = float(np.log(amplitude))
+    try:
+        a, y, it = _synthesis_root(problem, force, solve, la0, TRACK_FIRST_STEP, maxiter=maxiter)
+    except _PeakNotResolved:
+        return {**nan, "solves": len(calls),
+                "message": f"no EPMC root of the synthesis condition from modal amplitude {amplitude:.6g} "
+                           f"({len(calls)} Newton solves; Newton failed or the secant did not converge)"}
+    mode = _result(model, setup.system, problem, [a], [y], [it], True,
+                   f"forced peak at scale {scale:g} tracked from modal amplitude {amplitude:.6g} of a neighbouring "
+                   f"design ({len(calls)} EPMC solves)", setup.omega_lin, setup.zeta_lin, start.mode)
+    return {**_peak_record(a, y[N], y[N + 1], mode.output_amplitude[0]), "mode": mode, "solves": len(calls)}
 
 
 def _result(model, system, problem, amps, ys, its, success, message, omega_lin, zeta_lin, mode):

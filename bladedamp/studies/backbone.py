@@ -11,7 +11,11 @@ interpolation error of 1e-3 that jumps from one mass to the next moves the optim
 percents). The optimum over mass is found as in
 :func:`bladedamp.studies.mass.optimal_mass`: a log grid over the bracket (every mode shared by
 all levels), then per level a bounded Brent search in log(mass) in the grid interval around
-the best grid point (the modes of the refinement are cached and shared as well).
+the best grid point. A refinement needs one level's peak only, one EPMC solution at the root
+of the synthesis condition: it is tracked in mass, solved at the new mass from the nearest
+evaluated mass's solution at that level's peak
+(:func:`~bladedamp.hbm.nonlinear_modes.tracked_forced_peak`, about 6 EPMC solves instead of a
+continuation of ~35; the full mode where it does not converge). Every evaluation is cached.
 
 The synthesis assumes one resonant mode, well separated (the 1F family of the tuned disk at one
 engine order), and a first-harmonic excitation; its peaks are within about 0.1 % of the
@@ -40,7 +44,8 @@ class BackboneDesign(Saveable):
     Attributes (k masses evaluated, l excitation levels)
     ----------
     kind : damper type
-    mass : (k,) every damper mass whose nonlinear mode was computed, ascending [kg]
+    mass : (k,) every damper mass evaluated (a full nonlinear mode, or a peak tracked from a
+        neighbouring mass), ascending [kg]
     excitation_levels : (l,) excitation levels: the norm of the disk's force vector (F_x for the
         reference disk) [N]
     peak_amplitude : (k, l) predicted resonance tip amplitude (first harmonic, ``direction``) [m];
@@ -54,6 +59,9 @@ class BackboneDesign(Saveable):
     grid_mass : (g,) the log grid of the first stage [kg]
     failed_masses : masses whose nonlinear mode did not converge (never the optimum) [kg]
     at_bound : (l,) True where the optimum is a bound of the search (widen the bracket)
+    tracked_masses : refinement masses whose peak was tracked from the nearest mass's EPMC
+        solution (:func:`~bladedamp.hbm.nonlinear_modes.tracked_forced_peak`), no full mode [kg]
+    fallback_masses : refinement masses where the tracking failed and the full mode was computed [kg]
     elapsed_s : wall time of the study [s]
     message : what was done
     """
@@ -70,6 +78,8 @@ class BackboneDesign(Saveable):
     grid_mass: np.ndarray
     failed_masses: tuple = ()
     at_bound: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    tracked_masses: tuple = ()
+    fallback_masses: tuple = ()
     elapsed_s: float = float("nan")
     message: str = ""
 
@@ -112,7 +122,13 @@ def synthesised_peak(mode, scale: float = 1.0, direction: int = 0):
     own excitation by single-nonlinear-mode synthesis: the ``direction`` component of
     :meth:`~bladedamp.hbm.nonlinear_modes.NonlinearModeResponse.forced_peak` (the one peak
     finder); NaN where it finds no peak on the computed range."""
-    peak = mode.forced_peak(scale=scale)
+    return _tip_peak(mode.forced_peak(scale=scale), direction)
+
+
+def _tip_peak(peak: dict, direction: int):
+    """(tip amplitude [m], frequency [Hz]) of a peak record of
+    :meth:`~bladedamp.hbm.nonlinear_modes.NonlinearModeResponse.forced_peak` (or of
+    :func:`~bladedamp.hbm.nonlinear_modes.tracked_forced_peak`); NaN if not found."""
     out = np.asarray(peak["output_amplitude"], dtype=float)
     if not peak["found"] or out.size <= direction:
         return np.nan, np.nan
@@ -128,7 +144,7 @@ def _force_scale(disk) -> float:
 
 def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid_per_decade: float = GRID_PER_DECADE,
                              xatol: float = 5e-3, direction: int = 0, harmonics=(1,), n_points: int = 30,
-                             tol: float = 1e-9, f_range_hz=(90.0, 105.0)) -> BackboneDesign:
+                             tol: float = 1e-9, f_range_hz=(90.0, 105.0), track: bool = True) -> BackboneDesign:
     """Damper mass minimising the resonance tip amplitude at each of ``excitation_levels`` [N].
 
     ``disk`` : a TunedDisk with a damper (its mass is replaced), or the damper kind ("cylinder",
@@ -140,9 +156,13 @@ def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid
     ``tol`` : of :func:`bladedamp.nonlinear_mode` (30 points: the peaks are resolved by EPMC
     solves at their roots, so they do not depend on the points; measured on the reference
     cylinder at 0.9-1.1 g and 0.05-0.2 N: the same peaks to 7 digits with 30, 60 and 120 points,
-    while the interpolated ones move by up to 1e-3); ``f_range_hz`` : range of the undamped peak's FRF.
+    while the interpolated ones move by up to 1e-3); ``f_range_hz`` : range of the undamped peak's FRF;
+    ``track`` : a refinement mass's peak is tracked from the nearest evaluated mass's EPMC solution at
+    that level's peak (:func:`~bladedamp.hbm.nonlinear_modes.tracked_forced_peak`: the same root of
+    the synthesis condition to 1e-7 in log a, at a tenth of a full mode's cost), with the full mode
+    where that fails; False: a full mode for every mass.
     """
-    from ..hbm.nonlinear_modes import nonlinear_mode
+    from ..hbm.nonlinear_modes import nonlinear_mode, tracked_forced_peak
     from ..reference import reference_disk
 
     t0 = time.perf_counter()
@@ -163,26 +183,58 @@ def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid
     scales = levels / ref
 
     modes, peaks, freqs, resolved = {}, {}, {}, {}
+    roots = {}                  # (mass, level index): (mode holding the EPMC solution at the peak, its modal amplitude)
+    tracked, fallbacks = [], []
+
+    def full_mode(m: float, wanted):
+        """The nonlinear mode of mass m with the peaks of levels ``wanted`` resolved."""
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            r = nonlinear_mode(with_mass(disk, m), harmonics=harmonics, n_points=n_points, tol=tol,
+                               resolve_peaks=scales[list(wanted)])
+        modes[m] = r
+        if len(r.modal_amplitude) >= 2:
+            for j in wanted:
+                peak = r.forced_peak(scale=scales[j])
+                peaks[m][j], freqs[m][j] = _tip_peak(peak, direction)
+                if peak["found"]:
+                    roots[m, j] = (r, peak["modal_amplitude"])
+
+    def tracked_peak(m: float, j: int) -> bool:
+        """Level j's peak of mass m tracked from the nearest mass (in log) with a peak there;
+        False where there is none or the tracking does not converge."""
+        near = [mm for mm, jj in roots if jj == j]
+        if not near:
+            return False
+        m0 = min(near, key=lambda mm: abs(np.log(m / mm)))
+        start, amplitude = roots[m0, j]
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            peak = tracked_forced_peak(with_mass(disk, m), start, scales[j], amplitude, tol=tol)
+        if not peak["found"]:
+            return False
+        peaks[m][j], freqs[m][j] = _tip_peak(peak, direction)
+        roots[m, j] = (peak["mode"], peak["modal_amplitude"])
+        tracked.append(m)
+        return True
 
     def evaluate(m: float, level: int | None = None):
         """Peaks (l,) [m] of mass m (cached): at every level (``level`` None: the grid, shared by
-        all levels) or at level ``level`` only (a level's refinement: the other levels' peaks
-        stay NaN, which saves their EPMC root solves, a third of a mode's cost at 3 levels)."""
+        all levels: one full mode) or at level ``level`` only (a level's refinement: the peak
+        tracked from the nearest mass with ``track``, else, or where that fails, a full mode
+        resolving that level only; the other levels' peaks stay NaN)."""
         m = float(m)
         wanted = range(levels.size) if level is None else (level,)
-        if m not in peaks or any(not np.isfinite(peaks[m][j]) and j not in resolved[m] for j in wanted):
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                r = nonlinear_mode(with_mass(disk, m), harmonics=harmonics, n_points=n_points, tol=tol,
-                                   resolve_peaks=scales[list(wanted)])
-            modes[m] = r
-            p = peaks.get(m, np.full(levels.size, np.nan))
-            f = freqs.get(m, np.full(levels.size, np.nan))
-            if len(r.modal_amplitude) >= 2:
-                for j in wanted:
-                    p[j], f[j] = synthesised_peak(r, scales[j], direction)
-            peaks[m], freqs[m] = p, f
-            resolved[m] = resolved.get(m, set()) | set(wanted)
+        if m not in peaks:
+            peaks[m], freqs[m] = np.full(levels.size, np.nan), np.full(levels.size, np.nan)
+            resolved[m] = set()
+        todo = [j for j in wanted if j not in resolved[m]]
+        if todo:
+            if level is None or not (track and tracked_peak(m, level)):
+                if level is not None and track:
+                    fallbacks.append(m)
+                full_mode(m, todo)
+            resolved[m] |= set(todo)
         return peaks[m]
 
     n = max(5, int(np.ceil(grid_per_decade * np.log10(hi / lo))) + 1)
@@ -219,13 +271,16 @@ def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid
         at_bound[j] = m_best in (grid[0], grid[-1])
 
     masses = np.array(sorted(peaks))
-    failed = tuple(m for m in masses if not len(modes[m].modal_amplitude) >= 2 or not modes[m].success)
-    text = (f"{len(masses)} nonlinear modes ({n}-point log grid {1e3 * lo:.4g}-{1e3 * hi:.4g} g and a bounded "
-            f"search per level, xatol {xatol:g} in log mass), {levels.size} excitation level(s)")
+    failed = tuple(m for m in masses if m in modes and (len(modes[m].modal_amplitude) < 2 or not modes[m].success))
+    text = (f"{len(masses)} masses, {len(modes)} nonlinear modes ({n}-point log grid {1e3 * lo:.4g}-{1e3 * hi:.4g} g "
+            f"and a bounded search per level, xatol {xatol:g} in log mass), {levels.size} excitation level(s)")
+    if track:
+        text += (f"; {len(tracked)} refinement peaks tracked from the nearest mass"
+                 + (f", {len(fallbacks)} by a full mode where that failed" if fallbacks else ""))
     if failed:
         text += f"; no mode for {', '.join(f'{1e3 * m:.4g}' for m in failed)} g"
     if at_bound.any():
         text += f"; optimum at a bound of the bracket for level(s) {', '.join(f'{x:.3g}' for x in levels[at_bound])} N"
     return BackboneDesign(disk.damper.kind, masses, levels, np.array([peaks[m] for m in masses]),
                           np.array([freqs[m] for m in masses]), best_m, best_p, undamped, brackets, grid,
-                          failed, at_bound, time.perf_counter() - t0, text)
+                          failed, at_bound, tuple(tracked), tuple(fallbacks), time.perf_counter() - t0, text)
