@@ -834,6 +834,8 @@ def tracked_forced_peak(model, start: NonlinearModeResponse, scale: float = 1.0,
     solve, here from the secant line through the two nearest solutions), but without a bracket: a
     Newton solve that does not converge, or no convergence in ``maxiter`` secant steps, returns
     ``found`` False (compute the full :func:`nonlinear_mode` then). ``tol``: Newton tolerance.
+    The secant finds the root nearest the start, the full mode's (its largest) where h has one
+    root near the neighbour's peak, as it has along a damper-mass family of the reference disks.
 
     The peak is the EPMC solution at the root, as the resolved peak of the full mode is: the two
     agree to the root search's 1e-7 in log a (measured on the reference cylinder, tests/
@@ -874,10 +876,10 @@ def tracked_forced_peak(model, start: NonlinearModeResponse, scale: float = 1.0,
     def solve(la, found):
         calls.append(la)
         a = float(np.exp(la))
-        near = sorted(found, key=lambda x: abs(x - la))[:2]
-        if len(near) == 2 and near[0] != near[1]:
-            (l0, (_, y0, _)), (l1, (_, y1, _)) = ((x, found[x]) for x in near)
-            guess = y0 + (y1 - y0) * (la - l0) / (l1 - l0)
+        near = sorted(found, key=lambda x: abs(x - la))[:2]          # the secant line's solutions
+        if len(near) == 2:
+            l0, l1 = near
+            guess = found[l0][1] + (found[l1][1] - found[l0][1]) * (la - l0) / (l1 - l0)
         else:
             guess = found[near[0]][1] if near else y_start
         y, ok, it = _newton(problem, guess, a, *setup.scales(a), tol=tol)
