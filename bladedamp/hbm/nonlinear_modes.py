@@ -356,8 +356,8 @@ class NonlinearModeResponse(Saveable):
         interpolation errs by up to ~1e-3 of the peak with 60 points per mode, and that error
         jumps as the points move with a design parameter (a damper mass). A peak computed with
         ``nonlinear_mode(..., resolve_peaks=...)`` for this force has an EPMC solution at its root
-        (to 1e-7 in log a): the spline passes through it, so the peak is the EPMC's to its Newton
-        tolerance, not interpolated.
+        (h zero there to ~1e-12 of |phi^H F|): the spline passes through it, so the peak is the
+        EPMC's to its Newton tolerance, not interpolated.
 
         Returns {"modal_amplitude", "frequency_hz", "output_amplitude" (k,) [m],
         "damping_ratio", "found" (bool), "message"}; nan values when the peak is beyond the
@@ -421,9 +421,12 @@ class NonlinearModeResponse(Saveable):
 
 
 # ----- the driver --------------------------------------------------------------------------
-# the peak tracked from a neighbouring design (tracked_forced_peak): the secant's second point,
-# in log a (its first step is a difference quotient of h; 1e-3 as _resolve_peaks' 1e-3 of its
-# bracket, ~1e-3 in log a for 30 points), and its steps before giving up (the full mode then)
+# the peak tracked from a neighbouring design (tracked_forced_peaks): the offset of the secant's
+# second point in log a (its first step is a difference quotient of h; _resolve_peaks takes 1e-3
+# of its bracket, 3.4e-4 for the cylinder's 30 points over 4.2 decades, and h is smooth at that
+# scale: 1e-3 serves), and the secant steps before giving up (the full mode then): measured on the
+# reference cylinder's design (0.1-10 g, 0.05-0.2 N), 4-11 solves per peak over the 0.25-decade
+# steps of its grid, 4-6 in the refinements; 12 steps (14 solves) leave that margin
 TRACK_FIRST_STEP = 1e-3
 TRACK_MAXITER = 12
 def _local_force_norm(system, x, omega) -> float:
@@ -559,7 +562,8 @@ def nonlinear_mode(model, mode: int = 0, amplitudes=None, harmonics=(1,), n_samp
         solved for, not interpolated: after the continuation, a root search in log a on the
         interval that brackets the root of h(a) (a secant from the spline's root, Brent on the
         interval as the fallback), each evaluation an EPMC Newton solve from the interpolated
-        neighbours, to 1e-7 in log a; the solution at the root is added to the
+        neighbours, to 1e-7 in log a, and one more solve at the secant's root (h zero there to
+        ~1e-12 of |phi^H F|); the solution at the root is added to the
         points (so ``modal_amplitude`` holds these amplitudes besides ``amplitudes``). A peak
         outside the computed range, or a Newton failure in the interval, leaves it interpolated
 
@@ -736,7 +740,7 @@ def _synthesis_root(problem: EPMCProblem, force, solve, la_start: float, first_s
     ``solve(la, found)`` -> (a, y, iterations): the EPMC solution at a = exp(la), ``found`` the
     solutions so far ({la: (a, y, iterations)}, for its first guess); it raises _PeakNotResolved
     where Newton does not converge. A secant from ``la_start``, ``la_start + first_step`` to 1e-7
-    in log a (the solution returned is the last solve, within that of the root); with
+    in log a, and a last solve at its root (h there is zero to ~1e-12 of |phi^H F|); with
     ``bracket`` ((la0, h0), (la1, h1)), h0 < 0 < h1 at known solutions, Brent on it where the
     secant leaves it or stalls. Returns (a, y, iterations) at the root, None where the root is an
     end of the bracket (h there is zero to rounding); raises _PeakNotResolved where Newton fails or
@@ -756,7 +760,14 @@ def _synthesis_root(problem: EPMCProblem, force, solve, la_start: float, first_s
     sec = root_scalar(fun, method="secant", x0=la_start, x1=la_start + first_step, xtol=1e-7, maxiter=maxiter)
     inside = bracket is None or bracket[0][0] <= sec.root <= bracket[1][0]
     if sec.converged and inside and found:
-        root = min(found, key=lambda x: abs(x - sec.root))      # the last solve, within xtol of it
+        # the secant's root is closer to the true one than its last solve (up to xtol away, where
+        # h is up to ~1e-7 of |phi^H F|: the spline of forced_peak through that point can then
+        # cross zero up to 3e-6 away, measured on the cylinder at 4 g, 0.05 N): one more solve there
+        try:
+            fun(sec.root)
+            root = sec.root
+        except _PeakNotResolved:
+            root = min(found, key=lambda x: abs(x - sec.root))
     elif bracket is not None:
         root = brentq(fun, bracket[0][0], bracket[1][0], xtol=1e-7, rtol=1e-12)
     else:
@@ -819,37 +830,66 @@ class _PeakNotResolved(Exception):
     """Newton did not converge inside a peak's bracket (the peak stays interpolated)."""
 
 
-def tracked_forced_peak(model, start: NonlinearModeResponse, scale: float = 1.0, amplitude: float | None = None,
-                        tol: float = 1e-10, maxiter: int = TRACK_MAXITER) -> dict:
-    """The resonance of ``model`` under ``scale`` times its own excitation by single-nonlinear-mode
-    synthesis, solved from a neighbouring design's EPMC solution instead of a continuation from the
-    stuck mode (a design parameter changed a little: the damper mass in a refinement search).
+def tracked_forced_peaks(model, starts, scales, amplitudes=None, tol: float = 1e-10,
+                         maxiter: int = TRACK_MAXITER) -> list:
+    """The resonances of ``model`` under each of ``scales`` times its own excitation by
+    single-nonlinear-mode synthesis, each solved from a neighbouring design's EPMC solution
+    instead of a continuation from the stuck mode (a design parameter changed: the damper mass).
 
-    ``start``: a nonlinear mode of a model with the same degrees of freedom and harmonics (e.g. the
-    same disk with another damper mass): its point nearest ``amplitude`` (default: its own forced
-    peak at ``scale``, or its only point) is the first guess of an EPMC Newton solve of ``model``
-    at that modal amplitude, with ``start``'s mode number and phase DOF. From there the root of the
-    synthesis condition h(a) (:func:`peak_function`) is found as ``nonlinear_mode(...,
-    resolve_peaks=...)`` finds it (the same secant in log a to 1e-7, each step an EPMC Newton
-    solve, here from the secant line through the two nearest solutions), but without a bracket: a
-    Newton solve that does not converge, or no convergence in ``maxiter`` secant steps, returns
-    ``found`` False (compute the full :func:`nonlinear_mode` then). ``tol``: Newton tolerance.
-    The secant finds the root nearest the start, the full mode's (its largest) where h has one
-    root near the neighbour's peak, as it has along a damper-mass family of the reference disks.
+    ``starts``: per scale (or one for all), a nonlinear mode of a model with the same degrees of
+    freedom and harmonics (e.g. the same disk with another damper mass): its point nearest the
+    scale's entry of ``amplitudes`` (default: its own forced peak at that scale, or its only
+    point) is the first guess of an EPMC Newton solve of ``model`` at that modal amplitude, with
+    the start's mode number and phase DOF. From there the root of the synthesis condition h(a)
+    (:func:`peak_function`) is found as ``nonlinear_mode(..., resolve_peaks=...)`` finds it (the
+    same secant in log a, each step an EPMC Newton solve, here from the secant line through the
+    two nearest solutions, and the last at its root), but without a bracket: a Newton solve that does not
+    converge, or no convergence in ``maxiter`` secant steps, gives ``found`` False (compute the
+    full :func:`nonlinear_mode` then). ``tol``: Newton tolerance. The secant finds the root
+    nearest the start, the full mode's (its largest) where h has one root near the neighbour's
+    peak, as it has along the damper-mass family of the reference cylinder (0.1-10 g, 0.05-0.2 N).
+    The model's system and stuck mode are set up once for all scales.
 
     The peak is the EPMC solution at the root, as the resolved peak of the full mode is: the two
-    agree to the root search's 1e-7 in log a (measured on the reference cylinder, tests/
-    test_backbone_design.py), at about a tenth of the cost (no amplitude range, no continuation).
+    agree to 7e-9 in the tip amplitude and 1.4e-11 in frequency (the reference cylinder, each
+    grid mass of 0.1-5.6 g tracked from both neighbours 0.25 decades away at 0.05 / 0.1 / 0.2 N;
+    2 of 42 did not converge), at a fraction of the cost: no amplitude range, no continuation,
+    4-11 EPMC solves and ~10 ms per peak against 70-90 ms for a full mode with three resolved peaks.
 
-    Returns the record of :meth:`NonlinearModeResponse.forced_peak` ("modal_amplitude",
-    "frequency_hz", "output_amplitude" (k,) [m], "damping_ratio", "found", "message") and
-    "mode": the NonlinearModeResponse of the one solution at the root (a start for the next
-    design; None if not found), "solves": the number of EPMC Newton solves."""
-    if not isinstance(start, NonlinearModeResponse):
-        raise TypeError(f"start must be a NonlinearModeResponse (got {type(start).__qualname__})")
-    scale = float(validation.finite("scale", scale))
-    validation.positive("scale", scale)
+    Returns per scale the record of :meth:`NonlinearModeResponse.forced_peak` ("modal_amplitude",
+    "frequency_hz", "output_amplitude" (k,) [m], "damping_ratio", "found", "message") and "mode":
+    the NonlinearModeResponse of the one solution at the root (a start for the next design; None
+    if not found), "solves": the number of EPMC Newton solves."""
+    scales = np.atleast_1d(np.asarray(scales, dtype=float))
+    if scales.ndim != 1:
+        raise ValueError(f"scales must be a 1-D sequence of excitation scales in (0, inf) (got shape {scales.shape})")
+    validation.positive("scales", scales)
+    starts = [starts] * scales.size if isinstance(starts, NonlinearModeResponse) else list(starts)
+    amplitudes = [None] * scales.size if amplitudes is None else list(np.atleast_1d(amplitudes))
+    if len(starts) != scales.size or len(amplitudes) != scales.size:
+        raise ValueError(f"starts and amplitudes must have one entry per scale ({scales.size}; got "
+                         f"{len(starts)} and {len(amplitudes)})")
+    for start in starts:
+        if not isinstance(start, NonlinearModeResponse):
+            raise TypeError(f"starts must be NonlinearModeResponse objects (got {type(start).__qualname__})")
     maxiter = validation.integer("maxiter", maxiter, minimum=1)
+    setups = {}
+    out = []
+    for start, scale, amplitude in zip(starts, scales, amplitudes):
+        key = (start.mode, start.basis.harmonics, start.basis.n_samples, start.reference_dof)
+        if key not in setups:
+            setups[key] = _EPMCStart(model, *key)
+            problem = setups[key].problem
+            if np.shape(start.coefficients)[1:] != (problem.C, problem.n):
+                raise ValueError(f"a start has harmonic coefficients of shape {np.shape(start.coefficients)[1:]}, "
+                                 f"the model ({problem.C}, {problem.n}): not a mode of a neighbouring design")
+        out.append(_tracked_peak(model, setups[key], start, float(scale), amplitude, tol, maxiter))
+    return out
+
+
+def _tracked_peak(model, setup: _EPMCStart, start: NonlinearModeResponse, scale: float, amplitude, tol: float,
+                  maxiter: int) -> dict:
+    """One peak of :func:`tracked_forced_peaks` on the model's ``setup``."""
     a_start = np.asarray(start.modal_amplitude, dtype=float)
     nan = {"modal_amplitude": np.nan, "frequency_hz": np.nan, "damping_ratio": np.nan,
            "output_amplitude": np.full(np.shape(start.output_amplitude)[1:], np.nan), "found": False,
@@ -860,17 +900,11 @@ def tracked_forced_peak(model, start: NonlinearModeResponse, scale: float = 1.0,
         amplitude = a_start[0] if a_start.size == 1 else start.forced_peak(scale=scale)["modal_amplitude"]
         if not np.isfinite(amplitude):
             return {**nan, "message": "the start mode has no peak at this scale to start from"}
-    validation.positive("amplitude", amplitude)
+    validation.positive("amplitudes", amplitude)
     i0 = int(np.argmin(np.abs(np.log(a_start / amplitude))))
-
-    setup = _EPMCStart(model, start.mode, start.basis.harmonics, start.basis.n_samples, start.reference_dof)
     problem = setup.problem
-    if np.shape(start.coefficients)[1:] != (problem.C, problem.n):
-        raise ValueError(f"start has harmonic coefficients of shape {np.shape(start.coefficients)[1:]}, the model "
-                         f"({problem.C}, {problem.n}): not a mode of a neighbouring design")
     N = problem.N
     y_start = np.concatenate([np.ravel(start.coefficients[i0]), [start.omega[i0], start.damping_ratio[i0]]])
-
     calls = []
 
     def solve(la, found):
@@ -888,9 +922,8 @@ def tracked_forced_peak(model, start: NonlinearModeResponse, scale: float = 1.0,
         return a, y, it
 
     force = scale * _first_harmonic_force(problem, setup.omega_lin)
-    la0 = float(np.log(amplitude))
     try:
-        a, y, it = _synthesis_root(problem, force, solve, la0, TRACK_FIRST_STEP, maxiter=maxiter)
+        a, y, it = _synthesis_root(problem, force, solve, float(np.log(amplitude)), TRACK_FIRST_STEP, maxiter=maxiter)
     except _PeakNotResolved:
         return {**nan, "solves": len(calls),
                 "message": f"no EPMC root of the synthesis condition from modal amplitude {amplitude:.6g} "

@@ -1,21 +1,24 @@
 """Damper design by nonlinear modes: the optimal damper mass at many excitation levels from
-one EPMC backbone per mass (issue 14, item 4).
+EPMC backbones (issue 14, item 4).
 
-For each damper mass the damped nonlinear mode (EPMC, :func:`bladedamp.nonlinear_mode`) is
-computed once; the resonance peak at every excitation level then follows by single-nonlinear-mode
-synthesis (:meth:`NonlinearModeResponse.forced_peak`), which costs a root search on the
-backbone and no harmonic balance. The mode is computed with ``resolve_peaks`` at the levels'
-scales: each peak is an EPMC solution at its root, not a spline value between the mode's points
-(the valley of the peak over mass is flat, 0.1 % over +-5 % of mass at 0.1 N, so an
-interpolation error of 1e-3 that jumps from one mass to the next moves the optimum by
-percents). The optimum over mass is found as in
-:func:`bladedamp.studies.mass.optimal_mass`: a log grid over the bracket (every mode shared by
+The resonance peak of a damper mass at an excitation level follows from its damped nonlinear
+mode (EPMC, :func:`bladedamp.nonlinear_mode`) by single-nonlinear-mode synthesis
+(:meth:`NonlinearModeResponse.forced_peak`): a root of the synthesis condition on the backbone,
+no harmonic balance of the forced response. Each peak is an EPMC solution at that root
+(``resolve_peaks``), not a spline value between the mode's points (the valley of the peak over
+mass is flat, 0.1 % over +-5 % of mass at 0.1 N, so an interpolation error of 1e-3 that jumps
+from one mass to the next moves the optimum by percents). The optimum over mass is found as in
+:func:`bladedamp.studies.mass.optimal_mass`: a log grid over the bracket (every grid mass at
 all levels), then per level a bounded Brent search in log(mass) in the grid interval around
-the best grid point. A refinement needs one level's peak only, one EPMC solution at the root
-of the synthesis condition: it is tracked in mass, solved at the new mass from the nearest
-evaluated mass's solution at that level's peak
-(:func:`~bladedamp.hbm.nonlinear_modes.tracked_forced_peak`, about 6 EPMC solves instead of a
-continuation of ~35; the full mode where it does not converge). Every evaluation is cached.
+the best grid point.
+
+Only the first grid mass gets a full mode (the continuation from the stuck mode to gross slip,
+with the peaks of every level resolved). A peak is one EPMC solution, so every other peak is
+tracked in mass: solved at the new mass from the nearest evaluated mass's solution at that
+level's peak, from the modal amplitude interpolated over log mass between the two nearest
+(:func:`~bladedamp.hbm.nonlinear_modes.tracked_forced_peaks`: the same root to ~1e-8, 4-11
+EPMC solves instead of a continuation of ~50); a mass whose tracking does not converge gets its
+full mode. Every evaluation is cached.
 
 The synthesis assumes one resonant mode, well separated (the 1F family of the tuned disk at one
 engine order), and a first-harmonic excitation; its peaks are within about 0.1 % of the
@@ -57,11 +60,11 @@ class BackboneDesign(Saveable):
     undamped_peak_amplitude : (l,) the peak without damper (linear: proportional to the level) [m]
     bracket : (l, 2) the grid interval of each level's refinement [kg]
     grid_mass : (g,) the log grid of the first stage [kg]
-    failed_masses : masses whose nonlinear mode did not converge (never the optimum) [kg]
+    failed_masses : masses whose full nonlinear mode did not converge (never the optimum) [kg]
     at_bound : (l,) True where the optimum is a bound of the search (widen the bracket)
-    tracked_masses : refinement masses whose peak was tracked from the nearest mass's EPMC
-        solution (:func:`~bladedamp.hbm.nonlinear_modes.tracked_forced_peak`), no full mode [kg]
-    fallback_masses : refinement masses where the tracking failed and the full mode was computed [kg]
+    tracked_masses : masses whose peaks were all tracked from the nearest masses' EPMC solutions
+        (:func:`~bladedamp.hbm.nonlinear_modes.tracked_forced_peaks`), no full mode [kg]
+    fallback_masses : masses where a tracking failed and the full mode was computed [kg]
     elapsed_s : wall time of the study [s]
     message : what was done
     """
@@ -153,16 +156,17 @@ def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid
     masses [kg]; ``grid_per_decade`` : density of the log grid (at least 5 points);
     ``xatol`` : tolerance of the Brent search in log(mass) (5e-3: 0.5 % in mass);
     ``direction`` : tip DOF of the amplitude (0..2: u_x, u_y, u_z); ``harmonics``, ``n_points``,
-    ``tol`` : of :func:`bladedamp.nonlinear_mode` (30 points: the peaks are resolved by EPMC
+    ``tol`` : of :func:`bladedamp.nonlinear_mode` and the tracking (30 points: the peaks are resolved by EPMC
     solves at their roots, so they do not depend on the points; measured on the reference
     cylinder at 0.9-1.1 g and 0.05-0.2 N: the same peaks to 7 digits with 30, 60 and 120 points,
     while the interpolated ones move by up to 1e-3); ``f_range_hz`` : range of the undamped peak's FRF;
-    ``track`` : a refinement mass's peak is tracked from the nearest evaluated mass's EPMC solution at
-    that level's peak (:func:`~bladedamp.hbm.nonlinear_modes.tracked_forced_peak`: the same root of
-    the synthesis condition to 1e-7 in log a, at a tenth of a full mode's cost), with the full mode
-    where that fails; False: a full mode for every mass.
+    ``track`` : a full mode for the first grid mass only; every other peak is tracked in mass
+    from the nearest evaluated mass's EPMC solution at that level's peak
+    (:func:`~bladedamp.hbm.nonlinear_modes.tracked_forced_peaks`: the same root of the synthesis
+    condition to ~1e-8, at a fraction of a full mode's cost), with the full mode where that fails;
+    False: a full mode for every mass.
     """
-    from ..hbm.nonlinear_modes import nonlinear_mode, tracked_forced_peak
+    from ..hbm.nonlinear_modes import nonlinear_mode, tracked_forced_peaks
     from ..reference import reference_disk
 
     t0 = time.perf_counter()
@@ -184,7 +188,7 @@ def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid
 
     modes, peaks, freqs, resolved = {}, {}, {}, {}
     roots = {}                  # (mass, level index): (mode holding the EPMC solution at the peak, its modal amplitude)
-    tracked, fallbacks = [], []
+    fallbacks = []
 
     def full_mode(m: float, wanted):
         """The nonlinear mode of mass m with the peaks of levels ``wanted`` resolved."""
@@ -200,29 +204,40 @@ def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid
                 if peak["found"]:
                     roots[m, j] = (r, peak["modal_amplitude"])
 
-    def tracked_peak(m: float, j: int) -> bool:
-        """Level j's peak of mass m tracked from the nearest mass (in log) with a peak there;
-        False where there is none or the tracking does not converge."""
-        near = [mm for mm, jj in roots if jj == j]
-        if not near:
-            return False
-        m0 = min(near, key=lambda mm: abs(np.log(m / mm)))
-        start, amplitude = roots[m0, j]
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            peak = tracked_forced_peak(with_mass(disk, m), start, scales[j], amplitude, tol=tol)
-        if not peak["found"]:
-            return False
-        peaks[m][j], freqs[m][j] = _tip_peak(peak, direction)
-        roots[m, j] = (peak["mode"], peak["modal_amplitude"])
-        tracked.append(m)
-        return True
+    def tracked_peaks(m: float, wanted) -> list:
+        """Track the peaks of levels ``wanted`` to mass m, each from the nearest mass (in log) with
+        a peak at that level, starting at the modal amplitude interpolated (or extrapolated)
+        linearly in log a over log m from the two nearest. Returns the levels left without a peak:
+        no mass to start from, or no convergence (m is then a fallback)."""
+        js, starts, amplitudes = [], [], []
+        for j in wanted:
+            near = sorted((mm for mm, jj in roots if jj == j), key=lambda mm: abs(np.log(m / mm)))[:2]
+            if not near:
+                continue
+            start, amplitude = roots[near[0], j]
+            if len(near) == 2:
+                t = np.log(m / near[0]) / np.log(near[1] / near[0])
+                amplitude *= (roots[near[1], j][1] / amplitude) ** t
+            js.append(j)
+            starts.append(start)
+            amplitudes.append(amplitude)
+        if js:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                found = tracked_forced_peaks(with_mass(disk, m), starts, scales[js], amplitudes, tol=tol)
+            for j, peak in zip(js, found):
+                if peak["found"]:
+                    peaks[m][j], freqs[m][j] = _tip_peak(peak, direction)
+                    roots[m, j] = (peak["mode"], peak["modal_amplitude"])
+            if not all(peak["found"] for peak in found):
+                fallbacks.append(m)
+        return [j for j in wanted if (m, j) not in roots]
 
     def evaluate(m: float, level: int | None = None):
-        """Peaks (l,) [m] of mass m (cached): at every level (``level`` None: the grid, shared by
-        all levels: one full mode) or at level ``level`` only (a level's refinement: the peak
-        tracked from the nearest mass with ``track``, else, or where that fails, a full mode
-        resolving that level only; the other levels' peaks stay NaN)."""
+        """Peaks (l,) [m] of mass m (cached): at every level (``level`` None: the grid) or at level
+        ``level`` only (a level's refinement: the other levels' peaks stay NaN). With ``track``
+        each peak is tracked from the nearest mass with one; a full mode resolves the levels
+        left (the first grid mass's, and where tracking fails)."""
         m = float(m)
         wanted = range(levels.size) if level is None else (level,)
         if m not in peaks:
@@ -230,10 +245,9 @@ def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid
             resolved[m] = set()
         todo = [j for j in wanted if j not in resolved[m]]
         if todo:
-            if level is None or not (track and tracked_peak(m, level)):
-                if level is not None and track:
-                    fallbacks.append(m)
-                full_mode(m, todo)
+            left = tracked_peaks(m, todo) if track else todo
+            if left:
+                full_mode(m, left)
             resolved[m] |= set(todo)
         return peaks[m]
 
@@ -272,15 +286,16 @@ def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid
 
     masses = np.array(sorted(peaks))
     failed = tuple(m for m in masses if m in modes and (len(modes[m].modal_amplitude) < 2 or not modes[m].success))
-    text = (f"{len(masses)} masses, {len(modes)} nonlinear modes ({n}-point log grid {1e3 * lo:.4g}-{1e3 * hi:.4g} g "
-            f"and a bounded search per level, xatol {xatol:g} in log mass), {levels.size} excitation level(s)")
-    if track:
-        text += (f"; {len(tracked)} refinement peaks tracked from the nearest mass"
-                 + (f", {len(fallbacks)} by a full mode where that failed" if fallbacks else ""))
+    tracked = tuple(m for m in masses if m not in modes)
+    text = (f"{len(masses)} masses ({n}-point log grid {1e3 * lo:.4g}-{1e3 * hi:.4g} g and a bounded search per "
+            f"level, xatol {xatol:g} in log mass), {levels.size} excitation level(s): {len(modes)} full nonlinear "
+            f"mode(s), {len(tracked)} masses by peaks tracked from the nearest mass")
+    if fallbacks:
+        text += f" ({len(fallbacks)} full mode(s) where the tracking failed)"
     if failed:
         text += f"; no mode for {', '.join(f'{1e3 * m:.4g}' for m in failed)} g"
     if at_bound.any():
         text += f"; optimum at a bound of the bracket for level(s) {', '.join(f'{x:.3g}' for x in levels[at_bound])} N"
     return BackboneDesign(disk.damper.kind, masses, levels, np.array([peaks[m] for m in masses]),
                           np.array([freqs[m] for m in masses]), best_m, best_p, undamped, brackets, grid,
-                          failed, at_bound, tuple(tracked), tuple(fallbacks), time.perf_counter() - t0, text)
+                          failed, at_bound, tracked, tuple(fallbacks), time.perf_counter() - t0, text)
