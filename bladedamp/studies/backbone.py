@@ -289,7 +289,7 @@ def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid
     tracked = tuple(m for m in masses if m not in modes)
     text = (f"{len(masses)} masses ({n}-point log grid {1e3 * lo:.4g}-{1e3 * hi:.4g} g and a bounded search per "
             f"level, xatol {xatol:g} in log mass), {levels.size} excitation level(s): {len(modes)} full nonlinear "
-            f"mode(s), {len(tracked)} masses by peaks tracked from the nearest mass")
+            f"mode(s)" + (f", {len(tracked)} masses by peaks tracked from the nearest mass" if track else ""))
     if fallbacks:
         text += f" ({len(fallbacks)} full mode(s) where the tracking failed)"
     if failed:
