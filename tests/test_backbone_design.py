@@ -127,3 +127,20 @@ def test_failed_tracking_falls_back_to_the_full_mode(full_design, monkeypatch):
     np.testing.assert_array_equal(fallback.mass, full_design.mass)
     np.testing.assert_array_equal(fallback.optimal_mass, full_design.optimal_mass)
     np.testing.assert_array_equal(fallback.peak_amplitude, full_design.peak_amplitude)
+
+
+def test_tracked_forced_peaks_refuses_what_is_not_a_start():
+    from bladedamp.hbm.nonlinear_modes import tracked_forced_peaks
+
+    disk = bd.reference_disk("cylinder", 1e-3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        start = bd.nonlinear_mode(disk, amplitudes=[1e-4, 1e-3])
+    with pytest.raises(ValueError, match="one entry per scale"):
+        tracked_forced_peaks(disk, [start], [0.5, 1.0])
+    with pytest.raises(TypeError, match="NonlinearModeResponse"):
+        tracked_forced_peaks(disk, [object()], [0.5])
+    with pytest.raises(ValueError, match=r"scales must be in \(0, inf\)"):
+        tracked_forced_peaks(disk, start, [0.0])
+    with pytest.raises(ValueError, match="not a mode of a neighbouring design"):
+        tracked_forced_peaks(bd.FrictionOscillator(), start, [1.0])
