@@ -131,7 +131,7 @@ def synthesised_peak(mode, scale: float = 1.0, direction: int = 0):
 def _tip_peak(peak: dict, direction: int):
     """(tip amplitude [m], frequency [Hz]) of a peak record of
     :meth:`~bladedamp.hbm.nonlinear_modes.NonlinearModeResponse.forced_peak` (or of
-    :func:`~bladedamp.hbm.nonlinear_modes.tracked_forced_peak`); NaN if not found."""
+    :func:`~bladedamp.hbm.nonlinear_modes.tracked_forced_peaks`); NaN if not found."""
     out = np.asarray(peak["output_amplitude"], dtype=float)
     if not peak["found"] or out.size <= direction:
         return np.nan, np.nan
@@ -188,7 +188,7 @@ def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid
 
     modes, peaks, freqs, resolved = {}, {}, {}, {}
     roots = {}                  # (mass, level index): (mode holding the EPMC solution at the peak, its modal amplitude)
-    fallbacks = []
+    fallbacks = set()
 
     def full_mode(m: float, wanted):
         """The nonlinear mode of mass m with the peaks of levels ``wanted`` resolved."""
@@ -230,7 +230,7 @@ def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid
                     peaks[m][j], freqs[m][j] = _tip_peak(peak, direction)
                     roots[m, j] = (peak["mode"], peak["modal_amplitude"])
             if not all(peak["found"] for peak in found):
-                fallbacks.append(m)
+                fallbacks.add(m)
         return [j for j in wanted if (m, j) not in roots]
 
     def evaluate(m: float, level: int | None = None):
@@ -298,4 +298,4 @@ def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid
         text += f"; optimum at a bound of the bracket for level(s) {', '.join(f'{x:.3g}' for x in levels[at_bound])} N"
     return BackboneDesign(disk.damper.kind, masses, levels, np.array([peaks[m] for m in masses]),
                           np.array([freqs[m] for m in masses]), best_m, best_p, undamped, brackets, grid,
-                          failed, at_bound, tracked, tuple(fallbacks), time.perf_counter() - t0, text)
+                          failed, at_bound, tracked, tuple(sorted(fallbacks)), time.perf_counter() - t0, text)
