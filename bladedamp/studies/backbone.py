@@ -1,17 +1,24 @@
 """Damper design by nonlinear modes: the optimal damper mass at many excitation levels from
-one EPMC backbone per mass (issue 14, item 4).
+EPMC backbones (issue 14, item 4).
 
-For each damper mass the damped nonlinear mode (EPMC, :func:`bladedamp.nonlinear_mode`) is
-computed once; the resonance peak at every excitation level then follows by single-nonlinear-mode
-synthesis (:meth:`NonlinearModeResponse.forced_peak`), which costs a root search on the
-backbone and no harmonic balance. The mode is computed with ``resolve_peaks`` at the levels'
-scales: each peak is an EPMC solution at its root, not a spline value between the mode's points
-(the valley of the peak over mass is flat, 0.1 % over +-5 % of mass at 0.1 N, so an
-interpolation error of 1e-3 that jumps from one mass to the next moves the optimum by
-percents). The optimum over mass is found as in
-:func:`bladedamp.studies.mass.optimal_mass`: a log grid over the bracket (every mode shared by
+The resonance peak of a damper mass at an excitation level follows from its damped nonlinear
+mode (EPMC, :func:`bladedamp.nonlinear_mode`) by single-nonlinear-mode synthesis
+(:meth:`NonlinearModeResponse.forced_peak`): a root of the synthesis condition on the backbone,
+no harmonic balance of the forced response. Each peak is an EPMC solution at that root
+(``resolve_peaks``), not a spline value between the mode's points (the valley of the peak over
+mass is flat, 0.1 % over +-5 % of mass at 0.1 N, so an interpolation error of 1e-3 that jumps
+from one mass to the next moves the optimum by percents). The optimum over mass is found as in
+:func:`bladedamp.studies.mass.optimal_mass`: a log grid over the bracket (every grid mass at
 all levels), then per level a bounded Brent search in log(mass) in the grid interval around
-the best grid point (the modes of the refinement are cached and shared as well).
+the best grid point.
+
+Only the first grid mass gets a full mode (the continuation from the stuck mode to gross slip,
+with the peaks of every level resolved). A peak is one EPMC solution, so every other peak is
+tracked in mass: solved at the new mass from the nearest evaluated mass's solution at that
+level's peak, from the modal amplitude interpolated over log mass between the two nearest
+(:func:`~bladedamp.hbm.nonlinear_modes.tracked_forced_peaks`: the same root to ~1e-8, 4-11
+EPMC solves instead of a continuation of ~50); a mass whose tracking does not converge gets its
+full mode. Every evaluation is cached.
 
 The synthesis assumes one resonant mode, well separated (the 1F family of the tuned disk at one
 engine order), and a first-harmonic excitation; its peaks are within about 0.1 % of the
@@ -40,7 +47,8 @@ class BackboneDesign(Saveable):
     Attributes (k masses evaluated, l excitation levels)
     ----------
     kind : damper type
-    mass : (k,) every damper mass whose nonlinear mode was computed, ascending [kg]
+    mass : (k,) every damper mass evaluated (a full nonlinear mode, or a peak tracked from a
+        neighbouring mass), ascending [kg]
     excitation_levels : (l,) excitation levels: the norm of the disk's force vector (F_x for the
         reference disk) [N]
     peak_amplitude : (k, l) predicted resonance tip amplitude (first harmonic, ``direction``) [m];
@@ -52,8 +60,11 @@ class BackboneDesign(Saveable):
     undamped_peak_amplitude : (l,) the peak without damper (linear: proportional to the level) [m]
     bracket : (l, 2) the grid interval of each level's refinement [kg]
     grid_mass : (g,) the log grid of the first stage [kg]
-    failed_masses : masses whose nonlinear mode did not converge (never the optimum) [kg]
+    failed_masses : masses whose full nonlinear mode did not converge (never the optimum) [kg]
     at_bound : (l,) True where the optimum is a bound of the search (widen the bracket)
+    tracked_masses : masses whose peaks were all tracked from the nearest masses' EPMC solutions
+        (:func:`~bladedamp.hbm.nonlinear_modes.tracked_forced_peaks`), no full mode [kg]
+    fallback_masses : masses where a tracking failed and the full mode was computed [kg]
     elapsed_s : wall time of the study [s]
     message : what was done
     """
@@ -70,6 +81,8 @@ class BackboneDesign(Saveable):
     grid_mass: np.ndarray
     failed_masses: tuple = ()
     at_bound: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    tracked_masses: tuple = ()
+    fallback_masses: tuple = ()
     elapsed_s: float = float("nan")
     message: str = ""
 
@@ -112,7 +125,13 @@ def synthesised_peak(mode, scale: float = 1.0, direction: int = 0):
     own excitation by single-nonlinear-mode synthesis: the ``direction`` component of
     :meth:`~bladedamp.hbm.nonlinear_modes.NonlinearModeResponse.forced_peak` (the one peak
     finder); NaN where it finds no peak on the computed range."""
-    peak = mode.forced_peak(scale=scale)
+    return _tip_peak(mode.forced_peak(scale=scale), direction)
+
+
+def _tip_peak(peak: dict, direction: int):
+    """(tip amplitude [m], frequency [Hz]) of a peak record of
+    :meth:`~bladedamp.hbm.nonlinear_modes.NonlinearModeResponse.forced_peak` (or of
+    :func:`~bladedamp.hbm.nonlinear_modes.tracked_forced_peaks`); NaN if not found."""
     out = np.asarray(peak["output_amplitude"], dtype=float)
     if not peak["found"] or out.size <= direction:
         return np.nan, np.nan
@@ -128,7 +147,7 @@ def _force_scale(disk) -> float:
 
 def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid_per_decade: float = GRID_PER_DECADE,
                              xatol: float = 5e-3, direction: int = 0, harmonics=(1,), n_points: int = 30,
-                             tol: float = 1e-9, f_range_hz=(90.0, 105.0)) -> BackboneDesign:
+                             tol: float = 1e-9, f_range_hz=(90.0, 105.0), track: bool = True) -> BackboneDesign:
     """Damper mass minimising the resonance tip amplitude at each of ``excitation_levels`` [N].
 
     ``disk`` : a TunedDisk with a damper (its mass is replaced), or the damper kind ("cylinder",
@@ -137,12 +156,17 @@ def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid
     masses [kg]; ``grid_per_decade`` : density of the log grid (at least 5 points);
     ``xatol`` : tolerance of the Brent search in log(mass) (5e-3: 0.5 % in mass);
     ``direction`` : tip DOF of the amplitude (0..2: u_x, u_y, u_z); ``harmonics``, ``n_points``,
-    ``tol`` : of :func:`bladedamp.nonlinear_mode` (30 points: the peaks are resolved by EPMC
+    ``tol`` : of :func:`bladedamp.nonlinear_mode` and the tracking (30 points: the peaks are resolved by EPMC
     solves at their roots, so they do not depend on the points; measured on the reference
     cylinder at 0.9-1.1 g and 0.05-0.2 N: the same peaks to 7 digits with 30, 60 and 120 points,
-    while the interpolated ones move by up to 1e-3); ``f_range_hz`` : range of the undamped peak's FRF.
+    while the interpolated ones move by up to 1e-3); ``f_range_hz`` : range of the undamped peak's FRF;
+    ``track`` : a full mode for the first grid mass only; every other peak is tracked in mass
+    from the nearest evaluated mass's EPMC solution at that level's peak
+    (:func:`~bladedamp.hbm.nonlinear_modes.tracked_forced_peaks`: the same root of the synthesis
+    condition to ~1e-8, at a fraction of a full mode's cost), with the full mode where that fails;
+    False: a full mode for every mass.
     """
-    from ..hbm.nonlinear_modes import nonlinear_mode
+    from ..hbm.nonlinear_modes import nonlinear_mode, tracked_forced_peaks
     from ..reference import reference_disk
 
     t0 = time.perf_counter()
@@ -163,26 +187,68 @@ def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid
     scales = levels / ref
 
     modes, peaks, freqs, resolved = {}, {}, {}, {}
+    roots = {}                  # (mass, level index): (mode holding the EPMC solution at the peak, its modal amplitude)
+    fallbacks = set()
 
-    def evaluate(m: float, level: int | None = None):
-        """Peaks (l,) [m] of mass m (cached): at every level (``level`` None: the grid, shared by
-        all levels) or at level ``level`` only (a level's refinement: the other levels' peaks
-        stay NaN, which saves their EPMC root solves, a third of a mode's cost at 3 levels)."""
-        m = float(m)
-        wanted = range(levels.size) if level is None else (level,)
-        if m not in peaks or any(not np.isfinite(peaks[m][j]) and j not in resolved[m] for j in wanted):
+    def full_mode(m: float, wanted):
+        """The nonlinear mode of mass m with the peaks of levels ``wanted`` resolved."""
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            r = nonlinear_mode(with_mass(disk, m), harmonics=harmonics, n_points=n_points, tol=tol,
+                               resolve_peaks=scales[list(wanted)])
+        modes[m] = r
+        if len(r.modal_amplitude) >= 2:
+            for j in wanted:
+                peak = r.forced_peak(scale=scales[j])
+                peaks[m][j], freqs[m][j] = _tip_peak(peak, direction)
+                if peak["found"]:
+                    roots[m, j] = (r, peak["modal_amplitude"])
+
+    def tracked_peaks(m: float, wanted) -> list:
+        """Track the peaks of levels ``wanted`` to mass m, each from the nearest mass (in log) with
+        a peak at that level, starting at the modal amplitude interpolated (or extrapolated)
+        linearly in log a over log m from the two nearest. Returns the levels left without a peak:
+        no mass to start from, or no convergence (m is then a fallback)."""
+        js, starts, amplitudes = [], [], []
+        for j in wanted:
+            near = sorted((mm for mm, jj in roots if jj == j), key=lambda mm: abs(np.log(m / mm)))[:2]
+            if not near:
+                continue
+            start, amplitude = roots[near[0], j]
+            if len(near) == 2:
+                t = np.log(m / near[0]) / np.log(near[1] / near[0])
+                amplitude *= (roots[near[1], j][1] / amplitude) ** t
+            js.append(j)
+            starts.append(start)
+            amplitudes.append(amplitude)
+        if js:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                r = nonlinear_mode(with_mass(disk, m), harmonics=harmonics, n_points=n_points, tol=tol,
-                                   resolve_peaks=scales[list(wanted)])
-            modes[m] = r
-            p = peaks.get(m, np.full(levels.size, np.nan))
-            f = freqs.get(m, np.full(levels.size, np.nan))
-            if len(r.modal_amplitude) >= 2:
-                for j in wanted:
-                    p[j], f[j] = synthesised_peak(r, scales[j], direction)
-            peaks[m], freqs[m] = p, f
-            resolved[m] = resolved.get(m, set()) | set(wanted)
+                found = tracked_forced_peaks(with_mass(disk, m), starts, scales[js], amplitudes, tol=tol)
+            for j, peak in zip(js, found):
+                if peak["found"]:
+                    peaks[m][j], freqs[m][j] = _tip_peak(peak, direction)
+                    roots[m, j] = (peak["mode"], peak["modal_amplitude"])
+            if not all(peak["found"] for peak in found):
+                fallbacks.add(m)
+        return [j for j in wanted if (m, j) not in roots]
+
+    def evaluate(m: float, level: int | None = None):
+        """Peaks (l,) [m] of mass m (cached): at every level (``level`` None: the grid) or at level
+        ``level`` only (a level's refinement: the other levels' peaks stay NaN). With ``track``
+        each peak is tracked from the nearest mass with one; a full mode resolves the levels
+        left (the first grid mass's, and where tracking fails)."""
+        m = float(m)
+        wanted = range(levels.size) if level is None else (level,)
+        if m not in peaks:
+            peaks[m], freqs[m] = np.full(levels.size, np.nan), np.full(levels.size, np.nan)
+            resolved[m] = set()
+        todo = [j for j in wanted if j not in resolved[m]]
+        if todo:
+            left = tracked_peaks(m, todo) if track else todo
+            if left:
+                full_mode(m, left)
+            resolved[m] |= set(todo)
         return peaks[m]
 
     n = max(5, int(np.ceil(grid_per_decade * np.log10(hi / lo))) + 1)
@@ -219,13 +285,17 @@ def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid
         at_bound[j] = m_best in (grid[0], grid[-1])
 
     masses = np.array(sorted(peaks))
-    failed = tuple(m for m in masses if not len(modes[m].modal_amplitude) >= 2 or not modes[m].success)
-    text = (f"{len(masses)} nonlinear modes ({n}-point log grid {1e3 * lo:.4g}-{1e3 * hi:.4g} g and a bounded "
-            f"search per level, xatol {xatol:g} in log mass), {levels.size} excitation level(s)")
+    failed = tuple(m for m in masses if m in modes and (len(modes[m].modal_amplitude) < 2 or not modes[m].success))
+    tracked = tuple(m for m in masses if m not in modes)
+    text = (f"{len(masses)} masses ({n}-point log grid {1e3 * lo:.4g}-{1e3 * hi:.4g} g and a bounded search per "
+            f"level, xatol {xatol:g} in log mass), {levels.size} excitation level(s): {len(modes)} full nonlinear "
+            f"mode(s)" + (f", {len(tracked)} masses by peaks tracked from the nearest mass" if track else ""))
+    if fallbacks:
+        text += f" ({len(fallbacks)} full mode(s) where the tracking failed)"
     if failed:
         text += f"; no mode for {', '.join(f'{1e3 * m:.4g}' for m in failed)} g"
     if at_bound.any():
         text += f"; optimum at a bound of the bracket for level(s) {', '.join(f'{x:.3g}' for x in levels[at_bound])} N"
     return BackboneDesign(disk.damper.kind, masses, levels, np.array([peaks[m] for m in masses]),
                           np.array([freqs[m] for m in masses]), best_m, best_p, undamped, brackets, grid,
-                          failed, at_bound, time.perf_counter() - t0, text)
+                          failed, at_bound, tracked, tuple(sorted(fallbacks)), time.perf_counter() - t0, text)
