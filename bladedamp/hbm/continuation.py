@@ -114,10 +114,17 @@ class ConvergenceWarning(UserWarning):
 
 @dataclass
 class NewtonResult:
+    """x (n,); ``solve`` and ``dR_domega`` (n,): the factorised dR/dx (``solve(b) = J^-1 b``) and
+    dR/dOmega of the last iterate evaluated, whose residual met the tolerance (one update before
+    ``x``), for a tangent dx/dOmega = -solve(dR_domega) without another Jacobian; None if the
+    solve did not converge."""
+
     x: np.ndarray
     converged: bool
     iterations: int
     residual_norm: float
+    solve: object = None
+    dR_domega: np.ndarray | None = None
 
 
 def newton(fun, x0, omega, x_scale, residual_scale, tol=1e-10, max_iter=30, factorize=lu_factorize):
@@ -129,17 +136,18 @@ def newton(fun, x0, omega, x_scale, residual_scale, tol=1e-10, max_iter=30, fact
     x = np.array(x0, dtype=float)
     rnorm = np.inf
     for it in range(1, max_iter + 1):
-        R, J, _ = fun(x, omega)
+        R, J, Rw = fun(x, omega)
         rnorm = _norm(R) / residual_scale
         if not np.all(np.isfinite(R)):
             return NewtonResult(x, False, it, rnorm)
         try:
-            dx = -factorize(J)(R)
+            solve = factorize(J)
+            dx = -solve(R)
         except (np.linalg.LinAlgError, RuntimeError):   # singular (RuntimeError: splu)
             return NewtonResult(x, False, it, rnorm)
         x = x + dx
         if rnorm < tol and _norm(dx / x_scale) < np.sqrt(tol):
-            return NewtonResult(x, True, it, rnorm)
+            return NewtonResult(x, True, it, rnorm, solve, Rw)
     return NewtonResult(x, False, max_iter, rnorm)
 
 
