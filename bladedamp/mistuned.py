@@ -320,6 +320,14 @@ class AssemblySystem(HarmonicBalanceSystem):
     #: evaluation is cheaper than sparse assembly and LU below this size; measured at n = 320:
     #: dense with damper condensation 0.3 ms against 1.1 ms for splu)
     dense_limit = 1500
+    #: with the ring solver (:meth:`uses_ring`), systems with more unknowns than this return a
+    #: sparse Jacobian: the ring gathers its blocks from the CSC arrays, so the dense n x n
+    #: Jacobian and its bordered copy (0.8 MB each at n = 320) are only memory traffic. Measured
+    #: on the Monte Carlo's 16-blade disks (n = 320, the same 8 disks alternately, identical
+    #: peaks): 0.342 against 0.400 s CPU per disk, on a machine loaded by other processes (load
+    #: average 5), where that traffic costs most. Small assemblies (the tests' 2-6 blades, n <= 120)
+    #: stay dense
+    ring_dense_limit = 200
 
     def _damper_condensation(self, idx):
         """BlockCondensation of the damper coordinates: each damper's rows hold its own
@@ -387,6 +395,13 @@ class AssemblySystem(HarmonicBalanceSystem):
         self._ring_blades = n_blades
         return True
 
+    def uses_ring(self) -> bool:
+        """Whether :meth:`factorize` takes the ring: set up by :meth:`use_ring` and chosen by
+        :attr:`linear_solver`."""
+        solver = self.linear_solver
+        return self._ring is not None and (solver == "ring" or (solver == "auto" and
+                                                                self._ring_blades >= self.ring_min_blades))
+
     def factorize(self, A):
         """The linear solver of the continuation (:attr:`linear_solver`): the ring
         (:class:`~bladedamp.hbm.linsolve.BlockRing`, dense or sparse A) when set up by
@@ -395,7 +410,7 @@ class AssemblySystem(HarmonicBalanceSystem):
         solver = self.linear_solver
         if solver not in self._solvers:
             raise ValueError(f"linear_solver must be one of {self._solvers} (got {solver!r})")
-        if self._ring is not None and (solver == "ring" or (solver == "auto" and self._ring_blades >= self.ring_min_blades)):
+        if self.uses_ring():
             return self._ring(A)
         if solver != "lu" and self._condensation is not None and not sp.issparse(A):
             return self._condensation(A)
@@ -734,6 +749,8 @@ class MistunedDisk:
                                 None if static is None else static.tocsr())
         system.use_ring(s, nm, active)
         system.linear_solver = linear_solver
+        if system.uses_ring() and system.n_unknowns > system.ring_dense_limit:
+            system.dense = False
         return system
 
     def static_state(self, system: HarmonicBalanceSystem, omega: float) -> np.ndarray:
