@@ -323,10 +323,10 @@ class AssemblySystem(HarmonicBalanceSystem):
     #: with the ring solver (:meth:`uses_ring`), systems with more unknowns than this return a
     #: sparse Jacobian: the ring gathers its blocks from the CSC arrays, so the dense n x n
     #: Jacobian and its bordered copy (0.8 MB each at n = 320) are only memory traffic. Measured
-    #: on the Monte Carlo's 16-blade disks (n = 320, the same 8 disks alternately, identical
-    #: peaks): 0.342 against 0.400 s CPU per disk, on a machine loaded by other processes (load
-    #: average 5), where that traffic costs most. Small assemblies (the tests' 2-6 blades, n <= 120)
-    #: stay dense
+    #: on the Monte Carlo's 16-blade disks (n = 320, the same 8 disks alternately in one process,
+    #: identical peaks; the continuation's CSC bordering in one pass): 0.298 against 0.377 s CPU
+    #: per disk, on a machine loaded by other processes (load average 4-5), where that traffic
+    #: costs most. Small assemblies (the tests' 2-6 blades, n <= 120) stay dense
     ring_dense_limit = 200
 
     def _damper_condensation(self, idx):
