@@ -19,7 +19,8 @@ Run from the repository root::
    ``--compare TREE``: the same disks timed with another checkout's ``monte_carlo`` (e.g. a
    worktree of main) against this one, each in its own process (imports and numba caches warmed
    up first), alternately TREE, this, this, TREE so that a load that drifts weighs on both alike;
-   per-disk times (serial, without the harmonic error estimate) and both trees' accuracy.
+   per-disk times (serial, without the harmonic error estimate) and both trees' accuracy; then
+   both trees' Monte Carlo of the ``--disks`` disks on 1 and 2 local workers, in the same order.
 3. Monte Carlo throughput (target speed-up >= 1.7 on 2 cores): the same ``--disks`` random
    disks (2 %, seed 0) on a local Dask cluster with 1 and 2 worker processes (one thread each).
    Each cluster is started and its workers warmed up (one disk each: imports, numba caches)
@@ -167,6 +168,8 @@ def compare(tree, n_disks, seed=11):
         print(f"{name:10s} ({os.path.abspath(which)}): wall {' / '.join(f'{t:.3f}' for t in times[which])}, CPU "
               f"{' / '.join(f'{t:.3f}' for t in cpu[which])} s per disk (serial, {n_disks} disks, two runs); "
               f"largest peak within {worst:.1e} of the fine FRF")
+    same = np.abs(peaks[here].max(axis=1) / peaks[tree].max(axis=1) - 1).max()
+    print(f"the two trees' largest peaks per disk differ by at most {same:.1e} (relative)")
     ratios = {}
     for name, measure in (("wall", times), ("CPU", cpu)):
         old, new = np.mean(measure[tree]), np.mean(measure[here])
@@ -175,6 +178,52 @@ def compare(tree, n_disks, seed=11):
               f"{old / new:.2f}x less (run by run: {measure[tree][0] / measure[here][0]:.2f}, "
               f"{measure[tree][1] / measure[here][1]:.2f})")
     return ratios
+
+
+#: run in a fresh process with PYTHONPATH = the tree timed: argv (workers, disks); prints JSON
+#: with the wall time of ``monte_carlo`` on a local cluster of that many workers (started with
+#: monte_carlo's worker settings and warmed up, one disk each, before the clock starts)
+TIME_CLUSTER = '''
+import json, sys, time
+from dask.distributed import Client, LocalCluster
+from bladedamp.reference import reference_disk
+from bladedamp.studies import mistuning as mt
+if __name__ == "__main__":
+    workers, n = int(sys.argv[1]), int(sys.argv[2])
+    disk = reference_disk("cylinder", 1e-3)
+    with mt.local_worker_config():
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
+    with cluster, Client(cluster) as client:
+        mt.monte_carlo(disk, workers, seed=99, scheduler=cluster.scheduler_address, tuned_peak_amplitude=1.0)
+        t = time.perf_counter()
+        r = mt.monte_carlo(disk, n, seed=0, scheduler=cluster.scheduler_address, tuned_peak_amplitude=1.0)
+        print(json.dumps({"wall_s": time.perf_counter() - t, "amplification": r.amplification.tolist()}))
+'''
+
+
+def compare_throughput(tree, n_disks):
+    """Wall time of ``tree``'s Monte Carlo against this checkout's on 1 and 2 local workers, the
+    same ``n_disks`` disks (seed 0), each run in its own process, in the order tree, this, this,
+    tree for each worker count."""
+    here = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
+    script = os.path.join(os.environ.get("TMPDIR", "/tmp"), "bench_mistuned_cluster.py")
+    with open(script, "w") as f:
+        f.write(TIME_CLUSTER)            # a file: the workers are spawned processes that import __main__
+    for workers in (1, 2):
+        walls, amplification = {tree: [], here: []}, {}
+        for which in (tree, here, here, tree):
+            env = dict(os.environ, PYTHONPATH=os.path.abspath(which))
+            out = subprocess.run([sys.executable, script, str(workers), str(n_disks)], env=env, check=True,
+                                 capture_output=True, text=True, cwd=os.path.abspath(which)).stdout
+            result = json.loads(out.strip().splitlines()[-1])
+            walls[which].append(result["wall_s"])
+            amplification[which] = np.array(result["amplification"])
+        old, new = np.mean(walls[tree]), np.mean(walls[here])
+        same = np.abs(amplification[here] / amplification[tree] - 1).max()
+        print(f"Monte Carlo {n_disks} disks, {workers} worker(s), load {os.getloadavg()[0]:.1f}: compared "
+              f"{' / '.join(f'{t:.1f}' for t in walls[tree])} s, this tree {' / '.join(f'{t:.1f}' for t in walls[here])} s: "
+              f"{old / new:.2f}x less ({n_disks / new * 60:.0f} against {n_disks / old * 60:.0f} disks/min); "
+              f"amplifications equal to {same:.1e}")
 
 
 def throughput(n_disks):
@@ -219,6 +268,7 @@ def main(argv=None):
           f"{platform.processor() or platform.machine()}, {os.cpu_count()} CPUs, Python {platform.python_version()}")
     if args.compare:
         compare(args.compare, args.accuracy or 16)
+        compare_throughput(args.compare, args.disks)
         if args.compare_only:
             return
     cost_ratio(1 if args.quick else args.repeat)
