@@ -182,7 +182,8 @@ def compare(tree, n_disks, seed=11):
 
 #: run in a fresh process with PYTHONPATH = the tree timed: argv (workers, disks); prints JSON
 #: with the wall time of ``monte_carlo`` on a local cluster of that many workers (started with
-#: monte_carlo's worker settings and warmed up, one disk each, before the clock starts)
+#: monte_carlo's worker settings and warmed up, one disk each, before the clock starts) and the
+#: CPU time its worker processes spent meanwhile (what holds on a loaded machine)
 TIME_CLUSTER = '''
 import json, sys, time
 from dask.distributed import Client, LocalCluster
@@ -195,9 +196,12 @@ if __name__ == "__main__":
         cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
     with cluster, Client(cluster) as client:
         mt.monte_carlo(disk, workers, seed=99, scheduler=cluster.scheduler_address, tuned_peak_amplitude=1.0)
+        cpu = sum(client.run(time.process_time).values())
         t = time.perf_counter()
         r = mt.monte_carlo(disk, n, seed=0, scheduler=cluster.scheduler_address, tuned_peak_amplitude=1.0)
-        print(json.dumps({"wall_s": time.perf_counter() - t, "amplification": r.amplification.tolist()}))
+        wall = time.perf_counter() - t
+        cpu = sum(client.run(time.process_time).values()) - cpu
+        print(json.dumps({"wall_s": wall, "worker_cpu_s": cpu, "amplification": r.amplification.tolist()}))
 '''
 
 
@@ -210,20 +214,22 @@ def compare_throughput(tree, n_disks):
     with open(script, "w") as f:
         f.write(TIME_CLUSTER)            # a file: the workers are spawned processes that import __main__
     for workers in (1, 2):
-        walls, amplification = {tree: [], here: []}, {}
+        walls, cpus, amplification = {tree: [], here: []}, {tree: [], here: []}, {}
         for which in (tree, here, here, tree):
             env = dict(os.environ, PYTHONPATH=os.path.abspath(which))
             out = subprocess.run([sys.executable, script, str(workers), str(n_disks)], env=env, check=True,
                                  capture_output=True, text=True, cwd=os.path.abspath(which)).stdout
             result = json.loads(out.strip().splitlines()[-1])
             walls[which].append(result["wall_s"])
+            cpus[which].append(result["worker_cpu_s"] / n_disks)
             amplification[which] = np.array(result["amplification"])
         old, new = np.mean(walls[tree]), np.mean(walls[here])
         same = np.abs(amplification[here] / amplification[tree] - 1).max()
-        print(f"Monte Carlo {n_disks} disks, {workers} worker(s), load {os.getloadavg()[0]:.1f}: compared "
+        print(f"Monte Carlo {n_disks} disks, {workers} worker(s), load {os.getloadavg()[0]:.1f}: wall compared "
               f"{' / '.join(f'{t:.1f}' for t in walls[tree])} s, this tree {' / '.join(f'{t:.1f}' for t in walls[here])} s: "
-              f"{old / new:.2f}x less ({n_disks / new * 60:.0f} against {n_disks / old * 60:.0f} disks/min); "
-              f"amplifications equal to {same:.1e}")
+              f"{old / new:.2f}x less ({n_disks / new * 60:.0f} against {n_disks / old * 60:.0f} disks/min); workers' CPU "
+              f"per disk {np.mean(cpus[tree]):.3f} against {np.mean(cpus[here]):.3f} s: "
+              f"{np.mean(cpus[tree]) / np.mean(cpus[here]):.2f}x less; amplifications equal to {same:.1e}")
 
 
 def throughput(n_disks):

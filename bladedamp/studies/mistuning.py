@@ -442,8 +442,9 @@ def plot_cases(cases: dict[str, MistuningCase], path=None):
 #: :meth:`bladedamp.MistunedDisk.solve_peaks`), every local maximum within
 #: MONTE_CARLO_PEAK_MARGIN of the largest. Measured against fine FRFs (max_step 0.05, tol 1e-10)
 #: on random 2 % reference disks (benchmarks/bench_mistuned.py, benchmarks/README.md): the largest
-#: blade peak within 5.7e-4 relative (parabola through the coarse branch alone: 5.8e-3, 1.4e-2 on
-#: one disk); above max_step 0.4 the points do not get fewer (57-81 per disk at 0.4 and at 1.0:
+#: blade peak within 6.7e-4 relative on 16 disks (2026-12-06; the code before the shared set-up
+#: and sparse Jacobian gave the same peaks to 4e-15) (parabola through the coarse branch alone:
+#: 5.8e-3, 1.4e-2 on one disk); above max_step 0.4 the points do not get fewer (57-81 per disk at 0.4 and at 1.0:
 #: the corrector's iterations limit the step); the other blades' peaks are parabola-refined on the
 #: coarse branch (weak blades on sharp local modes up to 1.9e-1 off on 16 disks).
 MONTE_CARLO_MAX_STEP = 0.4
