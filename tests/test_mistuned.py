@@ -548,3 +548,84 @@ def test_solved_peak_on_coarse_branch_matches_fine_frf(i):
     assert abs(parabola.max() / p_fine.max() - 1) > 2e-3            # the mechanism is what makes it
     # solved peaks are maxima of the curve: never below the samples they refine
     assert np.all(peak >= coarse.tip_amplitude[:, :, 0].max(axis=0) * (1 - 1e-12))
+
+
+# ---------------------------------------------------------------------------------------
+# the Monte Carlo's shared set-up (issue 15, item 4)
+# ---------------------------------------------------------------------------------------
+def test_mistuned_copies_share_the_tuned_setup_with_the_same_residuals():
+    """MistunedDisk.mistuned: the copy's system is the source's with the blades' K and D
+    replaced (contacts, maps, Jacobian pattern and ring shared), and its residual, Jacobian and
+    dR/dOmega are bit-identical to those of the same disk built anew by from_tuned, at a stuck
+    and at a slipping state; a pickled copy builds its own system, with the same residual."""
+    import pickle
+
+    disk = reference_disk("cylinder", 1e-3)
+    assembly = MistunedDisk.from_tuned(disk)
+    kappa = mt.random_kappa(16, 0.02, seed=4)
+    copy, fresh = assembly.mistuned(kappa), MistunedDisk.from_tuned(disk, kappa)
+    assert np.array_equal([b.natural_frequencies_hz for b in copy.blades], [b.natural_frequencies_hz for b in fresh.blades])
+    shared, own = copy.hbm_system((1,)), fresh.hbm_system((1,))
+    source = assembly.hbm_system((1,))
+    assert shared.couplings[0] is source.couplings[0] and shared._pattern is source._pattern
+    assert shared._ring is source._ring and shared.mass is source.mass
+    assert own.couplings[0] is not source.couplings[0]
+    w = 2 * np.pi * 95.0
+    x = fresh.initial_guess(own, w)
+    unpickled = pickle.loads(pickle.dumps(copy)).hbm_system((1,))
+    assert unpickled.couplings[0] is not source.couplings[0]
+    for state in (x, 3 * x):                       # stuck, and slipping with lift-off
+        for system in (shared, unpickled):
+            for a, b in zip(system.residual(state, w), own.residual(state, w)):
+                a, b = (m.toarray() if hasattr(m, "toarray") else m for m in (a, b))
+                assert np.array_equal(a, b)
+    assert not np.array_equal(shared.residual(x, w)[0], source.residual(x, w)[0])     # the blades differ
+    with pytest.raises(ValueError, match="entries"):
+        assembly.mistuned(kappa[:3])
+    damping, stiffness = copy.blade_matrices()
+    with pytest.raises(ValueError, match="sparsity"):
+        source.with_linear_parts(damping, stiffness + stiffness.T @ stiffness[:, ::-1])
+
+
+def test_dampers_of_one_kind_evaluate_their_static_approach_once():
+    """The same damper at every position shares one approach function (one evaluation per
+    residual instead of one per damper); contact mistuning (each damper its own mass) keeps
+    one per damper. Either way the approaches are those of each damper's own function."""
+    td = tuned(4)
+    same = MistunedDisk.from_tuned(td, [1.0, 1.01, 0.99, 1.0])
+    dampers = [dataclasses.replace(td.damper, mass=m) for m in (0.5e-3, 1e-3, 2e-3, 1e-3)]
+    own = MistunedDisk.from_tuned(td, [1.0, 1.01, 0.99, 1.0], dampers=dampers)
+    w = 2 * np.pi * 95.0
+    for md, functions in ((same, 1), (own, 4)):
+        element = md.hbm_system((1,)).couplings[0].element
+        assert len({id(c.approach) for c in element.contacts}) == functions
+        offsets, doffsets = element._approach(w)
+        assert np.array_equal(offsets, np.array([c.approach(w)[0] for c in element.contacts]))
+        assert np.array_equal(doffsets, np.array([c.approach(w)[1] for c in element.contacts]))
+
+
+def test_sixteen_blades_take_the_sparse_jacobian_and_the_ring_solves_it_as_the_dense():
+    """Above AssemblySystem.ring_dense_limit unknowns the ring's systems return a sparse
+    Jacobian: the same entries as the dense assembly, and the ring's solution of its bordered
+    matrix (the continuation's, bordered in CSC) equal to that of the dense one to 1e-12."""
+    from bladedamp.hbm.continuation import _bordered
+
+    md = MistunedDisk.from_tuned(reference_disk("cylinder", 1e-3), mt.random_kappa(16, 0.02, seed=5))
+    system = md.hbm_system((1,))
+    assert system.uses_ring() and system.n_unknowns > system.ring_dense_limit and not system.dense
+    assert md.hbm_system((1,), linear_solver="condensation").dense      # condensation: dense below dense_limit
+    w = 2 * np.pi * 95.0
+    x = 3 * md.initial_guess(system, w)
+    R, J, Rw = system.residual(x, w)
+    system.dense = True
+    try:
+        R_d, J_d, Rw_d = system.residual(x, w)
+    finally:
+        system.dense = False
+    assert np.array_equal(R, R_d) and np.array_equal(Rw, Rw_d) and np.array_equal(J.toarray(), J_d)
+    rng = np.random.default_rng(0)
+    row, scale, b = rng.standard_normal(J_d.shape[0] + 1), rng.uniform(0.5, 2, J_d.shape[0]), rng.standard_normal(J_d.shape[0] + 1)
+    A, A_d = _bordered(J, Rw, row, scale, 0.3), _bordered(J_d, Rw, row, scale, 0.3)
+    assert np.array_equal(A.toarray(), A_d)
+    y, y_d = system.factorize(A)(b), system.factorize(A_d)(b)
+    assert np.abs(y - y_d).max() <= 1e-12 * np.abs(y_d).max()

@@ -139,3 +139,32 @@ def test_peak_search_solves_on_the_system_with_the_users_elements():
     exact = minimize_scalar(lambda f: -tip(f), bounds=(f_peak - 0.5, f_peak + 0.5), method="bounded",
                             options={"xatol": 1e-10})
     assert abs(peak / tip(exact.x) - 1) < 1e-8 and abs(f_peak - exact.x) < 1e-5
+
+
+def test_newton_returns_the_factorisation_of_its_last_iterate():
+    """newton's ``solve`` and ``dR_domega`` (what the peak solver's tangents now use instead of a
+    new Jacobian): -solve(dR_domega) is the tangent dx/dOmega at the solution, equal to that of a
+    fresh Jacobian there to 1e-8 (the last iterate met the tolerance), and to central differences."""
+    from bladedamp.hbm.continuation import newton
+
+    disk = reference_disk("cylinder", 1e-3)
+    system = disk.hbm_system((1,))
+    w = 2 * np.pi * 96.0                # slipping: 4 iterations from the stuck linear solution
+    x0 = disk.initial_guess(system, w)
+    scale = np.maximum(np.abs(x0), 1e-3 * np.abs(x0).max())
+    residual_scale = np.linalg.norm(system.excitation(w)[0])
+    r = newton(system.residual, x0, w, scale, residual_scale, tol=1e-10, factorize=system.factorize)
+    assert r.converged and r.iterations > 2 and r.solve is not None
+    tangent = -r.solve(r.dR_domega)
+    _, J, Rw = system.residual(r.x, w)
+    fresh = -system.factorize(J)(Rw)
+    assert np.abs(tangent - fresh).max() <= 1e-8 * np.abs(fresh).max()
+    h = 1e-6 * w
+    plus, minus = (newton(system.residual, r.x, w + s, scale, residual_scale, tol=1e-12, max_iter=40,
+                          factorize=system.factorize) for s in (h, -h))
+    assert plus.converged and minus.converged
+    difference = (plus.x - minus.x) / (2 * h)
+    assert np.abs(tangent - difference).max() <= 1e-4 * np.abs(difference).max()
+    failed = newton(system.residual, 3 * r.x, w, scale, residual_scale, tol=1e-10, max_iter=1,
+                    factorize=system.factorize)
+    assert not failed.converged and failed.solve is None

@@ -140,7 +140,8 @@ def mistuned_response(disk: TunedDisk, kappa, f_range_hz=None, harmonics=(1,), m
                       tuned_peak_amplitude: float | None = None, max_widenings: int = 3, n_sector: int | None = None,
                       n_samples: int | None = None, tol: float = 1e-10,
                       estimate_harmonic_error: bool = True, chord: bool = False,
-                      target_iterations: int = 5, range_margin: float = 0.03) -> MistunedResponse:
+                      target_iterations: int = 5, range_margin: float = 0.03,
+                      assembly: MistunedDisk | None = None) -> MistunedResponse:
     """Full-assembly response of ``disk`` with blade frequencies times ``kappa``; while some
     blade's largest amplitude is at an end of the range (default :func:`auto_range`), the branch
     is continued beyond that end by half the range's width (:meth:`MistunedDisk.extend_response`);
@@ -153,8 +154,14 @@ def mistuned_response(disk: TunedDisk, kappa, f_range_hz=None, harmonics=(1,), m
     continuation tolerance (defaults: the model's and the continuation's);
     ``estimate_harmonic_error``: as :meth:`MistunedDisk.frequency_response`. ``chord``,
     ``target_iterations``: the continuation's corrector (:func:`bladedamp.hbm.continuation.continuation`).
+    ``assembly``: None, or ``disk``'s tuned model ``MistunedDisk.from_tuned(disk, n_sector=n_sector)``
+    built once, whose harmonic-balance set-up the mistuned disk then shares
+    (:meth:`MistunedDisk.mistuned`, the same residuals; :func:`monte_carlo` passes one for all its disks).
     Raises RuntimeError if the continuation does not cover the range."""
-    md = MistunedDisk.from_tuned(disk, kappa, n_sector=n_sector)
+    if assembly is None:
+        md = MistunedDisk.from_tuned(disk, kappa, n_sector=n_sector)
+    else:
+        md = assembly.mistuned(kappa)
     if f_range_hz is None:
         f_range_hz = auto_range(disk, kappa, range_margin)
     lo, hi = (float(f) for f in f_range_hz)
@@ -435,8 +442,9 @@ def plot_cases(cases: dict[str, MistuningCase], path=None):
 #: :meth:`bladedamp.MistunedDisk.solve_peaks`), every local maximum within
 #: MONTE_CARLO_PEAK_MARGIN of the largest. Measured against fine FRFs (max_step 0.05, tol 1e-10)
 #: on random 2 % reference disks (benchmarks/bench_mistuned.py, benchmarks/README.md): the largest
-#: blade peak within 5.7e-4 relative (parabola through the coarse branch alone: 5.8e-3, 1.4e-2 on
-#: one disk); above max_step 0.4 the points do not get fewer (57-81 per disk at 0.4 and at 1.0:
+#: blade peak within 6.7e-4 relative on 16 disks (2026-12-06; the code before the shared set-up
+#: and sparse Jacobian gave the same peaks to 4e-15) (parabola through the coarse branch alone:
+#: 5.8e-3, 1.4e-2 on one disk); above max_step 0.4 the points do not get fewer (57-81 per disk at 0.4 and at 1.0:
 #: the corrector's iterations limit the step); the other blades' peaks are parabola-refined on the
 #: coarse branch (weak blades on sharp local modes up to 1.9e-1 off on 16 disks).
 MONTE_CARLO_MAX_STEP = 0.4
@@ -458,14 +466,16 @@ MONTE_CARLO_TARGET_ITERATIONS = 10
 MONTE_CARLO_RANGE_MARGIN = 0.01
 
 
-def _one_disk(disk, kappa, f_range_hz, settings):
+def _one_disk(disk, assembly, kappa, f_range_hz, settings):
     """Peaks (n,) and their frequencies (n,) of one mistuned disk, the failure's message ('' if
     none) and the harmonic error estimate (NaN if not estimated) (runs on a worker). ``settings``:
-    :func:`mistuned_response`'s options, and ``solve_within`` for :meth:`MistunedResponse.peaks`."""
+    :func:`mistuned_response`'s options, and ``solve_within`` for :meth:`MistunedResponse.peaks`;
+    ``assembly``: ``disk``'s tuned full assembly, shared by every disk of the worker (its set-up
+    is built on the worker's first disk, :meth:`MistunedDisk.mistuned`)."""
     options = dict(settings)
     solve_within = options.pop("solve_within", None)
     try:
-        r = mistuned_response(disk, kappa, f_range_hz, **options)
+        r = mistuned_response(disk, kappa, f_range_hz, assembly=assembly, **options)
         p, f = r.peaks(solve_within=solve_within)
         return p, f, "", float(r.harmonic_error)
     except RuntimeError as e:  # keep the study going; the failure is recorded
@@ -631,9 +641,12 @@ def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f
         tuned_peak_amplitude = tuned_peak(disk, f_range_hz or auto_range(disk, [1.0], 0.05), harmonics)[0]
     results = [None] * n_disks
     used = "serial"
+    # the tuned full assembly, whose harmonic-balance set-up every disk shares (built once per
+    # process: measured 33 ms of a disk's ~0.4 s when each disk built its own)
+    assembly = MistunedDisk.from_tuned(disk)
     if scheduler == "serial":
         for i, k in enumerate(kappas):
-            results[i] = _one_disk(disk, k, f_range_hz, _disk_settings(settings, i))
+            results[i] = _one_disk(disk, assembly, k, f_range_hz, _disk_settings(settings, i))
             if progress:
                 progress(i + 1, n_disks)
     else:
@@ -651,8 +664,11 @@ def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f
             client = Client(scheduler)
             used = f"scheduler {scheduler}"
         try:
-            disk_future = client.scatter(disk, broadcast=True)
-            futures = [client.submit(_one_disk, disk_future, k, f_range_hz, _disk_settings(settings, i), pure=False)
+            # scattered once: each worker keeps one copy of the assembly for all its disks, and
+            # builds its set-up on its first disk (the systems are not pickled)
+            disk_future, assembly_future = client.scatter([disk, assembly], broadcast=True)
+            futures = [client.submit(_one_disk, disk_future, assembly_future, k, f_range_hz,
+                                     _disk_settings(settings, i), pure=False)
                        for i, k in enumerate(kappas)]
             index = {f.key: i for i, f in enumerate(futures)}
             for done, fut in enumerate(as_completed(futures), 1):
