@@ -649,12 +649,12 @@ class TunedDisk:
         ``check_stop``: where the branch ends before the end of the range (not by ``stop_above``),
         integrate the full assembly in time just beyond where it got furthest (:meth:`stop_check`;
         at ``f_start_hz`` when no point was kept) and put the verdict in the result (its
-        ``stop_check`` and message, :func:`stop_verdict`): either no periodic motion exists there
-        (the damper hops on the platforms or keeps rolling, so no harmonic-balance branch can go on,
-        and the time integration's amplitude is the answer there) or one does, which the harmonic
-        set lost. One time integration (30-210 s for the reference disk on 2 cores), and only for
-        a branch that failed; rigid platforms and no ``extra_couplings`` (what ``time_response``
-        models).
+        ``stop_check`` and message, :func:`stop_verdict`): either the motion reached from the static
+        equilibrium there is not periodic (the damper hops on the platforms or keeps rolling: no
+        harmonic-balance branch represents it, and the time integration's amplitude is the answer
+        there) or it is periodic, and the branch did not reach it. One time integration (20-230 s
+        for 16 blades on 2 cores), and only for a branch that stopped before the end of its range;
+        rigid platforms and no ``extra_couplings`` (what ``time_response`` models).
         """
         validation.positive("f_start_hz", f_start_hz)
         validation.positive("f_end_hz", f_end_hz)
@@ -705,8 +705,7 @@ class TunedDisk:
 
         response = converged_response(model, solve, harmonics, harmonic_tolerance, max_harmonic,
                                       estimate=estimate_harmonic_error)
-        stopped_early = not (response.stopped_by or (response.success if response.reached_end is None
-                                                      else response.reached_end))
+        stopped_early = not (response.stopped_by or response.reached_range_end)
         check = self.stop_check(response, f_start_hz=f_start_hz) if check_stop and stopped_early else None
         return with_stop_note(response, f_start_hz, check)
 
@@ -846,9 +845,10 @@ class TunedDisk:
         :meth:`frequency_response`) got furthest: :meth:`time_response` at that frequency plus
         ``offset_hz`` [Hz] in the branch's direction (``options`` go to it); for a response that
         kept no point, at ``f_start_hz`` [Hz], where its branch was to start. Its ``periodic``
-        and ``status`` answer: "not settled" or "drifting" (the damper hops on the platforms or
-        keeps rolling) mean that no periodic response, so no harmonic-balance branch, exists
-        there; "periodic" means the branch lost a solution that exists (:func:`stop_verdict`).
+        and ``status`` answer for the motion reached from the static equilibrium: "not settled" or
+        "drifting" (the damper hops on the platforms or keeps rolling): not periodic, which no
+        harmonic-balance branch represents; "periodic": the branch did not reach a periodic motion
+        that exists (:func:`stop_verdict`).
         Costs one time integration of the full assembly (30-210 s for the reference disk on 2
         cores)."""
         validation.positive("offset_hz", offset_hz)
@@ -877,8 +877,8 @@ def stop_verdict(check, harmonics) -> str:
     separated = 100 * check.point_state[0][..., 2].mean()
     if check.periodic[0]:
         return (f"the time integration of the full assembly at {f:.4f} Hz (from the static equilibrium) settles on a "
-                f"periodic motion (largest tip "
-                f"amplitude {tip:.4g} mm, the damper's contact points separated {separated:.0f} % of the period): "
+                f"periodic motion (largest tip amplitude {tip:.4g} mm, the damper's contact points separated "
+                f"{separated:.0f} % of the period): "
                 f"one exists there, which the branch with harmonics {tuple(harmonics)} did not reach (more points, "
                 "max_points, or a richer set, harmonics='auto', may follow it; with the damper separated most of the "
                 "period, brief impacts, only a richer set can)")

@@ -175,9 +175,8 @@ def with_checks(response, failed: dict):
     if not failed:
         return response
     message = response.message + "; failed checks: " + "; ".join(f"{k}: {v}" for k, v in failed.items())
-    reached = response.success if response.reached_end is None else response.reached_end
     return dataclasses.replace(response, success=False, message=message, failed_checks=dict(failed),
-                               reached_end=bool(reached))
+                               reached_end=response.reached_range_end)
 
 
 def plot_branch(ax, x, y, stable=None, **kwargs):
@@ -252,6 +251,12 @@ class FrequencyResponse(Saveable):
     bifurcations: dict = field(default_factory=dict)
     stability_method: str = ""
     stopped_by: str = ""
+
+    @property
+    def reached_range_end(self) -> bool:
+        """Whether the continuation reached the end of the range (``reached_end``, or ``success``
+        where no physical check failed)."""
+        return bool(self.success if self.reached_end is None else self.reached_end)
 
     def reversed(self):
         """The same branch in the opposite order (a downward sweep as rising frequency): every
