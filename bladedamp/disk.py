@@ -32,7 +32,8 @@ from . import validation
 from .blade import ModalBlade
 from .contact.laws import LinearNormalLaw
 from .contact.patch import dof_jacobian
-from .contact.point import PointContactSamples, damper_contact_forces, normal_law_parameters, point_contact_forces
+from .contact.point import (MAX_PASSES, PERIODIC_TOL, PointContactSamples, damper_contact_forces, normal_law_parameters,
+                            point_contact_forces)
 from .damper.geometry import CylinderDamper, DamperGeometry, WedgeDamper
 from .damper.kinetics import centrifugal_force, seat
 from .hbm.accuracy import HARMONIC_TOLERANCE, converged_response
@@ -160,11 +161,6 @@ def point_map_forces(B, local, basis, k_t, mu, law, weights, offsets, jacobian, 
     return force, blocks, pts
 
 
-#: return map of the point contacts: passes and tolerance (point_contact_forces' defaults)
-RETURN_MAP_PASSES = 20
-RETURN_MAP_TOL = 1e-10
-
-
 def fused_point_map_forces(B, local, basis, k_t, mu, law, weights, offsets, jacobian):
     """:func:`point_map_forces` of rigid platforms (m = 6) through the fused kernel
     :func:`~bladedamp.contact.point.damper_contact_forces` (one numba call: point motion, normal
@@ -185,7 +181,7 @@ def fused_point_map_forces(B, local, basis, k_t, mu, law, weights, offsets, jaco
     damper_contact_forces(np.ascontiguousarray(B, dtype=float), np.ascontiguousarray(local, dtype=float),
                           basis.synthesis, basis.analysis, k_t, mu, weights,
                           np.ascontiguousarray(offsets, dtype=float).ravel(), params[0], params[1], static_index,
-                          RETURN_MAP_PASSES, RETURN_MAP_TOL, jacobian, force, blocks)
+                          MAX_PASSES, PERIODIC_TOL, jacobian, force, blocks)
     return force, blocks if jacobian else None
 
 

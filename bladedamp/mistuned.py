@@ -52,8 +52,9 @@ import scipy.sparse as sp
 from . import validation
 from .blade import ModalBlade
 from .contact.laws import LinearNormalLaw
+from .contact.point import MAX_PASSES, PERIODIC_TOL
 from .damper.kinetics import seat
-from .disk import (AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION, DAMPER_DOFS, RETURN_MAP_PASSES, RETURN_MAP_TOL,
+from .disk import (AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION, DAMPER_DOFS,
                    DamperContacts, TunedDisk, contact_point_maps, contact_rows, damper_weighted_scales,
                    fused_point_map_forces, point_map_forces, rotor_speed_in_hz)
 from .hbm.accuracy import HARMONIC_TOLERANCE, converged_response
@@ -178,7 +179,7 @@ class AssemblyContacts:
         _, B, k_t, mu, weights, law = stack                      # B (n_d, 2, P, 3, m)
         m = B.shape[-1]
         force, q_blocks, _ = point_map_forces(B, local.reshape(C, nd, 2, m), basis, k_t, mu, law, weights, offsets,
-                                              jacobian, max_passes=RETURN_MAP_PASSES, tol=RETURN_MAP_TOL)
+                                              jacobian, max_passes=MAX_PASSES, tol=PERIODIC_TOL)
         force = force.reshape(C, nd, L)
         if not jacobian:
             return force, None
