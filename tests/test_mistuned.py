@@ -644,6 +644,35 @@ def test_residual_kernels_give_the_numbers_of_the_scipy_operations(harmonics):
             assert np.array_equal(system.residual(x, w, False)[0], scipy_residual(system, x, w, False)[0])
 
 
+def test_euler_rate_is_the_numpy_formula_to_rounding():
+    """AssemblyContacts.evaluate's d force / d omega by Euler's identity (one numba call,
+    mistuned._euler_rate) equals the numpy formula it replaced, kappa_d = doffsets_d . offsets_d
+    / |offsets_d|^2 and (force - J local) kappa, to 1e-12 of its largest entry at a stuck and a
+    slipping state; an approach rate that is not homogeneous (one entry moved) is refused,
+    domega left as it was, and evaluate takes the central difference there."""
+    from bladedamp.mistuned import _euler_rate
+
+    md = MistunedDisk.from_tuned(reference_disk("cylinder", 1e-3), mt.random_kappa(16, 0.02, seed=5))
+    system = md.hbm_system((1,))
+    element, C = system.couplings[0].element, system.basis.n_coeffs
+    w = 2 * np.pi * 95.0
+    x0 = md.initial_guess(system, w)
+    for x in (x0, 3 * x0):
+        local = (system._contact[0] @ x).reshape(C, element.n_dampers, element.damper_local)
+        offsets, doffsets = element._approach(w)
+        force, blocks = element._forces(local, system.basis, offsets, True)
+        norms = np.einsum("dqp,dqp->d", offsets, offsets)
+        kappa = np.where(norms > 0, np.einsum("dqp,dqp->d", doffsets, offsets) / np.where(norms > 0, norms, 1), 0.0)
+        expected = (force - np.einsum("dambn,bdn->adm", blocks, local)) * kappa[None, :, None]
+        _, _, domega = element.evaluate(local, system.basis, w, True)
+        assert np.abs(domega - expected).max() <= 1e-12 * np.abs(expected).max()
+        skewed = doffsets.copy()
+        skewed[3, 1, 2] *= 1.001
+        out = np.full(force.shape, 7.0)
+        assert not _euler_rate(offsets, skewed, blocks, local, force, out) and np.all(out == 7.0)
+        assert _euler_rate(offsets, doffsets, blocks, local, force, out) and np.array_equal(out, domega)
+
+
 def test_dampers_of_one_kind_evaluate_their_static_approach_once():
     """The same damper at every position shares one approach function (one evaluation per
     residual instead of one per damper); contact mistuning (each damper its own mass) keeps
