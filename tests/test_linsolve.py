@@ -10,7 +10,7 @@ import scipy.linalg
 import scipy.sparse as sp
 
 from bladedamp import FrictionOscillator
-from bladedamp.hbm.continuation import _border
+from bladedamp.hbm.continuation import _border, _bordered, _scale_columns
 from bladedamp.hbm.linsolve import BlockCondensation, factorize
 from bladedamp.mistuned import MistunedDisk
 from bladedamp.reference import reference_disk
@@ -121,3 +121,30 @@ def test_condensation_on_mistuned_jacobians(kind, harmonics):
         y, y_lu = system.factorize(M)(b), factorize(M)(b)
         err = np.abs(y - y_lu).max() / np.abs(y_lu).max()
         assert err < 1e-10, f"condensation differs from LU by {err:.2e}"
+
+
+def test_bordered_forms_the_indices_once_per_pattern():
+    """The continuation's bordered matrix [[J diag(s), column] factor; row] of a sparse J: the
+    entries of _border(_scale_columns(J)) (scaled the same way), its index arrays formed once
+    for J's pattern and shared by the next bordered matrix of a Jacobian with the same index
+    arrays (the assembly's Jacobians share theirs); another pattern is bordered anew."""
+    rng = np.random.default_rng(3)
+    n = 40
+    J = sp.random(n, n, density=0.2, format="csc", random_state=rng) + sp.identity(n, format="csc")
+    J2 = J.copy()
+    J2.indices, J2.indptr = J.indices, J.indptr            # another Jacobian with the same index arrays
+    J2.data = rng.standard_normal(J.nnz)
+    other = sp.random(n, n, density=0.1, format="csc", random_state=rng) + sp.identity(n, format="csc")
+    factor = 0.3
+    previous = None
+    for M in (J, J2, other):
+        column, row, scale = rng.standard_normal(n), rng.standard_normal(n + 1), rng.uniform(0.5, 2, n)
+        A = _bordered(M, column, row, scale, factor)
+        B = _border(_scale_columns(M, scale * factor), column * factor, row)
+        assert A.shape == (n + 1, n + 1) and np.array_equal(A.toarray(), B.toarray())
+        assert np.array_equal(A.indices, B.indices) and np.array_equal(A.indptr, B.indptr)
+        if M is J2:
+            assert A.indices is previous.indices and A.indptr is previous.indptr
+        if M is other:
+            assert A.indices is not previous.indices
+        previous = A

@@ -587,6 +587,92 @@ def test_mistuned_copies_share_the_tuned_setup_with_the_same_residuals():
         source.with_linear_parts(damping, stiffness + stiffness.T @ stiffness[:, ::-1])
 
 
+def scipy_residual(system, x, omega, jacobian=True):
+    """AssemblySystem.residual written out with scipy / numpy operations (the code its numba
+    kernels replaced): R, the Jacobian (sparse or dense as the system's) and dR/domega."""
+    import scipy.sparse as sp
+
+    C = system.basis.n_coeffs
+    K0, M2, G = system._sparse_parts
+    f, df = system.excitation(omega)
+    m2x, gx = M2 @ x, G @ x
+    R = K0 @ x - omega ** 2 * m2x + omega * gx - f
+    Rw = -2 * omega * m2x + gx - df if jacobian else None
+    values = [system._lin[0].data, -omega ** 2 * system._lin[1].data, omega * system._lin[2].data]
+    T, TT, Tb, TbT, _ = system._contact
+    element = system.couplings[0].element
+    force, blocks, domega = element.evaluate((T @ x).reshape(C, element.n_local), system.basis, omega, jacobian)
+    R += TT @ force.ravel()
+    if jacobian:
+        values.append(np.matmul(TbT, np.matmul(blocks, Tb)).ravel())
+        if domega is not None:
+            Rw += TT @ domega.ravel()
+    if not jacobian:
+        return R, None, None
+    inverse, indices, indptr, nnz = system._pattern
+    data = np.bincount(inverse, weights=np.concatenate(values), minlength=nnz)
+    n = x.size
+    if system.dense:
+        J = np.zeros(n * n)
+        J[system._dense_index] = data
+        return R, J.reshape(n, n), Rw
+    return R, sp.csc_matrix((data, indices, indptr), shape=(n, n)), Rw
+
+
+@pytest.mark.parametrize("harmonics", [(1,), (0, 1)], ids=["h1", "h01"])
+def test_residual_kernels_give_the_numbers_of_the_scipy_operations(harmonics):
+    """AssemblySystem.residual forms its linear part (K_0, M_2, G), the contact map's products
+    (T x, T^T f, T^T df/domega) and the Jacobian's values in numba kernels, in the order of the
+    scipy / numpy operations they replaced: R, the Jacobian and dR/dOmega are bit-identical to
+    those (scipy_residual), with and without the Jacobian, at a stuck and a slipping state, on
+    the 16-blade disk (sparse Jacobian) and a 4-blade one (dense). The sparse Jacobians share
+    the system's index arrays (copies of one template matrix, not checked anew each time)."""
+    for md in (MistunedDisk.from_tuned(reference_disk("cylinder", 1e-3), mt.random_kappa(16, 0.02, seed=5)),
+               MistunedDisk.from_tuned(tuned(4), [1.0, 1.01, 0.99, 1.0])):
+        system = md.hbm_system(harmonics)
+        w = 2 * np.pi * 95.0
+        x0 = md.initial_guess(system, w)
+        for x in (x0, 3 * x0):                    # stuck, and slipping with lift-off
+            got, ref = system.residual(x, w), scipy_residual(system, x, w)
+            assert got[2] is not None and np.abs(got[2]).max() > 0
+            for a, b in zip(got, ref):
+                if hasattr(a, "toarray"):
+                    assert a.indices is system._jacobian_template.indices and a.indptr is system._jacobian_template.indptr
+                    assert np.array_equal(a.indices, b.indices) and np.array_equal(a.indptr, b.indptr)
+                    a, b = a.data, b.data
+                assert np.array_equal(a, b)
+            assert np.array_equal(system.residual(x, w, False)[0], scipy_residual(system, x, w, False)[0])
+
+
+def test_euler_rate_is_the_numpy_formula_to_rounding():
+    """AssemblyContacts.evaluate's d force / d omega by Euler's identity (one numba call,
+    mistuned._euler_rate) equals the numpy formula it replaced, kappa_d = doffsets_d . offsets_d
+    / |offsets_d|^2 and (force - J local) kappa, to 1e-12 of its largest entry at a stuck and a
+    slipping state; an approach rate that is not homogeneous (one entry moved) is refused,
+    domega left as it was, and evaluate takes the central difference there."""
+    from bladedamp.mistuned import _euler_rate
+
+    md = MistunedDisk.from_tuned(reference_disk("cylinder", 1e-3), mt.random_kappa(16, 0.02, seed=5))
+    system = md.hbm_system((1,))
+    element, C = system.couplings[0].element, system.basis.n_coeffs
+    w = 2 * np.pi * 95.0
+    x0 = md.initial_guess(system, w)
+    for x in (x0, 3 * x0):
+        local = (system._contact[0] @ x).reshape(C, element.n_dampers, element.damper_local)
+        offsets, doffsets = element._approach(w)
+        force, blocks = element._forces(local, system.basis, offsets, True)
+        norms = np.einsum("dqp,dqp->d", offsets, offsets)
+        kappa = np.where(norms > 0, np.einsum("dqp,dqp->d", doffsets, offsets) / np.where(norms > 0, norms, 1), 0.0)
+        expected = (force - np.einsum("dambn,bdn->adm", blocks, local)) * kappa[None, :, None]
+        _, _, domega = element.evaluate(local, system.basis, w, True)
+        assert np.abs(domega - expected).max() <= 1e-12 * np.abs(expected).max()
+        skewed = doffsets.copy()
+        skewed[3, 1, 2] *= 1.001
+        out = np.full(force.shape, 7.0)
+        assert not _euler_rate(offsets, skewed, blocks, local, force, out) and np.all(out == 7.0)
+        assert _euler_rate(offsets, doffsets, blocks, local, force, out) and np.array_equal(out, domega)
+
+
 def test_dampers_of_one_kind_evaluate_their_static_approach_once():
     """The same damper at every position shares one approach function (one evaluation per
     residual instead of one per damper); contact mistuning (each damper its own mass) keeps

@@ -369,13 +369,15 @@ def _iterate_passes(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s0,
 
 @njit(cache=True)
 def _point_return_map(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s0, s1, static_index, max_passes, tol,
-                      want_jac, f_out, df_out, state_out, ds, ds_begin, transfer, closed_form):
+                      want_jac, f_out, df_out, state_out, ds, ds_begin, transfer, closed_form, stuck_rows):
     """Periodic return map of one point (see :func:`_return_map`).
 
     ut (T,2); normal, dnormal (T,); s0, s1 the initial slider position; outputs f_out (T,>=2),
     df_out (T,>=2,3C) (rows 0, 1 written; untouched without the Jacobian), state_out (T,);
     ds, ds_begin: (2,3C) and transfer: (T,4) work arrays. Returns (slip work, passes without
-    the derivative, passes with it).
+    the derivative, passes with it). ``stuck_rows`` False: when the last pass neither slips nor
+    separates, df_out is left unwritten (its rows would all be -k_T ds + k_T E_t, ds the constant
+    slider derivative left in ``ds``: :func:`point_harmonics` forms their AFT from ds).
 
     Slider: the period is repeated until the slider position at its end repeats (to ``tol``
     of mu max N / k_T, at least two passes) or a pass neither slips nor separates, at most
@@ -449,6 +451,8 @@ def _point_return_map(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s
                 s0, s1, moved, work, _, _ = _derivative_pass(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s0, s1, f_out,
                                                              df_out, state_out, ds, transfer, np.bool_(False))
             s0, s1, moved, work = _slider_pass(ut, normal, seat, kt, mu, s0, s1, f_out, state_out)
+        if not stuck_rows:
+            return work, passes + (1 if passes > 1 else 0), passes - 1
         ds0 = ds[0]
         ds1 = ds[1]
         for t in range(T):
@@ -543,7 +547,7 @@ def _return_map(ut, normal, dnormal, seat, seat_rate, synthesis, k_t, mu, s_star
                                               k_t[p], mu[p],
                                               s_start[p, 0], s_start[p, 1], static_index, max_passes, tol,
                                               want_jac, f_out[p], dfp, state_out[p], ds, ds_begin, transfer,
-                                              closed_form)
+                                              closed_form, np.bool_(True))
         slip_work[p] = w
         passes[p, 0] = n_plain
         passes[p, 1] = n_jac
@@ -565,15 +569,25 @@ def normal_law_parameters(law):
 
 
 @njit(cache=True)
-def point_work(T, C):
-    """Work arrays of :func:`point_harmonics` for T samples and C coefficients (allocated once
-    per kernel call, reused for every point)."""
+def point_work(synthesis, analysis):
+    """Work arrays of :func:`point_harmonics` for the synthesis (T, C) and analysis (C, T) of a
+    basis (allocated once per kernel call, reused for every point), and the basis's column sums
+    of the analysis, sum_t analysis[a, t] (C,), and its Gram matrix
+    sum_t analysis[a, t] synthesis[t, b] (C, C) (the Jacobian of a point stuck all period)."""
+    T, C = synthesis.shape[0], synthesis.shape[1]
     n3 = 3 * C
     n3p = (n3 + 3) // 4 * 4          # padded to whole SIMD vectors
     df = np.zeros((T, 2, n3p))       # d f_tangential / d c of the last pass; padding stays 0
+    analysis_sums = np.zeros(C)
+    gram = np.zeros((C, C))
+    for a in range(C):
+        for t in range(T):
+            analysis_sums[a] += analysis[a, t]
+            for b in range(C):
+                gram[a, b] += analysis[a, t] * synthesis[t, b]
     return (np.empty((T, 2)), np.empty(T), np.empty(T), np.empty(T), np.empty((1, T)), np.empty((1, T)),
             np.empty((1, T)), np.empty((T, 2)), df, df.reshape((T, 2 * n3p)), np.empty(T, dtype=np.int8),
-            np.zeros((2, n3)), np.zeros((2, n3)), np.zeros((T, 4)))
+            np.zeros((2, n3)), np.zeros((2, n3)), np.zeros((T, 4)), analysis_sums, gram)
 
 
 @njit(cache=True)
@@ -592,7 +606,8 @@ def point_harmonics(c, synthesis, analysis, kt, mu, w, off, law_kind, law_params
     i = 0, 1 (n3p: 3C rounded up to a multiple of 4, ``work[8].shape[2]``), and
     jn (C, C) = d fc[a, 2] / d c[b, 2] [N/m], the normal row (its xi and eta columns are zero).
     """
-    ut, uz, normal, dnormal, approach, seats, seat_rates, f_t, df, df_flat, state, ds, ds_begin, transfer = work
+    (ut, uz, normal, dnormal, approach, seats, seat_rates, f_t, df, df_flat, state, ds, ds_begin, transfer,
+     analysis_sums, gram) = work
     T, C = synthesis.shape[0], synthesis.shape[1]
     n3p = df.shape[2]
     seat = seats[0]
@@ -637,7 +652,7 @@ def point_harmonics(c, synthesis, analysis, kt, mu, w, off, law_kind, law_params
         s0 = 0.0
         s1 = 0.0
     _point_return_map(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s0, s1, static_index,
-                      max_passes, tol, want_jac, f_t, df, state, ds, ds_begin, transfer, closed_form)
+                      max_passes, tol, want_jac, f_t, df, state, ds, ds_begin, transfer, closed_form, np.bool_(False))
     # force coefficients of the point (normal force -N)
     for a in range(C):
         a0 = 0.0
@@ -653,10 +668,21 @@ def point_harmonics(c, synthesis, analysis, kt, mu, w, off, law_kind, law_params
         fc[a, 2] = a2
     if not want_jac:
         return
+    _point_jacobian(synthesis, analysis, kt, dnormal, state, df_flat, ds, analysis_sums, gram, jt, jn)
+
+
+@njit(cache=True)
+def _point_jacobian(synthesis, analysis, kt, dnormal, state, df_flat, ds, analysis_sums, gram, jt, jn):
+    """The AFT of a point's Jacobian (the last step of :func:`point_harmonics`; jt, jn, kt,
+    synthesis, analysis as there): from the return map's states (T,), dN/du_zeta (T,) [N/m],
+    df_flat (T, 2 n3p) (d f_tangential / d c per sample) or, for a point stuck all the last
+    pass, its constant slider derivative ds (2, 3C) and the basis's analysis_sums (C,) and
+    gram (C, C) (:func:`point_work`)."""
+    T, C = synthesis.shape[0], synthesis.shape[1]
+    n3p = df_flat.shape[1] // 2
     # jt[a, i n3p + k C + b] = sum_t analysis[a, t] df[t, i, k C + b] (tangential rows i);
     # jn[a, b] = sum_t analysis[a, t] dN/da E[t, b] (normal row, zeta columns only);
     # separated samples carry no force and no derivative
-    jt[:, :] = 0.0
     jn[:, :] = 0.0
     for t in range(T):
         if state[t] == SEPARATED:
@@ -664,11 +690,37 @@ def point_harmonics(c, synthesis, analysis, kt, mu, w, off, law_kind, law_params
         dnda = -dnormal[t]
         for a in range(C):
             an = analysis[a, t]
+            for b in range(C):
+                jn[a, b] += an * (dnda * synthesis[t, b])
+    stuck = True
+    for t in range(T):
+        if state[t] != STICK:
+            stuck = False
+            break
+    if stuck:
+        # stuck all the last pass: the slider derivative ds (2, 3C) stays what it was at the
+        # pass start, df_t = -k_T ds + k_T E_t (own blocks) at every sample (as the return map
+        # writes it), so jt = -k_T (sum_t analysis) ds + k_T gram (own blocks), with the basis's
+        # sums (point_work) instead of T samples' (the same to rounding)
+        for a in range(C):
+            sa = -kt * analysis_sums[a]
+            for i in range(2):
+                for j in range(n3p):
+                    jt[a, i * n3p + j] = sa * ds[i, j] if j < 3 * C else 0.0
+            for b in range(C):
+                g = kt * gram[a, b]
+                jt[a, b] += g                   # xi row, xi block
+                jt[a, n3p + C + b] += g         # eta row, eta block
+        return
+    jt[:, :] = 0.0
+    for t in range(T):
+        if state[t] == SEPARATED:
+            continue
+        for a in range(C):
+            an = analysis[a, t]
             # (indexed, not row views: a view per sample costs reference counting)
             for r in range(2 * n3p):
                 jt[a, r] += an * df_flat[t, r]
-            for b in range(C):
-                jn[a, b] += an * (dnda * synthesis[t, b])
 
 
 @njit(cache=True)
@@ -692,7 +744,7 @@ def damper_contact_forces(B, local, synthesis, analysis, k_t, mu, weight, approa
     """
     nd, P = B.shape[0], B.shape[2]
     T, C = synthesis.shape[0], synthesis.shape[1]
-    work = point_work(T, C)
+    work = point_work(synthesis, analysis)
     n3p = work[8].shape[2]
     c = np.empty((C, 3))
     fc = np.empty((C, 3))
@@ -777,7 +829,7 @@ def point_contact_harmonics(local, synthesis, analysis, k_t, mu, weight, approac
     """
     P = local.shape[1]
     T, C = synthesis.shape[0], synthesis.shape[1]
-    work = point_work(T, C)
+    work = point_work(synthesis, analysis)
     n3p = work[8].shape[2]
     c = np.empty((C, 3))
     fc = np.empty((C, 3))

@@ -594,7 +594,17 @@ def _ring_gather_csc(data, indices, indptr, owner, local, links, D, Up, Lo, col,
 
 @njit(cache=True)
 def _mm_sub(A, B, C):
-    """C -= A @ B (2D, in place)."""
+    """C -= A @ B (2D, in place; C shares no memory with A or B). Each C[i, j] has a_il b_lj
+    subtracted in the order of l; with one column (the solves' right-hand sides) in a register
+    rather than in memory, which the compiler cannot do itself (C might overlap B): the same
+    numbers; a solve of the 16-blade disk's bordered Jacobian (n = 321) 13.5 against 29 us."""
+    if B.shape[1] == 1:
+        for i in range(A.shape[0]):
+            s = C[i, 0]
+            for l in range(A.shape[1]):
+                s -= A[i, l] * B[l, 0]
+            C[i, 0] = s
+        return
     for i in range(A.shape[0]):
         for l in range(A.shape[1]):
             a = A[i, l]
@@ -642,13 +652,26 @@ def _lu(W, piv):
 
 @njit(cache=True)
 def _lu_solve(W, piv, B):
-    """B <- W^-1 B in place (B: (q, k)) with the factors of :func:`_lu`."""
+    """B <- W^-1 B in place (B: (q, k)) with the factors of :func:`_lu`. One column (k = 1) is
+    substituted with each row's sum in a register (as :func:`_mm_sub`; the same numbers)."""
     q, k = B.shape
     for c in range(q):
         p = piv[c]
         if p != c:
             for j in range(k):
                 B[c, j], B[p, j] = B[p, j], B[c, j]
+    if k == 1:
+        for i in range(q):
+            s = B[i, 0]
+            for l in range(i):
+                s -= W[i, l] * B[l, 0]
+            B[i, 0] = s
+        for i in range(q - 1, -1, -1):
+            s = B[i, 0]
+            for l in range(i + 1, q):
+                s -= W[i, l] * B[l, 0]
+            B[i, 0] = s * (1.0 / W[i, i])
+        return
     for i in range(q):
         for l in range(i):
             f = W[i, l]
@@ -666,15 +689,19 @@ def _lu_solve(W, piv, B):
 
 @njit(cache=True)
 def _lu_solve_transposed(W, piv, x):
-    """x <- W^-T x in place (x: (q,)) with the factors of :func:`_lu`."""
+    """x <- W^-T x in place (x: (q,)) with the factors of :func:`_lu` (each row's sum in a
+    register, as :func:`_lu_solve`)."""
     q = x.size
     for i in range(q):
+        s = x[i]
         for l in range(i):
-            x[i] -= W[l, i] * x[l]
-        x[i] /= W[i, i]
+            s -= W[l, i] * x[l]
+        x[i] = s / W[i, i]
     for i in range(q - 1, -1, -1):
+        s = x[i]
         for l in range(i + 1, q):
-            x[i] -= W[l, i] * x[l]
+            s -= W[l, i] * x[l]
+        x[i] = s
     for c in range(q - 1, -1, -1):
         p = piv[c]
         if p != c:
