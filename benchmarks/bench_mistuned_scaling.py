@@ -9,7 +9,7 @@ Run from the repository root::
     python benchmarks/bench_mistuned_scaling.py --blades 8 16 32 --old-full-max 32
 
 The disk: the reference cylinder damper (1 g), EO = 1, 2 % random mistuning (seed 0) on n
-blades, harmonics (1,) with the default samples (a multiple of n: 64 up to n = 64, then n),
+blades, harmonics (1,) with the default samples (64 at every n; each damper on its own shifted grid),
 88-102 Hz, max_step 0.05. Timed: the continuation alone (start solution and scales before the
 clock), ms per branch point = wall time / points; "solver" is the part of it spent in
 factorize and its solves. Up to ``--old-full-max`` blades both solvers run the whole range

@@ -456,7 +456,7 @@ def frf_command(args) -> int:
     progress, a = Progress(), design.analysis
     responses = {}
     # a branch that stops early is checked by time integration just beyond its stop (a minute or
-    # more): its result then says whether a periodic motion exists there (TunedDisk.stop_check)
+    # more): its result then says whether a periodic motion exists there (TunedDisk / MistunedDisk.stop_check)
     check_stop = not args.no_stop_check and not design.disk.blade.flexible_platform
     for eo in design.engine_orders:
         progress(f"frequency response at EO = {eo}, {a.f_start_hz:g}-{a.f_end_hz:g} Hz")
@@ -465,7 +465,7 @@ def frf_command(args) -> int:
     if args.mistuned:
         progress(f"mistuned full assembly at EO = {design.disk.engine_order}")
         responses[f"mistuned_EO{design.disk.engine_order}"] = design.mistuned_disk().frequency_response(
-            a.f_start_hz, a.f_end_hz, **a.options())
+            a.f_start_hz, a.f_end_hz, check_stop=check_stop, **a.options())
     summary = frf_outputs(out, design, responses)
     peaks = ", ".join(f"{k} peak {v['peak_amplitude_mm']:.4f} mm at {v['peak_frequency_hz']:.3f} Hz"
                       if v["peak_amplitude_mm"] is not None else f"{k} no points"
@@ -681,8 +681,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--mistuned", action="store_true",
                    help="also the mistuned full assembly of the [mistuning] table (about 4 times the cost)")
     p.add_argument("--no-stop-check", action="store_true",
-                   help="skip the time integration beyond a tuned branch that stops before the end of the range\n"
-                        "(by default it runs, 1-3 min, and the summary says whether a periodic motion exists there;\n"
+                   help="skip the time integration beyond a branch (tuned or --mistuned) that stops before the end of\n"
+                        "the range (by default it runs, 1-3 min, and the summary says whether a periodic motion exists there;\n"
                         "not for solid FE blades with flexible platforms)")
     out_arg(p, "results/frf")
 

@@ -53,6 +53,7 @@ def _disk_paths():
                                        kappa=np.array([1.0, 1.01, 0.99, 1.0]))
 
     small().frequency_response(94.0, 94.2, harmonics=(1,), max_step=0.5)
+    small().frequency_response(94.0, 94.2, harmonics=(1,), max_step=0.5, n_samples=50)   # dampers' shifted grids
     small().time_response([94.0], max_periods=2, min_periods=1)
     four = dataclasses.replace(disk, n_blades=4, engine_order=1)      # the disk's monodromy (static term)
     r = four.frequency_response(92.0, 92.1, harmonics=(0, 1), max_step=0.5)

@@ -847,16 +847,24 @@ class TunedDisk:
         that exists (:func:`stop_verdict`).
         Costs one time integration of the full assembly (30-210 s for the reference disk on 2
         cores)."""
-        validation.positive("offset_hz", offset_hz)
-        if not len(response.omega):
-            if f_start_hz is None:
-                raise ValueError("stop_check needs a response with at least one point, or f_start_hz "
-                                 "(where a branch that kept none was to start)")
-            return self.time_response(validation.positive("f_start_hz", f_start_hz), **options)
-        o = response.omega
-        k = response.furthest_index()
-        direction = np.sign(o[k] - o[0]) or 1.0
-        return self.time_response(response.frequency_hz[k] + direction * offset_hz, **options)
+        return time_check_beyond(self, response, offset_hz, f_start_hz, **options)
+
+
+def time_check_beyond(model, response, offset_hz: float = STOP_CHECK_OFFSET_HZ, f_start_hz: float | None = None,
+                      **options):
+    """``model.time_response`` (a :class:`TunedDisk` or :class:`~bladedamp.mistuned.MistunedDisk`)
+    ``offset_hz`` [Hz] beyond where ``response`` got furthest, in its branch's direction, or at
+    ``f_start_hz`` [Hz] for a response that kept no point: the ``stop_check`` of both models."""
+    validation.positive("offset_hz", offset_hz)
+    if not len(response.omega):
+        if f_start_hz is None:
+            raise ValueError("stop_check needs a response with at least one point, or f_start_hz "
+                             "(where a branch that kept none was to start)")
+        return model.time_response(validation.positive("f_start_hz", f_start_hz), **options)
+    o = response.omega
+    k = response.furthest_index()
+    direction = np.sign(o[k] - o[0]) or 1.0
+    return model.time_response(response.frequency_hz[k] + direction * offset_hz, **options)
 
 
 def stop_verdict(check, harmonics) -> str:
@@ -885,8 +893,9 @@ def stop_verdict(check, harmonics) -> str:
             "integration is the answer there")
 
 
-def with_stop_note(response: "DiskResponse", f_start_hz: float | None = None, check=None) -> "DiskResponse":
-    """A failed ``response`` with what the damper did where its branch got furthest (the share
+def with_stop_note(response, f_start_hz: float | None = None, check=None):
+    """A failed ``response`` (a :class:`DiskResponse` or a
+    :class:`~bladedamp.mistuned.MistunedResponse`) with what the damper did where its branch got furthest (the share
     of the period its contact points stick, slip and are separated there) and how to tell
     whether a periodic motion exists just beyond (:meth:`TunedDisk.stop_check`). Measured on
     the 17 random disks of tests/test_random_designs.py whose branch does not reach the end
@@ -900,29 +909,36 @@ def with_stop_note(response: "DiskResponse", f_start_hz: float | None = None, ch
     integration, separated 80 % of the period; the robust start finds no solution with (0, 1, 2, 3)
     nor (0, ..., 5), one with (0, ..., 7)). ``check``: the time integration there
     (:meth:`TunedDisk.stop_check`), whose verdict (:func:`stop_verdict`) replaces how to tell, and
-    which the result keeps as its ``stop_check``. A successful one is returned unchanged."""
+    which the result keeps as its ``stop_check``. A successful one is returned unchanged, and so
+    is one without a damper."""
     if response.success or response.stopped_by:
         return response
     if check is not None:
         where = "at the start" if not len(response.omega) else "beyond where the branch got furthest"
         note = f"; {where}, {stop_verdict(check, response.basis.harmonics)}"
         return dataclasses.replace(response, message=response.message + note, stop_check=check)
+    model = type(response.disk).__name__ if response.disk is not None else "TunedDisk"
     if not len(response.omega):
         if f_start_hz is None:
             return response
-        note = (f"; TunedDisk.time_response({f_start_hz:.6g}) tells by time integration whether a periodic motion "
+        note = (f"; {model}.time_response({f_start_hz:.6g}) tells by time integration whether a periodic motion "
                 "exists at the start (where one does with the damper separated most of the period, brief impacts, "
                 "a richer harmonic set may find it: harmonics='auto'; frequency_response(..., check_stop=True) "
                 "runs it)")
         return dataclasses.replace(response, message=response.message + note)
-    if response.point_state is None:
-        return response
+    states = getattr(response, "point_state", None)                 # DiskResponse's, else None
+    dampers = getattr(response, "damper_dissipation", None)         # MistunedResponse's, else None
+    if states is None and (dampers is None or not dampers.size):
+        return response                                             # no damper: nothing to tell
     k = response.furthest_index()
-    stick, slip, separated = 100 * response.contact_state_shares()[k]
     f = response.frequency_hz[k]
-    note = (f"; where the branch got furthest ({f:.4f} Hz, tip amplitude {1e3 * response.tip_amplitude[k, 0]:.4g} mm) "
-            f"the damper's contact points stick {stick:.0f} %, slip {slip:.0f} %, are separated {separated:.0f} % of "
-            "the period; TunedDisk.stop_check(result) tells by time integration whether a periodic motion exists just "
+    tip = 1e3 * np.max(response.tip_amplitude[k][..., 0])
+    where = f"where the branch got furthest ({f:.4f} Hz, largest tip amplitude {tip:.4g} mm)"
+    if states is not None:
+        stick, slip, separated = 100 * response.contact_state_shares()[k]
+        where += (f" the damper's contact points stick {stick:.0f} %, slip {slip:.0f} %, are separated "
+                  f"{separated:.0f} % of the period")
+    note = (f"; {where}; {model}.stop_check(result) tells by time integration whether a periodic motion exists just "
             "beyond (a light damper may hop on the platforms or keep rolling: then none does; "
             "frequency_response(..., check_stop=True) runs it)")
     return dataclasses.replace(response, message=response.message + note)
@@ -1049,13 +1065,6 @@ class DiskResponse(FrequencyResponse):
         if self.point_state is None:
             return np.zeros((len(self.omega), 3))
         return self.point_state.mean(axis=(1, 2))
-
-    def furthest_index(self) -> int:
-        """Index of the point furthest from the branch's first point in frequency (where a branch
-        from the start of its range got furthest, also if it then turned back)."""
-        o = self.omega
-        direction = np.sign(o[np.argmax(np.abs(o - o[0]))] - o[0])
-        return int(np.argmax(direction * (o - o[0])))
 
     @property
     def peak_amplitude(self) -> float:

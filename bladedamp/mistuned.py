@@ -21,13 +21,16 @@ blade s-1 to blade 0 of the next sector, whose harmonic h is blade 0's times e^{
 paper's alternating mistuning (case d).
 
 Time sampling (AFT): the contact forces are evaluated at ``n_samples`` instants per period, and
-blade k's motion is blade 0's shifted by k dphi; the discrete friction laws are shift-invariant
-only when that shift is a whole number of samples. By default ``n_samples`` is therefore
-rounded up to a multiple of n / gcd(n, EO) (n = 16, EO = 1: 64, as the tuned disk); with
-another ``n_samples`` a tuned full assembly differs from the cyclic solution by the AFT
-discretisation error (measured: ~1e-3 relative with 6 blades, EO = 1, 64 samples). A branch
+in a tuned travelling wave blade k's motion is blade 0's shifted by k dphi; the discrete friction
+laws are shift-invariant only when that shift is a whole number of samples. Each damper is
+therefore sampled on its own grid, shifted by its phase k dphi (a rotation of its harmonic
+coefficients before the AFT and back after it, :meth:`AssemblyContacts._grid_rotations`;
+nothing to do where the shift is whole samples, n = 16 and EO = 1 at 64 samples): a tuned full
+assembly equals the cyclic solution to rounding at any ``n_samples``, and the default is the
+tuned disk's (64 for one harmonic at any n; before, it was rounded up to a multiple of
+n / gcd(n, EO), T = n above 64 blades, which made the contact kernel's cost grow as n^2). A branch
 that fails its checks with the default is solved once more with ``AUTO_SAMPLES_GROWTH`` times
-the samples (still such a multiple), as the tuned disk's (:func:`bladedamp.response.sampled_response`).
+the samples, as the tuned disk's (:func:`bladedamp.response.sampled_response`).
 
 The Jacobian is sparse (each damper couples two neighbours): the structural matrices and
 the contact map are scipy.sparse matrices (the Jacobian itself dense up to
@@ -55,9 +58,9 @@ from .blade import ModalBlade
 from .contact.laws import LinearNormalLaw
 from .contact.point import MAX_PASSES, PERIODIC_TOL
 from .damper.kinetics import seat
-from .disk import (AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION, DAMPER_DOFS,
+from .disk import (AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION, DAMPER_DOFS, STOP_CHECK_OFFSET_HZ,
                    DamperContacts, TunedDisk, contact_point_maps, contact_rows, damper_weighted_scales,
-                   fused_point_map_forces, point_map_forces, rotor_speed_in_hz)
+                   fused_point_map_forces, point_map_forces, rotor_speed_in_hz, time_check_beyond, with_stop_note)
 from .hbm.accuracy import HARMONIC_TOLERANCE, converged_response
 from .hbm.continuation import Branch, continuation
 from .hbm.start import robust_start
@@ -107,6 +110,9 @@ class AssemblyContacts:
 
     contacts: list[DamperContacts]
     n_local: int = 0
+    #: (n_d,) phase [rad] of each damper's motion in a tuned travelling wave (k dphi for the
+    #: damper on blade k), or None; damper d is sampled on a grid shifted by it (:meth:`_grid_rotations`)
+    grid_phase: np.ndarray | None = None
     _batch: tuple | None = field(default=None, init=False, repr=False)
     _index: dict = field(default_factory=dict, init=False, repr=False)
     _last_approach: tuple | None = field(default=None, init=False, repr=False)
@@ -150,8 +156,53 @@ class AssemblyContacts:
             self._index[C] = ((a * L * nd + L * d + m).ravel(), (b * L * nd + L * d + k).ravel())
         return self._index[C]
 
+    def _grid_rotations(self, basis):
+        """(n_d, C, C) rotations R_d of the harmonic coefficients that sample damper d on the
+        grid omega t_j - grid_phase_d (coefficients R_d c on the common grid), or None when every
+        phase is a whole number of samples (the common grid then serves every damper exactly).
+
+        In a tuned travelling wave damper d's motion is the first damper's advanced by its phase
+        theta_d: c_h,d = c_h,0 e^{i h theta_d} (complex c_h = a_h - i b_h). Sampled on the shifted
+        grid, every damper of a tuned assembly sees the first's samples, so its discrete friction
+        law (history-dependent through the return map) gives the first's forces shifted, and the
+        tuned full assembly equals the cyclic sector to rounding at any sample count, not only
+        at multiples of n / gcd(n, EO). The forces come back by R_d^T (R_d is orthogonal) and
+        the Jacobian blocks as R_d^T J_d R_d. For a mistuned disk the shifted grids are an
+        equally good discretisation as the common one."""
+        if self.grid_phase is None:
+            return None
+        T, C = basis.n_samples, basis.n_coeffs
+        key = ("grid", T, basis.harmonics)
+        if key not in self._index:
+            shift = np.asarray(self.grid_phase) * T / (2 * np.pi)          # in samples
+            if np.all(np.abs(shift - np.round(shift)) < 1e-9):
+                self._index[key] = None
+            else:
+                R = np.zeros((len(shift), C, C))
+                for h in basis.harmonics:
+                    j = basis.cos_index(h)
+                    if h == 0:
+                        R[:, j, j] = 1.0
+                        continue
+                    phi = -h * np.asarray(self.grid_phase)                  # c~ = c e^{i phi}
+                    c, sn = np.cos(phi), np.sin(phi)
+                    R[:, j, j], R[:, j, j + 1], R[:, j + 1, j], R[:, j + 1, j + 1] = c, sn, -sn, c
+                self._index[key] = R
+        return self._index[key]
+
     def _forces(self, local, basis, offsets, jacobian):
-        """Forces (C, n_d, L) and Jacobian blocks (n_d, C, L, C, L) or None.
+        """Forces (C, n_d, L) and Jacobian blocks (n_d, C, L, C, L) or None, each damper sampled
+        on its own grid where the interblade shift is not a whole number of samples
+        (:meth:`_grid_rotations`), else all on the common grid (:meth:`_forces_on_grid`)."""
+        R = self._grid_rotations(basis)
+        if R is None:
+            return self._forces_on_grid(local, basis, offsets, jacobian)
+        force, blocks = self._forces_on_grid(_rotated(R, np.ascontiguousarray(local, dtype=float), False), basis,
+                                             offsets, jacobian)
+        return _rotated(R, force, True), None if blocks is None else _rotated_blocks(R, blocks)
+
+    def _forces_on_grid(self, local, basis, offsets, jacobian):
+        """Forces (C, n_d, L) and Jacobian blocks (n_d, C, L, C, L) or None on the common grid.
 
         Batched dampers with rigid platforms and a normal law the fused kernel knows go through
         :func:`~bladedamp.disk.fused_point_map_forces` (one numba call: point motion, normal
@@ -246,6 +297,46 @@ class AssemblyContacts:
             return force.reshape(C, self.n_local), None, None
         jac = self._sparse(blocks, C)
         return force.reshape(C, self.n_local), jac, None if domega is None else domega.ravel()
+
+
+@njit(cache=True)
+def _rotated(R, values, transposed):
+    """(C, n_d, L) coefficients rotated damper by damper: R_d values_d, or R_d^T values_d
+    (``transposed``), R (n_d, C, C) (:meth:`AssemblyContacts._grid_rotations`)."""
+    C, nd, L = values.shape
+    out = np.zeros(values.shape)
+    for d in range(nd):
+        for a in range(C):
+            for b in range(C):
+                r = R[d, b, a] if transposed else R[d, a, b]
+                if r != 0.0:
+                    for m in range(L):
+                        out[a, d, m] += r * values[b, d, m]
+    return out
+
+
+@njit(cache=True)
+def _rotated_blocks(R, blocks):
+    """Jacobian blocks (n_d, C, L, C, L) rotated damper by damper: R_d^T J_d R_d (the forces
+    come back by R_d^T from coefficients that went in by R_d). As a numpy einsum it was 15 % of
+    a 128-blade FRF point; R_d has 2 x 2 blocks, so the loops skip its zeros."""
+    nd, C, L = blocks.shape[0], blocks.shape[1], blocks.shape[2]
+    out = np.zeros(blocks.shape)
+    for d in range(nd):
+        for a in range(C):
+            for b in range(C):
+                rba = R[d, b, a]
+                if rba == 0.0:
+                    continue
+                for c in range(C):
+                    for e in range(C):
+                        w = rba * R[d, c, e]
+                        if w == 0.0:
+                            continue
+                        for m in range(L):
+                            for n in range(L):
+                                out[d, a, m, e, n] += w * blocks[d, b, m, c, n]
+    return out
 
 
 #: Euler's identity needs the approach's omega-derivative to be kappa_d times the approach,
@@ -757,11 +848,10 @@ class MistunedDisk:
 
     # ----- harmonic balance ------------------------------------------------------------
     def default_samples(self, harmonics) -> int:
-        """HarmonicBasis' default sample count rounded up to a multiple of n / gcd(n, EO), so that
-        the interblade shift is a whole number of samples (see the module notes)."""
-        default = HarmonicBasis(tuple(harmonics)).n_samples
-        p = self.n_blades // np.gcd(self.n_blades, self.engine_order) if self.engine_order else 1
-        return int(-(-default // p) * p)
+        """HarmonicBasis' default sample count, as the tuned disk's: each damper is sampled on a
+        grid shifted by its interblade phase (:meth:`AssemblyContacts._grid_rotations`), so the
+        count need not be a multiple of n / gcd(n, EO) (see the module notes)."""
+        return HarmonicBasis(tuple(harmonics)).n_samples
 
     def hbm_system(self, harmonics=(1,), n_samples=None, static_retention: float = 1e-4,
                    linear_solver: str | None = None) -> HarmonicBalanceSystem:
@@ -857,7 +947,10 @@ class MistunedDisk:
 
         couplings = []
         if active:
-            couplings.append(Coupling(AssemblyContacts(contacts), sparse_real_form(basis, contact_map), "damper contacts"))
+            # each damper sampled on its own grid, shifted by its travelling-wave phase (exact tuned = cyclic at any T)
+            grid_phase = np.array([k * dphi for k in active]) if self.engine_order else None
+            couplings.append(Coupling(AssemblyContacts(contacts, grid_phase=grid_phase), sparse_real_form(basis, contact_map),
+                                      "damper contacts"))
         j1 = basis.cos_index(1)
         f1 = np.zeros((C, N))
         for k, f in enumerate(forces):
@@ -936,7 +1029,8 @@ class MistunedDisk:
     def frequency_response(self, f_start_hz: float, f_end_hz: float, harmonics="auto", n_samples=None,
                            max_step: float = 0.02, tuned_peak_amplitude: float | None = None,
                            harmonic_tolerance: float = HARMONIC_TOLERANCE, max_harmonic: int = 3,
-                           estimate_harmonic_error: bool = True, **continuation_options) -> "MistunedResponse":
+                           estimate_harmonic_error: bool = True, check_stop: bool = False,
+                           **continuation_options) -> "MistunedResponse":
         """Forced response of every blade from ``f_start_hz`` to ``f_end_hz`` [Hz] by continuation.
 
         ``harmonics``, ``harmonic_tolerance``, ``max_harmonic``: as :meth:`TunedDisk.frequency_response`
@@ -951,8 +1045,16 @@ class MistunedDisk:
         ``estimate_harmonic_error=False`` (given harmonics only) skips the error estimate, which
         costs about as much as a one-harmonic FRF of the assembly (5 enriched Newton solves of
         the full assembly with the static term; measured on the Monte Carlo's reference disks:
-        0.72 of 1.56 s per disk); the result then says "not estimated"."""
+        0.72 of 1.56 s per disk); the result then says "not estimated".
+        ``check_stop``: where the branch ends before the end of the range, integrate the assembly
+        in time just beyond where it got furthest (:meth:`stop_check`, at ``f_start_hz`` when no
+        point was kept) and put the verdict in the result, as :meth:`TunedDisk.frequency_response`
+        (its ``stop_check`` and message); rigid platforms only (what :meth:`time_response` models).
+        A failed branch without it says how to tell."""
         validation.positive("f_start_hz", f_start_hz)
+        if check_stop and any(b.flexible_platform for b in self.blades):
+            raise ValueError("check_stop integrates the disk in time, which models rigid platforms only: "
+                             "use rigid-platform blades or check_stop=False")
         validation.positive("f_end_hz", f_end_hz)
         if f_start_hz == f_end_hz:
             raise ValueError("f_end_hz must differ from f_start_hz")
@@ -981,8 +1083,20 @@ class MistunedDisk:
                                                          response.excitation_work, max_step, T, refine,
                                                          response.damper_work_bound))
 
-        return converged_response(self, solve, harmonics, harmonic_tolerance, max_harmonic,
-                                  estimate=estimate_harmonic_error)
+        response = converged_response(self, solve, harmonics, harmonic_tolerance, max_harmonic,
+                                      estimate=estimate_harmonic_error)
+        stopped_early = not (response.stopped_by or response.reached_range_end)
+        check = self.stop_check(response, f_start_hz=f_start_hz) if check_stop and stopped_early else None
+        return with_stop_note(response, f_start_hz, check)
+
+    def stop_check(self, response: "MistunedResponse", offset_hz: float = STOP_CHECK_OFFSET_HZ,
+                   f_start_hz: float | None = None, **options):
+        """Whether a periodic motion exists just beyond where ``response`` (a failed branch of
+        :meth:`frequency_response`) got furthest: :meth:`time_response` ``offset_hz`` [Hz] beyond
+        it (at ``f_start_hz`` [Hz] if it kept no point), as :meth:`TunedDisk.stop_check` (its
+        ``periodic``, ``status`` and :func:`~bladedamp.disk.stop_verdict`). One time integration of
+        the assembly."""
+        return time_check_beyond(self, response, offset_hz, f_start_hz, **options)
 
     # ----- the protocol of bladedamp.hbm.accuracy ----------------------------------------
     def output_amplitudes(self, coefficients: np.ndarray, basis: HarmonicBasis) -> np.ndarray:
@@ -1100,6 +1214,9 @@ class MistunedResponse(FrequencyResponse):
     damper_work_bound : (n_points, n_active_dampers) each damper's energy scale per period, the
         largest work its force and motion harmonics could do (HarmonicBasis.work_bound) [J]
     tuned_peak_amplitude : the tuned disk's peak u_x [m] if given (amplification factors)
+    stop_check : for a branch that stopped before the end of its range, computed with
+        ``check_stop=True``: the time integration of the assembly just beyond where it got
+        furthest (a one-frequency :class:`bladedamp.timedomain.DiskTimeResponse`), else None
     """
 
     tip_amplitude: np.ndarray = None
@@ -1109,6 +1226,7 @@ class MistunedResponse(FrequencyResponse):
     damper_dissipation: np.ndarray = None
     damper_work_bound: np.ndarray = None
     tuned_peak_amplitude: float | None = None
+    stop_check: object = None
     disk: MistunedDisk = None
 
     @classmethod

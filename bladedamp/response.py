@@ -258,6 +258,13 @@ class FrequencyResponse(Saveable):
         where no physical check failed)."""
         return bool(self.success if self.reached_end is None else self.reached_end)
 
+    def furthest_index(self) -> int:
+        """Index of the point furthest from the branch's first point in frequency (where a branch
+        from the start of its range got furthest, also if it then turned back)."""
+        o = self.omega
+        direction = np.sign(o[np.argmax(np.abs(o - o[0]))] - o[0])
+        return int(np.argmax(direction * (o - o[0])))
+
     def reversed(self):
         """The same branch in the opposite order (a downward sweep as rising frequency): every
         per-point array is flipped, turning points renumbered."""
