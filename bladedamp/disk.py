@@ -181,7 +181,7 @@ def fused_point_map_forces(B, local, basis, k_t, mu, law, weights, offsets, jaco
     damper_contact_forces(np.ascontiguousarray(B, dtype=float), np.ascontiguousarray(local, dtype=float),
                           basis.synthesis, basis.analysis, k_t, mu, weights,
                           np.ascontiguousarray(offsets, dtype=float).ravel(), params[0], params[1], static_index,
-                          MAX_PASSES, PERIODIC_TOL, jacobian, force, blocks)
+                          MAX_PASSES, PERIODIC_TOL, jacobian, force, blocks, True)
     return force, blocks if jacobian else None
 
 

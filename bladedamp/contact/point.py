@@ -725,8 +725,7 @@ def _point_jacobian(synthesis, analysis, kt, dnormal, state, df_flat, ds, analys
 
 @njit(cache=True)
 def damper_contact_forces(B, local, synthesis, analysis, k_t, mu, weight, approach_offset, law_kind,
-                          law_params, static_index, max_passes, tol, want_jac, force, blocks,
-                          closed_form=True):
+                          law_params, static_index, max_passes, tol, want_jac, force, blocks, closed_form):
     """Fused AFT of the two contact patches of n_d dampers (the batched path of AssemblyContacts).
 
     Per point (d, q, p): coefficients c = B[d, q, p] @ local[:, d, 6q:6q+6], then
@@ -739,8 +738,12 @@ def damper_contact_forces(B, local, synthesis, analysis, k_t, mu, weight, approa
     approach_offset (n_d*2*P,) in (d, q, p) order; law_params float (3,). Outputs
     (overwritten): force (C,n_d,12); blocks (n_d,C,12,C,12) if ``want_jac`` (patch q of
     damper d fills [d, :, 6q:6q+6, :, 6q:6q+6], the rest is zero), any array otherwise.
-    ``closed_form``: the periodic slider derivative in closed form (default; False: the
-    previous pass iteration, see :func:`_point_return_map`).
+    ``closed_form``: the periodic slider derivative in closed form (True, what the model
+    passes; False: the previous pass iteration, see :func:`_point_return_map`). No default: an
+    omitted argument is a numba literal, and the kernels it reaches (``point_harmonics``,
+    ``_point_return_map`` and what they inline) were compiled a second time for it, besides the
+    version ``point_contact_forces`` uses (measured: the reference FRF's first call on an empty
+    cache compiled ``_point_return_map`` twice).
     """
     nd, P = B.shape[0], B.shape[2]
     T, C = synthesis.shape[0], synthesis.shape[1]
