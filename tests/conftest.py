@@ -11,6 +11,7 @@ once per session.
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 import pytest
 
 FE_REASON = "the solid blade needs the fe extra: pip install 'bladedamp[fe]'"
@@ -71,6 +72,45 @@ def duffing_jenkins_residual(A, omega, osc):
 # ---------------------------------------------------------------------------------------
 # numerical helpers
 # ---------------------------------------------------------------------------------------
+def scale_columns(J, s):
+    """J diag(s) for dense or sparse J (sparse: a CSC copy). With :func:`border`, the reference
+    of bladedamp.hbm.continuation._bordered (the bordered continuation matrix in one pass)."""
+    if sp.issparse(J):
+        J = sp.csc_matrix(J, copy=True)
+        J.data *= np.repeat(s, np.diff(J.indptr))
+        return J
+    return J * s[None, :]
+
+
+def border(J, column=None, row=None):
+    """[J column; row 0] for dense or sparse J (either border may be None; sparse: CSC, one
+    insertion per column, each column's row entry last)."""
+    if sp.issparse(J):
+        J = J if sp.isspmatrix_csc(J) else sp.csc_matrix(J)
+        m, n = J.shape
+        data, indices, indptr = J.data, J.indices, J.indptr
+        if column is not None:
+            column = np.asarray(column, dtype=float)
+            data = np.concatenate([data, column])
+            indices = np.concatenate([indices, np.arange(m, dtype=indices.dtype)])
+            indptr = np.append(indptr, indptr[-1] + m)
+            n += 1
+        if row is not None:
+            row = np.asarray(row, dtype=float)
+            ends = indptr[1:]
+            data = np.insert(data, ends, row)
+            indices = np.insert(indices, ends, m)
+            indptr = indptr + np.arange(n + 1, dtype=indptr.dtype)
+            m += 1
+        return sp.csc_matrix((data, indices, indptr), shape=(m, n))
+    out = J
+    if column is not None:
+        out = np.hstack([out, column[:, None]])
+    if row is not None:
+        out = np.vstack([out, row[None, :]])
+    return out
+
+
 def central_difference(fun, x, step):
     """Jacobian of a vector function by central differences, column by column.
 

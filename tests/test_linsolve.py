@@ -9,8 +9,10 @@ import pytest
 import scipy.linalg
 import scipy.sparse as sp
 
+from conftest import border, scale_columns
+
 from bladedamp import FrictionOscillator
-from bladedamp.hbm.continuation import _border, _bordered, _scale_columns
+from bladedamp.hbm.continuation import _bordered
 from bladedamp.hbm.linsolve import BlockCondensation, factorize
 from bladedamp.mistuned import MistunedDisk
 from bladedamp.reference import reference_disk
@@ -58,7 +60,7 @@ def test_dense_lu_is_scipys_and_gives_the_sign_of_the_determinant():
     r = osc.frequency_response(14.0, 22.0, harmonics=(1, 3, 5))
     for x, omega in zip(r.coefficients.reshape(len(r.omega), -1), r.omega):
         _, J, Rw = system.residual(x, omega)
-        A = _border(J, Rw, rng.standard_normal(J.shape[0] + 1))
+        A = border(J, Rw, rng.standard_normal(J.shape[0] + 1))
         assert factorize(A).sign == np.linalg.slogdet(A)[0]
     for singular in (np.zeros((3, 3)), np.array([[1.0, 2.0], [2.0, 4.0]]), np.array([[np.nan, 1.0], [1.0, 1.0]])):
         with pytest.raises(np.linalg.LinAlgError):
@@ -70,7 +72,7 @@ def test_condensation_equals_lu_on_a_structured_matrix(bordered):
     rng = np.random.default_rng(1)
     A, cond = structured(rng)
     if bordered:
-        A = _border(A, rng.standard_normal(A.shape[0]), rng.standard_normal(A.shape[0] + 1))
+        A = border(A, rng.standard_normal(A.shape[0]), rng.standard_normal(A.shape[0] + 1))
     b = rng.standard_normal((A.shape[0], 3))
     x = cond(A)(b)
     assert np.abs(x - np.linalg.solve(A, b)).max() < 1e-12 * np.abs(x).max()
@@ -115,7 +117,7 @@ def test_condensation_on_mistuned_jacobians(kind, harmonics):
     x = x * (1 + 0.3 * np.random.default_rng(0).standard_normal(x.size))   # some slip and lift-off
     R, J, Rw = system.residual(x, w)
     assert isinstance(J, np.ndarray) and system._condensation is not None
-    A = _border(J, Rw, np.random.default_rng(1).standard_normal(J.shape[0] + 1))
+    A = border(J, Rw, np.random.default_rng(1).standard_normal(J.shape[0] + 1))
     for M in (J, A):
         b = np.random.default_rng(2).standard_normal(M.shape[0])
         y, y_lu = system.factorize(M)(b), factorize(M)(b)
@@ -125,7 +127,7 @@ def test_condensation_on_mistuned_jacobians(kind, harmonics):
 
 def test_bordered_forms_the_indices_once_per_pattern():
     """The continuation's bordered matrix [[J diag(s), column] factor; row] of a sparse J: the
-    entries of _border(_scale_columns(J)) (scaled the same way), its index arrays formed once
+    entries of border(scale_columns(J)) (scaled the same way), its index arrays formed once
     for J's pattern and shared by the next bordered matrix of a Jacobian with the same index
     arrays (the assembly's Jacobians share theirs); another pattern is bordered anew."""
     rng = np.random.default_rng(3)
@@ -140,7 +142,7 @@ def test_bordered_forms_the_indices_once_per_pattern():
     for M in (J, J2, other):
         column, row, scale = rng.standard_normal(n), rng.standard_normal(n + 1), rng.uniform(0.5, 2, n)
         A = _bordered(M, column, row, scale, factor)
-        B = _border(_scale_columns(M, scale * factor), column * factor, row)
+        B = border(scale_columns(M, scale * factor), column * factor, row)
         assert A.shape == (n + 1, n + 1) and np.array_equal(A.toarray(), B.toarray())
         assert np.array_equal(A.indices, B.indices) and np.array_equal(A.indptr, B.indptr)
         if M is J2:

@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from bladedamp.hbm.continuation import _border
+from conftest import border
+
 from bladedamp.hbm.linsolve import BlockRing, factorize
 from bladedamp.mistuned import AssemblySystem, MistunedDisk
 from bladedamp.reference import reference_disk
@@ -164,7 +165,7 @@ def jacobians(md, harmonics, seed=0):
     x = md.initial_guess(system, w)
     x = x * (1 + 0.3 * np.random.default_rng(seed).standard_normal(x.size))
     R, J, Rw = system.residual(x, w)
-    A = _border(J, Rw, np.random.default_rng(seed + 1).standard_normal(J.shape[0] + 1))
+    A = border(J, Rw, np.random.default_rng(seed + 1).standard_normal(J.shape[0] + 1))
     return system, J, A
 
 
