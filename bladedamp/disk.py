@@ -701,9 +701,7 @@ class TunedDisk:
 
         response = converged_response(model, solve, harmonics, harmonic_tolerance, max_harmonic,
                                       estimate=estimate_harmonic_error)
-        stopped_early = not (response.stopped_by or response.reached_range_end)
-        check = self.stop_check(response, f_start_hz=f_start_hz) if check_stop and stopped_early else None
-        return with_stop_note(response, f_start_hz, check)
+        return with_stop_check(self, response, f_start_hz, check_stop)
 
     def amplitude_stop(self, basis: HarmonicBasis, stop_above: float | None, direction: int = 0):
         """The continuation's ``stop_when`` for ``stop_above`` [m] (None: None): a message once the
@@ -865,6 +863,16 @@ def time_check_beyond(model, response, offset_hz: float = STOP_CHECK_OFFSET_HZ, 
     k = response.furthest_index()
     direction = np.sign(o[k] - o[0]) or 1.0
     return model.time_response(response.frequency_hz[k] + direction * offset_hz, **options)
+
+
+def with_stop_check(model, response, f_start_hz: float, check_stop: bool):
+    """``response`` of ``model.frequency_response`` (a :class:`TunedDisk` or
+    :class:`~bladedamp.mistuned.MistunedDisk`) with its stop note (:func:`with_stop_note`): with
+    ``check_stop``, a branch that stopped before the end of its range (not by ``stop_above``)
+    first gets ``model.stop_check``'s time integration, whose verdict the note gives."""
+    stopped_early = not (response.stopped_by or response.reached_range_end)
+    check = model.stop_check(response, f_start_hz=f_start_hz) if check_stop and stopped_early else None
+    return with_stop_note(response, f_start_hz, check)
 
 
 def stop_verdict(check, harmonics) -> str:

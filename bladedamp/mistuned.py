@@ -60,7 +60,7 @@ from .contact.point import MAX_PASSES, PERIODIC_TOL
 from .damper.kinetics import seat
 from .disk import (AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION, DAMPER_DOFS, STOP_CHECK_OFFSET_HZ,
                    DamperContacts, TunedDisk, contact_point_maps, contact_rows, damper_weighted_scales,
-                   fused_point_map_forces, point_map_forces, rotor_speed_in_hz, time_check_beyond, with_stop_note)
+                   fused_point_map_forces, point_map_forces, rotor_speed_in_hz, time_check_beyond, with_stop_check)
 from .hbm.accuracy import HARMONIC_TOLERANCE, converged_response
 from .hbm.continuation import Branch, continuation
 from .hbm.start import robust_start
@@ -115,6 +115,7 @@ class AssemblyContacts:
     grid_phase: np.ndarray | None = None
     _batch: tuple | None = field(default=None, init=False, repr=False)
     _index: dict = field(default_factory=dict, init=False, repr=False)
+    _rotations: dict = field(default_factory=dict, init=False, repr=False)
     _last_approach: tuple | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self):
@@ -171,24 +172,22 @@ class AssemblyContacts:
         equally good discretisation as the common one."""
         if self.grid_phase is None:
             return None
-        T, C = basis.n_samples, basis.n_coeffs
-        key = ("grid", T, basis.harmonics)
-        if key not in self._index:
-            shift = np.asarray(self.grid_phase) * T / (2 * np.pi)          # in samples
-            if np.all(np.abs(shift - np.round(shift)) < 1e-9):
-                self._index[key] = None
-            else:
-                R = np.zeros((len(shift), C, C))
+        key = (basis.n_samples, basis.harmonics)
+        if key not in self._rotations:
+            phase = np.asarray(self.grid_phase)
+            shift = phase * basis.n_samples / (2 * np.pi)                   # in samples
+            R = None
+            if np.any(np.abs(shift - np.round(shift)) >= 1e-9):
+                R = np.zeros((len(phase), basis.n_coeffs, basis.n_coeffs))
                 for h in basis.harmonics:
                     j = basis.cos_index(h)
                     if h == 0:
                         R[:, j, j] = 1.0
                         continue
-                    phi = -h * np.asarray(self.grid_phase)                  # c~ = c e^{i phi}
-                    c, sn = np.cos(phi), np.sin(phi)
+                    c, sn = np.cos(-h * phase), np.sin(-h * phase)          # c~ = c e^{-i h phase}
                     R[:, j, j], R[:, j, j + 1], R[:, j + 1, j], R[:, j + 1, j + 1] = c, sn, -sn, c
-                self._index[key] = R
-        return self._index[key]
+            self._rotations[key] = R
+        return self._rotations[key]
 
     def _forces(self, local, basis, offsets, jacobian):
         """Forces (C, n_d, L) and Jacobian blocks (n_d, C, L, C, L) or None, each damper sampled
@@ -1052,12 +1051,12 @@ class MistunedDisk:
         (its ``stop_check`` and message); rigid platforms only (what :meth:`time_response` models).
         A failed branch without it says how to tell."""
         validation.positive("f_start_hz", f_start_hz)
-        if check_stop and any(b.flexible_platform for b in self.blades):
-            raise ValueError("check_stop integrates the disk in time, which models rigid platforms only: "
-                             "use rigid-platform blades or check_stop=False")
         validation.positive("f_end_hz", f_end_hz)
         if f_start_hz == f_end_hz:
             raise ValueError("f_end_hz must differ from f_start_hz")
+        if check_stop and any(b.flexible_platform for b in self.blades):
+            raise ValueError("check_stop integrates the disk in time, which models rigid platforms only: "
+                             "use rigid-platform blades or check_stop=False")
         w0, w1 = 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz
 
         def solve(H):
@@ -1085,9 +1084,7 @@ class MistunedDisk:
 
         response = converged_response(self, solve, harmonics, harmonic_tolerance, max_harmonic,
                                       estimate=estimate_harmonic_error)
-        stopped_early = not (response.stopped_by or response.reached_range_end)
-        check = self.stop_check(response, f_start_hz=f_start_hz) if check_stop and stopped_early else None
-        return with_stop_note(response, f_start_hz, check)
+        return with_stop_check(self, response, f_start_hz, check_stop)
 
     def stop_check(self, response: "MistunedResponse", offset_hz: float = STOP_CHECK_OFFSET_HZ,
                    f_start_hz: float | None = None, **options):
