@@ -60,7 +60,8 @@ from .contact.point import MAX_PASSES, PERIODIC_TOL
 from .damper.kinetics import seat
 from .disk import (AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION, DAMPER_DOFS, STOP_CHECK_OFFSET_HZ,
                    DamperContacts, TunedDisk, contact_point_maps, contact_rows, damper_weighted_scales,
-                   fused_point_map_forces, point_map_forces, rotor_speed_in_hz, time_check_beyond, with_stop_check)
+                   fused_point_map_forces, point_map_forces, rotor_speed_in_hz, time_at_peak, time_check_beyond,
+                   with_peak_check, with_stop_check)
 from .hbm.accuracy import HARMONIC_TOLERANCE, converged_response
 from .hbm.continuation import Branch, continuation
 from .hbm.start import robust_start
@@ -1028,7 +1029,7 @@ class MistunedDisk:
     def frequency_response(self, f_start_hz: float, f_end_hz: float, harmonics="auto", n_samples=None,
                            max_step: float = 0.02, tuned_peak_amplitude: float | None = None,
                            harmonic_tolerance: float = HARMONIC_TOLERANCE, max_harmonic: int = 3,
-                           estimate_harmonic_error: bool = True, check_stop: bool = False,
+                           estimate_harmonic_error: bool = True, check_stop: bool = False, check_peak: bool = False,
                            **continuation_options) -> "MistunedResponse":
         """Forced response of every blade from ``f_start_hz`` to ``f_end_hz`` [Hz] by continuation.
 
@@ -1049,14 +1050,18 @@ class MistunedDisk:
         in time just beyond where it got furthest (:meth:`stop_check`, at ``f_start_hz`` when no
         point was kept) and put the verdict in the result, as :meth:`TunedDisk.frequency_response`
         (its ``stop_check`` and message); rigid platforms only (what :meth:`time_response` models).
-        A failed branch without it says how to tell."""
+        A failed branch without it says how to tell. ``check_peak``: for a branch that reached the
+        end, the time integration at the peak's frequency gives a direct harmonic error estimate,
+        or fails the response where that motion is not periodic, as
+        :meth:`TunedDisk.frequency_response` (:meth:`peak_check`, :func:`~bladedamp.disk.with_peak_check`)."""
         validation.positive("f_start_hz", f_start_hz)
         validation.positive("f_end_hz", f_end_hz)
         if f_start_hz == f_end_hz:
             raise ValueError("f_end_hz must differ from f_start_hz")
-        if check_stop and any(b.flexible_platform for b in self.blades):
-            raise ValueError("check_stop integrates the disk in time, which models rigid platforms only: "
-                             "use rigid-platform blades or check_stop=False")
+        for name, on in (("check_stop", check_stop), ("check_peak", check_peak)):
+            if on and any(b.flexible_platform for b in self.blades):
+                raise ValueError(f"{name} integrates the disk in time, which models rigid platforms only: "
+                                 f"use rigid-platform blades or {name}=False")
         w0, w1 = 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz
 
         def solve(H):
@@ -1084,7 +1089,20 @@ class MistunedDisk:
 
         response = converged_response(self, solve, harmonics, harmonic_tolerance, max_harmonic,
                                       estimate=estimate_harmonic_error)
+        can_check = not any(b.flexible_platform for b in self.blades)
+        response = with_peak_check(self, response, check_peak, harmonic_tolerance, can_check)
         return with_stop_check(self, response, f_start_hz, check_stop)
+
+    def peak_check(self, response: "MistunedResponse", **options):
+        """:meth:`time_response` at the frequency of ``response``'s peak (the largest first-harmonic
+        tip amplitude of any blade), as :meth:`TunedDisk.peak_check`."""
+        return time_at_peak(self, response, **options)
+
+    @staticmethod
+    def time_output_amplitudes(check) -> np.ndarray:
+        """(n_f, 3 s) first-harmonic tip amplitudes [m] of every blade of a :meth:`time_response`
+        ``check``, ordered as :meth:`output_amplitudes`."""
+        return check.tip_amplitude.reshape(len(check.tip_amplitude), -1)
 
     def stop_check(self, response: "MistunedResponse", offset_hz: float = STOP_CHECK_OFFSET_HZ,
                    f_start_hz: float | None = None, **options):
@@ -1214,6 +1232,8 @@ class MistunedResponse(FrequencyResponse):
     stop_check : for a branch that stopped before the end of its range, computed with
         ``check_stop=True``: the time integration of the assembly just beyond where it got
         furthest (a one-frequency :class:`bladedamp.timedomain.DiskTimeResponse`), else None
+    peak_check : for a branch whose harmonic error the enriched set could not verify, computed
+        with ``check_peak=True``: the time integration of the assembly at its peak's frequency, else None
     """
 
     tip_amplitude: np.ndarray = None
@@ -1224,6 +1244,7 @@ class MistunedResponse(FrequencyResponse):
     damper_work_bound: np.ndarray = None
     tuned_peak_amplitude: float | None = None
     stop_check: object = None
+    peak_check: object = None
     disk: MistunedDisk = None
 
     @classmethod

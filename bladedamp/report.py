@@ -795,13 +795,15 @@ def frf_outputs(out: Path, design, responses: dict) -> dict:
         err = getattr(r, "harmonic_error", float("nan"))
         i = int(np.argmax(tip)) if len(tip) else None
         peak, f_peak = (float(tip[i]), float(r.frequency_hz[i])) if len(tip) else (float("nan"), float("nan"))
+        check = getattr(r, "peak_check", None)          # the time integration at the peak (check_peak)
+        timed = None if check is None else str(check.status[0])
         summary["responses"][label] = {
             "success": bool(r.success), "message": r.message, "harmonics": list(r.basis.harmonics),
             "harmonic_error_pct": 100 * err, "peak_amplitude_mm": 1e3 * peak, "peak_frequency_hz": f_peak,
-            "frequency_hz": r.frequency_hz, "tip_amplitude_x_mm": 1e3 * tip}
+            "peak_time_check": timed, "frequency_hz": r.frequency_hz, "tip_amplitude_x_mm": 1e3 * tip}
         rows.append(f"| {label} | {'yes' if r.success else 'no: ' + r.message} | {tuple(r.basis.harmonics)} | "
                     f"{'not estimated' if not np.isfinite(err) else f'{100 * err:.2g} %'} | {_mm(peak)} | "
-                    f"{'-' if not np.isfinite(f_peak) else f'{f_peak:.3f} Hz'} |")
+                    f"{'-' if not np.isfinite(f_peak) else f'{f_peak:.3f} Hz'} | {timed or '-'} |")
     ax.set_xlabel("excitation frequency [Hz]")
     ax.set_ylabel("tip amplitude u_x [mm]")
     ax.grid(True, alpha=0.3)
@@ -810,7 +812,8 @@ def frf_outputs(out: Path, design, responses: dict) -> dict:
     save_figure(fig, out / "frf.png")
     write_json(out / "results.json", summary)
     files.append("results.json")
-    lines = ["| response | complete | harmonics | harmonic error | peak u_x | at |", "|---|---|---|---|---|---|", *rows]
+    lines = ["| response | complete | harmonics | harmonic error | peak u_x | at | time integration at the peak |",
+             "|---|---|---|---|---|---|---|", *rows]
     write_summary(out, "frf", design, lines, files)
     return summary
 

@@ -161,6 +161,11 @@ def test_frf_on_an_init_design_gives_the_reference_response(fast_design, tmp_pat
     direct = reference_disk().frequency_response(92.0, 99.0, harmonics=(1,), max_step=0.02)
     assert r["peak_amplitude_mm"] == pytest.approx(1e3 * direct.tip_amplitude[:, 0].max(), rel=1e-12)
     assert "| EO1 | yes | (1,) |" in summary
+    # the peak is checked by time integration by default: the reference 1 g cylinder keeps rolling
+    # there while the blades' vibration settles ("drifting", tests/test_timedomain_disk.py), and the
+    # one-harmonic answer is some per cent from the time integration's mean tip amplitude
+    assert r["peak_time_check"] == "drifting" and "| drifting |" in summary
+    assert 1 < r["harmonic_error_pct"] < 10
     loaded = bladedamp.load(out / "frf_EO1.npz")
     assert np.array_equal(loaded.tip_amplitude, direct.tip_amplitude)
 
@@ -196,18 +201,21 @@ def small_design(tmp_path_factory):
 
 def test_frf_checks_a_stopped_branch_by_time_integration_unless_told_not_to(small_design, tmp_path, monkeypatch):
     """``bladedamp frf`` asks the tuned responses for ``check_stop`` (the time integration beyond a
-    branch that stops early, tested in test_disk.py); ``--no-stop-check`` turns it off."""
+    branch that stops early, tested in test_disk.py) and ``check_peak`` (at the peak of a branch
+    whose harmonic error the enriched set could not verify, tested in test_random_designs.py);
+    ``--no-stop-check`` and ``--no-peak-check`` turn them off, each alone."""
     from bladedamp.disk import TunedDisk
 
     asked, original = [], TunedDisk.frequency_response
 
     def spy(self, *args, **options):
-        asked.append(options.get("check_stop"))
+        asked.append((options.get("check_stop"), options.get("check_peak")))
         return original(self, *args, **options)
     monkeypatch.setattr(TunedDisk, "frequency_response", spy)
     assert main(["frf", str(small_design), "--out", str(tmp_path / "a")]) == 0
     assert main(["frf", str(small_design), "--no-stop-check", "--out", str(tmp_path / "b")]) == 0
-    assert asked == [True, False]
+    assert main(["frf", str(small_design), "--no-peak-check", "--out", str(tmp_path / "c")]) == 0
+    assert asked == [(True, True), (False, True), (True, False)]
 
 
 def test_frf_mistuned_with_unit_kappa_is_the_tuned_response(small_design, tmp_path):

@@ -160,16 +160,17 @@ def test_mixing_flexible_and_rigid_blades_is_refused(steel):
 
 
 @needs_fe
-def test_check_stop_is_refused_for_flexible_platforms(steel):
-    """The stop check integrates in time, which models rigid platforms only: check_stop=True on
-    a flexible-platform blade is a ValueError naming the option, before any solve, for the
-    tuned and the mistuned disk alike."""
+@pytest.mark.parametrize("option", ["check_stop", "check_peak"])
+def test_time_checks_are_refused_for_flexible_platforms(steel, option):
+    """The stop and the peak checks integrate in time, which models rigid platforms only:
+    check_stop=True or check_peak=True on a flexible-platform blade is a ValueError naming the
+    option, before any solve, for the tuned and the mistuned disk alike."""
     tuned = dataclasses.replace(reference_disk("cylinder", 1e-3), blade=steel, n_blades=2)
-    with pytest.raises(ValueError, match="check_stop .*rigid platforms only"):
-        tuned.frequency_response(92.0, 93.0, check_stop=True)
-    with pytest.raises(ValueError, match="check_stop .*rigid platforms only"):
+    with pytest.raises(ValueError, match=f"{option} .*rigid platforms only"):
+        tuned.frequency_response(92.0, 93.0, **{option: True})
+    with pytest.raises(ValueError, match=f"{option} .*rigid platforms only"):
         MistunedDisk([steel, steel], bd.CylinderDamper(1e-3), n_blades=2).frequency_response(92.0, 93.0,
-                                                                                             check_stop=True)
+                                                                                             **{option: True})
 
 
 # --------------------------------------------------------------------------------------
