@@ -952,9 +952,10 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
             return response
         return dataclasses.replace(response, message=response.message + "; frequency_response(..., check_peak=True) "
                                    "checks the peak by time integration")
-    amp = model.output_amplitudes(response.coefficients, response.basis)
+    k = peak_index(model, response)
+    at_peak = model.output_amplitudes(response.coefficients[k:k + 1], response.basis)[0]
     check = model.peak_check(response)
-    f, peak = check.frequency_hz[0], max(float(amp.max()), 1e-300)
+    f, peak = check.frequency_hz[0], max(float(at_peak.max()), 1e-300)
     separated = 100 * check.point_state[0][..., 2].mean()
     where = f"at the peak, {f:.4f} Hz, the time integration of the full assembly (from the static equilibrium)"
     status = check.status[0]
@@ -963,12 +964,12 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
                  f"{separated:.0f} % of the period): the branch's peak is not a motion the disk settles on")
         warnings.warn(found, AccuracyWarning, stacklevel=3)
         return dataclasses.replace(with_checks(response, {"peak_time_check": found}), peak_check=check)
-    direct = float(np.abs(model.time_output_amplitudes(check)[0] - amp[peak_index(model, response)]).max() / peak)
+    direct = float(np.abs(model.time_output_amplitudes(check)[0] - at_peak).max() / peak)
     error = max(direct, enriched) if np.isfinite(enriched) else direct
     met = error <= tolerance
     motion = ("settles on a periodic motion" if status == "periodic" else
               f"settles on a vibration whose first harmonics are steady while a damper keeps rolling or walking "
-              f"({check.message[0].split(';')[0]}; its mean tip amplitudes compared)")
+              f"({check.message[0]}; its mean tip amplitudes compared)")
     note = (f"{where} {motion}, {100 * direct:.2g} % from the branch's first-harmonic tip amplitudes (the damper's "
             f"contact points separated {separated:.0f} % of the period): harmonic error estimate {100 * error:.2g} %, "
             + ("within" if met else "above") + f" the tolerance {100 * tolerance:.2g} %")
@@ -1119,9 +1120,9 @@ class DiskResponse(FrequencyResponse):
         ``check_stop=True``: the time integration of the full assembly just beyond where it got
         furthest (a one-frequency :class:`bladedamp.timedomain.DiskTimeResponse`; its ``periodic``
         says whether a periodic motion exists there, :func:`stop_verdict`), else None
-    peak_check : for a branch whose harmonic error the enriched set could not verify, computed
-        with ``check_peak=True``: the time integration of the full assembly at its peak's
-        frequency (a one-frequency DiskTimeResponse, :func:`with_peak_check`), else None
+    peak_check : for a branch that reached the end of its range, computed with
+        ``check_peak=True``: the time integration of the full assembly at its peak's frequency
+        (a one-frequency DiskTimeResponse, :func:`with_peak_check`), else None
     """
 
     tip_amplitude: np.ndarray = None

@@ -1052,7 +1052,7 @@ class MistunedDisk:
         (its ``stop_check`` and message); rigid platforms only (what :meth:`time_response` models).
         A failed branch without it says how to tell. ``check_peak``: for a branch that reached the
         end, the time integration at the peak's frequency gives a direct harmonic error estimate,
-        or fails the response where that motion is not periodic, as
+        or fails the response where the vibration there does not settle, as
         :meth:`TunedDisk.frequency_response` (:meth:`peak_check`, :func:`~bladedamp.disk.with_peak_check`)."""
         validation.positive("f_start_hz", f_start_hz)
         validation.positive("f_end_hz", f_end_hz)
@@ -1232,8 +1232,8 @@ class MistunedResponse(FrequencyResponse):
     stop_check : for a branch that stopped before the end of its range, computed with
         ``check_stop=True``: the time integration of the assembly just beyond where it got
         furthest (a one-frequency :class:`bladedamp.timedomain.DiskTimeResponse`), else None
-    peak_check : for a branch whose harmonic error the enriched set could not verify, computed
-        with ``check_peak=True``: the time integration of the assembly at its peak's frequency, else None
+    peak_check : for a branch that reached the end of its range, computed with
+        ``check_peak=True``: the time integration of the assembly at its peak's frequency, else None
     """
 
     tip_amplitude: np.ndarray = None
