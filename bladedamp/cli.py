@@ -688,7 +688,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "the range (by default it runs, 1-3 min, and the summary says whether a periodic motion exists there;\n"
                         "not for solid FE blades with flexible platforms)")
     p.add_argument("--no-peak-check", action="store_true",
-                   help="skip the time integration at the peak of a complete branch (by default it runs, 5-60 s,\n"
+                   help="skip the time integration at the peak of a complete branch (by default it runs, 5-31 s,\n"
                         "and gives a direct harmonic error estimate, or fails the branch where the vibration there does\n"
                         "not settle; not for solid FE blades with flexible platforms)")
     out_arg(p, "results/frf")

@@ -659,7 +659,7 @@ class TunedDisk:
         branch is a direct harmonic error estimate (the only one where the enriched set's Newton
         fails at the peak, typically with the damper separated most of the period); where the
         vibration does not settle, the response fails (:func:`with_peak_check`; its
-        ``peak_check`` keeps the integration). One time integration (1-3 s for 4 blades, 5-60 s
+        ``peak_check`` keeps the integration). One time integration (1-3 s for 4 blades, 5-31 s
         for 16 on 2 cores); the same restrictions as ``check_stop``.
         """
         validation.positive("f_start_hz", f_start_hz)
