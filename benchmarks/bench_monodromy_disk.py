@@ -36,7 +36,7 @@ def main(blades=(4, 16)):
             times.append(time.perf_counter() - t)
             print(f"  {n} blades {r.frequency_hz[i]:.2f} Hz: max |mu| {abs(mu[0]):.9f}, periodicity error {err:.2e}, "
                   f"{times[-1]:.2f} s")
-        mono, z, err, steps = disk_monodromy(disk, r.coefficients[idx[1]], r.basis, float(r.omega[idx[1]]))
+        mono, z, err, steps, _ = disk_monodromy(disk, r.coefficients[idx[1]], r.basis, float(r.omega[idx[1]]))
         print(f"{n} blades: state m = {z.size}, {steps} steps per period; HBM {t_hbm * 1e3:.1f} ms per point "
               f"({len(r.omega)} points), monodromy {np.mean(times):.2f} s per point = {np.mean(times) / t_hbm:.0f} x")
 

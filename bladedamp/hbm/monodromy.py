@@ -85,6 +85,8 @@ AccuracyWarning (periodicity error above ``PERIODICITY_LIMIT``).
 """
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
@@ -293,17 +295,27 @@ def _disk_sliders(arrays, X, basis):
     return sliders, amplitude
 
 
-def disk_monodromy(model, coefficients, basis, omega: float, steps: int | None = None):
+class DiskMonodromy(NamedTuple):
+    """The monodromy of a bladed disk's HBM orbit (:func:`disk_monodromy`); m = 2 N + 2 P."""
+    matrix: np.ndarray               # (m, m) d P(z) / d z by central differences, state (x_0, x_-1, s)
+    state: np.ndarray                # (m,) the orbit's state z at t = 0
+    periodicity_error: float         # max |P(z) - z| over x_0 and x_-1, relative to each kind's amplitude
+    steps: int                       # central-difference steps per period
+    fd_step: np.ndarray              # (m,) the finite-difference step h of each state component
+
+
+def disk_monodromy(model, coefficients, basis, omega: float, steps: int | None = None) -> DiskMonodromy:
     """Monodromy matrix (m, m), m = 2 N + 2 P, of a bladed disk's HBM solution (see the module
     docstring): ``model`` a TunedDisk (its sector solution written out on the full assembly) or
     a full-assembly MistunedDisk, ``coefficients`` (C * n,) or (C, n) in ``basis`` (with the
     static harmonic) at ``omega`` [rad/s]; ``steps`` per period (default: the more of
     MIN_STEPS_PER_PERIOD and 1 / 0.8 of the stability limit; fewer than the limit is a
-    ValueError). Returns (monodromy (m, m) in the state (x_0, x_-1, s) of the full assembly,
-    z (m,), periodicity error: max |P(z) - z| over x_0 and x_-1, each component relative to the
-    orbit's vibration amplitude of its kind (blade modal coordinates, damper translations,
-    damper rotations), steps). An AccuracyWarning when the periodicity error exceeds
-    ``PERIODICITY_LIMIT``."""
+    ValueError). Returns a :class:`DiskMonodromy`: the monodromy (m, m) in the state (x_0, x_-1,
+    s) of the full assembly, z (m,), the periodicity error (max |P(z) - z| over x_0 and x_-1,
+    each component relative to the orbit's vibration amplitude of its kind: blade modal
+    coordinates, damper translations, damper rotations), the steps per period and the
+    finite-difference steps h (m,) (a column's rounding error is about eps |P(z)| / h). An
+    AccuracyWarning when the periodicity error exceeds ``PERIODICITY_LIMIT``."""
     from ..timedomain import MIN_STEPS_PER_PERIOD, highest_frequency
 
     if not basis.has_static:
@@ -361,7 +373,7 @@ def disk_monodromy(model, coefficients, basis, omega: float, steps: int | None =
             f"integration (periodicity error {error:.3g}, largest in {worst}; a rolling cylinder drifts in "
             f"phi_y, which only the HBM's static retention spring holds): the multipliers linearise a transient, "
             f"their stability verdict does not apply"), stacklevel=2)
-    return mono, z, error, steps
+    return DiskMonodromy(mono, z, error, steps, h)
 
 
 def supports(model) -> bool:
@@ -391,6 +403,6 @@ def monodromy_multipliers(model, coefficients, basis, omega: float, steps: int |
         mono, _, error = oscillator_monodromy(model, coefficients, basis, omega,
                                               STEPS_PER_PERIOD if steps is None else steps)
     else:
-        mono, _, error, _ = disk_monodromy(model, coefficients, basis, omega, steps)
+        mono, _, error, _, _ = disk_monodromy(model, coefficients, basis, omega, steps)
     mu = np.linalg.eigvals(mono).astype(complex)
     return mu[np.argsort(-np.abs(mu))], error
