@@ -55,10 +55,11 @@ from meshcat.servers.tree import SceneTree, find_node, walk
 from meshcat.servers.zmqserver import VIEWER_ROOT, create_command
 
 from .. import geometry as bgeo
+from .. import palette
 from ..damper.kinetics import seat
 
-STATE_NAMES = ("stick", "slip", "separated")
-STATE_COLORS = np.array([[0.16, 0.62, 0.17], [0.90, 0.30, 0.10], [0.55, 0.55, 0.60]])   # green, orange, grey
+STATE_NAMES = palette.CONTACT_STATE_NAMES
+STATE_COLORS = np.array([palette.rgb(c) for c in palette.CONTACT_STATES])   # stick, slip, separated
 BLADE_COLOR = 0xb8c2cc
 PLATFORM_COLOR = 0x8796a6
 DAMPER_COLOR = 0xd4a017

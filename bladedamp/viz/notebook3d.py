@@ -25,9 +25,8 @@ from functools import lru_cache
 
 import numpy as np
 
-STATE_COLORS = ("#2a9e2c", "#e64d1a", "#8c8c99")   # stick, slip, separated (as in the 3D maps)
-STATE_NAMES = ("stick", "slip", "separated")
-
+from ..palette import CONTACT_STATE_NAMES as STATE_NAMES
+from ..palette import CONTACT_STATES as STATE_COLORS
 
 # --------------------------------------------------------------------------------------
 # showing recorded meshcat scenes

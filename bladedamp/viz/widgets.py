@@ -29,6 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import palette
 from ..contact.laws import LinearNormalLaw
 from ..contact.patch import ContactPatch
 from ..contact.point import SEPARATED, SLIP, STICK, point_contact_forces
@@ -43,7 +44,7 @@ __all__ = ["interactive_view", "hysteresis_loop", "hysteresis_figure", "describi
 # the slider callbacks set the slip force mu N; this splits it into mu and N (only the lift-off
 # and normal-load plots see the split)
 FRICTION_COEFFICIENT = 0.3
-STATE_COLOURS = {STICK: "tab:blue", SLIP: "tab:red", SEPARATED: "tab:gray"}
+STATE_COLOURS = {state: palette.CONTACT_STATES[state] for state in (STICK, SLIP, SEPARATED)}
 STATE_NAMES = {STICK: "stick", SLIP: "slip", SEPARATED: "lift-off"}
 
 
