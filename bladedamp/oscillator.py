@@ -172,7 +172,8 @@ class FrictionOscillator:
                                   **continuation_options)
             C = system.basis.n_coeffs
             response = FrequencyResponse(branch.omega, branch.x.reshape(-1, C, 1), system.basis, ("x",),
-                                         branch.success, branch.message, branch.iterations, branch.turning_points)
+                                         branch.success, branch.message, branch.iterations, branch.turning_points,
+                                         stopped_by=branch.stopped_by)
             # per point: the excitation work, and the contact's dissipation and energy scale (one AFT)
             work = np.array([system.excitation_work(x, w) for x, w in zip(branch.x, branch.omega)])
             energies = np.array([[sum(e) for e in system.element_energies(x, w)]

@@ -160,7 +160,11 @@ def test_frf_on_an_init_design_gives_the_reference_response(fast_design, tmp_pat
     # the same numbers as the reference disk computed directly with the file's settings
     direct = reference_disk().frequency_response(92.0, 99.0, harmonics=(1,), max_step=0.02)
     assert r["peak_amplitude_mm"] == pytest.approx(1e3 * direct.tip_amplitude[:, 0].max(), rel=1e-12)
-    assert "| EO1 | yes | (1,) |" in summary
+    # the one-harmonic answer, some per cent from the time integration below, is above the 1 %
+    # tolerance: the summary leads with that status, not with "complete"
+    assert r["status"] == "complete, above tolerance" and r["status_message"].startswith(r["status"])
+    assert f"- **EO1**: {r['status_message']}" in summary and "| EO1 | complete, above tolerance | (1,) |" in summary
+    assert not r["peak_at_range_end"]
     # the peak is checked by time integration by default: the reference 1 g cylinder keeps rolling
     # there while the blades' vibration settles ("drifting", tests/test_timedomain_disk.py), and the
     # one-harmonic answer is some per cent from the time integration's mean tip amplitude
