@@ -1268,7 +1268,7 @@ class MistunedResponse(FrequencyResponse):
                    branch.turning_points, tip_amplitude=tip, excitation_work=np.array(exc),
                    viscous_dissipation=np.array(visc), dissipated_energy=diss.sum(axis=1), damper_dissipation=diss,
                    damper_work_bound=bound,
-                   tuned_peak_amplitude=tuned_peak_amplitude, disk=disk)
+                   tuned_peak_amplitude=tuned_peak_amplitude, disk=disk, stopped_by=branch.stopped_by)
 
     @property
     def n_sector(self) -> int:

@@ -356,3 +356,24 @@ def test_progress_bar_in_place_on_a_terminal_and_one_line_otherwise():
             tick(done, 10)
     assert log.getvalue().count("\n") == 1 and "mass sweep done (10)" in log.getvalue()
     assert "\r" in tty.getvalue() and "10/10" in tty.getvalue() and "mass sweep done (10)" in tty.getvalue()
+
+
+def test_frf_leads_with_the_status_and_names_a_range_end_maximum(tmp_path, capsys):
+    """A 1 kg cylinder sticks and moves the resonance to 109.65 Hz, beyond the design's 90-105 Hz:
+    the largest amplitude at 105 Hz is reported as such, with where the resonance may lie."""
+    path = tmp_path / "heavy.toml"
+    path.write_text("[damper]\nmass_g = 1000.0\n\n[analysis]\nharmonics = [1]\n")
+    out = tmp_path / "frf"
+    assert main(["frf", str(path), "--no-stop-check", "--no-peak-check", "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    summary, results = _outputs(out, "frf.png", "summary.md", "results.json", "frf_EO1.npz")
+    r = results["responses"]["EO1"]
+    assert r["peak_at_range_end"] and r["peak_frequency_hz"] == pytest.approx(105.0, abs=1e-9)
+    free, stuck = r["linear_natural_frequencies_hz"]
+    assert free == pytest.approx(95.0) and stuck == pytest.approx(109.65, abs=0.01)
+    assert r["status"] == "complete, verified" and "may lie above the range" in r["status_message"]
+    assert f"EO1: {r['status_message']}" in err                          # the status leads the output
+    assert f"EO1 largest amplitude at the range end {r['peak_amplitude_mm']:.4f} mm at 105.000 Hz" in err
+    assert "EO1 peak" not in err
+    assert f"- **EO1**: {r['status_message']}" in summary
+    assert "| EO1 | complete, verified | (1,) |" in summary and "(largest amplitude at the range end)" in summary

@@ -240,3 +240,21 @@ def test_the_reference_disk_over_its_range_is_not_flagged():
         r = bd.reference_disk().frequency_response(92.0, 99.0, harmonics=(1,), max_step=0.05)
     assert r.success and not r.peak_at_range_end and r.linear_natural_frequencies_hz == ()
     assert "range end" not in r.status_message and "range end" not in r.message
+
+
+def test_a_mistuned_response_has_a_status_a_stop_reason_and_one_range_end_flag():
+    """Four blades, 1 g cylinders, 2 % mistuning: over 92-99 Hz every blade's peak lies inside
+    (tests/test_api.py); stopped by the caller at 95 Hz the curves still rise at the stop."""
+    td = dataclasses.replace(bd.reference_disk("cylinder", 1e-3), n_blades=4)
+    disk = bd.MistunedDisk.from_tuned(td, [1.01, 0.99, 1.02, 1.0])
+
+    def stop_when(x, omega):
+        return "budget: stopped at 95 Hz" if omega > 2 * np.pi * 95.0 else ""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        full = disk.frequency_response(92.0, 99.0, harmonics=(1,), max_step=0.1)
+        part = disk.frequency_response(92.0, 99.0, harmonics=(1,), max_step=0.1, stop_when=stop_when)
+    assert full.status is Status.COMPLETE_VERIFIED and full.peak_at_range_end is False
+    assert part.stopped_by == "budget: stopped at 95 Hz" and part.status is Status.OUT_OF_BUDGET
+    assert part.peak_at_range_end is True and part.linear_natural_frequencies_hz == ()
+    assert "end of the computed range (95" in part.status_message
