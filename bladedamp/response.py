@@ -188,7 +188,7 @@ class Status(enum.Enum):
     COMPLETE_VERIFIED = "complete, verified"
     COMPLETE_UNVERIFIED = "complete, unverified"
     COMPLETE_ABOVE_TOLERANCE = "complete, above tolerance"
-    CHECK_FAILED = "complete, check failed"
+    CHECK_FAILED = "check failed"
     STOPPED = "stopped"
     OUT_OF_BUDGET = "out of budget"
 
