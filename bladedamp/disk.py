@@ -1228,7 +1228,7 @@ class DiskResponse(FrequencyResponse):
         """|W_exc - W_visc - W_friction| / W_exc at every point."""
         return np.abs(self.excitation_work - self.viscous_dissipation - self.dissipated_energy) / np.abs(self.excitation_work)
 
-    def first_harmonic_output(self) -> np.ndarray:
+    def peak_curve(self) -> np.ndarray:
         """(n,) first-harmonic tip amplitude |u_x| at every point [m] (its largest is the peak)."""
         return self.tip_amplitude[:, 0]
 

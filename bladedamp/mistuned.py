@@ -1319,7 +1319,7 @@ class MistunedResponse(FrequencyResponse):
         """(s,) frequency of each blade's peak [Hz] (parabola-refined, as :attr:`peak_amplitude`)."""
         return self.peaks()[1]
 
-    def first_harmonic_output(self) -> np.ndarray:
+    def peak_curve(self) -> np.ndarray:
         """(n, s) first-harmonic tip amplitude |u_x| of every blade at every point [m]: the
         response's :attr:`peak_at_range_end` when any blade's largest lies at an end of the range."""
         return self.tip_amplitude[:, :, 0]

@@ -291,7 +291,7 @@ def range_end_note(response) -> str:
     none and the stuck one, so its resonance lies between these two frequencies (up to the shift
     of the contact's own inertia)."""
     f = response.frequency_hz
-    end = range_end_of_largest(f, response.first_harmonic_output())
+    end = range_end_of_largest(f, response.peak_curve())
     if end is None:
         return ""
     side = "above" if end == f.max() and f.max() > f.min() else "below"
@@ -448,12 +448,12 @@ class FrequencyResponse(Saveable):
 
     @property
     def peak_at_range_end(self) -> bool:
-        """Whether the largest first-harmonic output amplitude (:meth:`first_harmonic_output`)
+        """Whether the largest first-harmonic output amplitude (:meth:`peak_curve`)
         lies at the first or last frequency of the range (:func:`range_end_of_largest`): then it
         is no resonance, and :attr:`status_message` says where the resonance may lie."""
-        return range_end_of_largest(self.frequency_hz, self.first_harmonic_output()) is not None
+        return range_end_of_largest(self.frequency_hz, self.peak_curve()) is not None
 
-    def first_harmonic_output(self) -> np.ndarray:
+    def peak_curve(self) -> np.ndarray:
         """(n,) the output's first-harmonic amplitude at every point, whose largest is the peak:
         here |X_1| of the first DOF [SI]; the disks' the tip amplitude u_x [m] ((n, s), one
         column per blade, for a mistuned disk)."""
