@@ -24,7 +24,7 @@ def cylinder_frf():
 
 @pytest.fixture(scope="module")
 def ods(cylinder_frf):
-    return mv.ods_scene(cylinder_frf, n_frames=N_FRAMES)
+    return mv.ods_scene(cylinder_frf, n_frames=N_FRAMES, contact_maps=True)
 
 
 def test_blade_deflection_matches_the_mode_shapes_at_the_known_points():
@@ -201,7 +201,10 @@ def test_show_defaults_to_the_whole_disk_with_its_dampers_and_the_maps_beside_it
     assert info["layout"] == "disk" and len(info["blades"]) == n
     paths = scene.paths()
     assert all(f"/meshcat/bladedamp/dampers/damper_{k:02d}/body/mesh" in paths for k in range(n))
-    # the maps and their legend lie right of the blade tips' circle: they cross no blade
+    # the contact is painted on damper 0's faces, not drawn beside the disk (no maps by default)
+    assert list(info["paint"]["dampers"]) == [0] and not any("contact_map" in p for p in paths)
+    # asked for, the maps and their legend lie right of the blade tips' circle: they cross no blade
+    info = mv.show(cylinder_frf, n_frames=4, contact_maps=True).info
     r_tip = info["root_radius"] + bgeo.reference_blade_geometry().total_length
     x0 = info["map_origin"][0]
     assert x0 > r_tip
