@@ -171,10 +171,11 @@ def test_browser_renders_the_scene_and_its_animation(cylinder_frf, tmp_path):
     empty.vis["/Grid"].set_property("visible", False)
     empty.vis["/Axes"].set_property("visible", False)
     shots = {}
+    # the whole sector in view (the close-up on a damper, the default, is checked in test_viz_contact.py)
     scenes = {"empty": empty,
-              "phase0": mv.ods_scene(cylinder_frf, animate=False, phase=0.5 * np.pi, n_frames=N_FRAMES),
-              "phase1": mv.ods_scene(cylinder_frf, animate=False, phase=1.5 * np.pi, n_frames=N_FRAMES)}
-    animated = mv.ods_scene(cylinder_frf, n_frames=N_FRAMES, period_s=2.0)
+              "phase0": mv.ods_scene(cylinder_frf, animate=False, phase=0.5 * np.pi, n_frames=N_FRAMES, view="whole"),
+              "phase1": mv.ods_scene(cylinder_frf, animate=False, phase=1.5 * np.pi, n_frames=N_FRAMES, view="whole")}
+    animated = mv.ods_scene(cylinder_frf, n_frames=N_FRAMES, period_s=2.0, view="whole")
     for name, scene in scenes.items():
         html = scene.save_html(tmp_path / f"{name}.html")
         shots[name] = _pixels(mv.screenshot(html, tmp_path / f"{name}.png", virtual_time_ms=2000))
