@@ -887,7 +887,7 @@ def ods_scene(result, index: int | None = None, frequency_hz: float | None = Non
     if has_damper:
         # front and below: the platforms' inclined faces and the damper between them
         R0 = D[0][:3, :3]
-        cameras["damper"] = (D[0][:3, 3].copy(), R0 @ np.array([0.0, -0.042, -0.022]))
+        cameras["damper"] = (D[0][:3, 3].copy(), R0 @ np.array([0.0, -0.036, -0.018]))
     first = camera if camera is not None else cameras.get(view, whole)
     _set_camera(vis, *first)
     scene.info.update(index=data.index, frequency_hz=data.frequency_hz, scale=scale, n_frames=n_frames,
@@ -1066,7 +1066,7 @@ def overlay_html(scene, title: str, legend: dict | None) -> str:
         buttons.append('damper: ' + " ".join(f'<button id="bd-damper-{v}" type="button">{v}</button>'
                                              for v in DAMPER_VIEWS))
     controls.append('<div>' + " ".join(buttons) + '</div>')
-    style = ("#bd-overlay {position: absolute; top: 8px; left: 8px; z-index: 10; max-width: 520px; "
+    style = ("#bd-overlay {position: absolute; top: 8px; left: 8px; z-index: 10; max-width: 580px; "
              "font: 14px/1.5 system-ui, sans-serif; color: #111; background: rgba(255, 255, 255, 0.9); "
              "padding: 8px 12px; border-radius: 6px; box-shadow: 0 1px 4px rgba(0, 0, 0, 0.3);} "
              "#bd-overlay div {margin: 2px 0;} #bd-title {font-size: 16px; font-weight: 600;} "
