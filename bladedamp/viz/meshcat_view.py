@@ -339,6 +339,7 @@ class CycleData:
     displacement : (T, 2, P, 3) relative displacement damper - platform of every point in its
         contact frame (xi, eta, zeta) [m], None without damper
     force : (T, 2, P, 3) contact force of every point on the platform, same axes [N]
+    slip_work : (2, P) energy dissipated by friction at every point over the cycle [J]
     """
 
     index: int
@@ -352,6 +353,7 @@ class CycleData:
     normal_load: np.ndarray | None = field(default=None, repr=False)
     displacement: np.ndarray | None = field(default=None, repr=False)
     force: np.ndarray | None = field(default=None, repr=False)
+    slip_work: np.ndarray | None = field(default=None, repr=False)
 
     def sample(self, frame: int, n_frames: int) -> int:
         """The AFT time sample shown at animation frame ``frame`` of ``n_frames`` per cycle (the
@@ -366,7 +368,7 @@ def cycle_data(result, index: int | None = None, frequency_hz: float | None = No
     i = _pick(result, index, frequency_hz)
     disk, basis = result.disk, result.basis
     X = result.coefficients[i]
-    states = ratio = normal = disp = force = None
+    states = ratio = normal = disp = force = work = None
     patches = ()
     if disk is not None and disk.has_damper:
         system = disk.hbm_system(basis.harmonics, basis.n_samples)
@@ -377,6 +379,7 @@ def cycle_data(result, index: int | None = None, frequency_hz: float | None = No
         normal = np.stack([ev.points.normal_load.T for ev in evs], axis=1)         # (T, 2, P)
         disp = np.stack([ev.points.displacement.transpose(1, 0, 2) for ev in evs], axis=1)   # (T, 2, P, 3)
         force = np.stack([ev.points.force.transpose(1, 0, 2) for ev in evs], axis=1)
+        work = np.array([ev.points.slip_work for ev in evs])                         # (2, P)
         patches = coupling.element.geometry.patches
         if basis.has_static:
             a_static = np.zeros((2, patches[0].n_points))
@@ -388,7 +391,7 @@ def cycle_data(result, index: int | None = None, frequency_hz: float | None = No
         with np.errstate(divide="ignore", invalid="ignore"):
             ratio = np.where(mean > 0, (mean - a.min(axis=0)) / mean, np.inf)
     return CycleData(i, float(result.frequency_hz[i]), X, basis, states, ratio,
-                     float(result.tip_amplitude[i, 0]), patches, normal, disp, force)
+                     float(result.tip_amplitude[i, 0]), patches, normal, disp, force, work)
 
 
 # --------------------------------------------------------------------------------------
