@@ -27,12 +27,23 @@ What is drawn (blade frame: x circumferential, y axial, z radial):
 * dampers: rigid-body motion u_D (6 DOF) about their centre of gravity;
 * blade k moves with x_0(tau + k dphi) (cyclic symmetry, Eq. 25); displacements are multiplied
   by ``scale`` (default: the tip amplitude shown as 8 % of the blade length);
-* contact maps of the reference damper's OL and OR patches, enlarged beside the sector: the
-  state of every point (stick / slip / separated) at each frame of the cycle (from the AFT time
-  samples of the contact model at the chosen frequency), and the lift-off ratio
-  r = (mean(a) - min(a)) / mean(a) of the approach a(t) = a_static - u_zeta(t) (r > 1: the point
-  lifts off during the cycle; with one harmonic this is Fig. 9's ratio of ``wedge_liftoff_map``);
-* a legend (a textured plane drawn with matplotlib).
+* the contact painted on the faces: at every point contact's position on the platforms' and the
+  damper's contact faces (:meth:`bladedamp.geometry.SectorLayout.contact_points`) a tile in the
+  colour of its state (stick / slip / separated, :mod:`bladedamp.palette`) or of its normal
+  pressure, one mesh per frame of the cycle (from the AFT time samples of the contact model at
+  the chosen frequency; damper k shows damper 0's samples at tau + k dphi); platform tiles move
+  with their platform, damper tiles with the damper;
+* the damper solid, transparent or exploded (moved radially inwards) so that the faces show; the
+  first camera on damper 0 between its two platforms, or on the whole sector / disk;
+* an HTML overlay on the standalone page (:func:`overlay_html`): the design, the frequency, the
+  legend, play / pause, a phase scrubber and the camera and damper buttons; the page reads
+  ``?phase=DEG&paused&view=...&damper=...`` when it opens (the live server of
+  :meth:`Scene.serve` shows the scene without it);
+* optionally (``contact_maps=True``) flat contact maps of the reference damper's OL and OR
+  patches, enlarged beside the model: the state of every point at each frame and the lift-off
+  ratio r = (mean(a) - min(a)) / mean(a) of the approach a(t) = a_static - u_zeta(t) (r > 1: the
+  point lifts off during the cycle; with one harmonic this is Fig. 9's ratio of
+  ``wedge_liftoff_map``), with a legend (a textured plane drawn with matplotlib).
 """
 from __future__ import annotations
 
@@ -1211,7 +1222,8 @@ def show(result, path=None, live: bool = False, open_browser: bool = False, **op
     """Build :func:`ods_scene` for ``result``; write it to ``path`` (standalone HTML) if given; with
     ``live=True`` also start a localhost meshcat server and return ``(scene, view)`` (close the view).
     Returns the Scene otherwise. Default layout: the whole disk ("disk", every blade and damper,
-    the contact maps and their legend beside it) for a damped disk, the sector without damper."""
+    damper 0's contact painted on its faces, the camera on it) for a damped disk, the sector
+    without damper."""
     disk = getattr(result, "disk", None)
     options.setdefault("layout", "disk" if disk is not None and disk.has_damper else "sector")
     scene = ods_scene(result, **options)
