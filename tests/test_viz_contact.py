@@ -142,7 +142,7 @@ def test_pressure_paint_is_the_normal_load_over_the_cell(cylinder_frf):
     f = 5
     expected = matplotlib.colormaps["viridis"](p[entry["samples"][f]] / vmax)[..., :3]
     np.testing.assert_allclose(entry["colors"][f], expected, atol=1e-12)
-    assert f'normal pressure [N/mm]: 0' in scene.overlay and f"{vmax:.3g}</div>" in scene.overlay
+    assert 'normal pressure [N/mm]: 0' in scene.overlay and f"{vmax:.3g}</div>" in scene.overlay
 
 
 def test_bad_view_options_name_the_parameter(cylinder_frf):
