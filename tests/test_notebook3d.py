@@ -84,3 +84,93 @@ def test_cycle_figure_and_tangential_ratio(cylinder_frf):
     assert np.all(np.abs(w) > 1)
     share = cylinder_frf.point_state[data.index]
     assert np.all(share[..., 0] > 0) and np.all(share[..., 1] > 0)
+
+
+# --------------------------------------------------------------------------------------
+# the 3D view with a point's hysteresis loop beside it
+# --------------------------------------------------------------------------------------
+def test_hysteresis_loop_is_the_points_friction_cycle(cylinder_frf):
+    """The loop's area (both tangential directions, trapezoidal rule over the samples) is the
+    energy the point's slider dissipates (the contact model's backward-Euler sum), to within the
+    two rules' difference 1/2 |sum dF . du|; on sticking samples its slope is the point's
+    tangential stiffness k_T w_p (the elastic slider of the friction law)."""
+    data = mv.cycle_data(cylinder_frf)
+    u, f = data.displacement[..., :2], data.force[..., :2]
+    du, df = np.roll(u, -1, axis=0) - u, np.roll(f, -1, axis=0) - f
+    area = (0.5 * (np.roll(f, -1, axis=0) + f) * du).sum(axis=(0, 3))
+    bound = 0.5 * np.abs((df * du).sum(axis=(0, 3)))
+    assert np.all(np.abs(area - data.slip_work) <= bound) and np.all(data.slip_work > 0)
+    direction, slip, force = nb3.hysteresis_loops(data)
+    np.testing.assert_allclose(np.linalg.norm(direction, axis=-1), 1.0, rtol=1e-12)
+    # the cylinder's points move along xi (the damper's axis eta sees no motion in 1F)
+    np.testing.assert_allclose(np.abs(direction[..., 0]), 1.0, atol=1e-6)
+    patch = data.patches[0]
+    k_point = patch.tangential_stiffness * patch.weights                     # (P,)
+    st = data.states
+    both = (st == 0) & (np.roll(st, -1, axis=0) == 0)
+    ds, dF = np.roll(slip, -1, axis=0) - slip, np.roll(force, -1, axis=0) - force
+    moving = both & (np.abs(ds) > 1e-3 * np.abs(slip).max())
+    assert moving.sum() > 10
+    slope = (dF / np.where(moving, ds, 1.0))[moving]
+    np.testing.assert_allclose(np.abs(slope), np.broadcast_to(k_point, st.shape)[moving], rtol=1e-6)
+    # the panel draws these numbers: its pixels map back to slip and force
+    panel = nb3.loop_panel(data, 12, point=("OR", 2))
+    assert panel["point"] == "OR 3" and len(panel["loops"]) == 2 * patch.n_points
+    xy = panel["loops"]["OR 3"]["xy"]
+    x, y = panel["to_px"](slip[:, 1, 2], force[:, 1, 2])
+    np.testing.assert_allclose(xy, np.column_stack([x, y]))
+    np.testing.assert_array_equal(panel["loops"]["OR 3"]["states"], st[:, 1, 2])
+    with pytest.raises(ValueError, match="point"):
+        nb3.loop_panel(data, 12, point=("OX", 0))
+
+
+def test_contact_view_marker_follows_the_animation_in_the_browser(cylinder_frf, tmp_path):
+    """Headless Chromium: with the animation paused and sought to a phase, the panel's marker sits on
+    the sample the 3D view paints there; the picker redraws the loop of the point picked."""
+    import json
+    import re
+    import subprocess
+    import tempfile
+
+    exe = mv.chromium_executable()
+    if exe is None:
+        pytest.skip("no chromium on this machine (.ci/run installs the Debian package)")
+    n_frames = 12
+    scene = nb3.contact_view_scene(cylinder_frf, n_frames=n_frames, layout="sector")
+    panel = scene.info["loop_panel"]
+    data = scene.info["cycle"]
+    probe = r"""<script>(function wait() {
+      if (document.body.getAttribute('data-bd-ready') !== '1') { setTimeout(wait, 20); return; }
+      var C = window.bladedampControls, m = document.getElementById('bd-loop-marker'), out = {};
+      C.setPlaying(false); C.seek(90);
+      setTimeout(function () {
+        out.at90 = [parseFloat(m.getAttribute('cx')), parseFloat(m.getAttribute('cy')), parseInt(m.getAttribute('data-sample'))];
+        C.seek(240);
+        setTimeout(function () {
+          out.at240 = [parseFloat(m.getAttribute('cx')), parseFloat(m.getAttribute('cy')), parseInt(m.getAttribute('data-sample'))];
+          var pick = document.getElementById('bd-point'); pick.value = 'OR 3'; pick.dispatchEvent(new Event('change'));
+          out.loop = document.getElementById('bd-loop').getAttribute('points');
+          out.dots = document.getElementById('bd-loop-samples').children.length;
+          out.panelFont = parseFloat(getComputedStyle(document.getElementById('bd-panel')).fontSize);
+          document.title = 'REPORT' + JSON.stringify(out);
+        }, 300);
+      }, 300);
+    })();</script></body>"""
+    page = tmp_path / "view.html"
+    page.write_text(scene.html().replace("</body>", probe), encoding="utf-8")
+    with tempfile.TemporaryDirectory() as profile:
+        out = subprocess.run([exe, "--headless", "--no-sandbox", "--disable-gpu", "--enable-unsafe-swiftshader",
+                              f"--user-data-dir={profile}", "--virtual-time-budget=5000", "--window-size=1000,650",
+                              "--dump-dom", "file://" + str(page)], capture_output=True, text=True, timeout=180).stdout
+    found = re.search(r"<title>REPORT(\{.*?\})</title>", out)
+    assert found, "the page did not report"
+    r = json.loads(found.group(1))
+    T = data.states.shape[0]
+    for key, deg in (("at90", 90), ("at240", 240)):
+        s = data.sample(int(np.floor(deg / 360 * n_frames + 1e-6)), n_frames)   # the frame painted
+        assert r[key][2] == s
+        np.testing.assert_allclose(r[key][:2], panel["loops"]["OL 1"]["xy"][s], atol=0.01)
+    assert r["at90"][2] != r["at240"][2]
+    drawn = np.array([[float(v) for v in p.split(",")] for p in r["loop"].split()])
+    np.testing.assert_allclose(drawn[:-1], panel["loops"]["OR 3"]["xy"], atol=0.01)   # closed polyline
+    assert r["dots"] == T and r["panelFont"] >= 12
