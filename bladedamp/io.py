@@ -71,7 +71,7 @@ class WrongKindError(FileReadError, TypeError):
 
 #: what a reader raises on a file's bad content (a NameError or an ImportError is a bug, not the file's)
 CONTENT_ERRORS = (OSError, ValueError, LookupError, TypeError, AttributeError, EOFError, RecursionError,
-                  zipfile.BadZipFile, zlib.error, struct.error)
+                  NotImplementedError, zipfile.BadZipFile, zlib.error, struct.error)
 
 
 @contextlib.contextmanager
@@ -116,7 +116,7 @@ def _file_problem(path: Path, what: str, exc: BaseException) -> tuple[str, bool]
         return f"not a readable {what}: not UTF-8 text (byte {exc.object[exc.start]:#04x} at offset {exc.start})", True
     if isinstance(exc, ValueError) and not isinstance(exc, json.JSONDecodeError) and str(path) in str(exc):
         return str(exc), True
-    if isinstance(exc, (zipfile.BadZipFile, zlib.error, EOFError, struct.error)):
+    if isinstance(exc, (zipfile.BadZipFile, zlib.error, EOFError, struct.error, NotImplementedError)):
         return f"truncated or corrupted, not a readable {what} ({exc})", True
     if isinstance(exc, json.JSONDecodeError):
         return f"not a readable {what}: broken JSON ({exc})", True
