@@ -192,22 +192,21 @@ def test_a_broken_file_raises_one_value_error_naming_it(tmp_path, kind, how):
         assert "truncated or corrupted" in message, message
 
 
-def test_every_flipped_byte_and_every_cut_of_an_npz_gives_the_result_or_one_clean_error(tmp_path):
-    """Exhaustive over the two npz formats (a saved result: stored members; a blade file:
-    compressed ones): each single byte flipped, and the file cut at every length, either still
-    reads (a zip header field no reader checks, such as a time stamp) or raises one FileReadError
-    naming the file; never a raw exception."""
-    for kind, cut_step in (("result", 1), ("blade.npz", 3)):
+def test_flipped_bytes_and_cuts_all_over_an_npz_give_the_result_or_one_clean_error(tmp_path):
+    """Over the whole of the two npz formats (a saved result: stored members; a blade file:
+    compressed ones): every 5th byte flipped (about 900 files), and the file cut at every 17th
+    length, either still reads (a zip header field no reader checks, such as a time stamp) or
+    raises one FileReadError naming the file; never a raw exception."""
+    for kind in ("result", "blade.npz"):
         write, read = WRITERS[kind]
         good = write(tmp_path).read_bytes()
-        path = tmp_path / f"broken_{kind}"
-        path = path.with_name(path.name.replace(".npz", "") + ".npz")
+        path = tmp_path / f"broken_{kind.replace('.npz', '')}.npz"
         variants = []
-        for i in range(len(good)):
+        for i in range(0, len(good), 5):
             flipped = bytearray(good)
             flipped[i] ^= 0xFF
             variants.append(bytes(flipped))
-        variants += [good[:n] for n in range(0, len(good), cut_step)]
+        variants += [good[:n] for n in range(0, len(good), 17)]
         failed = 0
         for data in variants:
             path.write_bytes(data)
