@@ -122,7 +122,13 @@ def _file_problem(path: Path, what: str, exc: BaseException) -> tuple[str, bool]
         return f"not a readable {what}: broken JSON ({exc})", True
     if isinstance(exc, KeyError):
         return f"not a readable {what}: no entry {exc}", True
+    if type(exc) is ValueError:                      # a reader's own check, without the file's name
+        return f"not a readable {what}: {exc}", True
     return f"not a readable {what} ({type(exc).__name__}: {exc})", False
+
+
+#: the first bytes of a zip archive (an .npz): a local file header, or the end record of an empty one
+ZIP_MAGIC = (b"PK\x03\x04", b"PK\x05\x06")
 
 
 def open_npz(path) -> "np.lib.npyio.NpzFile":
@@ -132,14 +138,11 @@ def open_npz(path) -> "np.lib.npyio.NpzFile":
     path = Path(path)
     with open(path, "rb") as fh:
         head = fh.read(4)
-    if head and not head.startswith(b"PK"):
-        kind = "a single .npy array" if head.startswith(b"\x93NUM") else \
+    if head not in ZIP_MAGIC:
+        kind = "nothing" if not head else "a single .npy array" if head.startswith(b"\x93NUM") else \
             "text" if _is_text(path) else f"other bytes ({head!r}...)"
         raise ValueError(f"{path}: not a readable .npz file (it holds {kind}, not a zip archive of arrays)")
-    data = np.load(path, allow_pickle=False)
-    if not isinstance(data, np.lib.npyio.NpzFile):     # not reached after the check above; for safety
-        raise ValueError(f"{path}: not a readable .npz file (a single array, not an archive)")
-    return data
+    return np.load(path, allow_pickle=False)       # a zip archive: np.load gives an NpzFile
 
 
 def _is_text(path: Path) -> bool:

@@ -313,3 +313,21 @@ def test_cli_broken_design_or_blade_file_exits_2_with_one_line(tmp_path, capsys,
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
     assert err.startswith(f"bladedamp frf: error: {design}: ")
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("how", ["cut in half", "empty", "text", "random bytes", "deleted"])
+def test_a_broken_surface_mesh_names_the_file(tmp_path, how):
+    """A solid blade's surface (STL, read by trimesh; the package writes none, so a box exported by
+    trimesh stands for it). An STL has no checksum: a flipped byte is another mesh, which the
+    geometry's checks judge (closed, regions), so it is not among these cases."""
+    trimesh = pytest.importorskip("trimesh")
+    from bladedamp import solid
+
+    path = tmp_path / "blade.stl"
+    trimesh.creation.box((0.01, 0.01, 0.05)).export(path)
+    ALL_BREAKS[how](path, "stl")
+    with pytest.raises(ValueError) as info:
+        solid.SurfaceBladeGeometry(str(path), {})
+    message = str(info.value)
+    assert str(path) in message and "\n" not in message, message
+    assert isinstance(info.value, FileNotFoundError) == (how == "deleted"), type(info.value)
