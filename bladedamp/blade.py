@@ -77,6 +77,7 @@ import scipy.sparse
 import scipy.sparse.linalg
 
 from bladedamp import validation as check
+from bladedamp.io import open_npz, reading
 
 # Points every ModalBlade must carry.
 REQUIRED_POINTS = ("OL", "OR", "tip", "excitation")
@@ -492,25 +493,27 @@ class ModalBlade:
         mass-normalised 6-DOF shapes [m/sqrt(kg), rad/sqrt(kg)] at OL, OR, tip, excitation
         and any extra points) are described in the module docstring of :mod:`bladedamp.blade`.
         A file that breaks them raises ValueError naming the file, the key or column (and
-        the line) and what was expected; a missing file raises FileNotFoundError. A solid FE
+        the line) and what was expected; a file that is missing (:class:`bladedamp.io.MissingFileError`,
+        also a FileNotFoundError), empty, truncated, corrupted, not an ``.npz`` archive or not
+        UTF-8 text raises one :class:`bladedamp.io.FileReadError` (a ValueError) naming the file
+        and what is wrong (:func:`bladedamp.io.reading`). A solid FE
         blade's ``.npz`` (format :data:`SOLID_NPZ_FORMAT`, :meth:`bladedamp.solid.SolidModalBlade.save`)
         gives a :class:`bladedamp.solid.SolidModalBlade` with its flexible platforms and surface.
         """
         path = Path(path)
         kind = _modal_file_kind(path)
-        if not path.is_file():
-            raise FileNotFoundError(f"{path}: no such modal data file")
-        if kind == "npz":
-            fields, tag, extra = read_modal_npz(path)
-            if tag in SOLID_NPZ_FORMATS_READ:
-                from .solid import SolidModalBlade
-                return SolidModalBlade.from_npz_arrays(path, fields, extra)
-        else:
-            fields = _read_modal_csv(path)
-        try:
-            return cls(**fields)
-        except ValueError as err:
-            raise ValueError(f"{path}: {err}") from None
+        with reading(path, "modal data file"):
+            if kind == "npz":
+                fields, tag, extra = read_modal_npz(path)
+                if tag in SOLID_NPZ_FORMATS_READ:
+                    from .solid import SolidModalBlade
+                    return SolidModalBlade.from_npz_arrays(path, fields, extra)
+            else:
+                fields = _read_modal_csv(path)
+            try:
+                return cls(**fields)
+            except ValueError as err:
+                raise ValueError(f"{path}: {err}") from None
 
     def save(self, path) -> Path:
         """Write this blade to ``path``: ``.npz`` or ``.csv`` by its suffix (formats: module
@@ -706,15 +709,11 @@ def read_modal_npz(path) -> tuple[dict, str, dict]:
     file's ``format`` entry (:data:`MODAL_NPZ_FORMAT` when it has none, or
     :data:`SOLID_NPZ_FORMAT`); the other arrays (key -> array, read without pickle) are those
     beyond :data:`MODAL_NPZ_KEYS`, which only the solid format may have. ValueError naming the
-    file and the key for a file that breaks the format."""
+    file and the key for a file that breaks the format, :class:`bladedamp.io.FileReadError` (a
+    ValueError) naming the file for one that is missing, empty, truncated, corrupted or not an
+    ``.npz`` archive."""
     path = Path(path)
-    try:
-        data = np.load(path, allow_pickle=False)
-    except Exception as err:   # numpy raises several types for a file that is not an .npz
-        raise ValueError(f"{path}: not a readable .npz file ({err})") from None
-    if not isinstance(data, np.lib.npyio.NpzFile):
-        raise ValueError(f"{path}: expected an .npz archive of named arrays (got a single array)")
-    with data:
+    with reading(path, "modal data file"), open_npz(path) as data:
         keys = set(data.files)
 
         def array(key, kind):
@@ -771,8 +770,9 @@ def read_modal_npz(path) -> tuple[dict, str, dict]:
 
 
 def _read_modal_csv(path: Path) -> dict:
-    """ModalBlade fields from a .csv file, one row per (mode, point) (format: module docstring)."""
-    with open(path, newline="", encoding="utf-8-sig") as fh:
+    """ModalBlade fields from a .csv file, one row per (mode, point) (format: module docstring);
+    :class:`bladedamp.io.FileReadError` naming the file if it cannot be read as UTF-8 text."""
+    with reading(path, "modal data file"), open(path, newline="", encoding="utf-8-sig") as fh:
         numbered = [(n, line) for n, line in enumerate(fh, start=1)
                     if line.strip() and not line.lstrip().startswith("#")]
     if not numbered:

@@ -9,8 +9,10 @@
   bladedamp reproduce                 the paper's results on the reference configuration
   bladedamp precompile                compile every numba kernel once (after installing)
 
-Each command on a design writes into --out: results (npz and results.json), PNG figures and a
-short summary.md. A bad design field or option ends with exit code 2 and one line naming it.
+Each command on a design writes into --out (default: results/<design file name>/<command>):
+results (npz and results.json), PNG figures and a short summary.md. A folder that holds files
+already is refused unless --overwrite is given, and init keeps an existing design file. A bad
+design field, an unreadable file or a bad option ends with exit code 2 and one line naming it.
 """
 from __future__ import annotations
 
@@ -58,12 +60,20 @@ class Progress:
         return tick
 
 
-def output_dir(path: Path) -> Path:
-    """``path`` created if needed and checked writable (before any computation); UsageError otherwise."""
+def output_dir(path: Path, overwrite: bool = False) -> Path:
+    """``path`` created if needed and checked writable (before any computation); UsageError if
+    it is a file, cannot be written, or already holds files or folders and ``overwrite`` is
+    False (a run never replaces results a user has without being told to; with ``overwrite``
+    the files of the same names are replaced and the others stay)."""
     import tempfile
 
     if path.exists() and not path.is_dir():
         raise UsageError(f"--out {path}: is a file, not a folder")
+    held = sorted(p.name for p in path.iterdir()) if path.is_dir() else []
+    if held and not overwrite:
+        shown = ", ".join(held[:3]) + (f" and {len(held) - 3} more" if len(held) > 3 else "")
+        raise UsageError(f"--out {path}: the folder is not empty ({shown}); choose another --out, or add "
+                         "--overwrite to replace the files of the same names")
     try:
         path.mkdir(parents=True, exist_ok=True)
         with tempfile.NamedTemporaryFile(dir=path, prefix=".bladedamp-write-test-"):
@@ -73,12 +83,31 @@ def output_dir(path: Path) -> Path:
     return path
 
 
+#: the output folder of every command without --out: results/<design file stem>/<command>,
+#: or this folder (the built-in reference configuration: reproduce, montecarlo without a design)
+RESULTS = Path("results")
+
+
+def output_folder(args) -> Path:
+    """The folder a command writes into: ``--out``, else ``results/<design file stem>/<command>``
+    (so that two designs never share one), ``results/<command>`` for montecarlo without a design
+    file and ``results`` for reproduce (the built-in reference configuration)."""
+    if args.out is not None:
+        return args.out
+    if args.command == "reproduce":
+        return RESULTS
+    design = getattr(args, "design", None)
+    return RESULTS / args.command if design is None else RESULTS / design.stem / args.command
+
+
 # ---------------------------------------------------------------------------------------
 # reproduce: the paper on the reference configuration
 # ---------------------------------------------------------------------------------------
-def reproduce(out: Path, processes: int | None = None) -> dict:
+def reproduce(out: Path, processes: int | None = None, overwrite: bool = False) -> dict:
     """The paper's results on the reference configuration: summary.json, report.md and the
-    figures in ``out``; ``processes``: worker processes of the studies (None: every core)."""
+    figures in ``out``; ``processes``: worker processes of the studies (None: every core);
+    ``overwrite``: replace the files of an earlier run in ``out`` (else a folder that holds
+    files is refused, :func:`output_dir`)."""
     import json
     import warnings
 
@@ -95,7 +124,7 @@ def reproduce(out: Path, processes: int | None = None) -> dict:
     from .studies.parallel import parallel_map
 
     warnings.simplefilter("ignore")
-    output_dir(out)
+    output_dir(out, overwrite)
     t_start = time.perf_counter()
     masses = np.array([0.02, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 1.0, 1.5, 2.0, 3.0, 5.0, 10.0, 100.0, 1000.0]) * 1e-3
     progress = Progress()
@@ -371,13 +400,18 @@ def _design_studies(out: Path, progress, processes, timings, optima: dict, sweep
 # the commands on a design file
 # ---------------------------------------------------------------------------------------
 def _load(args):
-    """The design of ``args.design`` (figures drawn off-screen)."""
+    """The design of ``args.design`` (figures drawn off-screen); a file that sets no key says so
+    in one line on stderr (it is the reference design)."""
     import matplotlib
 
     matplotlib.use("Agg")
     from .design import load_design
 
-    return load_design(args.design)
+    design = load_design(args.design)
+    if not design.keys_given:
+        print(f"bladedamp {args.command}: note: {args.design} sets no key: running the reference design "
+              f"(bladedamp init writes it with every key)", file=sys.stderr)
+    return design
 
 
 def _damped(design, command: str):
@@ -426,7 +460,7 @@ def init_command(args) -> int:
     """``bladedamp init``: the reference design, every key commented."""
     from .design import write_template
 
-    path = write_template(args.design, overwrite=args.force)
+    path = write_template(args.design, overwrite=args.overwrite)
     print(f"wrote the reference design to {path}; edit it, then run: bladedamp frf {path}", file=sys.stderr)
     return 0
 
@@ -452,7 +486,7 @@ def frf_command(args) -> int:
     design = _load(args)
     if args.mistuned and design.mistuning is None:
         raise UsageError(f"{design.path}: --mistuned needs a [mistuning] table (std and seed, or kappa)")
-    out = output_dir(args.out)
+    out = output_dir(output_folder(args), args.overwrite)
     progress, a = Progress(), design.analysis
     responses = {}
     # a branch that stops early is checked by time integration just beyond its stop (a minute or
@@ -499,7 +533,7 @@ def optimize_command(args) -> int:
     for h in args.contact_height_mm or ():
         if not 0 < h <= 100:
             raise UsageError(f"--contact-height-mm {h:g}: must be in (0, 100] mm")
-    out = output_dir(args.out)
+    out = output_dir(output_folder(args), args.overwrite)
     progress = Progress()
     options = dict(f_range_hz=a.f_range_hz, harmonics=a.study_harmonics)
     progress(f"optimal mass in {1e3 * a.mass_bounds[0]:g}-{1e3 * a.mass_bounds[1]:g} g")
@@ -531,7 +565,7 @@ def eo_sweep_command(args) -> int:
     for eo in eos:
         if not 0 <= eo <= disk.n_blades // 2:
             raise UsageError(f"--engine-orders {eo}: must be in [0, {disk.n_blades // 2}] (n_blades / 2)")
-    out = output_dir(args.out)
+    out = output_dir(output_folder(args), args.overwrite)
     progress = Progress()
     sweep = engine_order_sweep(design.disk_at(1), sorted(set(eos)), a.mass_bounds, design.rotor_speed_eo0_hz, a.f_range_hz,
                                harmonics=a.study_harmonics, progress=progress.bar("engine orders"),
@@ -546,7 +580,7 @@ def monte_carlo_command(args) -> int:
     reference disk) on Dask."""
     import dataclasses
 
-    from .design import load_design, reference_design
+    from .design import reference_design
     from .report import montecarlo_outputs
     from .studies.mistuning import MONTE_CARLO_MAX_STEP, MONTE_CARLO_TOL, PAPER_STD, monte_carlo
 
@@ -564,7 +598,7 @@ def monte_carlo_command(args) -> int:
 
     matplotlib.use("Agg")
     if args.design is not None:
-        design = load_design(args.design)
+        design = _load(args)
     else:
         from .reference import reference_disk
 
@@ -572,7 +606,7 @@ def monte_carlo_command(args) -> int:
         design = dataclasses.replace(design, disk=reference_disk(args.damper or "cylinder",
                                                                  1e-3 * (1.0 if args.mass is None else args.mass)))
     disk = _damped(design, "montecarlo")
-    out = output_dir(args.out)
+    out = output_dir(output_folder(args), args.overwrite)
     file_mistuning = design.mistuning if args.design is not None else None
     std = args.std if args.std is not None else (file_mistuning.std if file_mistuning else PAPER_STD)
     seed = args.seed if args.seed is not None else (file_mistuning.seed if file_mistuning else 0)
@@ -606,7 +640,7 @@ def show_command(args) -> int:
 
     t0 = time.perf_counter()
     design = _load(args)
-    out = output_dir(args.out)
+    out = output_dir(output_folder(args), args.overwrite)
     a = design.analysis
     Progress()(f"frequency response at EO = {design.disk.engine_order}, {a.f_start_hz:g}-{a.f_end_hz:g} Hz")
     response = design.disk.frequency_response(a.f_start_hz, a.f_end_hz, **a.options())
@@ -621,7 +655,7 @@ def show_command(args) -> int:
 
 def reproduce_command(args) -> int:
     """``bladedamp reproduce``."""
-    reproduce(args.out, args.processes)
+    reproduce(output_folder(args), args.processes, args.overwrite)
     return 0
 
 
@@ -666,8 +700,12 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("design", type=Path, help="the design file (TOML; write one with: bladedamp init design.toml)")
 
     def out_arg(p, default):
-        p.add_argument("--out", type=Path, default=Path(default),
-                       help=f"output folder, created if needed and checked before computing (default: {default})")
+        p.add_argument("--out", type=Path, default=None,
+                       help=f"output folder, created if needed and checked before computing; one that holds files\n"
+                            f"is refused unless --overwrite is given (default: {default})")
+        p.add_argument("--overwrite", action="store_true",
+                       help="write into an --out folder that holds files already, replacing the files of the same\n"
+                            "names (the others stay)")
 
     def processes_arg(p):
         p.add_argument("--processes", type=int, default=None,
@@ -678,7 +716,7 @@ def build_parser() -> argparse.ArgumentParser:
                 "and the reason for its value beside it. Edit it, then run e.g.: bladedamp frf design.toml")
     p.add_argument("design", type=Path, nargs="?", default=Path("design.toml"),
                    help="the file to write (default: design.toml)")
-    p.add_argument("--force", action="store_true", help="overwrite the file if it exists")
+    p.add_argument("--overwrite", "--force", action="store_true", help="replace the file if it exists")
 
     p = command("frf", frf_command, "frequency response of a design",
                 "Harmonic balance and arc-length continuation over [analysis] frequency_range_hz at every\n"
@@ -694,7 +732,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="skip the time integration at the peak of a complete branch (by default it runs, 5-31 s,\n"
                         "and gives a direct harmonic error estimate, or fails the branch where the vibration there does\n"
                         "not settle; not for solid FE blades with flexible platforms)")
-    out_arg(p, "results/frf")
+    out_arg(p, "results/<design file name>/frf")
 
     p = command("optimize", optimize_command, "optimal damper mass of a design",
                 "The damper mass of the lowest resonance amplitude in [analysis] mass_range_g (global on a log\n"
@@ -707,7 +745,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--contact-height-mm", type=float, nargs="+", metavar="MM",
                    help="also optimise the mass at each of these wedge contact heights [mm], in (0, 100]")
     processes_arg(p)
-    out_arg(p, "results/optimize")
+    out_arg(p, "results/<design file name>/optimize")
 
     p = command("eo-sweep", eo_sweep_command, "optimal damper mass over engine orders",
                 "At each engine order the mass is re-optimised in [analysis] mass_range_g (Fig. 7, 8 of the\n"
@@ -717,7 +755,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--engine-orders", type=int, nargs="+", metavar="EO",
                    help="engine orders in [0, n_blades / 2] (default: the design's [disk] engine_order)")
     processes_arg(p)
-    out_arg(p, "results/eo-sweep")
+    out_arg(p, "results/<design file name>/eo-sweep")
 
     p = command("montecarlo", monte_carlo_command, "Monte Carlo of randomly mistuned disks (Dask)",
                 "Peak amplification (largest blade over the tuned peak) of N disks with Gaussian frequency\n"
@@ -744,7 +782,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "0.05 for full FRF accuracy)")
     p.add_argument("--tol", type=float, default=None,
                    help="continuation tolerance per disk, in (0, 1) (default 1e-6; 1e-10 for full FRF accuracy)")
-    out_arg(p, "results/montecarlo")
+    out_arg(p, "results/<design file name>/montecarlo, or results/montecarlo without a design")
 
     p = command("show", show_command, "3D view of a design's resonance (standalone HTML)",
                 "The operating deflection shape at the resonance with the contact states of every point, as an\n"
@@ -753,7 +791,7 @@ def build_parser() -> argparse.ArgumentParser:
     design_arg(p)
     p.add_argument("--layout", choices=("sector", "disk"), default=None,
                    help="sector (three blades) or disk (every blade); default: disk with a damper, sector without")
-    out_arg(p, "results/show")
+    out_arg(p, "results/<design file name>/show")
 
     p = command("reproduce", reproduce_command,
                 "reproduce the paper on the built-in reference configuration",
@@ -772,14 +810,15 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv=None) -> int:
     """Run ``bladedamp`` with ``argv`` (default: the command line); returns the exit code
-    (0 done, 2 a user error, printed as one line on stderr)."""
+    (0 done, 2 a user error: a bad option or output folder, a design file or another file that
+    cannot be read or has a bad value; printed as one line on stderr)."""
     args = build_parser().parse_args(argv)
-    from .design import DesignError
+    from .io import FileReadError
 
     try:
         _validate_flags(args)
         return args.run(args)
-    except (DesignError, UsageError) as exc:
+    except (FileReadError, UsageError) as exc:     # a design file or another file, an option
         print(f"bladedamp {args.command}: error: {exc}", file=sys.stderr)
         return 2
 

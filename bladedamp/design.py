@@ -28,10 +28,12 @@ from pathlib import Path
 
 import numpy as np
 
+from .io import FileReadError, reading
 
-class DesignError(ValueError):
+
+class DesignError(FileReadError):
     """A design file that cannot be read or has a bad field; the message is one line naming the
-    file, the key, the value and the allowed range."""
+    file and what is wrong (the key, the value and the allowed range for a bad field)."""
 
 
 class _Bad(Exception):
@@ -455,7 +457,7 @@ def write_template(path, overwrite: bool = False) -> Path:
     cannot be written."""
     path = Path(path)
     if path.exists() and not overwrite:
-        raise DesignError(f"{path}: exists already (choose another name, or overwrite it with --force)")
+        raise DesignError(f"{path}: exists already (choose another name, or replace it with --overwrite)")
     try:
         path.write_text(template())
     except OSError as exc:
@@ -523,7 +525,8 @@ class Design:
     [Hz], None for 'auto' (Omega_E / EO);
     values : {table: {key: value}} in the file's units, every key (defaults filled in);
     path : the file (None: the reference design); blade_geometry : the BeamBladeGeometry of a
-    beam or parametric solid blade (None for modal data from a file and a surface_file blade)
+    beam or parametric solid blade (None for modal data from a file and a surface_file blade);
+    keys_given : the (table, key) pairs the file sets (empty: the file is the reference design)
     """
     disk: object
     engine_orders: tuple
@@ -534,6 +537,7 @@ class Design:
     values: dict = field(repr=False, default_factory=dict)
     path: Path | None = None
     blade_geometry: object = None
+    keys_given: frozenset = frozenset()
 
     def disk_at(self, engine_order: int):
         """The design's disk at another engine order (at EO = 0 with the speed rotor_speed_eo0_hz
@@ -609,23 +613,24 @@ def _bad(path, table, key, value, allowed) -> DesignError:
 def load_design(path) -> Design:
     """Read a design file (TOML) into the models: a :class:`Design` with ``.disk`` (TunedDisk),
     ``.mistuned_disk()`` and ``.analysis``. Raises :class:`DesignError` (a ValueError) with one
-    line naming the file, key, value and allowed range for a bad field, an unknown key, a file
-    that is missing or not TOML."""
+    line naming the file, key, value and allowed range for a bad field or an unknown key, and
+    naming the file and what is wrong for a file that is missing, a folder, unreadable, not UTF-8
+    text (a byte-order mark is allowed) or not TOML (:func:`bladedamp.io.reading`). A file that
+    sets no key (empty, only comments or table headers) is the reference design:
+    ``Design.keys_given`` is then empty."""
     path = Path(path)
-    try:
-        with open(path, "rb") as fh:
-            raw = tomllib.load(fh)
-    except FileNotFoundError:
+    if not path.exists():
         raise DesignError(f"{path}: no such design file (write the reference design with: "
-                          f"bladedamp init {path})") from None
-    except IsADirectoryError:
-        raise DesignError(f"{path}: is a folder, not a design file") from None
-    except OSError as exc:
-        raise DesignError(f"{path}: cannot read the design file ({exc.strerror or exc})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise DesignError(f"{path}: not valid TOML ({exc})") from None
+                          f"bladedamp init {path})")
+    with reading(path, "design file (TOML)", DesignError):
+        try:
+            raw = tomllib.loads(path.read_bytes().decode("utf-8-sig"))
+        except tomllib.TOMLDecodeError as exc:
+            raise DesignError(f"{path}: not valid TOML ({exc})") from None
     values, given = _read_values(path, raw)
-    return _build(path, values, given, "mistuning" in raw)
+    design = _build(path, values, given, "mistuning" in raw)
+    design.keys_given = frozenset(given)
+    return design
 
 
 def _build(path: Path, v: dict, given: set, has_mistuning: bool) -> Design:
