@@ -17,6 +17,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+import warnings
 from pathlib import Path
 
 # Nothing heavy at module level: `bladedamp --help` must not import numpy, numba or the models.
@@ -56,6 +57,67 @@ class Progress:
                     state.pop("bar").close()
                 self(f"{study} done ({total})")
         return tick
+
+
+class Notes:
+    """The warnings raised while a command runs (the library's AccuracyWarning and
+    PlausibilityWarning, numpy's RuntimeWarning, numba's warnings, ...), collected instead of
+    printed with their category and source line: each distinct message is one plain line,
+    written to the command's summary.md and results.json (:meth:`write`) and printed at the end
+    of the run (:meth:`show`). Python's developer categories (DeprecationWarning,
+    PendingDeprecationWarning, ImportWarning, ResourceWarning) stay ignored, as they are by
+    default. ``Notes.current`` is the collection of the running command (None outside one)."""
+
+    current = None
+    IGNORED = (DeprecationWarning, PendingDeprecationWarning, ImportWarning, ResourceWarning)
+
+    def __init__(self):
+        self._catcher = warnings.catch_warnings(record=True)
+        self._records = []
+        self._printed = 0
+
+    def __enter__(self):
+        self._records = self._catcher.__enter__()
+        warnings.simplefilter("always")          # every occurrence: the duplicates are merged in lines()
+        for category in self.IGNORED:
+            warnings.simplefilter("ignore", category)
+        Notes.current = self
+        return self
+
+    def __exit__(self, *exc_info):
+        Notes.current = None
+        return self._catcher.__exit__(*exc_info)
+
+    def lines(self) -> list[str]:
+        """The distinct messages in the order they were first raised, each on one line."""
+        distinct = dict.fromkeys(" ".join(str(w.message).split()) for w in self._records)
+        return [line for line in distinct if line]
+
+    def write(self, out: Path) -> None:
+        """Add the messages to ``out``/summary.md (a Notes section) and ``out``/results.json (key
+        "notes"), where the command wrote those files; nothing without messages."""
+        import json
+
+        from .report import write_json
+
+        lines = self.lines()
+        if not lines:
+            return
+        summary, results = out / "summary.md", out / "results.json"
+        if summary.exists():
+            text = summary.read_text().rstrip("\n")
+            summary.write_text(text + "\n\n## Notes\n\n" + "".join(f"- {line}\n" for line in lines))
+        if results.exists():
+            data = json.loads(results.read_text())
+            data["notes"] = lines
+            write_json(results, data)
+
+    def show(self, stream=None) -> None:
+        """Print the messages not printed yet, one plain line each ("note: ...")."""
+        lines = self.lines()
+        for line in lines[self._printed:]:
+            print(f"note: {line}", file=stream if stream is not None else sys.stderr)
+        self._printed = len(lines)
 
 
 def output_dir(path: Path) -> Path:
@@ -417,6 +479,10 @@ def _check_platform_angle_option(design, option: str, angles_deg) -> None:
 
 
 def _done(out: Path, t0: float, what: str) -> int:
+    """The last line of a command on a design (what it found, where it wrote), after the
+    run's warnings were added to its summary.md and results.json (:class:`Notes`)."""
+    if Notes.current is not None:
+        Notes.current.write(out)
     print(f"{what}; wrote {out / 'summary.md'}, results and figures in {out} ({time.perf_counter() - t0:.1f} s)",
           file=sys.stderr)
     return 0
@@ -769,16 +835,20 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv=None) -> int:
     """Run ``bladedamp`` with ``argv`` (default: the command line); returns the exit code
-    (0 done, 2 a user error, printed as one line on stderr)."""
+    (0 done, 2 a user error, printed as one line on stderr). The warnings raised on the way are
+    printed last, one plain line each (:class:`Notes`)."""
     args = build_parser().parse_args(argv)
     from .design import DesignError
 
-    try:
-        _validate_flags(args)
-        return args.run(args)
-    except (DesignError, UsageError) as exc:
-        print(f"bladedamp {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+    with Notes() as notes:
+        try:
+            _validate_flags(args)
+            code = args.run(args)
+        except (DesignError, UsageError) as exc:
+            print(f"bladedamp {args.command}: error: {exc}", file=sys.stderr)
+            code = 2
+        notes.show()
+    return code
 
 
 if __name__ == "__main__":
