@@ -29,8 +29,8 @@ class UsageError(ValueError):
 
 class Progress:
     """Progress of a command on stderr: one line per step with the elapsed time; ``bar(study)``
-    gives a (done, total) callback drawn as a tqdm bar in place on a terminal, and as a single
-    line when the study is done otherwise (logs, CI), so a redirected run prints no bar lines."""
+    gives a (done, total) callback drawn as a ``tqdm.auto`` bar (:class:`bladedamp.progress.ProgressBar`)
+    in place on a terminal and none otherwise (logs, CI), and one line when the study is done."""
 
     def __init__(self, stream=None):
         self.start = time.perf_counter()
@@ -40,21 +40,22 @@ class Progress:
     def __call__(self, what: str):
         print(f"{time.perf_counter() - self.start:7.1f} s  {what}", file=self.stream, flush=True)
 
+    def compiling(self):
+        """One line before a command's first computation when numba's cache holds no compiled
+        kernel of bladedamp yet (:func:`bladedamp.compilation.cache_is_cold`)."""
+        from .compilation import COLD_COMPILE_SECONDS, cache_is_cold
+
+        if cache_is_cold():
+            self(f"compiling kernels once, about {COLD_COMPILE_SECONDS} s; `bladedamp precompile` does it ahead")
+
     def bar(self, study: str):
-        state = {}
+        from .progress import ProgressBar
+
+        bar = ProgressBar(f"{study:<28s}", file=self.stream, disable=not self.tty, leave=False)
 
         def tick(done, total):
-            if self.tty:
-                if "bar" not in state:
-                    from tqdm import tqdm
-
-                    state["bar"] = tqdm(total=total, desc=f"{study:<28s}", file=self.stream, leave=False,
-                                        bar_format="{desc} {bar} {n_fmt}/{total_fmt} [{elapsed}<{remaining}]")
-                state["bar"].n = done
-                state["bar"].refresh()
+            bar(done, total)
             if done >= total:
-                if "bar" in state:
-                    state.pop("bar").close()
                 self(f"{study} done ({total})")
         return tick
 
@@ -161,6 +162,7 @@ def reproduce(out: Path, processes: int | None = None) -> dict:
     t_start = time.perf_counter()
     masses = np.array([0.02, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 1.0, 1.5, 2.0, 3.0, 5.0, 10.0, 100.0, 1000.0]) * 1e-3
     progress = Progress()
+    progress.compiling()
     timings = {}
 
     # -- undamped reference (calibration target 1) --
@@ -520,6 +522,7 @@ def frf_command(args) -> int:
         raise UsageError(f"{design.path}: --mistuned needs a [mistuning] table (std and seed, or kappa)")
     out = output_dir(args.out)
     progress, a = Progress(), design.analysis
+    progress.compiling()
     responses = {}
     # a branch that stops early is checked by time integration just beyond its stop (a minute or
     # more): its result then says whether a periodic motion exists there (TunedDisk / MistunedDisk.stop_check)
@@ -564,6 +567,7 @@ def optimize_command(args) -> int:
             raise UsageError(f"--contact-height-mm {h:g}: must be in (0, 100] mm")
     out = output_dir(args.out)
     progress = Progress()
+    progress.compiling()
     options = dict(f_range_hz=a.f_range_hz, harmonics=a.study_harmonics)
     progress(f"optimal mass in {1e3 * a.mass_bounds[0]:g}-{1e3 * a.mass_bounds[1]:g} g")
     optimum = optimal_mass(disk, a.mass_bounds, processes=args.processes, progress=progress.bar("mass grid"), **options)
@@ -596,6 +600,7 @@ def eo_sweep_command(args) -> int:
             raise UsageError(f"--engine-orders {eo}: must be in [0, {disk.n_blades // 2}] (n_blades / 2)")
     out = output_dir(args.out)
     progress = Progress()
+    progress.compiling()
     sweep = engine_order_sweep(design.disk_at(1), sorted(set(eos)), a.mass_bounds, design.rotor_speed_eo0_hz, a.f_range_hz,
                                harmonics=a.study_harmonics, progress=progress.bar("engine orders"),
                                processes=args.processes)
@@ -640,6 +645,7 @@ def monte_carlo_command(args) -> int:
     std = args.std if args.std is not None else (file_mistuning.std if file_mistuning else PAPER_STD)
     seed = args.seed if args.seed is not None else (file_mistuning.seed if file_mistuning else 0)
     progress = Progress()
+    progress.compiling()
     result = monte_carlo(disk, args.disks, std=std, seed=seed, harmonics=design.analysis.study_harmonics,
                          scheduler=None if args.scheduler == "local" else args.scheduler, n_workers=args.workers,
                          progress=progress.bar("Monte Carlo disks"), out=None,
@@ -671,7 +677,9 @@ def show_command(args) -> int:
     design = _load(args)
     out = output_dir(args.out)
     a = design.analysis
-    Progress()(f"frequency response at EO = {design.disk.engine_order}, {a.f_start_hz:g}-{a.f_end_hz:g} Hz")
+    progress = Progress()
+    progress.compiling()
+    progress(f"frequency response at EO = {design.disk.engine_order}, {a.f_start_hz:g}-{a.f_end_hz:g} Hz")
     response = design.disk.frequency_response(a.f_start_hz, a.f_end_hz, **a.options())
     options = {} if args.layout is None else {"layout": args.layout}
     if design.blade_geometry is not None:

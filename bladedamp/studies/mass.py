@@ -11,6 +11,7 @@ from scipy.optimize import minimize_scalar
 from .. import validation
 from ..disk import TunedDisk
 from ..io import Saveable
+from ..progress import progress_callback
 from ..plotting import place_legend
 from ..response import refined_peak
 
@@ -265,8 +266,11 @@ def mass_sweep(disk: TunedDisk, masses, f_range_hz=(90.0, 105.0), harmonics=(1,)
                processes: int | None = 1) -> MassSweep:
     """Peak tip amplitude for each damper mass in ``masses`` [kg] (each > 0).
 
-    ``processes``: worker processes over the masses (None: every core)."""
+    ``processes``: worker processes over the masses (None: every core); ``progress``: True (a progress bar, tqdm.auto: a widget in Jupyter, a bar in a terminal), False / None (none) or a callable
+    (done, total)."""
     from .parallel import parallel_map
+
+    progress = progress_callback(progress, "mass sweep")
 
     masses = np.atleast_1d(np.asarray(masses, dtype=float))
     if masses.size == 0:
@@ -389,9 +393,12 @@ def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0),
     interval around the best grid point. Each mass is evaluated by :func:`robust_peak`
     (retries with a finer continuation and a downward sweep); masses that still fail are listed
     in the result with a lower bound of their peak, and ``success`` says whether they could
-    hide a better optimum. ``processes``: worker processes over the grid (None: every core).
+    hide a better optimum. ``processes``: worker processes over the grid (None: every core);
+    ``progress``: True (a progress bar, tqdm.auto: a widget in Jupyter, a bar in a terminal), False / None (none) or a callable (done, total) over the grid.
     """
     from .parallel import parallel_map, workers
+
+    progress = progress_callback(progress, "mass grid")
 
     lo, hi = validation.interval("mass bounds", bounds, "kg")
     validation.positive("xatol", xatol)
