@@ -834,8 +834,10 @@ def build_parser() -> argparse.ArgumentParser:
     out_arg(p, "results")
     processes_arg(p)
 
+    from .compilation import COLD_COMPILE_SECONDS
+
     command("precompile", precompile_command, "compile every numba kernel once, ahead of the first run",
-            "numba compiles bladedamp's kernels on their first call (about 10-20 s of CPU once per machine and\n"
+            f"numba compiles bladedamp's kernels on their first call (about {COLD_COMPILE_SECONDS} s once per machine and\n"
             "user) and keeps them in ~/.cache/bladedamp/numba. Run this once after installing (a lab machine, a\n"
             "Docker image) and no later run pays it; running it again only loads the cache.")
     return parser
