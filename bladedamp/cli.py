@@ -51,7 +51,7 @@ class Progress:
     def bar(self, study: str):
         from .progress import ProgressBar
 
-        bar = ProgressBar(f"{study:<28s}", file=self.stream, disable=not self.tty, leave=False)
+        bar = ProgressBar(study, file=self.stream, disable=not self.tty, leave=False)
 
         def tick(done, total):
             bar(done, total)

@@ -8,13 +8,14 @@ cases finish; :func:`progress_callback` turns that option into the callable the 
 from __future__ import annotations
 
 import sys
+import time
 
 
 class ProgressBar:
     """A ``(done, total[, message])`` callback drawn as a ``tqdm.auto`` bar titled ``description``.
 
-    The bar is made at the first call (when ``total`` is known) and closed when ``done`` reaches
-    ``total``. ``file``: the stream of a text bar (default stderr; a Jupyter widget has its own
+    The bar is made at the first call (when ``total`` is known), its clock started when this
+    object was (the study's start), and closed when ``done`` reaches ``total``. ``file``: the stream of a text bar (default stderr; a Jupyter widget has its own
     place); ``disable``: no bar at all (``None``: none when ``file`` is not a terminal, tqdm's
     rule); ``leave``: keep the finished bar on screen."""
 
@@ -24,6 +25,7 @@ class ProgressBar:
         self.disable = disable
         self.leave = leave
         self.bar = None
+        self.started = time.time()          # the bar's clock (tqdm's start_t, on time.time)
 
     def __call__(self, done: int, total: int, message: str | None = None) -> None:
         if self.bar is None:
@@ -31,6 +33,7 @@ class ProgressBar:
 
             self.bar = tqdm(total=total, desc=self.description, file=self.file if self.file is not None else sys.stderr,
                             disable=self.disable, leave=self.leave)
+            self.bar.start_t = self.started
         self.bar.n = done
         if message:
             self.bar.set_postfix_str(message, refresh=False)
