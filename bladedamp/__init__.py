@@ -23,7 +23,7 @@ _LAZY = {
     "TimeDomainElement": "hbm", "CubicSpring": "hbm", "GapSpring": "hbm", "with_element": "hbm",
     "FrictionOscillator": "oscillator",
     "reference_disk": "reference",
-    "FrequencyResponse": "response",
+    "FrequencyResponse": "response", "Status": "response",
     "load": "io", "save": "io",
     "load_design": "design",
     "nonlinear_mode": "hbm.nonlinear_modes",

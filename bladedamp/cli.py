@@ -539,7 +539,10 @@ def frf_command(args) -> int:
         responses[f"mistuned_EO{design.disk.engine_order}"] = design.mistuned_disk().frequency_response(
             a.f_start_hz, a.f_end_hz, **checks, **a.options())
     summary = frf_outputs(out, design, responses)
-    peaks = ", ".join(f"{k} peak {v['peak_amplitude_mm']:.4f} mm at {v['peak_frequency_hz']:.3f} Hz"
+    for k, v in summary["responses"].items():      # each response's status first
+        print(f"{k}: {v['status_message']}", file=sys.stderr)
+    peaks = ", ".join(f"{k} {'largest amplitude at the range end' if v['peak_at_range_end'] else 'peak'} "
+                      f"{v['peak_amplitude_mm']:.4f} mm at {v['peak_frequency_hz']:.3f} Hz"
                       if v["peak_amplitude_mm"] is not None else f"{k} no points"
                       for k, v in summary["responses"].items())
     return _done(out, t0, peaks)

@@ -28,6 +28,7 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.linalg
 
 from . import validation
 from .blade import ModalBlade
@@ -39,11 +40,13 @@ from .damper.geometry import CylinderDamper, DamperGeometry, WedgeDamper
 from .damper.kinetics import centrifugal_force, seat
 from .hbm.accuracy import HARMONIC_TOLERANCE, AccuracyWarning, converged_response
 from .hbm.continuation import continuation
+from .hbm.nonlinear_modes import linear_stuck_mode
 from .hbm.peaks import PeakSolver, first_harmonic_output
 from .hbm.start import robust_start
 from .hbm.fourier import HarmonicBasis
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import REFINE_SAMPLES_FACTOR, FrequencyResponse, physical_checks, with_checks, plot_branch, sampled_response
+from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, nearest_to_range, physical_checks, plot_branch,
+                       sampled_response, with_checks, with_range_end_estimate)
 
 DAMPER_DOFS = ("uD_x", "uD_y", "uD_z", "phiD_x", "phiD_y", "phiD_z")
 # the automatic AFT sampling of a disk's branch (TunedDisk and MistunedDisk) may grow the samples
@@ -712,7 +715,35 @@ class TunedDisk:
         can_check = extra_couplings is None and not self.blade.flexible_platform
         response = peak_checked_response(self, model, solve, harmonics, harmonic_tolerance, max_harmonic,
                                          estimate_harmonic_error, check_peak, can_check)
-        return with_stop_check(self, response, f_start_hz, check_stop)
+        return with_range_end_estimate(self, with_stop_check(self, response, f_start_hz, check_stop))
+
+    def linear_natural_frequencies_hz(self, f_low_hz: float, f_high_hz: float) -> tuple[float, float]:
+        """(without dampers, dampers stuck): the natural frequency [Hz] of each linear sector
+        model (engine order ``engine_order``) nearest the range [``f_low_hz``, ``f_high_hz``]
+        (:func:`bladedamp.response.nearest_to_range`). Without dampers: the generalised eigenvalues
+        of the blade's stiffness and mass; stuck: the zero-amplitude linearisation at the static
+        state, each mode at its own frequency when the preload follows the rotor speed
+        (:func:`bladedamp.hbm.nonlinear_modes.linear_stuck_mode`), nan where it cannot be
+        computed. A friction-damped resonance lies between them (up to the damper's inertia);
+        used to say where a resonance outside the range may lie (:func:`with_range_end_estimate`)."""
+        free_system = dataclasses.replace(self, damper=None).hbm_system((1,))
+        M, K = (np.atleast_2d(m.toarray() if hasattr(m, "toarray") else np.asarray(m, dtype=float))
+                for m in (free_system.mass, free_system.stiffness))
+        lam = scipy.linalg.eigvals(K, M)
+        lam = np.real(lam[np.isfinite(lam) & (np.real(lam) > 0)])
+        free = nearest_to_range(np.sqrt(lam) / (2 * np.pi), f_low_hz, f_high_hz)
+        if not self.has_damper:
+            return free, free
+        system, stuck = self.hbm_system((1,)), []
+        for mode in range(system.n_dof):          # upwards until a mode lies above the range
+            try:
+                omega = linear_stuck_mode(self, system, mode)[0]
+            except (ValueError, np.linalg.LinAlgError):   # no such mode, or a repeated one
+                break
+            stuck.append(omega / (2 * np.pi))
+            if stuck[-1] > f_high_hz:
+                break
+        return free, nearest_to_range(stuck, f_low_hz, f_high_hz)
 
     def amplitude_stop(self, basis: HarmonicBasis, stop_above: float | None, direction: int = 0):
         """The continuation's ``stop_when`` for ``stop_above`` [m] (None: None): a message once the
@@ -1213,6 +1244,10 @@ class DiskResponse(FrequencyResponse):
     def energy_balance_error(self) -> np.ndarray:
         """|W_exc - W_visc - W_friction| / W_exc at every point."""
         return np.abs(self.excitation_work - self.viscous_dissipation - self.dissipated_energy) / np.abs(self.excitation_work)
+
+    def peak_curve(self) -> np.ndarray:
+        """(n,) first-harmonic tip amplitude |u_x| at every point [m] (its largest is the peak)."""
+        return self.tip_amplitude[:, 0]
 
     def plot(self, ax=None, *, direction: int = 0, label: str | None = None, **kwargs):
         """Tip amplitude [mm] over frequency [Hz] (the paper's Fig. 4-6 style)."""

@@ -1267,7 +1267,7 @@ class MistunedResponse(FrequencyResponse):
                    branch.turning_points, tip_amplitude=tip, excitation_work=np.array(exc),
                    viscous_dissipation=np.array(visc), dissipated_energy=diss.sum(axis=1), damper_dissipation=diss,
                    damper_work_bound=bound,
-                   tuned_peak_amplitude=tuned_peak_amplitude, disk=disk)
+                   tuned_peak_amplitude=tuned_peak_amplitude, disk=disk, stopped_by=branch.stopped_by)
 
     @property
     def n_sector(self) -> int:
@@ -1318,11 +1318,10 @@ class MistunedResponse(FrequencyResponse):
         """(s,) frequency of each blade's peak [Hz] (parabola-refined, as :attr:`peak_amplitude`)."""
         return self.peaks()[1]
 
-    @property
-    def peak_at_range_end(self) -> np.ndarray:
-        """(s,) bool: the blade's largest amplitude is at an end of the computed range."""
-        i = np.argmax(self.tip_amplitude[:, :, 0], axis=0)
-        return (i == 0) | (i == len(self.omega) - 1)
+    def peak_curve(self) -> np.ndarray:
+        """(n, s) first-harmonic tip amplitude |u_x| of every blade at every point [m]: the
+        response's :attr:`peak_at_range_end` when any blade's largest lies at an end of the range."""
+        return self.tip_amplitude[:, :, 0]
 
     def amplification(self, tuned_peak_amplitude: float | None = None) -> np.ndarray:
         """(s,) peak of each blade over the tuned disk's peak."""

@@ -24,7 +24,8 @@ from .hbm.start import robust_start
 from .hbm.elements import CubicSpring
 from .hbm.fourier import HarmonicBasis
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import REFINE_SAMPLES_FACTOR, FrequencyResponse, physical_checks, sampled_response, with_checks
+from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, physical_checks, sampled_response, with_checks,
+                       with_range_end_estimate)
 from .timedomain import TimeResponse, oscillator_steady_state
 
 # most AFT samples per period the automatic sampling may choose (sampled_response; one DOF:
@@ -86,6 +87,19 @@ class FrictionOscillator:
         """mu N0 [N]."""
         return self.friction_coefficient * self.normal_load
 
+    @property
+    def stuck_contact_stiffness(self) -> float:
+        """The stuck contact's stiffness along the motion, k_T cos^2(alpha) + k_N sin^2(alpha) [N/m]."""
+        return self.contact_stiffness * np.cos(self.contact_angle) ** 2 \
+            + self.normal_stiffness * np.sin(self.contact_angle) ** 2
+
+    def linear_natural_frequencies_hz(self, f_low_hz: float = 0.0, f_high_hz: float = 0.0) -> tuple[float, float]:
+        """(without the contact, contact stuck): sqrt(k / m) / 2 pi and sqrt((k + k_stuck) / m) / 2 pi
+        [Hz], the natural frequencies of the two linear systems (one each: the range is not
+        needed); the friction-damped resonance lies between them."""
+        return (float(np.sqrt(self.stiffness / self.mass) / (2 * np.pi)),
+                float(np.sqrt((self.stiffness + self.stuck_contact_stiffness) / self.mass) / (2 * np.pi)))
+
     def linear_amplitude(self, f_hz, stuck: bool) -> np.ndarray:
         """Amplitude of the linear system with the contact stuck or absent (k) [m] at the
         excitation frequencies ``f_hz`` [Hz] (scalar or array; same shape).
@@ -97,9 +111,7 @@ class FrictionOscillator:
     def _linear_amplitude(self, omega, stuck: bool) -> np.ndarray:
         """:meth:`linear_amplitude` at angular frequencies ``omega`` [rad/s]."""
         omega = np.asarray(omega, dtype=float)
-        stuck_k = self.contact_stiffness * np.cos(self.contact_angle) ** 2 \
-            + self.normal_stiffness * np.sin(self.contact_angle) ** 2
-        k = self.stiffness + (stuck_k if stuck else 0.0)
+        k = self.stiffness + (self.stuck_contact_stiffness if stuck else 0.0)
         return np.abs(self.forcing / (k - self.mass * omega ** 2 + 1j * self.damping * omega))
 
     # ----- harmonic balance -----------------------------------------------------------
@@ -160,7 +172,8 @@ class FrictionOscillator:
                                   **continuation_options)
             C = system.basis.n_coeffs
             response = FrequencyResponse(branch.omega, branch.x.reshape(-1, C, 1), system.basis, ("x",),
-                                         branch.success, branch.message, branch.iterations, branch.turning_points)
+                                         branch.success, branch.message, branch.iterations, branch.turning_points,
+                                         stopped_by=branch.stopped_by)
             # per point: the excitation work, and the contact's dissipation and energy scale (one AFT)
             work = np.array([system.excitation_work(x, w) for x, w in zip(branch.x, branch.omega)])
             energies = np.array([[sum(e) for e in system.element_energies(x, w)]
@@ -175,7 +188,8 @@ class FrictionOscillator:
                                                          work, continuation_options.get("max_step") or 0.02,
                                                          T, refine, energies[:, 1:]))
 
-        return converged_response(self, solve, harmonics, harmonic_tolerance, max_harmonic)
+        return with_range_end_estimate(self, converged_response(self, solve, harmonics, harmonic_tolerance,
+                                                                max_harmonic))
 
     def _start_solution(self, system: HarmonicBalanceSystem, omega: float, scale: float) -> np.ndarray:
         """Solution at the first frequency by :func:`bladedamp.hbm.start.robust_start`: damped

@@ -780,11 +780,13 @@ def write_summary(out: Path, command: str, design, lines: list, files: list, ana
 
 def frf_outputs(out: Path, design, responses: dict) -> dict:
     """frf.png, frf_<label>.npz, results.json and summary.md of ``bladedamp frf``.
-    ``responses``: {label: DiskResponse or MistunedResponse}. Returns the JSON summary."""
+    ``responses``: {label: DiskResponse or MistunedResponse}. Each response's entry and summary.md
+    lead with its status (:attr:`~bladedamp.response.FrequencyResponse.status_message`); a largest
+    amplitude at an end of the range is named so, not a peak. Returns the JSON summary."""
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(7.5, 4.5))
-    rows, files, summary = [], ["frf.png"], {"design": design.path, "responses": {}}
+    leads, rows, files, summary = [], [], ["frf.png"], {"design": design.path, "responses": {}}
     for label, r in responses.items():
         tip = r.tip_amplitude[:, 0] if r.tip_amplitude.ndim == 2 else r.tip_amplitude[:, :, 0].max(axis=1)
         shown = label.replace("EO", "EO = ").replace("_", ", ")
@@ -797,12 +799,17 @@ def frf_outputs(out: Path, design, responses: dict) -> dict:
         peak, f_peak = (float(tip[i]), float(r.frequency_hz[i])) if len(tip) else (float("nan"), float("nan"))
         check = getattr(r, "peak_check", None)          # the time integration at the peak (check_peak)
         timed = None if check is None else str(check.status[0])
+        at_end = bool(r.peak_at_range_end)
         summary["responses"][label] = {
+            "status": r.status.value, "status_message": r.status_message, "peak_at_range_end": at_end,
+            "linear_natural_frequencies_hz": list(r.linear_natural_frequencies_hz),
             "success": bool(r.success), "message": r.message, "harmonics": list(r.basis.harmonics),
             "harmonic_error_pct": 100 * err, "peak_amplitude_mm": 1e3 * peak, "peak_frequency_hz": f_peak,
             "peak_time_check": timed, "frequency_hz": r.frequency_hz, "tip_amplitude_x_mm": 1e3 * tip}
-        rows.append(f"| {label} | {'yes' if r.success else 'no: ' + r.message} | {tuple(r.basis.harmonics)} | "
-                    f"{'not estimated' if not np.isfinite(err) else f'{100 * err:.2g} %'} | {_mm(peak)} | "
+        leads.append(f"- **{label}**: {r.status_message}")
+        rows.append(f"| {label} | {r.status.value} | {tuple(r.basis.harmonics)} | "
+                    f"{'not estimated' if not np.isfinite(err) else f'{100 * err:.2g} %'} | {_mm(peak)}"
+                    f"{' (largest amplitude at the range end)' if at_end else ''} | "
                     f"{'-' if not np.isfinite(f_peak) else f'{f_peak:.3f} Hz'} | {timed or '-'} |")
     ax.set_xlabel("excitation frequency [Hz]")
     ax.set_ylabel("tip amplitude u_x [mm]")
@@ -812,8 +819,8 @@ def frf_outputs(out: Path, design, responses: dict) -> dict:
     save_figure(fig, out / "frf.png")
     write_json(out / "results.json", summary)
     files.append("results.json")
-    lines = ["| response | complete | harmonics | harmonic error | peak u_x | at | time integration at the peak |",
-             "|---|---|---|---|---|---|---|", *rows]
+    lines = [*leads, "", "| response | status | harmonics | harmonic error | peak u_x | at | "
+             "time integration at the peak |", "|---|---|---|---|---|---|---|", *rows]
     write_summary(out, "frf", design, lines, files)
     return summary
 
