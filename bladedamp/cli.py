@@ -583,7 +583,8 @@ def optimize_command(args) -> int:
         for h in args.contact_height_mm:
             progress(f"optimal mass at h_C = {h:g} mm")
             heights.append((1e-3 * h, optimal_mass(with_contact_height(disk, 1e-3 * h), a.mass_bounds,
-                                                   processes=args.processes, **options)))
+                                                   processes=args.processes,
+                                                   progress=progress.bar(f"mass grid at h_C = {h:g} mm"), **options)))
     optimize_outputs(out, design, optimum, angles, heights)
     return _done(out, t0, f"optimal mass {1e3 * optimum.mass:.4g} g, peak {1e3 * optimum.peak_amplitude:.4f} mm, "
                           f"reduction {fmt_percent(optimum.reduction)}")
