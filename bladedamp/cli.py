@@ -19,6 +19,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+import warnings
 from pathlib import Path
 
 # Nothing heavy at module level: `bladedamp --help` must not import numpy, numba or the models.
@@ -30,8 +31,8 @@ class UsageError(ValueError):
 
 class Progress:
     """Progress of a command on stderr: one line per step with the elapsed time; ``bar(study)``
-    gives a (done, total) callback drawn as a tqdm bar in place on a terminal, and as a single
-    line when the study is done otherwise (logs, CI), so a redirected run prints no bar lines."""
+    gives a (done, total) callback drawn as a ``tqdm.auto`` bar (:class:`bladedamp.progress.ProgressBar`)
+    in place on a terminal and none otherwise (logs, CI), and one line when the study is done."""
 
     def __init__(self, stream=None):
         self.start = time.perf_counter()
@@ -41,23 +42,85 @@ class Progress:
     def __call__(self, what: str):
         print(f"{time.perf_counter() - self.start:7.1f} s  {what}", file=self.stream, flush=True)
 
+    def compiling(self):
+        """One line before a command's first computation when numba's cache holds no compiled
+        kernel of bladedamp yet (:func:`bladedamp.compilation.cache_is_cold`)."""
+        from .compilation import COLD_COMPILE_SECONDS, cache_is_cold
+
+        if cache_is_cold():
+            self(f"compiling kernels once, about {COLD_COMPILE_SECONDS} s; `bladedamp precompile` does it ahead")
+
     def bar(self, study: str):
-        state = {}
+        from .progress import ProgressBar
+
+        bar = ProgressBar(study, file=self.stream, disable=not self.tty, leave=False)
 
         def tick(done, total):
-            if self.tty:
-                if "bar" not in state:
-                    from tqdm import tqdm
-
-                    state["bar"] = tqdm(total=total, desc=f"{study:<28s}", file=self.stream, leave=False,
-                                        bar_format="{desc} {bar} {n_fmt}/{total_fmt} [{elapsed}<{remaining}]")
-                state["bar"].n = done
-                state["bar"].refresh()
+            bar(done, total)
             if done >= total:
-                if "bar" in state:
-                    state.pop("bar").close()
                 self(f"{study} done ({total})")
         return tick
+
+
+class Notes:
+    """The warnings raised while a command runs (the library's AccuracyWarning and
+    PlausibilityWarning, numpy's RuntimeWarning, numba's warnings, ...), collected instead of
+    printed with their category and source line: each distinct message is one plain line,
+    written to the command's summary.md and results.json (:meth:`write`) and printed at the end
+    of the run (:meth:`show`). Python's developer categories (DeprecationWarning,
+    PendingDeprecationWarning, ImportWarning, ResourceWarning) stay ignored, as they are by
+    default. ``Notes.current`` is the collection of the running command (None outside one)."""
+
+    current = None
+    IGNORED = (DeprecationWarning, PendingDeprecationWarning, ImportWarning, ResourceWarning)
+
+    def __init__(self):
+        self._catcher = warnings.catch_warnings(record=True)
+        self._records = []
+        self._printed = 0
+
+    def __enter__(self):
+        self._records = self._catcher.__enter__()
+        warnings.simplefilter("always")          # every occurrence: the duplicates are merged in lines()
+        for category in self.IGNORED:
+            warnings.simplefilter("ignore", category)
+        Notes.current = self
+        return self
+
+    def __exit__(self, *exc_info):
+        Notes.current = None
+        return self._catcher.__exit__(*exc_info)
+
+    def lines(self) -> list[str]:
+        """The distinct messages in the order they were first raised, each on one line."""
+        distinct = dict.fromkeys(" ".join(str(w.message).split()) for w in self._records)
+        return [line for line in distinct if line]
+
+    def write(self, out: Path) -> None:
+        """Add the messages to ``out``/summary.md (a Notes section) and ``out``/results.json (key
+        "notes"), where the command wrote those files; nothing without messages."""
+        import json
+
+        from .report import write_json
+
+        lines = self.lines()
+        if not lines:
+            return
+        summary, results = out / "summary.md", out / "results.json"
+        if summary.exists():
+            text = summary.read_text().rstrip("\n")
+            summary.write_text(text + "\n\n## Notes\n\n" + "".join(f"- {line}\n" for line in lines))
+        if results.exists():
+            data = json.loads(results.read_text())
+            data["notes"] = lines
+            write_json(results, data)
+
+    def show(self, stream=None) -> None:
+        """Print the messages not printed yet, one plain line each ("note: ...")."""
+        lines = self.lines()
+        for line in lines[self._printed:]:
+            print(f"note: {line}", file=stream if stream is not None else sys.stderr)
+        self._printed = len(lines)
 
 
 def output_dir(path: Path, overwrite: bool = False) -> Path:
@@ -128,6 +191,7 @@ def reproduce(out: Path, processes: int | None = None, overwrite: bool = False) 
     t_start = time.perf_counter()
     masses = np.array([0.02, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 1.0, 1.5, 2.0, 3.0, 5.0, 10.0, 100.0, 1000.0]) * 1e-3
     progress = Progress()
+    progress.compiling()
     timings = {}
 
     # -- undamped reference (calibration target 1) --
@@ -451,6 +515,10 @@ def _check_platform_angle_option(design, option: str, angles_deg) -> None:
 
 
 def _done(out: Path, t0: float, what: str) -> int:
+    """The last line of a command on a design (what it found, where it wrote), after the
+    run's warnings were added to its summary.md and results.json (:class:`Notes`)."""
+    if Notes.current is not None:
+        Notes.current.write(out)
     print(f"{what}; wrote {out / 'summary.md'}, results and figures in {out} ({time.perf_counter() - t0:.1f} s)",
           file=sys.stderr)
     return 0
@@ -488,6 +556,7 @@ def frf_command(args) -> int:
         raise UsageError(f"{design.path}: --mistuned needs a [mistuning] table (std and seed, or kappa)")
     out = output_dir(output_folder(args), args.overwrite)
     progress, a = Progress(), design.analysis
+    progress.compiling()
     responses = {}
     # a branch that stops early is checked by time integration just beyond its stop (a minute or
     # more): its result then says whether a periodic motion exists there (TunedDisk / MistunedDisk.stop_check)
@@ -535,6 +604,7 @@ def optimize_command(args) -> int:
             raise UsageError(f"--contact-height-mm {h:g}: must be in (0, 100] mm")
     out = output_dir(output_folder(args), args.overwrite)
     progress = Progress()
+    progress.compiling()
     options = dict(f_range_hz=a.f_range_hz, harmonics=a.study_harmonics)
     progress(f"optimal mass in {1e3 * a.mass_bounds[0]:g}-{1e3 * a.mass_bounds[1]:g} g")
     optimum = optimal_mass(disk, a.mass_bounds, processes=args.processes, progress=progress.bar("mass grid"), **options)
@@ -547,7 +617,8 @@ def optimize_command(args) -> int:
         for h in args.contact_height_mm:
             progress(f"optimal mass at h_C = {h:g} mm")
             heights.append((1e-3 * h, optimal_mass(with_contact_height(disk, 1e-3 * h), a.mass_bounds,
-                                                   processes=args.processes, **options)))
+                                                   processes=args.processes,
+                                                   progress=progress.bar(f"mass grid at h_C = {h:g} mm"), **options)))
     optimize_outputs(out, design, optimum, angles, heights)
     return _done(out, t0, f"optimal mass {1e3 * optimum.mass:.4g} g, peak {1e3 * optimum.peak_amplitude:.4f} mm, "
                           f"reduction {fmt_percent(optimum.reduction)}")
@@ -567,6 +638,7 @@ def eo_sweep_command(args) -> int:
             raise UsageError(f"--engine-orders {eo}: must be in [0, {disk.n_blades // 2}] (n_blades / 2)")
     out = output_dir(output_folder(args), args.overwrite)
     progress = Progress()
+    progress.compiling()
     sweep = engine_order_sweep(design.disk_at(1), sorted(set(eos)), a.mass_bounds, design.rotor_speed_eo0_hz, a.f_range_hz,
                                harmonics=a.study_harmonics, progress=progress.bar("engine orders"),
                                processes=args.processes)
@@ -611,6 +683,7 @@ def monte_carlo_command(args) -> int:
     std = args.std if args.std is not None else (file_mistuning.std if file_mistuning else PAPER_STD)
     seed = args.seed if args.seed is not None else (file_mistuning.seed if file_mistuning else 0)
     progress = Progress()
+    progress.compiling()
     result = monte_carlo(disk, args.disks, std=std, seed=seed, harmonics=design.analysis.study_harmonics,
                          scheduler=None if args.scheduler == "local" else args.scheduler, n_workers=args.workers,
                          progress=progress.bar("Monte Carlo disks"), out=None,
@@ -642,7 +715,9 @@ def show_command(args) -> int:
     design = _load(args)
     out = output_dir(output_folder(args), args.overwrite)
     a = design.analysis
-    Progress()(f"frequency response at EO = {design.disk.engine_order}, {a.f_start_hz:g}-{a.f_end_hz:g} Hz")
+    progress = Progress()
+    progress.compiling()
+    progress(f"frequency response at EO = {design.disk.engine_order}, {a.f_start_hz:g}-{a.f_end_hz:g} Hz")
     response = design.disk.frequency_response(a.f_start_hz, a.f_end_hz, **a.options())
     options = {} if args.layout is None else {"layout": args.layout}
     if design.blade_geometry is not None:
@@ -801,8 +876,10 @@ def build_parser() -> argparse.ArgumentParser:
     out_arg(p, "results")
     processes_arg(p)
 
+    from .compilation import COLD_COMPILE_SECONDS
+
     command("precompile", precompile_command, "compile every numba kernel once, ahead of the first run",
-            "numba compiles bladedamp's kernels on their first call (about 10-20 s of CPU once per machine and\n"
+            f"numba compiles bladedamp's kernels on their first call (about {COLD_COMPILE_SECONDS} s once per machine and\n"
             "user) and keeps them in ~/.cache/bladedamp/numba. Run this once after installing (a lab machine, a\n"
             "Docker image) and no later run pays it; running it again only loads the cache.")
     return parser
@@ -811,16 +888,20 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv=None) -> int:
     """Run ``bladedamp`` with ``argv`` (default: the command line); returns the exit code
     (0 done, 2 a user error: a bad option or output folder, a design file or another file that
-    cannot be read or has a bad value; printed as one line on stderr)."""
+    cannot be read or has a bad value; printed as one line on stderr). The warnings raised on
+    the way are printed last, one plain line each (:class:`Notes`)."""
     args = build_parser().parse_args(argv)
     from .io import FileReadError
 
-    try:
-        _validate_flags(args)
-        return args.run(args)
-    except (FileReadError, UsageError) as exc:     # a design file or another file, an option
-        print(f"bladedamp {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+    with Notes() as notes:
+        try:
+            _validate_flags(args)
+            code = args.run(args)
+        except (FileReadError, UsageError) as exc:     # a design file or another file, an option
+            print(f"bladedamp {args.command}: error: {exc}", file=sys.stderr)
+            code = 2
+        notes.show()
+    return code
 
 
 if __name__ == "__main__":

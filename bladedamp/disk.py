@@ -712,10 +712,9 @@ class TunedDisk:
                                                          response.excitation_work, max_step, T, refine,
                                                          points_dissipation(response, "point_work_bound")))
 
-        response = converged_response(model, solve, harmonics, harmonic_tolerance, max_harmonic,
-                                      estimate=estimate_harmonic_error)
         can_check = extra_couplings is None and not self.blade.flexible_platform
-        response = with_peak_check(self, response, check_peak, harmonic_tolerance, can_check)
+        response = peak_checked_response(self, model, solve, harmonics, harmonic_tolerance, max_harmonic,
+                                         estimate_harmonic_error, check_peak, can_check)
         return with_range_end_estimate(self, with_stop_check(self, response, f_start_hz, check_stop))
 
     def linear_natural_frequencies_hz(self, f_low_hz: float, f_high_hz: float) -> tuple[float, float]:
@@ -945,6 +944,24 @@ def with_stop_check(model, response, f_start_hz: float, check_stop: bool):
     return with_stop_note(response, f_start_hz, check)
 
 
+def peak_checked_response(model, system_model, solve, harmonics, tolerance: float, max_harmonic: int, estimate: bool,
+                          check_peak: bool, can_check: bool):
+    """The response of ``model.frequency_response`` (a :class:`TunedDisk` or
+    :class:`~bladedamp.mistuned.MistunedDisk`) before its stop check: the branches of ``solve``
+    with their harmonic error estimate (:func:`~bladedamp.hbm.accuracy.converged_response` on
+    ``system_model``), then :func:`with_peak_check`. One accuracy warning per call: where the
+    peak check runs, its verdict (which includes the estimate) replaces the estimate's
+    AccuracyWarning; every other warning raised on the way is raised again at the caller of
+    ``frequency_response``."""
+    with warnings.catch_warnings(record=True) as raised:
+        response = converged_response(system_model, solve, harmonics, tolerance, max_harmonic, estimate=estimate)
+    response = with_peak_check(model, response, check_peak, tolerance, can_check)
+    for w in raised:
+        if response.peak_check is None or not issubclass(w.category, AccuracyWarning):
+            warnings.warn(w.message, w.category, stacklevel=3)     # this function, frequency_response, its caller
+    return response
+
+
 def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMONIC_TOLERANCE,
                     can_check: bool = True):
     """``response`` of ``model.frequency_response`` (a :class:`TunedDisk` or
@@ -993,7 +1010,7 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
     if status not in ("periodic", "drifting"):
         found = (f"{where} finds no periodic motion ({check.message[0]}; the damper's contact points separated "
                  f"{separated:.0f} % of the period): the branch's peak is not a motion the disk settles on")
-        warnings.warn(found, AccuracyWarning, stacklevel=3)
+        warnings.warn(found, AccuracyWarning, stacklevel=4)   # with_peak_check, peak_checked_response, the model, the caller
         return dataclasses.replace(with_checks(response, {"peak_time_check": found}), peak_check=check)
     direct = float(np.abs(model.time_output_amplitudes(check)[0] - at_peak).max() / peak)
     error = max(direct, enriched) if np.isfinite(enriched) else direct
@@ -1005,7 +1022,7 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
             f"contact points separated {separated:.0f} % of the period): harmonic error estimate {100 * error:.2g} %, "
             + ("within" if met else "above") + f" the tolerance {100 * tolerance:.2g} %")
     if not met:
-        warnings.warn(note, AccuracyWarning, stacklevel=3)
+        warnings.warn(note, AccuracyWarning, stacklevel=4)
     return dataclasses.replace(response, harmonic_error=error, harmonic_tolerance=tolerance, harmonics_converged=met,
                                peak_check=check, message=response.message + "; " + note)
 

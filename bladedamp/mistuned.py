@@ -60,9 +60,9 @@ from .contact.point import MAX_PASSES, PERIODIC_TOL
 from .damper.kinetics import seat
 from .disk import (AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION, DAMPER_DOFS, STOP_CHECK_OFFSET_HZ,
                    DamperContacts, TunedDisk, contact_point_maps, contact_rows, damper_weighted_scales,
-                   fused_point_map_forces, point_map_forces, rotor_speed_in_hz, time_at_peak, time_check_beyond,
-                   with_peak_check, with_stop_check)
-from .hbm.accuracy import HARMONIC_TOLERANCE, converged_response
+                   fused_point_map_forces, peak_checked_response, point_map_forces, rotor_speed_in_hz, time_at_peak,
+                   time_check_beyond, with_stop_check)
+from .hbm.accuracy import HARMONIC_TOLERANCE
 from .hbm.continuation import Branch, continuation
 from .hbm.start import robust_start
 from .hbm.linsolve import BlockCondensation, BlockRing, one_blas_thread
@@ -1087,10 +1087,9 @@ class MistunedDisk:
                                                          response.excitation_work, max_step, T, refine,
                                                          response.damper_work_bound))
 
-        response = converged_response(self, solve, harmonics, harmonic_tolerance, max_harmonic,
-                                      estimate=estimate_harmonic_error)
         can_check = not any(b.flexible_platform for b in self.blades)
-        response = with_peak_check(self, response, check_peak, harmonic_tolerance, can_check)
+        response = peak_checked_response(self, self, solve, harmonics, harmonic_tolerance, max_harmonic,
+                                         estimate_harmonic_error, check_peak, can_check)
         return with_stop_check(self, response, f_start_hz, check_stop)
 
     def peak_check(self, response: "MistunedResponse", **options):

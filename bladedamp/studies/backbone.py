@@ -37,7 +37,7 @@ from scipy.optimize import minimize_scalar
 
 from .. import validation
 from ..io import Saveable
-from .mass import GRID_PER_DECADE, peak_response, with_mass
+from .mass import GRID_PER_DECADE, log_mass_grid, peak_response, with_mass
 
 
 @dataclass
@@ -251,9 +251,8 @@ def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid
             resolved[m] |= set(todo)
         return peaks[m]
 
-    n = max(5, int(np.ceil(grid_per_decade * np.log10(hi / lo))) + 1)
-    loggrid = np.linspace(np.log(lo), np.log(hi), n)
-    grid = np.exp(loggrid)
+    loggrid, grid = log_mass_grid((lo, hi), grid_per_decade)
+    n = len(grid)
     grid_vals = np.array([evaluate(m) for m in grid])              # (n, l)
 
     with warnings.catch_warnings():
@@ -271,7 +270,7 @@ def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid
             continue
         i = int(np.nanargmin(col))
         a, b = loggrid[max(i - 1, 0)], loggrid[min(i + 1, n - 1)]
-        brackets[j] = np.exp([a, b])
+        brackets[j] = grid[max(i - 1, 0)], grid[min(i + 1, n - 1)]
         fail = 10 * undamped[j]
 
         def objective(logm, j=j, fail=fail):
