@@ -15,6 +15,7 @@ frequencies for comparison.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 from functools import cached_property
 
 import numpy as np
@@ -685,34 +686,47 @@ def _drift_verdict(means, scale, tol):
     return int(d), int(a), float(rate[d, a])
 
 
-def map_convergence(history, decay_per_period: float, settle_tol: float):
-    """Whether the period-to-period map of a time integration converges: (converged, residual
-    drift, contraction q per block, block length L) of ``history`` (p, ...) complex, the first
+class MapConvergence(NamedTuple):
+    """The convergence of a time integration's period-to-period map (:func:`map_convergence`)."""
+    converged: bool
+    residual: float          # bound on the last block mean's distance from the limit, relative to the amplitude
+    contraction: float       # q, per block
+    block: int               # L, periods per block
+    change: float            # c_2, the mean change per period over the last block, relative
+    change_before: float     # c_1, the same over the block before
+
+
+def map_convergence(history, decay_per_period: float, settle_tol: float, fluctuation_tol: float) -> MapConvergence:
+    """Whether the period-to-period map of a time integration converges (a
+    :class:`MapConvergence`) from ``history`` (p, ...) complex, the first
     harmonics of p consecutive periods. The means over the last three blocks of L = p // 4
     periods (a mean averages out a fluctuation from period to period) differ by D_1 (older) and
     D_2 (newer), relative to the largest first harmonic, and the mean change from one period to
     the next is c_1 over the middle block and c_2 over the last. A transient that decays at least
     geometrically by q per block leaves the newest mean at most D_2 q / (1 - q) from the limit
-    (the geometric tail), and shrinks both D and c by q per block; q is the largest of the
-    observed D_2 / D_1 and c_2 / c_1 and of exp(-sigma T L), the decay over a block of the slowest
-    viscously damped blade mode (``decay_per_period`` = sigma T, sigma = zeta omega_n [1/s] of
-    that mode, T the period; friction only adds damping). A motion that is not periodic keeps
-    changing from period to period (c_2 / c_1 about 1, chaotic block means about as far apart
-    as their sampling noise): q about 1, an unbounded residual. Converged when q < 1 and that
-    residual drift is at most ``settle_tol``."""
+    (the geometric tail); q is the larger of the observed D_2 / D_1 and exp(-sigma T L), the
+    decay over a block of the slowest viscously damped blade mode (``decay_per_period`` = sigma T,
+    sigma = zeta omega_n [1/s] of that mode, T the period; friction only adds damping). The
+    transient's share of the per-period change shrinks by q per block too, on top of a fluctuation
+    that does not decay (the dampers ringing on their contact springs) of at most
+    ``fluctuation_tol``: c_2 <= q c_1 + fluctuation_tol. A motion that is not periodic (a damper
+    hopping) keeps changing from period to period by about as much in every block, c_2 about
+    c_1 above the fluctuation, and fails it, whatever its block means do. Converged when q < 1,
+    c_2 <= q c_1 + fluctuation_tol and the residual drift is at most ``settle_tol``."""
     p = len(history)
     L = p // 4
     if L < 1:
-        return False, np.inf, np.inf, L
+        return MapConvergence(False, np.inf, np.inf, L, np.inf, np.inf)
     means = [np.mean(history[p - (j + 1) * L:p - j * L], axis=0) for j in (2, 1, 0)]
     amp = max(np.abs(means[-1]).max(), 1e-300)
     d1 = np.abs(means[1] - means[0]).max() / amp
     d2 = np.abs(means[2] - means[1]).max() / amp
     steps = np.abs(np.diff(history[p - 2 * L - 1:], axis=0)).reshape(2 * L, -1).max(axis=1) / amp
     c1, c2 = steps[:L].mean(), steps[L:].mean()
-    q = max(d2 / max(d1, 1e-300), c2 / max(c1, 1e-300), float(np.exp(-decay_per_period * L)))
+    q = max(d2 / max(d1, 1e-300), float(np.exp(-decay_per_period * L)))
     residual = d2 * q / (1 - q) if q < 1 else np.inf
-    return bool(residual <= settle_tol), float(residual), float(q), L
+    return MapConvergence(bool(residual <= settle_tol and c2 <= q * c1 + fluctuation_tol), float(residual), float(q), L,
+                          float(c2), float(c1))
 
 
 def row_nonzeros(A):
@@ -958,7 +972,8 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
             p = max_periods
             verdict = _drift_verdict(np.array(mean_hist[-drift_periods - 1:]), np.repeat(scale, 3), tol) \
                 if nd and p > drift_periods else None
-            converged, residual, q, L = map_convergence(np.array(tip_hist), decay_rate * 2 * np.pi / w, settle_tol)
+            conv = map_convergence(np.array(tip_hist), decay_rate * 2 * np.pi / w, settle_tol, fluctuation_tol)
+            converged, residual, q, L = conv.converged, conv.residual, conv.contraction, conv.block
             out["residual_drift"][i] = residual
             how = (f"the period-to-period map converges: the first harmonics' means over the last blocks of {L} "
                    f"periods approach their limit by a factor {q:.3g} per block (the slowest blade mode's viscous "
@@ -982,7 +997,11 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
                 message = (f"not settled: first harmonics changed by {change:.2g} per period (tol {tol:g}) after {p} "
                            f"periods, and the period-to-period map does not converge to settle_tol {settle_tol:g}: "
                            + (f"the means over the last blocks of {L} periods approach a limit by a factor {q:.3g} "
-                              f"per block, a residual drift of {residual:.2g} of the amplitude"
+                              f"per block, a residual drift of {residual:.2g} of the amplitude, and the first "
+                              f"harmonics change by {conv.change:.2g} per period over the last block against "
+                              f"{conv.change_before:.2g} over the one before (a converging transient's change "
+                              f"shrinks by that factor, on top of a fluctuation of at most fluctuation_tol "
+                              f"{fluctuation_tol:g})"
                               if q < 1 else f"the means over the last blocks of {L} periods move apart (a factor "
                               f"{q:.3g} per block)"))
         out["tip_harmonic"][i] = X
