@@ -657,7 +657,8 @@ class TunedDisk:
         for 16 blades on 2 cores), and only for a branch that stopped before the end of its range;
         rigid platforms and no ``extra_couplings`` (what ``time_response`` models).
         ``check_peak``: for a branch that reached the end of the range, integrate the full
-        assembly in time at the peak's frequency (:meth:`peak_check`): where that motion is
+        assembly in time at the peak's frequency, started on the branch's own state there
+        (:meth:`peak_check`): where that motion is
         periodic (or the blades settle while a damper keeps rolling), its difference from the
         branch is a direct harmonic error estimate (the only one where the enriched set's Newton
         fails at the peak, typically with the damper separated most of the period); where the
@@ -868,8 +869,10 @@ class TunedDisk:
     def time_response(self, f_hz, **options):
         """Steady state at each excitation frequency ``f_hz`` [Hz] (scalar or array) by time
         integration of the full assembly (``MistunedDisk.from_tuned(self)``: every blade and
-        damper written out, no cyclic reduction), from the static equilibrium under F_CG (Eq. 26);
-        see :func:`bladedamp.timedomain.disk_time_response` for ``options``.
+        damper written out, no cyclic reduction), from the static equilibrium under F_CG (Eq. 26)
+        or a harmonic solution's state (``start_coefficients`` of the full assembly:
+        :func:`bladedamp.hbm.monodromy.full_assembly_coefficients`); see
+        :func:`bladedamp.timedomain.disk_time_response` for ``options``.
         Returns a :class:`bladedamp.timedomain.DiskTimeResponse` (tip amplitudes of every blade)."""
         from .mistuned import MistunedDisk
         from .timedomain import disk_time_response
@@ -892,7 +895,9 @@ class TunedDisk:
 
     def peak_check(self, response: "DiskResponse", **options):
         """:meth:`time_response` at the frequency of ``response``'s peak (the point of the
-        largest first-harmonic tip amplitude in any direction), ``options`` going to it: what
+        largest first-harmonic tip amplitude in any direction), started on the branch's state
+        there (``start="hbm"``, default) or from the static equilibrium (``start="static"``;
+        :func:`time_at_peak`), the other ``options`` going to it: what
         ``frequency_response(..., check_peak=True)`` runs (:func:`with_peak_check`)."""
         return time_at_peak(self, response, **options)
 
