@@ -95,8 +95,9 @@ def physical_checks(omega, omega_range, dissipation, excitation_work, max_step=N
         how = f", confirmed with {REFINE_SAMPLES_FACTOR * n_samples} AFT samples per period"
         if judge_solution_samples and not bad.any() and (own < -SAMPLING_FLOOR).any():
             bad, relative = own < -SAMPLING_FLOOR, own
-            how = (f" with {n_samples} AFT samples per period, above -{SAMPLING_FLOOR:g} with "
-                   f"{REFINE_SAMPLES_FACTOR * n_samples}: the AFT's energy error")
+            how = (f" with {n_samples} AFT samples per period: the AFT's energy error, since with "
+                   f"{REFINE_SAMPLES_FACTOR * n_samples} on the same coefficients it is above -{SAMPLING_FLOOR:g} of "
+                   f"that scale; more samples per period cure it")
     if bad.any():
         of = "the excitation work" if work_bound is None else "the energy scale (excitation work or the contact's)"
         failed["dissipation"] = (f"negative friction dissipation at {int(bad.sum())} points "
