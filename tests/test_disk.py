@@ -734,6 +734,7 @@ def test_check_peak_estimates_the_harmonic_error_by_time_integration(monkeypatch
     assert checked.harmonic_error == max(direct, plain.harmonic_error) and checked.harmonics_converged is False
     assert mistuned.harmonic_error == pytest.approx(checked.harmonic_error, rel=0.02)
     assert mistuned.peak_check.status[0] == "drifting"
+    assert check.start[0] == mistuned.peak_check.start[0] == "HBM solution"      # both start on their branch
     monkeypatch.setattr(TunedDisk, "time_response", lambda *a, **k: pytest.fail("no time integration expected"))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
