@@ -657,7 +657,8 @@ class TunedDisk:
         for 16 blades on 2 cores), and only for a branch that stopped before the end of its range;
         rigid platforms and no ``extra_couplings`` (what ``time_response`` models).
         ``check_peak``: for a branch that reached the end of the range, integrate the full
-        assembly in time at the peak's frequency (:meth:`peak_check`): where that motion is
+        assembly in time at the peak's frequency, started on the branch's own state there
+        (:meth:`peak_check`): where that motion is
         periodic (or the blades settle while a damper keeps rolling), its difference from the
         branch is a direct harmonic error estimate (the only one where the enriched set's Newton
         fails at the peak, typically with the damper separated most of the period); where the
@@ -867,8 +868,10 @@ class TunedDisk:
     def time_response(self, f_hz, **options):
         """Steady state at each excitation frequency ``f_hz`` [Hz] (scalar or array) by time
         integration of the full assembly (``MistunedDisk.from_tuned(self)``: every blade and
-        damper written out, no cyclic reduction), from the static equilibrium under F_CG (Eq. 26);
-        see :func:`bladedamp.timedomain.disk_time_response` for ``options``.
+        damper written out, no cyclic reduction), from the static equilibrium under F_CG (Eq. 26)
+        or a harmonic solution's state (``start_coefficients`` of the full assembly:
+        :func:`bladedamp.hbm.monodromy.full_assembly_coefficients`); see
+        :func:`bladedamp.timedomain.disk_time_response` for ``options``.
         Returns a :class:`bladedamp.timedomain.DiskTimeResponse` (tip amplitudes of every blade)."""
         from .mistuned import MistunedDisk
         from .timedomain import disk_time_response
@@ -891,7 +894,9 @@ class TunedDisk:
 
     def peak_check(self, response: "DiskResponse", **options):
         """:meth:`time_response` at the frequency of ``response``'s peak (the point of the
-        largest first-harmonic tip amplitude in any direction), ``options`` going to it: what
+        largest first-harmonic tip amplitude in any direction), started on the branch's state
+        there (``start="hbm"``, default) or from the static equilibrium (``start="static"``;
+        :func:`time_at_peak`), the other ``options`` going to it: what
         ``frequency_response(..., check_peak=True)`` runs (:func:`with_peak_check`)."""
         return time_at_peak(self, response, **options)
 
@@ -909,12 +914,27 @@ def peak_index(model, response) -> int:
     return int(np.argmax(model.output_amplitudes(response.coefficients, response.basis).max(axis=1)))
 
 
-def time_at_peak(model, response, **options):
+def time_at_peak(model, response, start: str = "hbm", **options):
     """``model.time_response`` at the frequency of ``response``'s peak (:func:`peak_index`): the
-    ``peak_check`` of both models."""
+    ``peak_check`` of both models. ``start``: "hbm" (default) starts on the peak's harmonic
+    solution (displacements and velocities from its Fourier series at t = 0, every friction
+    slider from the contact's return map over one period of its motion:
+    :func:`bladedamp.hbm.monodromy.orbit_state`), so the run tests that branch; a harmonic set
+    without the static harmonic 0 (the dampers seated beforehand, not in the solution) starts
+    from the static equilibrium instead. "static": from the static equilibrium under F_CG, the
+    motion a run-up from rest reaches. The result's ``start`` says which."""
+    from .hbm import monodromy
+
+    if start not in ("hbm", "static"):
+        raise ValueError(f"start must be 'hbm' (the HBM solution's state) or 'static' (the static equilibrium), "
+                         f"got {start!r}")
     if not len(response.omega):
         raise ValueError("peak_check needs a response with at least one point")
-    return model.time_response(response.frequency_hz[peak_index(model, response)], **options)
+    k = peak_index(model, response)
+    if start == "hbm" and response.basis.has_static and monodromy.supports(model):
+        X = monodromy.full_assembly_coefficients(model, response.coefficients[k], response.basis)
+        options = dict(options, start_coefficients=X[None], start_basis=response.basis)
+    return model.time_response(response.frequency_hz[k], **options)
 
 
 def time_check_beyond(model, response, offset_hz: float = STOP_CHECK_OFFSET_HZ, f_start_hz: float | None = None,
@@ -967,7 +987,9 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
     """``response`` of ``model.frequency_response`` (a :class:`TunedDisk` or
     :class:`~bladedamp.mistuned.MistunedDisk`) with its peak checked by time integration, with
     ``check_peak`` and a branch that reached the end of its range: ``model.peak_check``, the full
-    assembly integrated at the peak's frequency from the static equilibrium.
+    assembly integrated at the peak's frequency, started on the branch's own state there
+    (:func:`time_at_peak`; from the static equilibrium for a harmonic set without the static
+    term), so it tests that branch; the message says which start it used.
 
     * Periodic there: the largest difference of the first-harmonic tip amplitudes (every blade,
       x, y, z) relative to the branch's peak amplitude is a second harmonic error estimate, a
@@ -981,6 +1003,11 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
       reference 1 g cylinder in its slip range, 95.1-96.1 Hz: tests/test_timedomain_disk.py, where
       the HBM is within 2 % of the mean tip amplitudes): compared as above, with the time
       integration's mean tip amplitudes, and the message says the damper drifts.
+    * Periodic or drifting, but farther from the branch than its one-period defect allows for a
+      motion that stays on it (:func:`orbit_departure`): the motion left the branch for a
+      coexisting one. A note, not a harmonic error estimate (``harmonic_error`` and
+      ``harmonics_converged`` stay the enriched set's); ``peak_check(result, start='static')``
+      gives the motion reached from rest.
     * Not settled or unstable there (the vibration does not settle: random disks 51 and 87,
       cylinders of 7.1 and 3.4 g at EO 7 and 8, whose (0, 1) branches reach the end unverified,
       the damper separated 87 and 19 % of the period): the branch's peak is not a motion the disk
@@ -1005,7 +1032,11 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
     check = model.peak_check(response)
     f, peak = check.frequency_hz[0], max(float(at_peak.max()), 1e-300)
     separated = 100 * check.point_state[0][..., 2].mean()
-    where = f"at the peak, {f:.4f} Hz, the time integration of the full assembly (from the static equilibrium)"
+    on_orbit = check.start is not None and check.start[0] == "HBM solution"
+    origin = ("started on the HBM solution's state: displacements, velocities and the sliders' states over one "
+              "period of its motion" if on_orbit else "from the static equilibrium" +
+              ("" if response.basis.has_static else ": the harmonic set has no static term to start on"))
+    where = f"at the peak, {f:.4f} Hz, the time integration of the full assembly ({origin})"
     status = check.status[0]
     if status not in ("periodic", "drifting"):
         found = (f"{where} finds no periodic motion ({check.message[0]}; the damper's contact points separated "
@@ -1013,6 +1044,14 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
         warnings.warn(found, AccuracyWarning, stacklevel=4)   # with_peak_check, peak_checked_response, the model, the caller
         return dataclasses.replace(with_checks(response, {"peak_time_check": found}), peak_check=check)
     direct = float(np.abs(model.time_output_amplitudes(check)[0] - at_peak).max() / peak)
+    if on_orbit:
+        left = orbit_departure(model, check, at_peak, peak, direct, tolerance)
+        if left is not None:
+            note = (f"{where} leaves the branch for a coexisting periodic motion {left}; the branch's peak is not the "
+                    "motion a disk started on it keeps (an unstable or coexisting solution): this is no harmonic error "
+                    "estimate, peak_check(result, start='static') gives the motion reached from rest")
+            warnings.warn(note, AccuracyWarning, stacklevel=3)
+            return dataclasses.replace(response, peak_check=check, message=response.message + "; " + note)
     error = max(direct, enriched) if np.isfinite(enriched) else direct
     met = error <= tolerance
     motion = ("settles on a periodic motion" if status == "periodic" else
@@ -1025,6 +1064,30 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
         warnings.warn(note, AccuracyWarning, stacklevel=4)
     return dataclasses.replace(response, harmonic_error=error, harmonic_tolerance=tolerance, harmonics_converged=met,
                                peak_check=check, message=response.message + "; " + note)
+
+
+def orbit_departure(model, check, at_peak, peak: float, direct: float, tolerance: float) -> str | None:
+    """Whether the time integration ``check``, started on the HBM solution at the peak (tip
+    amplitudes ``at_peak``, ``model.output_amplitudes``' order, largest ``peak`` [m]), left that
+    branch for another periodic motion; its settled tip amplitudes differ from the branch's by
+    ``direct`` (relative to ``peak``). A solution of truncation error e is a fixed point of the
+    period map only to within its one-period defect d_1 (the first period's first harmonics'
+    largest difference from the branch's, relative to ``peak``); where the period map contracts
+    at least as fast as the slowest viscously damped blade mode decays, rho = exp(-sigma T) per
+    period (``check.decay_rate`` = sigma; friction only adds dissipation), the motion it settles
+    on lies within d_1 / (1 - rho) of the start (the contraction's fixed-point bound). A settled
+    motion farther than that and than ``tolerance`` is another motion: returns what says so (the
+    numbers), else None."""
+    if not np.isfinite(check.decay_rate) or check.decay_rate <= 0 or not len(check.tip_history[0]):
+        return None
+    first = dataclasses.replace(check, tip_amplitude=np.abs(check.tip_history[0][:1]))
+    defect = float(np.abs(model.time_output_amplitudes(first)[0] - at_peak).max() / peak)
+    bound = defect / -np.expm1(-check.decay_rate * 2 * np.pi / check.omega[0])
+    if direct <= max(bound, tolerance):
+        return None
+    return (f"{100 * direct:.3g} % from the branch's first-harmonic tip amplitudes, beyond the {100 * bound:.3g} % "
+            f"that the branch's one-period defect ({100 * defect:.3g} % in the first period) allows for a motion "
+            f"that stays on it (the blades' slowest viscous decay, {check.decay_rate:.3g} 1/s)")
 
 
 def stop_verdict(check, harmonics) -> str:

@@ -1211,7 +1211,8 @@ class MistunedDisk:
     def time_response(self, f_hz, **options):
         """Steady state of every blade at each excitation frequency ``f_hz`` [Hz] (scalar or
         array) by time integration of the full assembly (``len(blades) == n_blades``), from the
-        static equilibrium under F_CG (Eq. 26); see :func:`bladedamp.timedomain.disk_time_response`.
+        static equilibrium under F_CG (Eq. 26) or a harmonic solution's state
+        (``start_coefficients``); see :func:`bladedamp.timedomain.disk_time_response`.
         Returns a :class:`bladedamp.timedomain.DiskTimeResponse`."""
         from .timedomain import disk_time_response
 

@@ -149,7 +149,11 @@ class FrictionOscillator:
         fails, up to ``MAX_AUTO_SAMPLES``). ``continuation_options`` go to
         :func:`bladedamp.hbm.continuation.continuation` (``max_step`` sets the point density).
         The result is ``success`` only if the branch reached the end and passed
-        :func:`bladedamp.response.physical_checks`.
+        :func:`bladedamp.response.physical_checks`, with the contact's dissipation judged at the
+        solve's own samples (``judge_solution_samples``): a successful result's contact
+        dissipation is at least -``SAMPLING_FLOOR`` (:mod:`bladedamp.response`) of each point's
+        energy scale, the larger of the excitation work and the contact's work bound (its AFT
+        energy error); where it is not, the samples grow as above.
         """
         validation.positive("f_start_hz", f_start_hz)
         validation.positive("f_end_hz", f_end_hz)
@@ -186,7 +190,7 @@ class FrictionOscillator:
 
             return with_checks(response, physical_checks(branch.omega, (omega_start, omega_end), energies[:, :1],
                                                          work, continuation_options.get("max_step") or 0.02,
-                                                         T, refine, energies[:, 1:]))
+                                                         T, refine, energies[:, 1:], judge_solution_samples=True))
 
         return with_range_end_estimate(self, converged_response(self, solve, harmonics, harmonic_tolerance,
                                                                 max_harmonic))
