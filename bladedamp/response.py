@@ -135,11 +135,11 @@ def sampled_response(solve, n_samples, first: int, most: int, most_for_dissipati
     samples were chosen."""
     if n_samples is not None:
         return solve(n_samples)
-    n, tried, response, empty = int(first), [], None, None
+    n, tried, response, empty, stopped_by = int(first), [], None, None, ""
     while True:
         finer = solve(n)
         if response is not None and not len(finer.omega):
-            empty = n                                 # the coarser branch is kept
+            empty, stopped_by = n, finer.stopped_by   # the coarser branch is kept (and the stop, e.g. a budget)
             break
         response = finer
         if response.stopped_by:                       # stopped as the caller asked: no retry
@@ -155,7 +155,9 @@ def sampled_response(solve, n_samples, first: int, most: int, most_for_dissipati
     if failed_with:
         note += f"; AFT samples per period raised to {n_used} (the branch failed with {', '.join(failed_with)})"
     if empty is not None:
-        note += f"; with {empty} AFT samples per period the branch kept no point"
+        note += f"; with {empty} AFT samples per period the branch kept no point" + (f": {stopped_by}" if stopped_by else "")
+    if stopped_by:
+        return dataclasses.replace(response, message=response.message + note, success=False, stopped_by=stopped_by)
     return dataclasses.replace(response, message=response.message + note) if note else response
 
 

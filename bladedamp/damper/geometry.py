@@ -60,6 +60,20 @@ def contact_frame(normal: np.ndarray) -> np.ndarray:
     return np.array([xi, eta, normal])
 
 
+# Contact stiffness per unit contact length [N/m per m] a damper contact can have; a value
+# outside is refused (ValueError), not warned about: far outside, the model stops being a contact
+# and the continuation finds no end (a tangential stiffness of 1e-6 N/m^2, with the default
+# k_N / k_T, ran past 60 CPU s). Upper end: a line contact between steel bodies is about pi E*/4
+# per unit length over a logarithmic factor, E* = 1.15e11 Pa for steel on steel, so 1e10-1e11; a
+# stiffness two decades above E* is no contact (the normal and the tangential stiffness). Lower
+# end (normal stiffness only): the reference contact (k_T 1.7e7, k_N 2.1e7 N/m^2) is soft because
+# it lumps the platforms' local flexibility; at 1e5 N/m^2 the reference 1 g cylinder's
+# centrifugal preload at 100 Hz (m R Omega^2 = 39 N over l_C = 20 mm) would press it 2 cm into
+# the platform, ten times its radius. The tangential stiffness has no lower end: k_T -> 0 is the
+# frictionless limit of a contact (its normal springs stay), which the nonlinear modes use.
+CONTACT_STIFFNESS_PER_LENGTH_RANGE = (1.0e5, 1.0e13)       # N/m per m
+
+
 @dataclass(frozen=True)
 class ContactProperties:
     """Contact parameters shared by both contacts of a damper.
@@ -88,6 +102,18 @@ class ContactProperties:
         validation.nonnegative("friction_coefficient (mu)", self.friction_coefficient)
         validation.positive("tangential_stiffness_per_length", self.tangential_stiffness_per_length)
         validation.positive("normal_to_tangential_stiffness", self.normal_to_tangential_stiffness)
+        low, high = CONTACT_STIFFNESS_PER_LENGTH_RANGE
+        if self.tangential_stiffness_per_length > high:
+            raise ValueError(f"tangential_stiffness_per_length must be in (0, {high:g}] N/m per m of contact length "
+                             f"(got {self.tangential_stiffness_per_length!r}; a steel line contact is 1e10-1e11)")
+        normal = self.normal_to_tangential_stiffness * self.tangential_stiffness_per_length
+        if not low <= normal <= high:
+            raise ValueError(f"the normal contact stiffness per length, normal_to_tangential_stiffness x "
+                             f"tangential_stiffness_per_length = {self.normal_to_tangential_stiffness!r} x "
+                             f"{self.tangential_stiffness_per_length!r} = {normal:.3g} N/m per m, must be in the "
+                             f"plausible range [{low:g}, {high:g}] N/m per m of contact length (a steel line contact "
+                             f"is 1e10-1e11; softer values lump the platforms' flexibility; below {low:g} the "
+                             f"centrifugal preload presses a damper centimetres into its platform)")
         validation.in_range("roughness_exponent", self.roughness_exponent, 1.0, 5.0)
         validation.positive("roughness_reference_load", self.roughness_reference_load)
         validation.integer("points_along_length", self.points_along_length, minimum=1)
