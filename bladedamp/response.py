@@ -281,7 +281,8 @@ def range_end_of_largest(frequency_hz, amplitude) -> float | None:
     whose amplitude is within ``END_AMPLITUDE_RESOLUTION`` of the largest counts as holding it
     (both ends: the one with the larger amplitude). There the range holds no maximum: the curve
     still rises towards that end. ``amplitude`` (n, k): k curves (e.g. one per blade), the end
-    of the largest curve whose largest lies at an end. None for an empty branch."""
+    of the largest curve whose largest lies at an end. None for an empty branch, and for curves
+    that are zero everywhere (at rest: no resonance to miss)."""
     f, a = np.asarray(frequency_hz, dtype=float), np.asarray(amplitude, dtype=float)
     if not f.size:
         return None
@@ -290,6 +291,8 @@ def range_end_of_largest(frequency_hz, amplitude) -> float | None:
     low, high = f <= f.min() + same, f >= f.max() - same
     found = []
     for curve in a.T:
+        if not curve.max() > 0:
+            continue                     # no motion at all (a response at rest): no resonance anywhere
         best, end = max((float(curve[low].max()), float(f.min())), (float(curve[high].max()), float(f.max())))
         if best >= (1 - END_AMPLITUDE_RESOLUTION) * curve.max():
             found.append((best, end))

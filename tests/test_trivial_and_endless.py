@@ -18,6 +18,7 @@ from bladedamp.damper.geometry import (CONTACT_STIFFNESS_PER_LENGTH_RANGE, MIN_D
 from bladedamp.hbm.continuation import DEFAULT_CPU_BUDGET_S, Budget
 from bladedamp.mistuned import MistunedDisk
 from bladedamp.reference import reference_blade, reference_disk
+from bladedamp.response import Status
 
 F_RANGE = (90.0, 105.0)
 
@@ -44,8 +45,8 @@ def test_a_point_budget_stops_the_oscillator_keeping_its_points(oscillator_frf):
     n = len(full.omega) // 3
     r = quiet(osc.frequency_response, 10.0, 30.0, harmonics=(1,), point_budget=n)
     assert not r.success and len(r.omega) == n
-    assert r.stopped_by == f"the budget of {n} continuation points ran out at {r.frequency_hz[-1]:.6g} Hz"
-    assert r.stopped_by in r.message
+    assert r.stopped_by == f"budget: {n} continuation points ran out at {r.frequency_hz[-1]:.6g} Hz"
+    assert r.stopped_by in r.message and r.status is Status.OUT_OF_BUDGET
     # the points kept are those of the run without a budget
     np.testing.assert_allclose(r.coefficients, full.coefficients[:n], rtol=0,
                                atol=1e-12 * np.abs(full.coefficients).max())
@@ -60,8 +61,8 @@ def test_a_cpu_budget_stops_the_oscillator_keeping_its_points(oscillator_frf, mo
     r = quiet(osc.frequency_response, 10.0, 30.0, harmonics=(1,), cpu_budget_s=30.0)
     monkeypatch.undo()
     assert not r.success and 10 < len(r.omega) <= 30 < len(full.omega)
-    assert r.stopped_by == f"the CPU budget of 30 s ran out at {r.frequency_hz[-1]:.6g} Hz"
-    assert r.stopped_by in r.message
+    assert r.stopped_by == f"budget: 30 CPU s ran out at {r.frequency_hz[-1]:.6g} Hz"
+    assert r.stopped_by in r.message and r.status is Status.OUT_OF_BUDGET
     n = len(r.omega)
     np.testing.assert_allclose(r.coefficients, full.coefficients[:n], rtol=0,
                                atol=1e-12 * np.abs(full.coefficients).max())
@@ -70,7 +71,8 @@ def test_a_cpu_budget_stops_the_oscillator_keeping_its_points(oscillator_frf, mo
 def test_a_budget_spent_before_the_branch_starts_keeps_no_point_and_says_so():
     r = quiet(FrictionOscillator().frequency_response, 10.0, 30.0, harmonics=(1,), cpu_budget_s=1e-12)
     assert not r.success and len(r.omega) == 0
-    assert r.stopped_by == "the CPU budget of 1e-12 s ran out at 10 Hz" and r.stopped_by in r.message
+    assert r.stopped_by == "budget: 1e-12 CPU s ran out at 10 Hz" and r.stopped_by in r.message
+    assert r.status is Status.OUT_OF_BUDGET
 
 
 @pytest.mark.parametrize("cpu, points, name", [(0.0, 10, "cpu_budget_s"), (np.nan, 10, "cpu_budget_s"),
@@ -86,8 +88,8 @@ def test_a_point_budget_stops_the_tuned_disk_keeping_its_points():
     assert full.success
     r = quiet(disk.frequency_response, *F_RANGE, harmonics=(1,), estimate_harmonic_error=False, point_budget=25)
     assert not r.success and len(r.omega) == 25
-    assert r.stopped_by == f"the budget of 25 continuation points ran out at {r.frequency_hz[-1]:.6g} Hz"
-    assert r.stopped_by in r.message
+    assert r.stopped_by == f"budget: 25 continuation points ran out at {r.frequency_hz[-1]:.6g} Hz"
+    assert r.stopped_by in r.message and r.status is Status.OUT_OF_BUDGET
     np.testing.assert_allclose(r.tip_amplitude, full.tip_amplitude[:25], rtol=1e-10)
 
 
@@ -96,7 +98,8 @@ def test_a_point_budget_stops_the_mistuned_disk_keeping_its_points():
     disk = MistunedDisk.from_tuned(tuned, kappa=[0.98, 1.0, 1.01, 1.03])
     r = quiet(disk.frequency_response, *F_RANGE, harmonics=(1,), estimate_harmonic_error=False, point_budget=8)
     assert not r.success and len(r.omega) == 8
-    assert r.stopped_by == f"the budget of 8 continuation points ran out at {r.frequency_hz[-1]:.6g} Hz"
+    assert r.stopped_by == f"budget: 8 continuation points ran out at {r.frequency_hz[-1]:.6g} Hz"
+    assert r.status is Status.OUT_OF_BUDGET
     assert np.all(np.diff(r.omega) > 0) and np.all(np.isfinite(r.tip_amplitude))
 
 
@@ -120,6 +123,7 @@ def test_a_disk_without_excitation_is_at_rest(kind):
     disk = reference_disk(kind, 1e-3, excitation=np.zeros(6))
     r = quiet(disk.frequency_response, *F_RANGE)
     assert r.success and r.harmonics_converged and r.harmonic_error == 0.0, r.message
+    assert r.status is Status.COMPLETE_VERIFIED and not r.peak_at_range_end     # at rest: no resonance to miss
     assert r.frequency_hz[0] == F_RANGE[0] and r.frequency_hz[-1] == F_RANGE[1]
     assert np.all(r.tip_amplitude == 0.0) and np.all(r.coefficients == 0.0)
     system = disk.hbm_system(r.basis.harmonics, r.basis.n_samples)
@@ -133,6 +137,7 @@ def test_a_mistuned_disk_without_excitation_is_at_rest():
     disk = MistunedDisk.from_tuned(tuned, kappa=[0.98, 1.0, 1.01, 1.03])
     r = quiet(disk.frequency_response, *F_RANGE)
     assert r.success and np.all(r.tip_amplitude == 0.0), r.message
+    assert r.status is Status.COMPLETE_VERIFIED and not r.peak_at_range_end
     system = disk.hbm_system(r.basis.harmonics, r.basis.n_samples)
     x, w = r.coefficients[len(r.omega) // 2].ravel(), r.omega[len(r.omega) // 2]
     assert np.linalg.norm(system.residual(x, w)[0]) < 1e-12 * max(tuned.static_normal_loads(F_RANGE[1]).max(), 1.0)
@@ -141,6 +146,7 @@ def test_a_mistuned_disk_without_excitation_is_at_rest():
 def test_an_oscillator_without_forcing_is_at_rest():
     r = quiet(FrictionOscillator(forcing=0.0).frequency_response, 10.0, 30.0)
     assert r.success and np.all(r.coefficients == 0.0), r.message
+    assert r.status.complete and not r.peak_at_range_end
 
 
 # ---------------------------------------------------------------------------------------
@@ -238,7 +244,7 @@ def test_the_undamped_oscillator_above_the_friction_limit_grows_without_bound_in
     its amplitude grows; below the friction limit it stays bounded by the stuck and free
     linear responses' scale."""
     osc = FrictionOscillator(damping=0.0)
-    f_n = osc.natural_frequency_hz
+    f_n = osc.linear_natural_frequencies_hz()[0]
     short = osc.time_response(f_n, max_periods=100, min_periods=100)
     long = osc.time_response(f_n, max_periods=400, min_periods=400)
     assert not long.converged[0]

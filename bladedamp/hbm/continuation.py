@@ -153,12 +153,14 @@ class Budget:
 
     def exhausted(self, omega: float) -> str:
         """'' while the budget lasts; otherwise what ran out, at the angular frequency ``omega``
-        [rad/s] (reported in Hz)."""
+        [rad/s] (reported in Hz), starting with "budget" (the word by which
+        :func:`bladedamp.response.response_status` tells it from a caller's stop): "budget: 300
+        CPU s ran out at 97.3 Hz" or "budget: 5000 continuation points ran out at 97.3 Hz"."""
         where = f"{omega / (2 * np.pi):.6g} Hz"
         if self.points >= self.max_points:
-            return f"the budget of {self.max_points} continuation points ran out at {where}"
+            return f"budget: {self.max_points} continuation points ran out at {where}"
         if self.cpu_used() > self.cpu_seconds:
-            return f"the CPU budget of {self.cpu_seconds:g} s ran out at {where}"
+            return f"budget: {self.cpu_seconds:g} CPU s ran out at {where}"
         return ""
 
     def spend(self, omega: float) -> str:
