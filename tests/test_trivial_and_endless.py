@@ -4,6 +4,7 @@ response, or a contact stiffness that is no contact, is refused before any solve
 from __future__ import annotations
 
 import dataclasses
+import re
 import warnings
 
 import numpy as np
@@ -218,7 +219,7 @@ def test_the_cli_refuses_a_vanishing_damper_and_a_non_contact(tmp_path, capsys, 
     assert main(["frf", str(path), "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err
     lines = err.strip().splitlines()
-    assert len(lines) == 1 and "Traceback" not in err and "nan" not in err, err
+    assert len(lines) == 1 and "Traceback" not in err and not re.search(r"\bnan\b", err), err
     for needle in (str(path),) + needles:
         assert needle in lines[0], (needle, lines[0])
     assert not (tmp_path / "out").exists()
@@ -278,3 +279,22 @@ def test_a_contact_stiffness_that_is_no_contact_is_refused_with_the_plausible_ra
     # the frictionless limit k_T -> 0 with the normal springs kept is a contact
     ContactProperties(tangential_stiffness_per_length=1e-5, normal_to_tangential_stiffness=2e12)
     ContactProperties(tangential_stiffness_per_length=low, normal_to_tangential_stiffness=1.0)
+
+
+def test_the_cli_names_a_response_without_points_and_prints_no_nan(tmp_path, capsys, monkeypatch):
+    """A response that kept no point (here: its budget spent before the first) has no peak: the
+    command says so, and no number it prints is nan."""
+    from bladedamp.disk import TunedDisk
+
+    computed = TunedDisk.frequency_response
+
+    def spent(self, *args, **options):
+        return computed(self, *args, **{**options, "cpu_budget_s": 1e-12})
+
+    monkeypatch.setattr(TunedDisk, "frequency_response", spent)
+    path = tmp_path / "design.toml"
+    path.write_text("[analysis]\nfrequency_range_hz = [92.0, 99.0]\nharmonics = [1]\n")
+    assert main(["frf", str(path), "--out", str(tmp_path / "out")]) == 0
+    err = capsys.readouterr().err
+    assert "EO1 no peak: no point computed" in err and "out of budget" in err
+    assert not re.search(r"\bnan\b", err), err
