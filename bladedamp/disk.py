@@ -700,11 +700,11 @@ class TunedDisk:
         ``peak_check`` keeps the integration). One time integration (1-3 s for 4 blades, 5-31 s
         for 16 on 2 cores); the same restrictions as ``check_stop``.
         ``cpu_budget_s`` [s] and ``point_budget``: the CPU time (``time.process_time``) and the
-        continuation points this whole analysis may spend (the
-        time integrations of ``check_stop`` and ``check_peak`` excepted) (:class:`bladedamp.hbm.continuation.Budget`;
+        continuation points this whole analysis may spend, the time integrations of
+        ``check_stop`` and ``check_peak`` excepted (:class:`bladedamp.hbm.continuation.Budget`;
         defaults ``DEFAULT_CPU_BUDGET_S``, ``DEFAULT_POINT_BUDGET``). Where it runs out the branch
-        ends there with every point it has, not ``success``, and ``stopped_by`` and the message
-        say what ran out and at which frequency.
+        ends there with every point it has, status ``OUT_OF_BUDGET`` (not ``success``), and
+        ``stopped_by`` and the message say what ran out and at which frequency.
         """
         validation.positive("f_start_hz", f_start_hz)
         validation.positive("f_end_hz", f_end_hz)
@@ -1003,10 +1003,10 @@ def rest_response(model, omega_start: float, omega_end: float, max_step: float, 
     """The exact response of a disk (``model``: a TunedDisk or MistunedDisk) without dynamic
     excitation over ``omega_start``..``omega_end`` [rad/s]: every blade and damper at rest (each
     harmonic of the motion zero; the preload holds the dampers on their platforms), at points
-    ``max_step`` of the range apart. Zero motion solves the first-harmonic residual exactly (the
-    contacts' constant forces have no first harmonic, and no friction force moves), so the
-    response is ``success`` with a harmonic error of 0, computed with harmonics (1,) whatever set
-    was asked for. ``respond(system, branch)`` makes the model's response from the branch."""
+    ``max_step`` of the range apart. Zero motion solves the first-harmonic residual (the
+    contacts' forces are then constant and have no first harmonic; to rounding), so the response
+    is ``success`` with a harmonic error of 0 (no harmonic set moves), computed with harmonics
+    (1,) whatever set was asked for. ``respond(system, branch)`` makes the model's response."""
     system = model.hbm_system((1,))
     n = int(np.ceil(1.0 / max_step)) + 1
     omega = np.linspace(omega_start, omega_end, n)

@@ -187,8 +187,8 @@ class FrictionOscillator:
         ``cpu_budget_s`` [s] and ``point_budget``: the CPU time (``time.process_time``) and the
         continuation points this whole analysis may spend (:class:`bladedamp.hbm.continuation.Budget`;
         defaults ``DEFAULT_CPU_BUDGET_S``, ``DEFAULT_POINT_BUDGET``). Where it runs out the branch
-        ends there with every point it has, not ``success``, and ``stopped_by`` and the message
-        say what ran out and at which frequency.
+        ends there with every point it has, status ``OUT_OF_BUDGET`` (not ``success``), and
+        ``stopped_by`` and the message say what ran out and at which frequency.
         """
         validation.positive("f_start_hz", f_start_hz)
         validation.positive("f_end_hz", f_end_hz)
