@@ -1056,7 +1056,9 @@ class MistunedDisk:
         or fails the response where the vibration there does not settle, as
         :meth:`TunedDisk.frequency_response` (:meth:`peak_check`, :func:`~bladedamp.disk.with_peak_check`).
         Without dynamic excitation (``excitation`` zero) the response is rest, exactly
-        (:func:`~bladedamp.disk.rest_response`).
+        (:func:`~bladedamp.disk.rest_response`). Without dampers, a range holding the natural
+        frequency of an excited blade mode without modal damping has no bounded response and is
+        refused with a ValueError (:meth:`TunedDisk.check_bounded` of each blade).
         ``cpu_budget_s`` [s] and ``point_budget``: the CPU time (``time.process_time``) and the
         continuation points this whole analysis may spend, the time integrations of
         ``check_stop`` and ``check_peak`` excepted (:class:`bladedamp.hbm.continuation.Budget`;
@@ -1072,6 +1074,9 @@ class MistunedDisk:
             if on and any(b.flexible_platform for b in self.blades):
                 raise ValueError(f"{name} integrates the disk in time, which models rigid platforms only: "
                                  f"use rigid-platform blades or {name}=False")
+        if not self.active_dampers:         # every blade on its own: as a tuned disk without damper
+            for sector in self.sectors:
+                sector.check_bounded(f_start_hz, f_end_hz)
         w0, w1 = 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz
         if not np.any(self.excitation):
             return rest_response(self, w0, w1, max_step, harmonic_tolerance, lambda system, branch:

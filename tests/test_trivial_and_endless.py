@@ -269,6 +269,14 @@ def test_an_undamped_disk_mode_no_damper_touches_is_refused():
     assert r.success and r.tip_amplitude[0, 0] == pytest.approx(closed, rel=1e-9)
 
 
+def test_an_undamped_mistuned_disk_without_dampers_is_refused():
+    blade = dataclasses.replace(reference_blade(), damping_ratios=np.zeros(4))
+    tuned = dataclasses.replace(reference_disk(None), blade=blade, n_blades=4)
+    disk = MistunedDisk.from_tuned(tuned, kappa=[0.98, 1.0, 1.01, 1.03])
+    with pytest.raises(ValueError, match=r"blade mode 1F has damping_ratios = 0"):
+        disk.frequency_response(*F_RANGE)
+
+
 def test_a_contact_stiffness_that_is_no_contact_is_refused_with_the_plausible_range():
     low, high = CONTACT_STIFFNESS_PER_LENGTH_RANGE
     with pytest.raises(ValueError, match=r"normal_to_tangential_stiffness x tangential_stiffness_per_length .* "
