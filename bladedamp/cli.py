@@ -17,6 +17,7 @@ design field, an unreadable file or a bad option ends with exit code 2 and one l
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 import warnings
@@ -577,7 +578,8 @@ def frf_command(args) -> int:
         print(f"{k}: {v['status_message']}", file=sys.stderr)
     peaks = ", ".join(f"{k} {'largest amplitude at the range end' if v['peak_at_range_end'] else 'peak'} "
                       f"{v['peak_amplitude_mm']:.4f} mm at {v['peak_frequency_hz']:.3f} Hz"
-                      if v["peak_amplitude_mm"] is not None else f"{k} no points"
+                      if v["peak_amplitude_mm"] is not None and math.isfinite(v["peak_amplitude_mm"])
+                      else f"{k} no peak: no point computed (summary.md says why)"
                       for k, v in summary["responses"].items())
     return _done(out, t0, peaks)
 

@@ -635,7 +635,7 @@ def load_design(path) -> Design:
 
 def _build(path: Path, v: dict, given: set, has_mistuning: bool) -> Design:
     """The models of checked values ``v``; the checks that involve two keys are made here."""
-    from .damper.geometry import ContactProperties, CylinderDamper, WedgeDamper
+    from .damper.geometry import MIN_DAMPER_MASS, ContactProperties, CylinderDamper, WedgeDamper
     from .disk import TunedDisk
 
     blade, geometry = _build_blade(path, v, given)
@@ -647,11 +647,18 @@ def _build(path: Path, v: dict, given: set, has_mistuning: bool) -> Design:
                    f"an integer or a list of integers in [0, {n // 2}] (n_blades / 2)")
     damper = None
     if k["kind"] != "none":
-        contact = ContactProperties(k["friction_coefficient"], k["tangential_stiffness_per_length_n_per_m2"],
-                                    k["normal_to_tangential_stiffness"], k["roughness_exponent"],
-                                    k["roughness_reference_load_n"], k["points_along_length"],
-                                    k["points_across_height"])
+        try:
+            contact = ContactProperties(k["friction_coefficient"], k["tangential_stiffness_per_length_n_per_m2"],
+                                        k["normal_to_tangential_stiffness"], k["roughness_exponent"],
+                                        k["roughness_reference_load_n"], k["points_along_length"],
+                                        k["points_across_height"])
+        except ValueError as exc:       # a combination of keys (each in its own range) that is no contact
+            raise DesignError(f"{path}: [damper]: {exc}") from None
         mass, length = 1e-3 * k["mass_g"], 1e-3 * k["length_mm"]
+        if mass < MIN_DAMPER_MASS:
+            raise _bad(path, "damper", "mass_g", k["mass_g"],
+                       f"in [{1e3 * MIN_DAMPER_MASS:g}, 1000] g (a lighter damper's limit is the disk without one: "
+                       f"kind = \"none\")")
         damper = (CylinderDamper(mass, 1e-3 * k["cylinder_radius_mm"], length, contact) if k["kind"] == "cylinder"
                   else WedgeDamper(mass, 1e-3 * k["contact_height_mm"], length, contact))
     speed = None if d["rotor_speed_rpm"] == "auto" else d["rotor_speed_rpm"] / 60.0      # rpm -> Hz

@@ -39,7 +39,7 @@ from .contact.point import (MAX_PASSES, PERIODIC_TOL, PointContactSamples, dampe
 from .damper.geometry import CylinderDamper, DamperGeometry, WedgeDamper
 from .damper.kinetics import centrifugal_force, seat
 from .hbm.accuracy import HARMONIC_TOLERANCE, AccuracyWarning, converged_response
-from .hbm.continuation import continuation
+from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_POINT_BUDGET, Branch, Budget, continuation
 from .hbm.nonlinear_modes import linear_stuck_mode
 from .hbm.peaks import PeakSolver, first_harmonic_output
 from .hbm.start import robust_start
@@ -604,6 +604,35 @@ class TunedDisk:
 
         return approach
 
+    def check_bounded(self, f_start_hz: float, f_end_hz: float) -> None:
+        """ValueError where no bounded periodic response exists in ``f_start_hz``..``f_end_hz``
+        [Hz]: a blade mode j with zero modal damping, a modal force phi_j^T F != 0, its natural
+        frequency f_0j inside the range, and no damper acting on it (no damper, or rigid
+        platforms that do not move at OL and OR in that mode). Its modal equation is then
+        q_j'' + omega_0j^2 q_j = phi_j^T F cos(Omega t) alone, whose amplitude grows without
+        bound at Omega = omega_0j. (With a damper on that mode the bound of its friction forces
+        is no closed form: the normal loads vary with the motion.)"""
+        blade = self.blade
+        force = blade.shape("excitation").T @ self.excitation                 # (nm,) modal forces [N]
+        lo, hi = min(f_start_hz, f_end_hz), max(f_start_hz, f_end_hz)
+        if self.has_damper:
+            if blade.flexible_platform:
+                return
+            at_damper = np.abs(np.vstack([blade.shape("OL"), blade.shape("OR")])).max(axis=0) > 0
+        else:
+            at_damper = np.zeros(blade.n_modes, dtype=bool)
+        f0 = np.asarray(blade.natural_frequencies_hz, dtype=float)
+        free = (blade.damping_ratios == 0) & (force != 0) & ~at_damper & (f0 >= lo) & (f0 <= hi)
+        if np.any(free):
+            j = int(np.flatnonzero(free)[0])
+            name = blade.mode_names[j] if len(blade.mode_names) else str(j + 1)
+            why = "the disk has no damper" if not self.has_damper else "the damper's platforms do not move in it"
+            raise ValueError(
+                f"no bounded response: blade mode {name} has damping_ratios = 0, a modal force "
+                f"{force[j]:.6g} N and its natural frequency {f0[j]:.6g} Hz inside the range {f_start_hz:g}-"
+                f"{f_end_hz:g} Hz, and {why}: its amplitude grows without bound there; give the mode a damping "
+                f"ratio > 0 or a range without {f0[j]:.6g} Hz")
+
     def static_normal_loads(self, f_hz: float) -> np.ndarray:
         """Static normal loads (N_OL, N_OR) [N] from frictionless seating under F_CG at the
         excitation frequency ``f_hz`` [Hz]."""
@@ -616,6 +645,7 @@ class TunedDisk:
                            max_harmonic: int = 7, extra_couplings=None, stop_above: float | None = None,
                            stop_direction: int = 0, estimate_harmonic_error: bool = True,
                            check_stop: bool = False, check_peak: bool = False,
+                           cpu_budget_s: float = DEFAULT_CPU_BUDGET_S, point_budget: int = DEFAULT_POINT_BUDGET,
                            **continuation_options) -> "DiskResponse":
         """Forced response from ``f_start_hz`` to ``f_end_hz`` [Hz] by continuation.
 
@@ -630,7 +660,11 @@ class TunedDisk:
         result above the tolerance says so).
         ``max_step`` is the largest arc-length step in scaled units (the frequency range is 1;
         smaller: more points). The result is ``success`` only if the branch reached the end and
-        passed :func:`bladedamp.response.physical_checks`. ``n_samples``: AFT samples per period;
+        passed :func:`bladedamp.response.physical_checks`; a range where no bounded response
+        exists (:meth:`check_bounded`) is refused with a ValueError before any solve. Without
+        dynamic excitation (``excitation`` zero, no ``extra_couplings``) the response is rest,
+        exactly (:func:`rest_response`).
+        ``n_samples``: AFT samples per period;
         None (default): the basis default, and once four times more if that branch fails
         (:func:`bladedamp.response.sampled_response`; ``AUTO_SAMPLES_GROWTH``), once more again
         if it reached the end and failed only the dissipation check (``AUTO_SAMPLES_GROWTH_DISSIPATION``).
@@ -665,11 +699,18 @@ class TunedDisk:
         vibration does not settle, the response fails (:func:`with_peak_check`; its
         ``peak_check`` keeps the integration). One time integration (1-3 s for 4 blades, 5-31 s
         for 16 on 2 cores); the same restrictions as ``check_stop``.
+        ``cpu_budget_s`` [s] and ``point_budget``: the CPU time (``time.process_time``) and the
+        continuation points this whole analysis may spend, the time integrations of
+        ``check_stop`` and ``check_peak`` excepted (:class:`bladedamp.hbm.continuation.Budget`;
+        defaults ``DEFAULT_CPU_BUDGET_S``, ``DEFAULT_POINT_BUDGET``). Where it runs out the branch
+        ends there with every point it has, status ``OUT_OF_BUDGET`` (not ``success``), and
+        ``stopped_by`` and the message say what ran out and at which frequency.
         """
         validation.positive("f_start_hz", f_start_hz)
         validation.positive("f_end_hz", f_end_hz)
         if f_start_hz == f_end_hz:
             raise ValueError("f_end_hz must differ from f_start_hz")
+        self.check_bounded(f_start_hz, f_end_hz)
         w0, w1 = 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz
         if stop_above is not None:
             validation.positive("stop_above", stop_above)
@@ -683,6 +724,10 @@ class TunedDisk:
                 raise ValueError(f"{name} integrates the disk in time, which models rigid platforms only: "
                                  f"use blade.rigid_platform_blade() or {name}=False")
         model = self if extra_couplings is None else WithCouplings(self, extra_couplings)
+        if not np.any(self.excitation) and extra_couplings is None:
+            return rest_response(self, w0, w1, max_step, harmonic_tolerance,
+                                 lambda system, branch: DiskResponse.from_branch(self, system, branch))
+        budget = Budget(cpu_budget_s, point_budget)
 
         def solve(H):
             first = HarmonicBasis(tuple(H)).n_samples
@@ -697,7 +742,7 @@ class TunedDisk:
                                   start_at_end=lambda: self.start_solution(system, w1, scales),
                                   retry_x_scale=self.retry_scales(system, scales),
                                   stop_when=self.amplitude_stop(system.basis, stop_above, stop_direction),
-                                  **continuation_options)
+                                  budget=budget, **continuation_options)
             response = DiskResponse.from_branch(self, system, branch)
             T = system.basis.n_samples
 
@@ -952,6 +997,23 @@ def time_check_beyond(model, response, offset_hz: float = STOP_CHECK_OFFSET_HZ, 
     k = response.furthest_index()
     direction = np.sign(o[k] - o[0]) or 1.0
     return model.time_response(response.frequency_hz[k] + direction * offset_hz, **options)
+
+
+def rest_response(model, omega_start: float, omega_end: float, max_step: float, tolerance: float, respond):
+    """The exact response of a disk (``model``: a TunedDisk or MistunedDisk) without dynamic
+    excitation over ``omega_start``..``omega_end`` [rad/s]: every blade and damper at rest (each
+    harmonic of the motion zero; the preload holds the dampers on their platforms), at points
+    ``max_step`` of the range apart. Zero motion solves the first-harmonic residual (the
+    contacts' forces are then constant and have no first harmonic; to rounding), so the response
+    is ``success`` with a harmonic error of 0 (no harmonic set moves), computed with harmonics
+    (1,) whatever set was asked for. ``respond(system, branch)`` makes the model's response."""
+    system = model.hbm_system((1,))
+    n = int(np.ceil(1.0 / max_step)) + 1
+    omega = np.linspace(omega_start, omega_end, n)
+    branch = Branch(omega, np.zeros((n, system.n_unknowns)), np.zeros(n, dtype=int), True,
+                    "no dynamic excitation (excitation is zero): every blade and damper at rest at every frequency")
+    return dataclasses.replace(respond(system, branch), harmonic_error=0.0, harmonic_tolerance=tolerance,
+                               harmonics_converged=True)
 
 
 def with_stop_check(model, response, f_start_hz: float, check_stop: bool):

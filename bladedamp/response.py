@@ -135,11 +135,11 @@ def sampled_response(solve, n_samples, first: int, most: int, most_for_dissipati
     samples were chosen."""
     if n_samples is not None:
         return solve(n_samples)
-    n, tried, response, empty = int(first), [], None, None
+    n, tried, response, empty, stopped_by = int(first), [], None, None, ""
     while True:
         finer = solve(n)
         if response is not None and not len(finer.omega):
-            empty = n                                 # the coarser branch is kept
+            empty, stopped_by = n, finer.stopped_by   # the coarser branch is kept (and the stop, e.g. a budget)
             break
         response = finer
         if response.stopped_by:                       # stopped as the caller asked: no retry
@@ -155,7 +155,9 @@ def sampled_response(solve, n_samples, first: int, most: int, most_for_dissipati
     if failed_with:
         note += f"; AFT samples per period raised to {n_used} (the branch failed with {', '.join(failed_with)})"
     if empty is not None:
-        note += f"; with {empty} AFT samples per period the branch kept no point"
+        note += f"; with {empty} AFT samples per period the branch kept no point" + (f": {stopped_by}" if stopped_by else "")
+    if stopped_by:
+        return dataclasses.replace(response, message=response.message + note, success=False, stopped_by=stopped_by)
     return dataclasses.replace(response, message=response.message + note) if note else response
 
 
@@ -279,7 +281,8 @@ def range_end_of_largest(frequency_hz, amplitude) -> float | None:
     whose amplitude is within ``END_AMPLITUDE_RESOLUTION`` of the largest counts as holding it
     (both ends: the one with the larger amplitude). There the range holds no maximum: the curve
     still rises towards that end. ``amplitude`` (n, k): k curves (e.g. one per blade), the end
-    of the largest curve whose largest lies at an end. None for an empty branch."""
+    of the largest curve whose largest lies at an end. None for an empty branch, and for curves
+    that are zero everywhere (at rest: no resonance to miss)."""
     f, a = np.asarray(frequency_hz, dtype=float), np.asarray(amplitude, dtype=float)
     if not f.size:
         return None
@@ -288,6 +291,8 @@ def range_end_of_largest(frequency_hz, amplitude) -> float | None:
     low, high = f <= f.min() + same, f >= f.max() - same
     found = []
     for curve in a.T:
+        if not curve.max() > 0:
+            continue                     # no motion at all (a response at rest): no resonance anywhere
         best, end = max((float(curve[low].max()), float(f.min())), (float(curve[high].max()), float(f.max())))
         if best >= (1 - END_AMPLITUDE_RESOLUTION) * curve.max():
             found.append((best, end))

@@ -174,7 +174,9 @@ def robust_peak(disk: TunedDisk, f_range_hz=(90.0, 105.0), harmonics=(1,), direc
         except IncompleteResponse as exc:
             messages.append(f"{options}: {exc}")
             bound = np.fmax(bound, exc.lower_bound)
-            if exc.response is not None and exc.response.stopped_by:
+            # stopped by stop_above (its amplitude passed the bound), not by the budget
+            r = exc.response
+            if r is not None and r.stopped_by and len(r.omega) and r.tip_amplitude[:, direction].max() > stop_above:
                 return PeakEvaluation(False, np.nan, np.nan, float(bound), f"stopped above the bound: {exc}", runs,
                                       stopped_above=True)
             r = exc.response
