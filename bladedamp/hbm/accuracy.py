@@ -204,7 +204,11 @@ def converged_response(model, solve, harmonics="auto", tolerance: float = HARMON
 
     ``harmonics="auto"``: the sets of :func:`auto_sets` (``max_harmonic``) in turn until one meets
     ``tolerance``; otherwise the given set, checked once. A set whose branch fails (does not reach the end of the range) is
-    followed by the next richer one in the automatic choice. ``estimate=False`` (a given set
+    followed by the next richer one in the automatic choice. Where a budget
+    (:class:`~bladedamp.hbm.continuation.Budget`) stops a richer set's branch after a poorer
+    set's reached the end, or a stop leaves a richer set without a point, the poorer set's
+    branch is returned with its estimate, not ``success``, its ``stopped_by`` the stop's and its
+    message naming the set not finished. ``estimate=False`` (a given set
     only): no estimate (``harmonic_error`` NaN, ``harmonics_converged`` None: "not estimated"),
     for a study that estimates it on a representative case instead (the Monte Carlo's first disk)."""
     if isinstance(harmonics, str):
