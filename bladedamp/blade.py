@@ -491,11 +491,12 @@ class ModalBlade:
                   fixed_dofs=(), mass: str | None = None, stiffness: str | None = None,
                   **matrix_options) -> "ModalBlade":
         """Read a modal data file (``.npz``, ``.csv``) or the reduced mass and stiffness
-        matrices of an FE export (``.op4``, ``.pch``, ``.mtx``, ``.mat``), by the suffix of ``path``.
+        matrices of an FE export (``.op4``, ``.pch``, ``.mtx``, ``.mat``, ``.full``), by the suffix of ``path``.
 
         FE exports (formats: :mod:`bladedamp.fe_formats`): Nastran OUTPUT4 text or binary
         (``.op4``), Nastran punch DMIG (``.pch``), Abaqus matrix output (``.mtx``: ``path`` is the
-        ``_STIF`` or the ``_MASS`` file, the other is found beside it), MATLAB v4-v7.3 (``.mat``).
+        ``_STIF`` or the ``_MASS`` file, the other is found beside it), MATLAB v4-v7.3 (``.mat``),
+        Ansys ``.full`` (needs the ``ansys`` extra; its constrained DOF are left out).
         The matrices go to :meth:`from_matrices`, whose arguments ``points``, ``n_modes`` and
         ``damping_ratios`` are then required, and ``rigid_links``, ``mode_names``, ``solver``,
         ``symmetry_tolerance`` may be given. The matrices must be in SI units.
@@ -503,7 +504,7 @@ class ModalBlade:
         ``dof_map`` and ``fixed_dofs`` name rows as the exporting code numbers them:
 
         - files that label rows by node and DOF (DMIG: grid and component 1-6, 0 for a scalar
-          point; Abaqus MATRIX INPUT: node and DOF 1-6): a point is ``node`` (its DOF 1-6, i.e.
+          point; Abaqus MATRIX INPUT: node and DOF 1-6; Ansys: node and 1-6 for UX .. ROTZ): a point is ``node`` (its DOF 1-6, i.e.
           ux, uy, uz, phix, phiy, phiz) or ``(node, dofs)`` with 6 or 3 DOF numbers in that
           order, e.g. ``{"OL": 101, "tip": (250, (1, 2, 3)), ...}``; ``fixed_dofs`` is a list of
           such entries, e.g. ``[1, 2, 3]`` clamps nodes 1-3.

@@ -29,8 +29,15 @@ triangle of the symmetric matrix; negative node numbers are Abaqus' internal nod
 lines are comments. Stiffness and mass are separate files (``job_STIF1.mtx``,
 ``job_MASS1.mtx``).
 
-MATLAB (``.mat``): v4 to v7 through :func:`scipy.io.loadmat`, v7.3 (HDF5) through h5py;
+MATLAB (``.mat``): v4 to v7 through :func:`scipy.io.loadmat`, v7.3 (HDF5) through h5py
+(the ``matlab`` extra);
 dense or sparse real variables; rows numbered 1, 2, ... as MATLAB indexes them.
+
+Ansys (``.full``, the assembled matrices of a modal or substructure run): through
+ansys-mapdl-reader (the ``ansys`` extra; it brings pyvista and vtk). The stiffness and mass of
+the free DOF; the constrained DOF (zero rows in the file) are left out. Rows are labelled
+(node, component) with component = the reader's DOF index + 1: 1-3 UX, UY, UZ and 4-6 ROTX,
+ROTY, ROTZ for a structural model with rotations.
 
 The OUTPUT4 and DMIG readers are written here from the formats' published descriptions:
 pyNastran, the usual Python reader, pins numpy < 2 and cannot be a dependency. Abaqus matrix
@@ -50,7 +57,7 @@ import numpy as np
 import scipy.sparse
 
 # file suffix -> format name, for ModalBlade.from_file
-FE_SUFFIXES = {"op4": "op4", "pch": "dmig", "mtx": "abaqus", "mat": "matlab"}
+FE_SUFFIXES = {"op4": "op4", "pch": "dmig", "mtx": "abaqus", "mat": "matlab", "full": "ansys"}
 
 # default matrix names, in the order they are looked for (case-insensitive)
 DEFAULT_MASS_NAMES = ("MAAX", "MAA", "M", "MASS")
@@ -598,7 +605,7 @@ def _read_matlab_hdf5(path: Path) -> dict:
     try:
         import h5py
     except ImportError:
-        raise ValueError(f"{path}: a MATLAB v7.3 (HDF5) file needs h5py: pip install bladedamp[fe]") from None
+        raise ValueError(f"{path}: a MATLAB v7.3 (HDF5) file needs h5py: pip install bladedamp[matlab]") from None
     out = {}
     with h5py.File(path, "r") as f:
         for name, item in f.items():
@@ -616,6 +623,41 @@ def _read_matlab_hdf5(path: Path) -> dict:
                     arr = arr["real"] + 1j * arr["imag"]
                 out[name] = np.asarray(arr).T     # MATLAB stores column-major
     return out
+
+
+# --------------------------------------------------------------------------------------
+# Ansys
+# --------------------------------------------------------------------------------------
+def read_ansys_full(path) -> FEMatrices:
+    """Stiffness and mass of the free DOF of an Ansys .full file (through ansys-mapdl-reader)."""
+    path = Path(path)
+    try:
+        from ansys.mapdl import reader as mapdl_reader
+    except ImportError:
+        raise ValueError(f"{path}: reading an Ansys .full file needs ansys-mapdl-reader: "
+                         "pip install bladedamp[ansys]") from None
+    try:
+        full = mapdl_reader.read_binary(str(path))
+        if type(full).__name__ != "FullFile":
+            raise ValueError(f"a {type(full).__name__}")
+        dof_ref, K, M = full.load_km(as_sparse=True, sort=True)
+    except Exception as err:    # the library raises many types on a bad file; report its words
+        raise ValueError(f"{path}: not a readable Ansys .full file ({type(err).__name__}: {err}); "
+                         "expected the .full file of a modal or substructure run (WRFULL or a solve)") from None
+    labels = np.asarray(dof_ref, dtype=np.int64) + np.array([0, 1])
+    K, M = scipy.sparse.csr_matrix(K), scipy.sparse.csr_matrix(M)
+    free = np.flatnonzero((abs(K).sum(axis=1).A1 != 0) | (abs(M).sum(axis=1).A1 != 0))
+    out = []
+    for name, A in (("mass", M), ("stiffness", K)):
+        A = A[free][:, free]
+        upper = scipy.sparse.triu(A, 1)
+        lower = scipy.sparse.tril(A, -1)
+        if lower.nnz and upper.nnz and abs(upper - lower.T).max() > SYMMETRY_TOLERANCE * abs(A).max():
+            raise ValueError(f"{path}: the {name} matrix is unsymmetric; expected a symmetric matrix")
+        if not lower.nnz:                    # the file stores one triangle
+            A = A + upper.T
+        out.append(scipy.sparse.csr_matrix(A))
+    return FEMatrices(mass=out[0], stiffness=out[1], labels=labels[free], path=path, names=("mass", "stiffness"))
 
 
 # --------------------------------------------------------------------------------------
@@ -660,7 +702,7 @@ def _matlab_matrix(path: Path, name: str, value):
 
 def read_fe_matrices(path, *, mass=None, stiffness=None) -> FEMatrices:
     """Mass and stiffness matrices of an FE export, format by the suffix of ``path``
-    (``.op4``, ``.pch``, ``.mtx``, ``.mat``: see the module docstring).
+    (``.op4``, ``.pch``, ``.mtx``, ``.mat``, ``.full``: see the module docstring).
 
     ``mass``, ``stiffness``: the matrix (or MATLAB variable) names in the file; by default the
     one of :data:`DEFAULT_MASS_NAMES` / :data:`DEFAULT_STIFFNESS_NAMES` the file holds. For
@@ -676,6 +718,11 @@ def read_fe_matrices(path, *, mass=None, stiffness=None) -> FEMatrices:
         raise FileNotFoundError(f"{path}: no such FE matrix file")
     if kind == "abaqus":
         return _read_abaqus_pair(path, mass, stiffness)
+    if kind == "ansys":
+        if mass is not None or stiffness is not None:
+            raise ValueError(f"{path}: an Ansys .full file holds one stiffness and one mass matrix; "
+                             "remove mass= and stiffness=")
+        return read_ansys_full(path)
     if kind == "matlab":
         variables = read_matlab(path)
         pair = []

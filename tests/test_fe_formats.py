@@ -368,3 +368,33 @@ def test_fe_options_need_an_fe_file_and_an_fe_file_needs_them(tmp_path):
     path.write_text("x\n")
     with pytest.raises(ValueError, match=r"blade\.csv: \['dof_map'\] apply to FE matrix files only"):
         ModalBlade.from_file(path, dof_map={"OL": 1})
+
+
+# ---------------------------------------------------------------------------------------
+# Ansys (the ansys extra)
+# ---------------------------------------------------------------------------------------
+def test_ansys_full_file_blade():
+    """The .full file of a hexahedral beam shipped with ansys-mapdl-reader (MIT; written by
+    Ansys): constrained DOF left out, rows labelled (node, 1-3), and the blade's frequencies are
+    the ones ansys-mapdl-reader publishes for this file (its examples.load_km, 8 decimals)."""
+    pytest.importorskip("ansys.mapdl.reader")
+    from ansys.mapdl.reader import examples
+    published_hz = [1283.20036921, 1283.20036921, 5781.97486169, 6919.39887714, 6919.39887714, 10172.61497694]
+    fe = read_fe_matrices(examples.fullfile)
+    assert fe.n == 900 and set(fe.labels[:, 1]) == {1, 2, 3}       # 321 nodes x 3, 21 nodes clamped
+    node = int(fe.labels[-1, 0])
+    with pytest.warns(UserWarning, match=r"dof_map\['O[LR]'\] has translations only"):   # OL and OR
+        blade = ModalBlade.from_file(examples.fullfile, dof_map={p: (node, (1, 2, 3)) for p in POINTS}, points=POINTS,
+                                     n_modes=6, damping_ratios=0.001)
+    np.testing.assert_allclose(blade.natural_frequencies_hz, published_hz, rtol=1e-9)
+    with pytest.raises(ValueError, match=r"file\.full: dof_map\['OL'\] names node 1 component 1, which is not in "
+                                         r"the file"):                 # node 1 is clamped
+        ModalBlade.from_file(examples.fullfile, **blade_args({p: (1, (1, 2, 3)) for p in POINTS}))
+
+
+def test_ansys_bad_file(tmp_path):
+    pytest.importorskip("ansys.mapdl.reader")
+    path = tmp_path / "blade.full"
+    path.write_bytes((DATA / "mat_b_s2.op4").read_bytes())
+    with pytest.raises(ValueError, match=r"blade\.full: not a readable Ansys \.full file .*expected the \.full file"):
+        read_fe_matrices(path)
