@@ -56,7 +56,9 @@ it has no CSV form.  A bad file raises ValueError naming the file, the key or
 column (and line) and what was expected.
 
 Reduced FE matrices (:meth:`ModalBlade.from_matrices`): Craig-Bampton or Guyan exports with
-the root clamped; the modes are computed and picked at the named points.
+the root clamped; the modes are computed and picked at the named points. :meth:`ModalBlade.from_file`
+reads them from Nastran OUTPUT4 / punch DMIG, Abaqus, MATLAB and Ansys files
+(:mod:`bladedamp.fe_formats`).
 
 The reference blade (:func:`bladedamp.reference.reference_blade`, calibrated on the paper)
 lives in :mod:`bladedamp.reference`; ``bladedamp.blade.reference_blade`` and
@@ -764,11 +766,16 @@ def _blade_from_fe_file(cls, path: Path, dof_map, points, n_modes, damping_ratio
                          f"{m_diag[bad[0]]:g}; expected a positive diagonal on the free DOF (clamp the row with "
                          "fixed_dofs or condense it out)")
     try:
-        return cls.from_matrices(fe.mass, fe.stiffness, rows, points=points, n_modes=n_modes,
-                                 damping_ratios=damping_ratios, rigid_links=rigid_links, fixed_dofs=fixed,
-                                 **matrix_options)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            blade = cls.from_matrices(fe.mass, fe.stiffness, rows, points=points, n_modes=n_modes,
+                                      damping_ratios=damping_ratios, rigid_links=rigid_links, fixed_dofs=fixed,
+                                      **matrix_options)
     except ValueError as err:
         raise ValueError(f"{path}: matrices {fe.names[0]} (mass), {fe.names[1]} (stiffness): {err}") from None
+    for w in caught:                  # point the warnings at the caller of from_file
+        warnings.warn(f"{path}: {w.message}", w.category, stacklevel=3)
+    return blade
 
 
 def _modal_file_kind(path: Path) -> str:
