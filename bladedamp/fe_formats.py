@@ -154,44 +154,76 @@ def _node_entries(name: str, value):
 # Entry lists -> matrices (shared by the readers)
 # --------------------------------------------------------------------------------------
 class _Entries:
-    """COO entries of one matrix with the place (line or record) each came from."""
+    """COO entries of one matrix with the place (line, record or column number) each came from."""
 
     def __init__(self, name: str, kind: str):
-        self.name, self.kind = name, kind     # kind: e.g. "line"
-        self.rows, self.cols, self.vals, self.places = [], [], [], []
+        self.name, self.kind = name, kind     # kind names the place: "line", "record", ...
         self.complex = False
+        self._single = ([], [], [], [])       # rows, cols, values, places of single entries
+        self._blocks = []                     # (rows, cols, values, places) arrays
 
     def add(self, r, c, v, place):
-        self.rows.append(r)
-        self.cols.append(c)
-        self.vals.append(v)
-        self.places.append(place)
+        for store, x in zip(self._single, (r, c, v, place)):
+            store.append(x)
+
+    def add_block(self, rows, cols, values, places):
+        """Many entries at once (arrays; cols and places may be scalars)."""
+        rows = np.asarray(rows, dtype=np.int64)
+        self._blocks.append((rows, np.broadcast_to(np.asarray(cols, dtype=np.int64), rows.shape),
+                             np.asarray(values), np.broadcast_to(np.asarray(places), rows.shape)))
+
+    def arrays(self):
+        """(rows, cols, values, places) as arrays."""
+        r, c, v, p = self._single
+        dtype = complex if self.complex else float
+        parts = [(np.asarray(r, dtype=np.int64), np.asarray(c, dtype=np.int64), np.asarray(v, dtype=dtype),
+                  np.asarray(p, dtype=np.int64))] + self._blocks
+        return tuple(np.concatenate([part[k] for part in parts]) for k in range(4))
+
+    def relabel(self, remap: np.ndarray) -> None:
+        """Replace every row and column index i by remap[i]."""
+        r, c, v, p = self.arrays()
+        self._single = ([], [], [], [])
+        self._blocks = [(remap[r], remap[c], v, p)] if r.size else []
+
+    @property
+    def rows(self):
+        return self.arrays()[0]
+
+    @property
+    def cols(self):
+        return self.arrays()[1]
+
+    @property
+    def vals(self):
+        return self.arrays()[2]
 
 
 def _assemble(path: Path, e: _Entries, n_rows: int, n_cols: int, one_triangle: bool):
-    """Square real symmetric CSR matrix of the entries; an entry given twice, a missing
-    transposed partner that disagrees, or a non-square shape raise ValueError with the place."""
+    """Square real symmetric CSR matrix of the entries; an entry given twice, a transposed
+    partner that disagrees, or a non-square shape raise ValueError with the place."""
     where = f"{path}: matrix {e.name}"
     if e.complex:
         raise ValueError(f"{where} is complex; expected a real mass or stiffness matrix")
     if n_rows != n_cols:
         raise ValueError(f"{where} is {n_rows} x {n_cols}; expected a square matrix")
-    r = np.asarray(e.rows, dtype=np.int64)
-    c = np.asarray(e.cols, dtype=np.int64)
-    v = np.asarray(e.vals, dtype=float)
+    r, c, v, places = e.arrays()
+    v = v.astype(float)
     if not np.all(np.isfinite(v)):
         k = int(np.flatnonzero(~np.isfinite(v))[0])
-        raise ValueError(f"{where}: {e.kind} {e.places[k]}: value {v[k]} is not finite; expected a finite number")
+        raise ValueError(f"{where}: {e.kind} {places[k]}: value {v[k]} is not finite; expected a finite number")
     key = r * n_cols + c
     order = np.argsort(key, kind="stable")
-    dup = np.flatnonzero(np.diff(key[order]) == 0)
+    sorted_keys = key[order]
+    dup = np.flatnonzero(np.diff(sorted_keys) == 0)
     if dup.size:
         a, b = order[dup[0]], order[dup[0] + 1]
-        raise ValueError(f"{where}: {e.kind} {e.places[b]}: entry ({r[b] + 1}, {c[b] + 1}) is given again "
-                         f"(first at {e.kind} {e.places[a]}); expected each entry once")
-    position = dict(zip(key.tolist(), range(key.size)))
+        raise ValueError(f"{where}: {e.kind} {places[b]}: entry ({r[b] + 1}, {c[b] + 1}) is given again "
+                         f"(first at {e.kind} {places[a]}); expected each entry once")
     tkey = c * n_cols + r
-    partner = np.array([position.get(k, -1) for k in tkey.tolist()], dtype=np.int64)
+    at = np.minimum(np.searchsorted(sorted_keys, tkey), max(key.size - 1, 0))
+    found = key.size > 0
+    partner = np.where(found & (sorted_keys[at] == tkey), order[at], -1) if key.size else np.zeros(0, np.int64)
     scale = np.abs(v).max() if v.size else 0.0
     both = np.flatnonzero((partner >= 0) & (r != c))
     if both.size:
@@ -200,8 +232,8 @@ def _assemble(path: Path, e: _Entries, n_rows: int, n_cols: int, one_triangle: b
         if gap[worst] > SYMMETRY_TOLERANCE * scale:
             k = both[worst]
             raise ValueError(
-                f"{where}: {e.kind} {e.places[k]}: entry ({r[k] + 1}, {c[k] + 1}) = {v[k]:.9g} but its "
-                f"transpose at {e.kind} {e.places[partner[k]]} is {v[partner[k]]:.9g}; expected a symmetric "
+                f"{where}: {e.kind} {places[k]}: entry ({r[k] + 1}, {c[k] + 1}) = {v[k]:.9g} but its "
+                f"transpose at {e.kind} {places[partner[k]]} is {v[partner[k]]:.9g}; expected a symmetric "
                 f"matrix (relative difference <= {SYMMETRY_TOLERANCE:g})")
     lonely = np.flatnonzero((partner < 0) & (r != c))
     if lonely.size and not one_triangle:
@@ -211,7 +243,7 @@ def _assemble(path: Path, e: _Entries, n_rows: int, n_cols: int, one_triangle: b
         if gap[worst] > SYMMETRY_TOLERANCE * scale:
             k = lonely[worst]
             raise ValueError(
-                f"{where}: {e.kind} {e.places[k]}: entry ({r[k] + 1}, {c[k] + 1}) = {v[k]:.9g} has no "
+                f"{where}: {e.kind} {places[k]}: entry ({r[k] + 1}, {c[k] + 1}) = {v[k]:.9g} has no "
                 f"transposed entry ({c[k] + 1}, {r[k] + 1}); expected a symmetric matrix")
     rr = np.concatenate([r, c[lonely]])
     cc = np.concatenate([c, r[lonely]])
@@ -304,14 +336,14 @@ def _read_op4_text(path: Path, data: bytes) -> dict:
             return values, k
 
         def store(col, row0, values, line_no):
+            values = np.array(values)
             if e.complex:
-                values = [complex(a, b) for a, b in zip(values[0::2], values[1::2])]
-            if row0 < 1 or row0 - 1 + len(values) > nrow:
-                raise ValueError(f"{path}: line {line_no}: rows {row0}..{row0 + len(values) - 1} of column {col} "
+                values = values[0::2] + 1j * values[1::2]
+            if row0 < 1 or row0 - 1 + values.size > nrow:
+                raise ValueError(f"{path}: line {line_no}: rows {row0}..{row0 + values.size - 1} of column {col} "
                                  f"fall outside the {nrow} rows of matrix {name}")
-            for k, val in enumerate(values):
-                if val != 0:
-                    e.add(row0 - 1 + k, col - 1, val, line_no)
+            nz = np.flatnonzero(values)
+            e.add_block(row0 - 1 + nz, col - 1, values[nz], line_no)
 
         while True:
             icol, irow, nw = ints(i, 3, f"a column record ICOL, IROW, NW of matrix {name}")
@@ -407,8 +439,8 @@ def _read_op4_binary(path: Path, data: bytes) -> dict:
                 if row0 < 1 or row0 - 1 + values.size > nrow:
                     raise ValueError(f"{path}: record {record}: rows {row0}..{row0 + values.size - 1} of column "
                                      f"{icol} fall outside the {nrow} rows of matrix {name}")
-                for k in np.flatnonzero(values):
-                    e.add(row0 - 1 + int(k), icol - 1, values[k], record)
+                nz = np.flatnonzero(values)
+                e.add_block(row0 - 1 + nz, icol - 1, values[nz], record)
 
             if irow > 0:
                 store(irow, words)
@@ -435,6 +467,10 @@ def _read_op4_binary(path: Path, data: bytes) -> dict:
 # Nastran punch DMIG
 # --------------------------------------------------------------------------------------
 def _nastran_float(text: str) -> float:
+    try:
+        return float(text)                    # the common case: 1.234E+05
+    except ValueError:
+        pass
     s = text.strip().upper().replace("D", "E")
     if not s:
         return 0.0
@@ -543,8 +579,13 @@ def read_abaqus_mtx(path):
     except UnicodeDecodeError:
         raise ValueError(f"{path}: not a text file; expected Abaqus matrix output lines "
                          "'node, dof, node, dof, value'") from None
+    lines = text.splitlines()
+    fast = _abaqus_fast(lines)
+    if fast is not None:
+        ints, values, numbers = fast
+        return _abaqus_entries(path, ints, values, numbers)
     records, n_fields = [], None
-    for number, raw in enumerate(text.splitlines(), start=1):
+    for number, raw in enumerate(lines, start=1):
         line = raw.strip()
         if not line or line.startswith("**"):
             continue
@@ -569,20 +610,45 @@ def read_abaqus_mtx(path):
         records.append((ints, value, number))
     if not records:
         raise ValueError(f"{path}: no matrix entries; expected Abaqus matrix output lines 'node, dof, node, dof, value'")
+    return _abaqus_entries(path, np.array([r[0] for r in records], dtype=np.int64),
+                           np.array([r[1] for r in records]), np.array([r[2] for r in records]))
+
+
+def _abaqus_fast(lines):
+    """(integer columns, values, line numbers) of a well-formed .mtx file by numpy, or None
+    (then the line-by-line reading finds and names the bad line)."""
+    numbered = [(k, line) for k, line in enumerate(lines, start=1)
+                if line.strip() and not line.lstrip().startswith("**")]
+    if not numbered:
+        return None
+    try:
+        table = np.loadtxt([line.rstrip().rstrip(",") for _, line in numbered], delimiter=",", ndmin=2)
+    except ValueError:
+        return None
+    if table.shape[1] not in (3, 5):
+        return None
+    ints = table[:, :-1]
+    if np.any(ints != np.round(ints)) or np.abs(ints).max() > 2**31:
+        return None
+    return ints.astype(np.int64), table[:, -1], np.array([k for k, _ in numbered], dtype=np.int64)
+
+
+def _abaqus_entries(path: Path, ints: np.ndarray, values: np.ndarray, numbers: np.ndarray):
+    """(entries, labels or None, n) of the integer columns and values of an .mtx file."""
     e = _Entries(path.name, "line")
-    if n_fields == 5:
-        labels = sorted({(r[0][0], r[0][1]) for r in records} | {(r[0][2], r[0][3]) for r in records})
-        index = {lab: k for k, lab in enumerate(labels)}
-        for (a, b, c, d), value, number in records:
-            e.add(index[(a, b)], index[(c, d)], value, number)
-        return e, np.array(labels, dtype=np.int64), len(labels)
-    n = 0
-    for (a, b), value, number in records:
-        if a < 1 or b < 1:
-            raise ValueError(f"{path}: line {number}: equation numbers must be >= 1 (got {a}, {b})")
-        e.add(a - 1, b - 1, value, number)
-        n = max(n, a, b)
-    return e, None, n
+    if ints.shape[1] == 4:
+        pairs = np.vstack([ints[:, :2], ints[:, 2:]])
+        labels, inverse = np.unique(pairs, axis=0, return_inverse=True)
+        inverse = inverse.reshape(-1)
+        m = ints.shape[0]
+        e.add_block(inverse[:m], inverse[m:], values, numbers)
+        return e, labels.astype(np.int64), len(labels)
+    bad = np.flatnonzero((ints < 1).any(axis=1))
+    if bad.size:
+        k = bad[0]
+        raise ValueError(f"{path}: line {numbers[k]}: equation numbers must be >= 1 (got {ints[k, 0]}, {ints[k, 1]})")
+    e.add_block(ints[:, 0] - 1, ints[:, 1] - 1, values, numbers)
+    return e, None, int(ints.max())
 
 
 # --------------------------------------------------------------------------------------
@@ -688,15 +754,14 @@ def _matlab_matrix(path: Path, name: str, value):
         dense = True
     if A.ndim != 2 or not (np.issubdtype(A.dtype, np.floating) or np.issubdtype(A.dtype, np.integer)):
         raise ValueError(f"{path}: variable {name!r} is {A.dtype} of shape {A.shape}; expected a real 2-D matrix")
-    e = _Entries(name, "variable")
+    e = _Entries(name, f"variable {name}, column")
     if dense:
         r, c = np.nonzero(A)
         v = A[r, c]
     else:
         C = A.tocoo()
         r, c, v = C.row, C.col, C.data
-    e.rows, e.cols, e.vals = list(r), list(c), list(v.astype(float))
-    e.places = [f"{name}({i + 1},{j + 1})" for i, j in zip(r, c)]
+    e.add_block(r, c, v.astype(float), c + 1)
     return e, A.shape
 
 
@@ -754,9 +819,7 @@ def read_fe_matrices(path, *, mass=None, stiffness=None) -> FEMatrices:
         index = {tuple(lab): k for k, lab in enumerate(labels.tolist())}
         built = []
         for (name, e, ifo), labs in zip(pair, label_sets):
-            remap = np.array([index[tuple(lab)] for lab in labs.tolist()], dtype=np.int64)
-            e.rows = list(remap[np.asarray(e.rows, dtype=np.int64)]) if e.rows else []
-            e.cols = list(remap[np.asarray(e.cols, dtype=np.int64)]) if e.cols else []
+            e.relabel(np.array([index[tuple(lab)] for lab in labs.tolist()], dtype=np.int64))
             built.append((name, _assemble(path, e, len(labels), len(labels), one_triangle=ifo == 6)))
         pair = built
     (mname, M), (kname, K) = pair
@@ -791,9 +854,7 @@ def _read_abaqus_pair(path: Path, mass, stiffness) -> FEMatrices:
         index = {tuple(lab): k for k, lab in enumerate(labels.tolist())}
         mats = []
         for (e, labs, _), f in zip(read, files):
-            remap = np.array([index[tuple(lab)] for lab in labs.tolist()], dtype=np.int64)
-            e.rows = list(remap[np.asarray(e.rows, dtype=np.int64)])
-            e.cols = list(remap[np.asarray(e.cols, dtype=np.int64)])
+            e.relabel(np.array([index[tuple(lab)] for lab in labs.tolist()], dtype=np.int64))
             mats.append(_assemble(f, e, len(labels), len(labels), one_triangle=True))
     else:
         labels = None

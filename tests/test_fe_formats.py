@@ -398,3 +398,50 @@ def test_ansys_bad_file(tmp_path):
     path.write_bytes((DATA / "mat_b_s2.op4").read_bytes())
     with pytest.raises(ValueError, match=r"blade\.full: not a readable Ansys \.full file .*expected the \.full file"):
         read_fe_matrices(path)
+
+
+def test_matrix_names_and_complex_or_rectangular_matrices(tmp_path):
+    with pytest.raises(ValueError, match=r"se_test_n11\.op4: no matrix named 'MHH' \(mass\); the file holds \['KAA'"):
+        read_fe_matrices(DATA / "se_test_n11.op4", mass="MHH")
+    with pytest.raises(ValueError, match=r"mat_t_s2\.op4: matrix RND1CD is complex; expected a real mass or "
+                                         r"stiffness matrix"):
+        read_fe_matrices(DATA / "mat_t_s2.op4", mass="RND1CD", stiffness="RND1RD")
+    with pytest.raises(ValueError, match=r"mat_t_s2\.op4: matrix STRINGS is 30 x 20; expected a square matrix"):
+        read_fe_matrices(DATA / "mat_t_s2.op4", mass="EYE10", stiffness="STRINGS")
+    with pytest.raises(ValueError, match=r"dmig\.pch: more than one mass matrix among the default names .*name it "
+                                         r"with mass="):
+        path = tmp_path / "dmig.pch"
+        path.write_text((DATA / "dmig.pch").read_text().replace("BAAX", "MAA "))
+        read_fe_matrices(path)
+
+
+def test_unsymmetric_full_storage_output4_names_the_line(tmp_path):
+    M, K, _, _ = reference_matrices()
+    bad = K.copy()
+    bad[3, 0] += 1e-3 * np.abs(K).max()
+    path = tmp_path / "blade.op4"
+    write_op4_text(path, {"KAA": bad, "MAA": M})
+    with pytest.raises(ValueError, match=r"blade\.op4: matrix KAA: line 2: entry \(4, 1\) = .* has no transposed "
+                                         r"entry \(1, 4\); expected a symmetric matrix"):   # K[0, 3] = 0
+        read_fe_matrices(path)
+    bad = K.copy()
+    bad[6, 0] *= 1.001                                         # both entries given, disagreeing
+    write_op4_text(path, {"KAA": bad, "MAA": M})
+    with pytest.raises(ValueError, match=r"blade\.op4: matrix KAA: line \d+: entry \((7, 1|1, 7)\) = .* but its "
+                                         r"transpose at line \d+ is .*expected a symmetric matrix"):
+        read_fe_matrices(path)
+
+
+def test_abaqus_d_exponents_and_a_bad_line(tmp_path):
+    """The numpy fast path falls back to the line-by-line reading, which reads Fortran D
+    exponents and names a bad line."""
+    for which in ("STIF", "MASS"):
+        text = (DATA / f"model_{which}1.mtx").read_text().replace("e+", "D+").replace("e-", "D-")
+        (tmp_path / f"model_{which}1.mtx").write_text(text)
+    fe, ref = read_fe_matrices(tmp_path / "model_STIF1.mtx"), read_fe_matrices(DATA / "model_STIF1.mtx")
+    np.testing.assert_array_equal(fe.stiffness.toarray(), ref.stiffness.toarray())
+    lines = (DATA / "model_MASS1.mtx").read_text().splitlines()
+    lines[6] = "1,1, -1,x, 1.0"
+    (tmp_path / "model_MASS1.mtx").write_text("\n".join(lines) + "\n")
+    with pytest.raises(ValueError, match=r"model_MASS1\.mtx: line 7: expected node, dof, node, dof, value"):
+        read_fe_matrices(tmp_path / "model_STIF1.mtx")
