@@ -480,10 +480,17 @@ def _nastran_float(text: str) -> float:
 
 
 def _bulk_cards(path: Path, text: str):
-    """Yield (first line number, fields) of every bulk card (continuations joined)."""
-    card, start = None, 0
+    """Yield (first line number, card name, data fields) of every bulk card, continuations joined.
+    A ``$`` comment line ends a card (a punch file's result sections start with ``$`` headers),
+    and data lines with no card before them (such result lines) are skipped."""
+    card, start, card_name = None, 0, ""
     for number, raw in enumerate(text.splitlines(), start=1):
-        line = raw.split("$", 1)[0].rstrip() if not raw.startswith("$") else ""
+        if raw.startswith("$"):
+            if card is not None:
+                yield start, card_name, card
+            card = None
+            continue
+        line = raw.split("$", 1)[0].rstrip()
         if not line.strip():
             continue
         if "," in line:
@@ -498,9 +505,8 @@ def _bulk_cards(path: Path, text: str):
         is_continuation = head == "" or head.startswith("+") or (head.startswith("*") and len(head) <= 8
                                                                  and not head.rstrip("*").isalpha())
         if is_continuation:
-            if card is None:
-                raise ValueError(f"{path}: line {number}: a continuation line with no card before it")
-            card.extend(data)
+            if card is not None:
+                card.extend(data)
             continue
         if card is not None:
             yield start, card_name, card
@@ -662,9 +668,19 @@ def read_matlab(path) -> dict:
         data = scipy.io.loadmat(path)
     except NotImplementedError:              # v7.3: an HDF5 file
         return _read_matlab_hdf5(path)
-    except (ValueError, TypeError, OSError) as err:
+    except (ValueError, TypeError, OSError, scipy.io.matlab.MatReadError) as err:
+        if _is_hdf5(path):                   # an HDF5 .mat without MATLAB's text header
+            return _read_matlab_hdf5(path)
         raise ValueError(f"{path}: not a readable MATLAB .mat file ({err}); expected a MAT-file v4-v7.3") from None
     return {k: v for k, v in data.items() if not k.startswith("__")}
+
+
+def _is_hdf5(path: Path) -> bool:
+    """Whether the file carries the HDF5 signature at offset 0, 512, 1024, ... (a user block)."""
+    signature = b"\x89HDF\r\n\x1a\n"
+    with open(path, "rb") as fh:
+        data = fh.read(1 << 16)
+    return any(data[k:k + 8] == signature for k in [0] + [512 << j for j in range(7)])
 
 
 def _read_matlab_hdf5(path: Path) -> dict:

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 import scipy.io
 import scipy.linalg
+import scipy.sparse
 
 from bladedamp.blade import ModalBlade, beam_modes
 from bladedamp.fe_formats import read_fe_matrices, read_op4
@@ -445,3 +446,35 @@ def test_abaqus_d_exponents_and_a_bad_line(tmp_path):
     (tmp_path / "model_MASS1.mtx").write_text("\n".join(lines) + "\n")
     with pytest.raises(ValueError, match=r"model_MASS1\.mtx: line 7: expected node, dof, node, dof, value"):
         read_fe_matrices(tmp_path / "model_STIF1.mtx")
+
+
+def test_dmig_cards_in_a_punch_file_with_result_sections(tmp_path):
+    """A punch file also holding result output (a $ header, then data lines) reads the DMIG
+    cards only."""
+    results = ("$TITLE   = \n$DISPLACEMENTS\n$REAL OUTPUT\n"
+               "         1       G      0.000000E+00      0.000000E+00      0.000000E+00       7\n"
+               "-CONT-                  0.000000E+00      0.000000E+00      0.000000E+00       8\n")
+    path = tmp_path / "mixed.pch"
+    path.write_text(results + (DATA / "dmig.pch").read_text() + results)
+    fe, ref = read_fe_matrices(path), read_fe_matrices(DATA / "dmig.pch")
+    np.testing.assert_array_equal(fe.stiffness.toarray(), ref.stiffness.toarray())
+    np.testing.assert_array_equal(fe.labels, ref.labels)
+
+
+def test_matlab_v73_sparse_matrices(tmp_path):
+    """MATLAB v7.3 stores a sparse matrix as a group (data, ir, jc; attribute MATLAB_sparse =
+    number of rows), compressed by columns."""
+    h5py = pytest.importorskip("h5py")
+    M, K, nodes, points = reference_matrices()
+    path = tmp_path / "blade.mat"
+    with h5py.File(path, "w", userblock_size=512) as f:
+        for name, A in (("MAA", M), ("KAA", K)):
+            C = scipy.sparse.csc_matrix(A)
+            g = f.create_group(name)
+            g.attrs["MATLAB_class"] = np.bytes_("double")
+            g.attrs["MATLAB_sparse"] = np.uint64(A.shape[0])
+            g["data"], g["ir"], g["jc"] = C.data, C.indices.astype(np.uint64), C.indptr.astype(np.uint64)
+    fe = read_fe_matrices(path)
+    assert fe.names == ("MAA", "KAA")
+    np.testing.assert_array_equal(fe.stiffness.toarray(), K)
+    np.testing.assert_array_equal(fe.mass.toarray(), M)
