@@ -12,6 +12,7 @@ and its numbers: dense columns (IROW > 0) hold NW numbers from row IROW on; spar
 or, when NROW < 0 ("bigmat"), by a line L, IROW (L - 1 data words). A double-precision
 number is two words. The column NCOL + 1 ends the matrix. Binary files: the same records
 as Fortran unformatted records (4-byte length markers, either byte order, 4-byte words).
+A name written again (e.g. one QHH per Mach number) is read as NAME#2, NAME#3, ...
 OUTPUT4 does not record the node and DOF of a row: rows are numbered 1, 2, ... (in Nastran's
 a-set order: grid and scalar point IDs ascending, components 1-6 of a grid, one row per
 scalar point).
@@ -262,8 +263,18 @@ def _op4_words_per_number(ntype: int) -> int:
     return 2 if ntype in (2, 4) else 1
 
 
+def _unique_name(existing: dict, name: str) -> str:
+    """``name``, or ``name#2``, ``name#3``, ... for its second, third matrix of that name."""
+    k, key = 1, name
+    while key in existing:
+        k += 1
+        key = f"{name}#{k}"
+    return key
+
+
 def read_op4(path) -> dict:
-    """All matrices of an OUTPUT4 file (text or binary) by name: name -> (entries, nrow, ncol, form)."""
+    """All matrices of an OUTPUT4 file (text or binary) by name: name -> (entries, nrow, ncol, form).
+    A name that occurs again (e.g. one QHH per Mach number) is ``name#2``, ``name#3``, ..."""
     path = Path(path)
     data = path.read_bytes()
     if not data:
@@ -379,7 +390,7 @@ def _read_op4_text(path: Path, data: bytes) -> dict:
             if used != nw:
                 raise ValueError(f"{path}: line {rec_line}: column {icol} of matrix {name} has strings of "
                                  f"{used} words; expected NW = {nw}")
-        matrices[name] = (e, nrow, ncol, form)
+        matrices[_unique_name(matrices, name)] = (e, nrow, ncol, form)
     if not matrices:
         raise ValueError(f"{path}: no matrix found; expected Nastran OUTPUT4 matrices")
     return matrices
@@ -459,7 +470,7 @@ def _read_op4_binary(path: Path, data: bytes) -> dict:
                                      f"expected a multiple of {wpn} inside the column's {nw} words")
                 store(row0, words[4 * start:4 * (start + n_words)])
                 w = start + n_words
-        matrices[name] = (e, nrow, ncol, form)
+        matrices[_unique_name(matrices, name)] = (e, nrow, ncol, form)
     return matrices
 
 

@@ -478,3 +478,14 @@ def test_matlab_v73_sparse_matrices(tmp_path):
     assert fe.names == ("MAA", "KAA")
     np.testing.assert_array_equal(fe.stiffness.toarray(), K)
     np.testing.assert_array_equal(fe.mass.toarray(), M)
+
+
+def test_a_matrix_name_written_twice_is_read_as_name_2(tmp_path):
+    M, K, _, _ = reference_matrices()
+    write_op4_text(tmp_path / "a.op4", {"KAA": K, "MAA": M})
+    write_op4_text(tmp_path / "b.op4", {"KAA": 2.0 * K})
+    path = tmp_path / "both.op4"
+    path.write_text((tmp_path / "a.op4").read_text() + (tmp_path / "b.op4").read_text())
+    assert sorted(read_op4(path)) == ["KAA", "KAA#2", "MAA"]
+    np.testing.assert_array_equal(read_fe_matrices(path).stiffness.toarray(), K)
+    np.testing.assert_array_equal(read_fe_matrices(path, stiffness="KAA#2").stiffness.toarray(), 2.0 * K)
