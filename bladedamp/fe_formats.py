@@ -99,11 +99,14 @@ class FEMatrices:
         (``fixed_dofs``). Files without: a sequence of 1-based row numbers.
         """
         if self.labels is None:
-            rows = np.asarray(value)
+            try:
+                rows = np.asarray(value)
+            except ValueError:                # ragged, e.g. a (node, dofs) pair
+                rows = np.zeros(0)
             if rows.ndim != 1 or rows.size == 0 or not np.issubdtype(rows.dtype, np.integer) \
                     or rows.min() < 1 or rows.max() > self.n:
                 raise ValueError(f"{self.path}: {name} must be a sequence of row numbers in [1, {self.n}] "
-                                 f"(this file numbers rows only; got {value!r})")
+                                 f"(this file numbers rows only, it has no node labels; got {value!r})")
             return rows - 1
         lookup = {(int(a), int(b)): i for i, (a, b) in enumerate(self.labels)}
         rows = []

@@ -489,3 +489,94 @@ def test_a_matrix_name_written_twice_is_read_as_name_2(tmp_path):
     assert sorted(read_op4(path)) == ["KAA", "KAA#2", "MAA"]
     np.testing.assert_array_equal(read_fe_matrices(path).stiffness.toarray(), K)
     np.testing.assert_array_equal(read_fe_matrices(path, stiffness="KAA#2").stiffness.toarray(), 2.0 * K)
+
+
+# ---------------------------------------------------------------------------------------
+# the design file: [blade] modal_file with [blade.fe]
+# ---------------------------------------------------------------------------------------
+FE_DESIGN = """[blade]
+modal_file = "{file}"
+n_modes = 4
+damping_ratio = 0.002
+
+[blade.fe]
+fixed_rows = {fixed}
+
+[blade.fe.platform]
+rows = [1, 2, 3, 4, 5, 6]
+position_mm = [0.0, 0.0, 50.0]
+
+[blade.fe.OL]
+link = "platform"
+position_mm = [-12.0, 0.0, 50.0]
+
+[blade.fe.OR]
+link = "platform"
+position_mm = [12.0, 0.0, 50.0]
+
+[blade.fe.tip]
+rows = [1, 2, 3, 4, 5, 6]
+position_mm = [0.0, 0.0, 80.0]
+
+[blade.fe.excitation]
+rows = [1, 2, 3, 4, 5, 6]
+position_mm = [0.0, 0.0, 80.0]
+"""
+
+
+def write_fe_design(tmp_path, text=None):
+    (tmp_path / "se.op4").write_bytes((DATA / "se_test_n11.op4").read_bytes())
+    path = tmp_path / "design.toml"
+    path.write_text(text if text is not None else FE_DESIGN.format(file="se.op4", fixed=list(range(7, 73))))
+    return path
+
+
+def test_design_file_fe_blade_is_from_file_with_the_same_arguments(tmp_path):
+    from bladedamp.design import load_design
+    design = load_design(write_fe_design(tmp_path))
+    points = {"platform": (0, 0, 0.05), "OL": (-0.012, 0, 0.05), "OR": (0.012, 0, 0.05), "tip": (0, 0, 0.08),
+              "excitation": (0, 0, 0.08)}
+    blade = ModalBlade.from_file(DATA / "se_test_n11.op4", dof_map={p: range(1, 7) for p in ("platform", "tip",
+                                                                                          "excitation")},
+                                 points=points, n_modes=4, damping_ratios=0.002, fixed_dofs=range(7, 73),
+                                 rigid_links={"OL": "platform", "OR": "platform"})
+    got = design.disk.blade
+    np.testing.assert_array_equal(got.natural_frequencies_hz, blade.natural_frequencies_hz)
+    np.testing.assert_array_equal(got.damping_ratios, blade.damping_ratios)
+    for p in points:
+        np.testing.assert_array_equal(got.mode_shapes[p], blade.mode_shapes[p])
+        np.testing.assert_allclose(got.points[p], blade.points[p], rtol=1e-15)
+
+
+@pytest.mark.parametrize("edit, expected", [
+    (lambda t: t.replace('[blade.fe.tip]\nrows = [1, 2, 3, 4, 5, 6]\n', '[blade.fe.tip]\n'),
+     r"\[blade\.fe\.tip\] needs exactly one of node, rows or link \(got none\)"),
+    (lambda t: t.replace('link = "platform"\nposition_mm = [-12.0', 'link = "platform"\nrows = [1]\nposition_mm = [-12.0'),
+     r"\[blade\.fe\.OL\] needs exactly one of node, rows or link \(got rows, link\)"),
+    (lambda t: t.replace('rows = [1, 2, 3, 4, 5, 6]\nposition_mm = [0.0, 0.0, 80.0]\n\n[blade.fe.excitation]',
+                         'rows = [101, 102, 103, 104, 105, 106]\nposition_mm = [0.0, 0.0, 80.0]\n\n[blade.fe.excitation]'),
+     r"modal_file = \"se\.op4\": .*se\.op4: dof_map\['tip'\] must be a sequence of row numbers in \[1, 105\]"),
+    (lambda t: t.replace('modal_file = "se.op4"', 'modal_file = "blade.npz"'),
+     r"\[blade\.fe\] fixed_rows applies to an FE matrix file as \[blade\] modal_file"),
+])
+def test_design_file_fe_blade_errors_are_one_line_naming_the_key(tmp_path, edit, expected):
+    from bladedamp.design import DesignError, load_design
+    text = edit(FE_DESIGN.format(file="se.op4", fixed=list(range(7, 73))))
+    with pytest.raises(DesignError, match=expected) as info:
+        load_design(write_fe_design(tmp_path, text))
+    assert "\n" not in str(info.value)
+
+
+def test_cli_fe_blade_error_is_one_line_with_exit_code_2(tmp_path):
+    import os
+    import subprocess
+    import sys
+    text = FE_DESIGN.format(file="se.op4", fixed=list(range(7, 73))).replace(
+        '[blade.fe.tip]\nrows = [1, 2, 3, 4, 5, 6]', '[blade.fe.tip]\nnode = 5')
+    path = write_fe_design(tmp_path, text)
+    env = dict(os.environ, PYTHONPATH=str(Path(__file__).parents[1]))
+    run = subprocess.run([sys.executable, "-m", "bladedamp.cli", "frf", str(path), "--out", str(tmp_path / "out")],
+                         capture_output=True, text=True, env=env, timeout=120)
+    assert run.returncode == 2
+    lines = run.stderr.strip().splitlines()
+    assert len(lines) == 1 and "se.op4" in lines[0] and "row numbers" in lines[0], run.stderr
