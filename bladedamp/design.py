@@ -8,7 +8,10 @@ is part of every key's name. Every key is optional: a missing key takes the refe
 so a file holding only ``[damper]`` / ``mass_g = 2.0`` is the reference disk with a 2 g damper.
 Unknown tables and keys are errors (a typo must not pass silently).
 
-A blade of your own is modal data (``[blade] modal_file``) or a closed surface mesh meshed as a
+A blade of your own is modal data (``[blade] modal_file``), reduced FE matrices (``modal_file``
+an ``.op4``, ``.pch``, ``.mtx``, ``.mat`` or ``.full`` file with ``[blade.fe]`` and the point tables
+``[blade.fe.OL]``, ``[blade.fe.OR]``, ``[blade.fe.tip]``, ``[blade.fe.excitation]``, optionally
+``[blade.fe.platform]``; :meth:`bladedamp.blade.ModalBlade.from_file`) or a closed surface mesh meshed as a
 solid FE blade (``[blade] model = "solid"``, ``surface_file``, ``surface_units`` and the named
 regions ``[blade.regions.clamp]``, ``[blade.regions.OL]``, ``[blade.regions.OR]``, optionally
 ``[blade.regions.tip]``, each a plane or its own surface file; :class:`bladedamp.solid.SurfaceBladeGeometry`);
