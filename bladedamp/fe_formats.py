@@ -57,6 +57,8 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse
 
+from .io import MissingFileError, reading
+
 # file suffix -> format name, for ModalBlade.from_file
 FE_SUFFIXES = {"op4": "op4", "pch": "dmig", "mtx": "abaqus", "mat": "matlab", "full": "ansys"}
 
@@ -593,7 +595,8 @@ def read_abaqus_mtx(path):
     """(entries, labels or None) of one Abaqus .mtx file (MATRIX INPUT or COORDINATE format)."""
     path = Path(path)
     if not path.is_file():
-        raise FileNotFoundError(f"{path}: no such Abaqus matrix file")
+        raise MissingFileError(f"{path}: no such Abaqus matrix file (the {'mass' if '_MASS' in path.name.upper() else 'other'} "
+                               "matrix beside the one given; name it with mass= or stiffness=)")
     try:
         text = path.read_text(encoding="ascii")
     except UnicodeDecodeError:
@@ -809,8 +812,11 @@ def read_fe_matrices(path, *, mass=None, stiffness=None) -> FEMatrices:
     kind = FE_SUFFIXES.get(path.suffix.lower().lstrip("."))
     if kind is None:
         raise ValueError(f"{path}: an FE matrix file must end in {sorted('.' + s for s in FE_SUFFIXES)}")
-    if not path.is_file():
-        raise FileNotFoundError(f"{path}: no such FE matrix file")
+    with reading(path, "finite-element matrix file"):     # missing, empty, a folder ...: one FileReadError
+        return _read_fe_matrices(path, kind, mass, stiffness)
+
+
+def _read_fe_matrices(path: Path, kind: str, mass, stiffness) -> FEMatrices:
     if kind == "abaqus":
         return _read_abaqus_pair(path, mass, stiffness)
     if kind == "ansys":
@@ -860,6 +866,8 @@ def read_fe_matrices(path, *, mass=None, stiffness=None) -> FEMatrices:
 
 
 def _read_abaqus_pair(path: Path, mass, stiffness) -> FEMatrices:
+    if not path.is_file():
+        raise OSError(f"{path}: not a file")   # reading() says: no such file, or a folder
     name = path.name
     if mass is None and stiffness is None:
         if "_STIF" in name.upper():

@@ -331,7 +331,7 @@ def test_dof_map_naming_a_node_or_row_not_in_the_file():
                                          r"in \[1, 105\]"):
         ModalBlade.from_file(DATA / "se_test_n11.op4", **blade_args(dict({p: range(1, 7) for p in POINTS},
                                                                          tip=range(101, 107))))
-    with pytest.raises(FileNotFoundError, match=r"absent_MASS1\.mtx: no such Abaqus matrix file"):
+    with pytest.raises(FileNotFoundError, match=r"absent_MASS1\.mtx: no such Abaqus matrix file \(the mass matrix beside"):
         read_fe_matrices(DATA / "model_STIF1.mtx", mass="absent_MASS1.mtx")
 
 
@@ -580,3 +580,17 @@ def test_cli_fe_blade_error_is_one_line_with_exit_code_2(tmp_path):
     assert run.returncode == 2
     lines = run.stderr.strip().splitlines()
     assert len(lines) == 1 and "se.op4" in lines[0] and "row numbers" in lines[0], run.stderr
+
+
+@pytest.mark.parametrize("suffix", ["op4", "pch", "mtx", "mat"])
+def test_missing_empty_or_folder_fe_files_are_one_file_read_error(tmp_path, suffix):
+    from bladedamp.io import FileReadError, MissingFileError
+    with pytest.raises(MissingFileError, match=rf"none_STIF1\.{suffix}: no such finite-element matrix file"):
+        read_fe_matrices(tmp_path / f"none_STIF1.{suffix}")
+    (tmp_path / f"empty_STIF1.{suffix}").write_bytes(b"")
+    (tmp_path / f"empty_MASS1.{suffix}").write_bytes(b"")
+    with pytest.raises(FileReadError, match=rf"empty_STIF1\.{suffix}: .*(empty|no matrix|no DMIG|not a readable)"):
+        read_fe_matrices(tmp_path / f"empty_STIF1.{suffix}")
+    (tmp_path / f"dir.{suffix}").mkdir()
+    with pytest.raises(FileReadError, match=rf"dir\.{suffix}: is a folder, not a finite-element matrix file"):
+        read_fe_matrices(tmp_path / f"dir.{suffix}")
