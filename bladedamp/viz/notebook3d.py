@@ -1,6 +1,6 @@
 """Helpers of notebook 04 (contact in 3D): plain functions, values in, data or figures out.
 
-* :func:`embed_scene` / :func:`save_scene`: show a recorded meshcat :class:`~bladedamp.viz.Scene`
+* :func:`show_scene` (a PNG still, then the live view), :func:`embed_scene` / :func:`save_scene`: show a recorded meshcat :class:`~bladedamp.viz.Scene`
   in a notebook cell (an ``<iframe srcdoc>`` of its standalone HTML) or write it to a file and
   link it. Neither starts a meshcat server: the scene is recorded in-process.
 * :func:`wedge_disk`, :func:`liftoff_case`, :func:`liftoff_figure`: the reference wedge's
@@ -21,6 +21,7 @@ from __future__ import annotations
 import dataclasses
 import html as _html
 import os
+import subprocess
 from functools import lru_cache
 
 import numpy as np
@@ -46,6 +47,47 @@ def embed_scene(scene, height: int = 480):
     from IPython.display import HTML
 
     return HTML(scene_iframe(scene, height))
+
+
+#: what the still of a 3D view says under it, in a notebook
+LIVE_VIEW_HINT = ("A still of the 3D view. The live view below (drag to turn, scroll to zoom, the cycle "
+                  "animates) shows once the notebook is trusted: in JupyterLab File > Trust Notebook, or "
+                  "`jupyter trust` on the file; running the cell rebuilds it.")
+
+
+def scene_snapshot(scene, size=(900, 520)) -> bytes | None:
+    """PNG bytes of ``scene`` rendered by headless Chromium (software WebGL) at ``size`` (width,
+    height) [px], or None when no Chromium is installed or it drew nothing."""
+    import tempfile
+
+    from .meshcat_view import chromium_executable, screenshot
+
+    if chromium_executable() is None:
+        return None
+    with tempfile.TemporaryDirectory() as tmp:
+        page = scene.save_html(os.path.join(tmp, "scene.html"))
+        try:
+            png = screenshot(page, os.path.join(tmp, "scene.png"), size=size, virtual_time_ms=2000)
+        except (RuntimeError, OSError, subprocess.SubprocessError):
+            return None
+        with open(png, "rb") as f:
+            return f.read()
+
+
+def show_scene(scene, height: int = 480):
+    """Display a PNG still of ``scene`` (:func:`scene_snapshot`) with :data:`LIVE_VIEW_HINT` under
+    it, then return :func:`embed_scene`'s live view. The still is what a notebook shows where the
+    live view cannot be drawn (an untrusted notebook, a static viewer); without Chromium the
+    line says that no still was made."""
+    from IPython.display import Image, Markdown, display
+
+    png = scene_snapshot(scene, size=(900, height))
+    if png is not None:
+        display(Image(data=png, format="png"))
+        display(Markdown(LIVE_VIEW_HINT))
+    else:
+        display(Markdown("No still of the 3D view (it needs Chromium). " + LIVE_VIEW_HINT.split(". ", 1)[1]))
+    return embed_scene(scene, height)
 
 
 def save_scene(scene, path, text: str | None = None):
