@@ -45,7 +45,7 @@ def test_widgets_and_3d_views_are_saved(path):
             if WIDGET_VIEW in data:
                 assert data[WIDGET_VIEW]["model_id"] in state, (path.name, cell["source"][:2])
             views += "".join(data.get("text/html", "")).count("<iframe srcdoc=")
-        if cell["cell_type"] == "code" and "embed_scene(" in "".join(cell["source"]):
+        if cell["cell_type"] == "code" and re.search(r"(embed|show)_scene\(", "".join(cell["source"])):
             assert cell.get("outputs"), f"{path.name}: a 3D view cell saved without its view"
     if path.name.startswith("04_"):
         assert views == 2, views           # the cylinder at resonance and the misfit wedge

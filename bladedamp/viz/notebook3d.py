@@ -4,7 +4,7 @@
   in a notebook cell (an ``<iframe srcdoc>`` of its standalone HTML) or write it to a file and
   link it. Neither starts a meshcat server: the scene is recorded in-process.
 * :func:`wedge_disk`, :func:`liftoff_case`, :func:`liftoff_figure`: the reference wedge's
-  lift-off map (Fig. 9) for a contact height and tip excitation, memoised, so a slider moved
+  lift-off map (Fig. 9), labelled as the one-harmonic approximation it is (:func:`one_harmonic_label`) for a contact height and tip excitation, memoised, so a slider moved
   back answers at once (a new value costs one continuation run over a narrow window, ~1 s).
 * :func:`misfit_wedge_disk`: the wedge with one face angle off by a few degrees
   (:func:`bladedamp.geometry.misfit_gaps` -> ``TunedDisk(initial_gaps=...)``).
@@ -153,8 +153,22 @@ def liftoff_figure(contact_height_mm: float = 2.0, force_n: float = 0.1, mass_g:
     axes[0].set_ylabel("xi* = xi / h_C (across the height)")
     fig.colorbar(sc, ax=axes, label="r = |w_zeta,1| / a_static  (r > 1, red ring: lifts off)")
     fig.suptitle(f"wedge {mass_g:g} g, h_C = {contact_height_mm:g} mm, F_x = {force_n:g} N: "
-                 f"resonance {m.peak_frequency_hz:.2f} Hz, tip {1e3 * m.peak_amplitude:.3f} mm", fontsize=10)
+                 f"resonance {m.peak_frequency_hz:.2f} Hz, tip {1e3 * m.peak_amplitude:.3f} mm\n"
+                 + one_harmonic_label(m.harmonic_error), fontsize=10)
     return fig
+
+
+def one_harmonic_label(harmonic_error: float) -> str:
+    """One plain line naming a result of the one-harmonic model (the paper's) as the approximation
+    it is: how far its amplitudes may be off by the harmonic error estimate [-], and what to do."""
+    from ..hbm.accuracy import HARMONIC_TOLERANCE
+
+    if not np.isfinite(harmonic_error):
+        return "one-harmonic approximation (as in the paper); its error was not estimated"
+    if harmonic_error <= HARMONIC_TOLERANCE:
+        return f"one-harmonic approximation (as in the paper), within {100 * HARMONIC_TOLERANCE:g} % of the converged one"
+    return (f"one-harmonic approximation (as in the paper): amplitudes may be off by up to about "
+            f"{100 * harmonic_error:.0f} %; harmonics='auto' computes the converged ones")
 
 
 # --------------------------------------------------------------------------------------
