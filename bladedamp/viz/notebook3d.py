@@ -151,7 +151,7 @@ def liftoff_figure(contact_height_mm: float = 2.0, force_n: float = 0.1, mass_g:
         ax.set_xlim(-0.65, 0.65)
         ax.set_ylim(-0.65, 0.65)
     axes[0].set_ylabel("xi* = xi / h_C (across the height)")
-    fig.colorbar(sc, ax=axes, label="r = |w_zeta,1| / a_static  (r > 1, red ring: lifts off)")
+    fig.colorbar(sc, ax=axes, label="lift-off ratio r (red ring: r > 1)")
     fig.suptitle(f"wedge {mass_g:g} g, h_C = {contact_height_mm:g} mm, F_x = {force_n:g} N: "
                  f"resonance {m.peak_frequency_hz:.2f} Hz, tip {1e3 * m.peak_amplitude:.3f} mm\n"
                  + one_harmonic_label(m.harmonic_error), fontsize=10)
