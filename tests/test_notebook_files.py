@@ -248,3 +248,12 @@ def test_notebooks_extra_installs_every_notebook_import():
                 continue
             dists = {_requirement_name(d) for d in owners.get(module, [module])}
             assert dists & installed, f"{path.name} imports {module} ({sorted(dists)}), not in the notebooks extra"
+
+
+def test_readme_gives_the_reading_order_and_run_time_of_every_notebook():
+    text = (ROOT / "notebooks" / "README.md").read_text(encoding="utf-8")
+    rows = re.findall(r"^\| (\d+) \| (\w+) \| ([^|]+) \|", text, flags=re.MULTILINE)
+    assert [name for _, name, _ in rows] == [p.stem for p in NOTEBOOKS]
+    assert [int(order) for order, _, _ in rows] == list(range(1, len(NOTEBOOKS) + 1))
+    for _, name, time in rows:
+        assert re.fullmatch(r"(\d+ min )?\d+ s|\d+ min", time.strip()), (name, time)
