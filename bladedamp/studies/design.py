@@ -433,6 +433,8 @@ class LiftoffMap(Saveable):
     static_approach : (2, P) a_static [m]
     normal_amplitude : (2, P) |w_zeta,1| [m]
     peak_frequency_hz : [Hz]; peak_amplitude : [m]; n_samples : time samples per period of the AFT
+    harmonic_error : the one-harmonic response's harmonic error estimate at its peak [-] (relative
+        change of the tip amplitude with the static term and more harmonics; NaN if not estimated)
     """
 
     xi_star: np.ndarray
@@ -445,6 +447,7 @@ class LiftoffMap(Saveable):
     peak_frequency_hz: float
     peak_amplitude: float
     n_samples: int
+    harmonic_error: float = float("nan")
 
     @property
     def lifts_off(self) -> np.ndarray:
@@ -491,7 +494,8 @@ def wedge_liftoff_map(disk: TunedDisk, f_range_hz=(90.0, 105.0)) -> LiftoffMap:
     min_a = a_t.min(axis=0)
     xi_s, eta_s = geometry.patches[0].normalised_coordinates
     return LiftoffMap(xi_s, eta_s, amplitude / a_static, (a_static - min_a) / a_static, min_a, a_static,
-                      amplitude, float(r.frequency_hz[i]), float(r.tip_amplitude[i, 0]), basis.n_samples)
+                      amplitude, float(r.frequency_hz[i]), float(r.tip_amplitude[i, 0]), basis.n_samples,
+                      float(r.harmonic_error))
 
 
 # ---------------------------------------------------------------------------------------
