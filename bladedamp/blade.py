@@ -710,6 +710,30 @@ class ModalBlade:
         return cls(natural_frequencies_hz=np.sqrt(lam) / (2.0 * np.pi), damping_ratios=damping,
                    mode_shapes=shapes, points=positions, mode_names=mode_names)
 
+    @classmethod
+    def from_test(cls, path, points: dict, *, positions: dict | None = None, damping_ratios=None,
+                  modal_masses=None, units: str | None = None, mode_names=()) -> "ModalBlade":
+        """A blade from measured (or exported) normal modes, UFF dataset 55 or 2414
+        (:func:`bladedamp.measurement.load_modes`), at named nodes.
+
+        points : point name -> node number of the file, for "OL", "OR", "tip", "excitation" (and any
+            other). Each point takes the node's six shape values (rotations zero where the file
+            gives translations only: then OL and OR do not rotate the damper contact).
+        positions : point name -> (3,) position [m] in the blade frame; default: the node's
+            coordinates from the file's dataset 15 or 2411 (ValueError if it has none).
+        damping_ratios : modal damping ratios [-] (scalar or (n_m,)); default: the file's viscous
+            damping ratios (ValueError if all are 0).
+        modal_masses : modal mass [kg] of each stored shape (scalar or (n_m,); 1.0 for
+            mass-normalised shapes); default: the file's (ValueError naming the mode where it
+            gives none). The shapes are divided by sqrt(modal mass): mass-normalised, Eq. 2.
+        units : "SI" for a file without a dataset 164 (unit system); default: the file's.
+        """
+        from .measurement import load_modes, modal_blade_from_modes
+
+        modes = load_modes(path, units=units)
+        return modal_blade_from_modes(modes, points, positions=positions, damping_ratios=damping_ratios,
+                                      modal_masses=modal_masses, mode_names=mode_names)
+
     # -- linear reference solution -----------------------------------------------------
     def linear_frf(self, f_hz: np.ndarray, force: np.ndarray, at: str = "excitation",
                    response_at: str = "tip") -> np.ndarray:

@@ -472,7 +472,7 @@ def load_modes(path, *, units: str | None = None) -> MeasuredModes:
                         j = at[int(n)]
                         coordinates[i] = np.array([s["x"][j], s["y"][j], s["z"][j]], dtype=float) / f_len
         return MeasuredModes(np.array([m[2] for m in modes]), np.array([m[4] for m in modes]), masses, nodes,
-                             shapes, coordinates, path.name)
+                             shapes, coordinates, str(path))
 
 
 def modal_blade_from_modes(modes: MeasuredModes, points: dict, *, positions: dict | None = None,
