@@ -1,0 +1,254 @@
+"""Measured data: UFF 58 / CSV responses, UFF 55 / 2414 modes, ModalBlade.from_test, overlays."""
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+pyuff = pytest.importorskip("pyuff")
+
+import bladedamp as bd  # noqa: E402
+from bladedamp import palette  # noqa: E402
+from bladedamp.cli import main  # noqa: E402
+from bladedamp.io import FileReadError  # noqa: E402
+from bladedamp.measurement import (G_STANDARD, MeasuredResponse, draw_measurement, load_measurement,  # noqa: E402
+                                   load_modes, parse_unit)
+
+DATA = Path(__file__).parent / "data" / "measured"
+F = np.linspace(0.0, 200.0, 201)
+H = 1e-3 / (100.0**2 - F**2 + 2j * 0.02 * 100.0 * F)          # an accelerance-like complex FRF
+# pyuff writes ASCII dataset 58 values as %20.11e: 12 significant digits, half an ulp of the last
+ASCII_58_RTOL = 0.5e-11
+
+
+def write_58(path, data, x=F, binary=0, num="m/s^2", den="N", num_type=12, func_type=4, node=3, direction=1, **extra):
+    d = pyuff.prepare_58(binary=binary, func_type=func_type, rsp_node=node, rsp_dir=direction, ref_node=7, ref_dir=3,
+                         data=data, x=x, id1="test", rsp_ent_name="blade", ref_ent_name="blade", abscissa_spacing=1,
+                         abscissa_spec_data_type=18, ordinate_spec_data_type=num_type, orddenom_spec_data_type=13,
+                         abscissa_axis_units_lab="Hz", ordinate_axis_units_lab=num, orddenom_axis_units_lab=den,
+                         **extra)
+    pyuff.UFF(str(path)).write_sets(d, mode="add")
+    return path
+
+
+def write_164(path, length=1.0, force=1.0):
+    pyuff.UFF(str(path)).write_sets(pyuff.prepare_164(units_code=1, units_description="SI", temp_mode=1,
+                                                      length=length, force=force, temp=1.0, temp_offset=273.15),
+                                    mode="add")
+
+
+# ----- UFF 58 written by pyuff from known data ------------------------------------------------
+def test_binary_58b_complex_frf_reads_back_exactly(tmp_path):
+    m = load_measurement(write_58(tmp_path / "b.uff", H, binary=1))
+    assert np.array_equal(m.frequency_hz, F) and np.array_equal(m.response, H)
+    assert (m.unit, m.point, m.direction, m.reference_point, m.reference_direction) == ("m/s^2/N", "3", "+x", "7", "+z")
+
+
+def test_ascii_58_complex_frf_reads_back_to_its_printed_digits(tmp_path):
+    m = load_measurement(write_58(tmp_path / "a.uff", H))
+    assert m.is_complex and np.array_equal(m.frequency_hz, F)
+    np.testing.assert_allclose(m.response.real, H.real, rtol=ASCII_58_RTOL, atol=0)
+    np.testing.assert_allclose(m.response.imag, H.imag, rtol=ASCII_58_RTOL, atol=0)
+
+
+def test_units_convert_to_si(tmp_path):
+    """mm/N -> m/N by 1e-3, g/N -> m/s^2/N by 9.80665, per kN by 1e-3; binary so exact up to one product."""
+    for k, (num, den, unit, factor) in enumerate([("mm", "N", "m/N", 1e-3), ("g", "N", "m/s^2/N", G_STANDARD),
+                                                   ("m/s", "kN", "m/s/N", 1e-3)]):
+        m = load_measurement(write_58(tmp_path / f"u{k}.uff", H, binary=1, num=num, den=den))
+        assert m.unit == unit
+        np.testing.assert_allclose(m.response, factor * H, rtol=1e-15, atol=0)
+
+
+def test_amplitude_frf_and_the_unit_from_dataset_164(tmp_path):
+    """An FRF of real amplitudes without units labels, displacement over force: the unit system
+    of dataset 164 (length factor 1000, force factor 1: the file is in mm and N) gives m/N."""
+    path = tmp_path / "s.uff"
+    write_164(path, length=1000.0)
+    amp = np.abs(H) * 1e6
+    write_58(path, amp.astype(float), num="NONE", den="NONE", num_type=8)
+    m = load_measurement(path)
+    assert m.unit == "m/N" and not m.is_complex and m.per_force
+    np.testing.assert_allclose(m.response, amp / 1000.0, rtol=ASCII_58_RTOL + 1e-15, atol=0)
+
+
+def test_acceleration_to_displacement_only_when_asked(tmp_path):
+    """a = -omega^2 x: the accelerance divided by -omega^2 is the receptance; nan at 0 Hz."""
+    path = write_58(tmp_path / "b.uff", H, binary=1)
+    assert load_measurement(path).unit == "m/s^2/N"
+    x = load_measurement(path, as_displacement=True)
+    omega = 2 * np.pi * F
+    assert x.unit == "m/N" and np.isnan(x.response[0])
+    np.testing.assert_allclose(x.response[1:], H[1:] / -omega[1:] ** 2, rtol=1e-14, atol=0)
+
+
+def test_parse_unit():
+    assert parse_unit("m/N") == (0, True, 1.0)
+    assert parse_unit("mm/s^2") == (2, False, 1e-3)
+    assert parse_unit("in/s/lbf")[:2] == (1, True)
+    for bad in ("Pa", "m/s^3", "V/N", "m/N/N"):
+        with pytest.raises(ValueError, match="not a response unit"):
+            parse_unit(bad)
+
+
+# ----- CSV ------------------------------------------------------------------------------------
+def test_csv_complex_and_amplitude(tmp_path):
+    path = tmp_path / "frf.csv"
+    path.write_text("# rig test, blade 3 tip\nfrequency [Hz],re [mm/N],im [mm/N]\n"
+                    + "".join(f"{float(f)!r},{float(h.real)!r},{float(h.imag)!r}\n" for f, h in zip(F, 1e3 * H)))
+    m = load_measurement(path, node="tip", direction="+x")
+    assert (m.unit, m.point, m.direction) == ("m/N", "tip", "+x")
+    np.testing.assert_allclose(m.response, H, rtol=1e-15, atol=0)      # repr round-trips; one product by 1e-3
+    amp = tmp_path / "amp.csv"
+    amp.write_text("frequency [Hz],amplitude [mm]\n10,0.5\n20,1.5\n")
+    a = load_measurement(amp)
+    assert a.unit == "m" and np.array_equal(a.response, [0.5e-3, 1.5e-3]) and not a.is_complex
+
+
+# ----- a public UFF file of a modal-test package ------------------------------------------------
+def test_public_pyuff_frf_file():
+    """tests/data/measured/pyuff_measurement.uff (ladisk/pyuff, see the README there): three
+    accelerance FRFs (function 4, acceleration over excitation force) with no units labels and
+    no dataset 164: the unit cannot be told, so it is refused until the caller states it."""
+    path = DATA / "pyuff_measurement.uff"
+    with pytest.raises(FileReadError, match=r"dataset 1 \(UFF 58, response node 1\): the unit cannot be told"):
+        load_measurement(path, record=0)
+    m = load_measurement(path, record=2, unit="m/s^2/N")
+    raw = pyuff.UFF(str(path)).read_sets(2)
+    assert m.unit == "m/s^2/N" and m.frequency_hz.shape == (1001,)
+    assert np.array_equal(m.response, raw["data"]) and np.array_equal(m.frequency_hz, raw["x"])
+    assert m.frequency_hz[0] == 0.0 and m.frequency_hz[-1] == 1000.0
+
+
+def test_public_pyuff_mode_file():
+    """tests/data/measured/pyuff_uff55_translation_rotation.uff: one normal mode (97.013 Hz) at
+    43 nodes with 6 values each, no modal mass and no unit system."""
+    path = DATA / "pyuff_uff55_translation_rotation.uff"
+    with pytest.raises(FileReadError, match="no dataset 164"):
+        load_modes(path)
+    modes = load_modes(path, units="SI")
+    assert modes.natural_frequencies_hz.tolist() == [97.013] and modes.shapes.shape == (43, 6, 1)
+    assert modes.shapes[0, :3, 0].tolist() == [5.3569e-02, 2.0271e-02, 4.6623e-03]
+    with pytest.raises(ValueError, match="mode 1 .* has no modal mass"):
+        modes.mass_normalised()
+
+
+# ----- ModalBlade.from_test -------------------------------------------------------------------
+NODES = {"OL": 11, "OR": 12, "tip": 13, "excitation": 14}
+
+
+def rounded(x):
+    """``x`` as pyuff prints a dataset 55 value (%13.5e: 6 significant digits)."""
+    return np.vectorize(lambda v: float(f"{v:.5e}"))(np.asarray(x, dtype=float))
+
+
+def write_blade_modes(path, blade, modal_mass=1.0):
+    """``blade``'s modes as UFF 55 normal modes in SI (shapes scaled to ``modal_mass`` [kg]),
+    with dataset 164 and node coordinates (dataset 15)."""
+    write_164(path)
+    names = list(NODES)
+    xyz = np.array([blade.points[n] for n in names])
+    pyuff.UFF(str(path)).write_sets(pyuff.prepare_15(node_nums=[NODES[n] for n in names], def_cs=[0] * 4,
+                                                     disp_cs=[0] * 4, color=[0] * 4, x=xyz[:, 0], y=xyz[:, 1],
+                                                     z=xyz[:, 2]), mode="add")
+    for j in range(blade.n_modes):
+        shape = np.array([blade.mode_shapes[n][:, j] for n in names]) * np.sqrt(modal_mass)
+        d = pyuff.prepare_55(model_type=1, analysis_type=2, data_ch=3, spec_data_type=8, data_type=2,
+                             n_data_per_node=6, load_case=1, mode_n=j + 1, freq=float(blade.natural_frequencies_hz[j]),
+                             modal_m=modal_mass, modal_damp_vis=float(blade.damping_ratios[j]), modal_damp_his=0.0,
+                             node_nums=[NODES[n] for n in names], **{f"r{i + 1}": shape[:, i] for i in range(6)})
+        pyuff.UFF(str(path)).write_sets(d, mode="add")
+    return path
+
+
+def rounded_blade(blade, modal_mass=1.0):
+    shapes = {n: rounded(s * np.sqrt(modal_mass)) / np.sqrt(rounded(modal_mass)) for n, s in blade.mode_shapes.items()}
+    return bd.ModalBlade(rounded(blade.natural_frequencies_hz), rounded(blade.damping_ratios), shapes,
+                         {n: rounded(p) for n, p in blade.points.items()}, blade.mode_names)
+
+
+@pytest.mark.parametrize("modal_mass", [1.0, 0.37])
+def test_from_test_gives_the_blade_of_its_modes(tmp_path, modal_mass):
+    """The reference blade's modes written to UFF 55 (mass-normalised, or scaled to a modal mass
+    of 0.37 kg that the file states) give back the blade with its values rounded to the file's 6
+    digits: the same tip FRF to rounding of the arithmetic."""
+    blade = bd.reference_blade()
+    path = write_blade_modes(tmp_path / "modes.uff", blade, modal_mass)
+    got = bd.ModalBlade.from_test(path, NODES, mode_names=blade.mode_names)
+    want = rounded_blade(blade, modal_mass)
+    f = np.linspace(50.0, 1500.0, 400)
+    force = np.array([0.1, 0, 0, 0, 0, 0])
+    a, b = got.linear_frf(f, force), want.linear_frf(f, force)
+    np.testing.assert_allclose(a, b, rtol=1e-10, atol=1e-12 * np.abs(b).max())
+    for n in NODES:
+        np.testing.assert_allclose(got.points[n], want.points[n], rtol=1e-15, atol=1e-15)
+    # and the rounding to 6 digits is all that separates it from the reference blade: within
+    # 5e-6 relative in frequency, far from the resonances the FRF within 1e-4
+    np.testing.assert_allclose(got.natural_frequencies_hz, blade.natural_frequencies_hz, rtol=5e-6)
+
+
+def test_from_test_errors_name_the_file(tmp_path):
+    blade = bd.reference_blade()
+    path = write_blade_modes(tmp_path / "modes.uff", blade, 1.0)
+    with pytest.raises(ValueError, match=f"{path}: no node 99"):
+        bd.ModalBlade.from_test(path, {**NODES, "tip": 99})
+    with pytest.raises(ValueError, match="points must map"):
+        bd.ModalBlade.from_test(path, {"tip": 13})
+
+
+# ----- bad files ------------------------------------------------------------------------------
+def test_bad_files_give_one_error_naming_the_file(tmp_path):
+    good = write_58(tmp_path / "a.uff", H)
+    text = good.read_text()
+    cut = tmp_path / "cut.uff"
+    cut.write_text(text[: len(text) // 2])
+    cases = {cut: "", tmp_path / "none.uff": "no such", DATA / "pyuff_uff55_translation_rotation.uff":
+             "no dataset 58", tmp_path / "text.uff": "not a Universal File Format file"}
+    (tmp_path / "text.uff").write_text("frequency,re,im\n1,2,3\n")
+    for path, what in cases.items():
+        with pytest.raises(FileReadError) as info:
+            load_measurement(path)
+        msg = str(info.value)
+        assert str(path) in msg and "\n" not in msg and what in msg, msg
+    time = tmp_path / "time.uff"
+    write_58(time, H.real.copy(), func_type=1)
+    with pytest.raises(FileReadError, match=r"time.uff: dataset 1 \(UFF 58, response node 3\) holds a time "
+                                            r"response; expected a frequency response function"):
+        load_measurement(time)
+    bad_csv = tmp_path / "bad.csv"
+    bad_csv.write_text("frequency [Hz],re,im\n1,2,3\n")
+    with pytest.raises(FileReadError, match="bad.csv: header: the unit cannot be told"):
+        load_measurement(bad_csv)
+
+
+def test_cli_bad_measured_file_is_one_line_exit_2(tmp_path, capsys):
+    from bladedamp.design import write_template
+
+    design = write_template(tmp_path / "design.toml")
+    bad = tmp_path / "rig.uff"
+    bad.write_text("    -1\n    58\nbroken\n")
+    assert main(["frf", str(design), "--measured", str(bad), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"bladedamp frf: error: {bad}"), err
+    assert not (tmp_path / "o").exists()
+
+
+# ----- drawing beside a prediction ------------------------------------------------------------
+def test_draw_measurement_converts_to_the_plotted_displacement(tmp_path):
+    """An accelerance drawn on a tip-amplitude axes in mm: |H| / omega^2 * F * 1e3, inside the
+    axes' frequency range, in the measured colour."""
+    m = MeasuredResponse(F, H, "m/s^2/N", "3", "+x")
+    fig, ax = plt.subplots()
+    ax.plot([90.0, 110.0], [0.0, 1.0])
+    with pytest.raises(ValueError, match="force amplitude is needed"):
+        draw_measurement(ax, m)
+    line = draw_measurement(ax, m, force_n=0.1)
+    f, y = line.get_xdata(), line.get_ydata()
+    keep = (F >= 90) & (F <= 110)
+    assert np.array_equal(f, F[keep])
+    np.testing.assert_allclose(y, 1e3 * 0.1 * np.abs(H[keep]) / (2 * np.pi * F[keep]) ** 2, rtol=1e-14)
+    assert line.get_color() == palette.MEASURED
+    plt.close(fig)
