@@ -723,9 +723,10 @@ class ModalBlade:
             coordinates from the file's dataset 15 or 2411 (ValueError if it has none).
         damping_ratios : modal damping ratios [-] (scalar or (n_m,)); default: the file's viscous
             damping ratios (ValueError if all are 0).
-        modal_masses : modal mass [kg] of each stored shape (scalar or (n_m,); 1.0 for
-            mass-normalised shapes); default: the file's (ValueError naming the mode where it
-            gives none). The shapes are divided by sqrt(modal mass): mass-normalised, Eq. 2.
+        modal_masses : modal mass [kg] of each stored shape (scalar or (n_m,); 1.0 for shapes
+            mass-normalised in kg, 1000.0 for shapes mass-normalised in a file in mm, N, s and
+            tonnes); default: the file's (ValueError naming the mode where it gives none). The
+            shapes are divided by sqrt(modal mass): mass-normalised, Eq. 2.
         units : "SI" for a file without a dataset 164 (unit system); default: the file's.
         """
         from .measurement import load_modes, modal_blade_from_modes

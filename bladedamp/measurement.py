@@ -169,7 +169,8 @@ class MeasuredResponse(Saveable):
     @property
     def label(self) -> str:
         """A legend label: "measured", the point and direction."""
-        where = " ".join(s for s in (self.point, self.direction) if s)
+        point = f"node {self.point}" if self.point.isdigit() else self.point
+        where = " ".join(s for s in (point, self.direction) if s)
         return f"measured{' ' + where if where else ''}"
 
     def plot(self, ax=None, **kwargs):
@@ -179,7 +180,7 @@ class MeasuredResponse(Saveable):
 
         if ax is None:
             _, ax = plt.subplots(figsize=(6, 4))
-        scale, unit = (1e3, "mm" + self.unit[1:]) if self.unit.startswith("m") else (1.0, self.unit)
+        scale, unit = (1e3, "mm" + self.unit[1:]) if self.order == 0 else (1.0, self.unit)
         kwargs.setdefault("label", self.label)
         ax.semilogy(self.frequency_hz, scale * self.amplitude, color=palette.MEASURED, marker="o", ms=2.5,
                     lw=0.8, **kwargs)
@@ -225,8 +226,9 @@ class MeasuredModes(Saveable):
 
     def mass_normalised(self, modal_masses=None) -> np.ndarray:
         """(n_nodes, 6, n_m) shapes scaled to unit modal mass: divided by sqrt(m_j), m_j from
-        ``modal_masses`` [kg] (scalar or (n_m,); 1 for shapes already mass-normalised) or else
-        from the file; ValueError naming the file and the mode where neither gives it."""
+        ``modal_masses`` [kg] (scalar or (n_m,); 1 for shapes mass-normalised in kg, 1000 for
+        shapes mass-normalised in tonnes, a file in mm, N, s) or else from the file; ValueError
+        naming the file and the mode where neither gives it."""
         m = self.modal_masses if modal_masses is None else np.broadcast_to(
             np.asarray(modal_masses, dtype=float), self.natural_frequencies_hz.shape)
         bad = np.flatnonzero(~(np.isfinite(m) & (m > 0)))
@@ -444,10 +446,15 @@ def load_modes(path, *, units: str | None = None) -> MeasuredModes:
                 if int(s.get("dataset_location", 1)) != 1:
                     raise ValueError(f"{path}: {where}: data at elements; expected data at nodes (location 1)")
                 nodes = np.asarray(s["node_nums"], dtype=int)
-                data = np.asarray(s["data_at_node"], dtype=float)
+                data = np.asarray(s["data_at_node"], dtype=float).reshape(nodes.size, -1)
+                if data.shape[1] not in (3, 6):
+                    raise ValueError(f"{path}: {where}: {data.shape[1]} values per node; expected 3 (translations) "
+                                     "or 6 (translations and rotations)")
                 values = np.zeros((nodes.size, 6))
-                values[:, :min(6, data.shape[1])] = data[:, :6]
-                freq, mass, damp = s["frequency"], s.get("modal_mass", 0.0), s.get("viscous_damping", 0.0)
+                values[:, :data.shape[1]] = data
+                # record 12 of a normal mode: time, frequency, eigenvalue, modal mass, viscous, hysteretic damping
+                freq, mass, damp = (s.get(k, s.get(f"record12_field{i}", 0.0)) for k, i in
+                                    (("frequency", 2), ("modal_mass", 4), ("viscous_damping", 5)))
             if values.shape[0] != nodes.size or not np.all(np.isfinite(values)):
                 raise ValueError(f"{path}: {where}: {values.shape[0]} shape rows for {nodes.size} nodes, or values "
                                  "that are not finite numbers (truncated?)")

@@ -136,6 +136,24 @@ def test_public_pyuff_mode_file():
         modes.mass_normalised()
 
 
+def test_public_permas_2414_modes():
+    """tests/data/measured/pyuff_2411_and_2414_permas.uff (ladisk/pyuff; written by Permas 18):
+    ten normal modes (dataset 2414, 6 values at 441 nodes) and the nodes (dataset 2411), no
+    modal masses, no unit system. The frequencies are those the file prints in record 12."""
+    path = DATA / "pyuff_2411_and_2414_permas.uff"
+    modes = load_modes(path, units="SI")
+    assert modes.natural_frequencies_hz.tolist() == [0.956363, 2.34163, 5.88075, 7.50675, 8.54122, 14.9563,
+                                                     17.0424, 17.818, 19.7208, 25.7643]
+    assert modes.shapes.shape == (441, 6, 10) and np.all(np.isfinite(modes.coordinates))
+    raw = [s for s in pyuff.UFF(str(path)).read_sets() if s["type"] == 2414]
+    assert np.array_equal(modes.shapes[:, :, 3], np.asarray(raw[3]["data_at_node"]))
+    nodes = [s for s in pyuff.UFF(str(path)).read_sets() if s["type"] == 2411][0]
+    i = modes.node_index(int(nodes["node_nums"][5]))
+    assert modes.coordinates[i].tolist() == [nodes["x"][5], nodes["y"][5], nodes["z"][5]]
+    with pytest.raises(ValueError, match=r"mode 1 \(0.956363 Hz\) has no modal mass"):
+        modes.mass_normalised()
+
+
 # ----- ModalBlade.from_test -------------------------------------------------------------------
 NODES = {"OL": 11, "OR": 12, "tip": 13, "excitation": 14}
 
@@ -145,49 +163,57 @@ def rounded(x):
     return np.vectorize(lambda v: float(f"{v:.5e}"))(np.asarray(x, dtype=float))
 
 
-def write_blade_modes(path, blade, modal_mass=1.0):
-    """``blade``'s modes as UFF 55 normal modes in SI (shapes scaled to ``modal_mass`` [kg]),
-    with dataset 164 and node coordinates (dataset 15)."""
-    write_164(path)
+def write_blade_modes(path, blade, modal_mass=1.0, length=1.0):
+    """``blade``'s modes as UFF 55 normal modes with shapes scaled to ``modal_mass`` [kg], node
+    coordinates (dataset 15) and the unit system (dataset 164) of ``length`` file units per metre
+    and newtons (1000: mm, N, s and tonnes)."""
+    write_164(path, length=length)
     names = list(NODES)
-    xyz = np.array([blade.points[n] for n in names])
+    xyz = np.array([blade.points[n] for n in names]) * length
     pyuff.UFF(str(path)).write_sets(pyuff.prepare_15(node_nums=[NODES[n] for n in names], def_cs=[0] * 4,
                                                      disp_cs=[0] * 4, color=[0] * 4, x=xyz[:, 0], y=xyz[:, 1],
                                                      z=xyz[:, 2]), mode="add")
     for j in range(blade.n_modes):
         shape = np.array([blade.mode_shapes[n][:, j] for n in names]) * np.sqrt(modal_mass)
+        shape[:, :3] *= length
         d = pyuff.prepare_55(model_type=1, analysis_type=2, data_ch=3, spec_data_type=8, data_type=2,
                              n_data_per_node=6, load_case=1, mode_n=j + 1, freq=float(blade.natural_frequencies_hz[j]),
-                             modal_m=modal_mass, modal_damp_vis=float(blade.damping_ratios[j]), modal_damp_his=0.0,
-                             node_nums=[NODES[n] for n in names], **{f"r{i + 1}": shape[:, i] for i in range(6)})
+                             modal_m=modal_mass / length, modal_damp_vis=float(blade.damping_ratios[j]),
+                             modal_damp_his=0.0, node_nums=[NODES[n] for n in names],
+                             **{f"r{i + 1}": shape[:, i] for i in range(6)})
         pyuff.UFF(str(path)).write_sets(d, mode="add")
     return path
 
 
-def rounded_blade(blade, modal_mass=1.0):
-    shapes = {n: rounded(s * np.sqrt(modal_mass)) / np.sqrt(rounded(modal_mass)) for n, s in blade.mode_shapes.items()}
+def rounded_blade(blade, modal_mass=1.0, length=1.0):
+    """``blade`` as :func:`write_blade_modes` stores it (6 digits in the file's units), in SI."""
+    in_file = np.array([length] * 3 + [1.0] * 3)[:, None]
+    mass = rounded(modal_mass / length) * length
+    shapes = {n: rounded(s * np.sqrt(modal_mass) * in_file) / in_file / np.sqrt(mass)
+              for n, s in blade.mode_shapes.items()}
     return bd.ModalBlade(rounded(blade.natural_frequencies_hz), rounded(blade.damping_ratios), shapes,
-                         {n: rounded(p) for n, p in blade.points.items()}, blade.mode_names)
+                         {n: rounded(p * length) / length for n, p in blade.points.items()}, blade.mode_names)
 
 
-@pytest.mark.parametrize("modal_mass", [1.0, 0.37])
-def test_from_test_gives_the_blade_of_its_modes(tmp_path, modal_mass):
+@pytest.mark.parametrize("modal_mass, length", [(1.0, 1.0), (0.37, 1.0), (0.37, 1000.0)])
+def test_from_test_gives_the_blade_of_its_modes(tmp_path, modal_mass, length):
     """The reference blade's modes written to UFF 55 (mass-normalised, or scaled to a modal mass
-    of 0.37 kg that the file states) give back the blade with its values rounded to the file's 6
-    digits: the same tip FRF to rounding of the arithmetic."""
+    of 0.37 kg that the file states; in m, N, kg or in mm, N, tonnes) give back the blade with its
+    values rounded to the file's 6 digits: the same tip FRF to rounding of the arithmetic."""
     blade = bd.reference_blade()
-    path = write_blade_modes(tmp_path / "modes.uff", blade, modal_mass)
+    path = write_blade_modes(tmp_path / "modes.uff", blade, modal_mass, length)
     got = bd.ModalBlade.from_test(path, NODES, mode_names=blade.mode_names)
-    want = rounded_blade(blade, modal_mass)
+    want = rounded_blade(blade, modal_mass, length)
     f = np.linspace(50.0, 1500.0, 400)
     force = np.array([0.1, 0, 0, 0, 0, 0])
     a, b = got.linear_frf(f, force), want.linear_frf(f, force)
     np.testing.assert_allclose(a, b, rtol=1e-10, atol=1e-12 * np.abs(b).max())
     for n in NODES:
-        np.testing.assert_allclose(got.points[n], want.points[n], rtol=1e-15, atol=1e-15)
-    # and the rounding to 6 digits is all that separates it from the reference blade: within
-    # 5e-6 relative in frequency, far from the resonances the FRF within 1e-4
+        np.testing.assert_allclose(got.points[n], want.points[n], rtol=1e-14, atol=1e-15)
+    # the rounding to 6 digits is all that separates it from the reference blade
     np.testing.assert_allclose(got.natural_frequencies_hz, blade.natural_frequencies_hz, rtol=5e-6)
+    np.testing.assert_allclose(got.mode_shapes["tip"], blade.mode_shapes["tip"], rtol=1e-5,
+                               atol=1e-5 * np.abs(blade.mode_shapes["tip"]).max())
 
 
 def test_from_test_errors_name_the_file(tmp_path):
