@@ -541,7 +541,7 @@ def draw_measurement(ax, measured, *, scale: float = 1e3, force_n: float | None 
         keep = (f >= lo) & (f <= hi)
         f, y = f[keep], y[keep]
     (line,) = ax.plot(f, y, linestyle="none", marker="o", ms=3.5, mfc="none", color=palette.MEASURED,
-                      label=m.label + (f" ({force_n:g} N)" if force_n else ""))
+                      label=m.label + (f", FRF x {force_n:g} N" if force_n else ""))
     ax.legend()
     return line
 

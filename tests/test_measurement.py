@@ -278,3 +278,35 @@ def test_draw_measurement_converts_to_the_plotted_displacement(tmp_path):
     np.testing.assert_allclose(y, 1e3 * 0.1 * np.abs(H[keep]) / (2 * np.pi * F[keep]) ** 2, rtol=1e-14)
     assert line.get_color() == palette.MEASURED
     plt.close(fig)
+
+
+def test_cli_frf_draws_the_measurement(tmp_path, monkeypatch):
+    """``bladedamp frf --measured`` draws the file on frf.png: a receptance CSV in mm/N times the
+    design's excitation force |F| [N], in mm, inside the computed range."""
+    import bladedamp.measurement as measurement
+    from bladedamp.design import load_design, write_template
+
+    design = write_template(tmp_path / "design.toml")
+    text = design.read_text()
+    for old, new in {'frequency_range_hz = [90.0, 105.0]': 'frequency_range_hz = [92.0, 99.0]',
+                     'harmonics = "auto"': 'harmonics = [1]'}.items():
+        assert old in text
+        text = text.replace(old, new)
+    design.write_text(text)
+    force = float(np.linalg.norm(load_design(design).disk.excitation[:3]))
+    rig = tmp_path / "rig.csv"
+    f = np.linspace(80.0, 110.0, 61)
+    receptance_mm = 1e3 * bd.reference_blade().linear_frf(f, np.array([1.0, 0, 0, 0, 0, 0]))[:, 0]
+    rig.write_text("frequency [Hz],re [mm/N],im [mm/N]\n"
+                   + "".join(f"{a!r},{b.real!r},{b.imag!r}\n" for a, b in zip(f.tolist(), receptance_mm.tolist())))
+    drawn = []
+    draw = measurement.draw_measurement
+    monkeypatch.setattr(measurement, "draw_measurement", lambda ax, m, **kw: drawn.append(draw(ax, m, **kw)) or drawn[-1])
+    out = tmp_path / "out"
+    assert main(["frf", str(design), "--measured", str(rig), "--no-stop-check", "--no-peak-check",
+                 "--out", str(out)]) == 0
+    assert (out / "frf.png").is_file() and len(drawn) == 1
+    x, y = drawn[0].get_xdata(), drawn[0].get_ydata()
+    keep = (f >= 92.0) & (f <= 99.0)
+    assert np.array_equal(x, f[keep])
+    np.testing.assert_allclose(y, force * np.abs(receptance_mm[keep]), rtol=1e-13)
