@@ -246,9 +246,23 @@ def _uff_sets(path: Path) -> list[dict]:
     import pyuff
 
     with open(path, "rb") as fh:
-        first = next((line.strip() for line in fh.read(4096).splitlines() if line.strip()), b"")
+        lines = fh.read().split(b"\n")
+    first = next((line.strip() for line in lines if line.strip()), b"")
     if first != b"-1":
         raise ValueError(f"{path}: not a Universal File Format file (it must begin with a '    -1' line)")
+    opened = None                                # (line number, dataset type) of an unclosed block
+    for number, line in enumerate(lines, start=1):
+        # a binary 58b block's data run into its closing '    -1' without a line break
+        binary_end = opened is not None and opened[1] == "58b" and line.rstrip().endswith(b"    -1")
+        if line.strip() == b"-1" or binary_end:
+            if opened is None:
+                kind = lines[number].split()[:1] if number < len(lines) else []
+                opened = (number, kind[0].decode("ascii", "replace") if kind else "?")
+            else:
+                opened = None
+    if opened is not None:
+        raise ValueError(f"{path}: line {opened[0]}: dataset {opened[1]} starting there has no closing -1 line "
+                         "(the file is truncated); expected a complete UFF file")
     sets = pyuff.UFF(str(path)).read_sets()
     return [sets] if isinstance(sets, dict) else list(sets)
 

@@ -231,7 +231,11 @@ def test_bad_files_give_one_error_naming_the_file(tmp_path):
     text = good.read_text()
     cut = tmp_path / "cut.uff"
     cut.write_text(text[: len(text) // 2])
-    cases = {cut: "", tmp_path / "none.uff": "no such", DATA / "pyuff_uff55_translation_rotation.uff":
+    binary = write_58(tmp_path / "b.uff", H, binary=1).read_bytes()
+    cut_binary = tmp_path / "cut_binary.uff"
+    cut_binary.write_bytes(binary[: len(binary) // 2])
+    truncated = "line 1: dataset {} starting there has no closing -1 line (the file is truncated)"
+    cases = {cut: truncated.format("58"), cut_binary: truncated.format("58b"), tmp_path / "none.uff": "no such", DATA / "pyuff_uff55_translation_rotation.uff":
              "no dataset 58", tmp_path / "text.uff": "not a Universal File Format file"}
     (tmp_path / "text.uff").write_text("frequency,re,im\n1,2,3\n")
     for path, what in cases.items():
