@@ -314,3 +314,20 @@ def test_cli_frf_draws_the_measurement(tmp_path, monkeypatch):
     keep = (f >= 92.0) & (f <= 99.0)
     assert np.array_equal(x, f[keep])
     np.testing.assert_allclose(y, force * np.abs(receptance_mm[keep]), rtol=1e-13)
+
+
+def test_the_readme_example_files_hold_the_reference_blade():
+    """tests/data/measured/reference_blade_*.uff (written by make_reference_files.py there): the
+    receptance reads as the reference blade's linear FRF to the file's 12 digits per part, and
+    the modes give the reference blade rounded to the file's 6 digits."""
+    blade = bd.reference_blade()
+    m = load_measurement(DATA / "reference_blade_tip_frf.uff")
+    assert (m.unit, m.point, m.direction, m.reference_point) == ("m/N", "13", "+x", "14")
+    h = blade.linear_frf(m.frequency_hz, np.array([1.0, 0, 0, 0, 0, 0]))[:, 0]
+    np.testing.assert_allclose(m.response.real, h.real, rtol=ASCII_58_RTOL, atol=0)
+    np.testing.assert_allclose(m.response.imag, h.imag, rtol=ASCII_58_RTOL, atol=0)
+    got = bd.ModalBlade.from_test(DATA / "reference_blade_modes.uff", NODES)
+    want = rounded_blade(blade)
+    f = np.linspace(50.0, 1500.0, 400)
+    a, b = (x.linear_frf(f, np.array([0.1, 0, 0, 0, 0, 0])) for x in (got, want))
+    np.testing.assert_allclose(a, b, rtol=1e-10, atol=1e-12 * np.abs(b).max())
