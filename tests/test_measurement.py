@@ -331,3 +331,15 @@ def test_the_readme_example_files_hold_the_reference_blade():
     f = np.linspace(50.0, 1500.0, 400)
     a, b = (x.linear_frf(f, np.array([0.1, 0, 0, 0, 0, 0])) for x in (got, want))
     np.testing.assert_allclose(a, b, rtol=1e-10, atol=1e-12 * np.abs(b).max())
+
+
+def test_measurement_and_modes_save_and_load(tmp_path):
+    m = load_measurement(DATA / "reference_blade_tip_frf.uff")
+    back = bd.load(m.save(tmp_path / "m"))
+    assert isinstance(back, MeasuredResponse) and back.unit == m.unit and back.point == m.point
+    assert np.array_equal(back.response, m.response) and np.array_equal(back.frequency_hz, m.frequency_hz)
+    modes = load_modes(DATA / "reference_blade_modes.uff")
+    again = bd.load(modes.save(tmp_path / "modes"))
+    assert np.array_equal(again.shapes, modes.shapes) and np.array_equal(again.nodes, modes.nodes)
+    assert back.plot().get_lines()
+    plt.close("all")
