@@ -40,6 +40,7 @@ import numpy as np
 
 from . import palette
 from .io import Saveable, reading
+from .plotting import place_legend
 
 G_STANDARD = 9.80665                     #: standard gravity [m/s^2], the unit "g"
 
@@ -540,7 +541,7 @@ def draw_measurement(ax, measured, *, scale: float = 1e3, force_n: float | None 
     converted to displacement, an FRF multiplied by the force amplitude ``force_n`` [N] (or the
     excitation force |F| of ``model``, an object with ``excitation`` (6,)). Only the points
     inside the axes' frequency range are drawn when it holds data. Markers in
-    :data:`bladedamp.palette.MEASURED`. Returns the line; ValueError for an FRF without a force."""
+    :data:`bladedamp.palette.MEASURED`; the legend is placed clear of the data. Returns the line; ValueError for an FRF without a force."""
     m = as_measurement(measured).as_displacement()
     if m.per_force:
         if force_n is None and model is not None and getattr(model, "excitation", None) is not None:
@@ -556,7 +557,9 @@ def draw_measurement(ax, measured, *, scale: float = 1e3, force_n: float | None 
         f, y = f[keep], y[keep]
     (line,) = ax.plot(f, y, linestyle="none", marker="o", ms=3.5, mfc="none", color=palette.MEASURED,
                       label=m.label + (f", FRF x {force_n:g} N" if force_n else ""))
-    ax.legend()
+    old = ax.get_legend()
+    size = old.get_texts()[0].get_fontsize() if old is not None and old.get_texts() else None
+    place_legend(ax, **({"fontsize": size} if size else {}))     # clear of the peak and the markers
     return line
 
 

@@ -314,6 +314,14 @@ def test_cli_frf_draws_the_measurement(tmp_path, monkeypatch):
     keep = (f >= 92.0) & (f <= 99.0)
     assert np.array_equal(x, f[keep])
     np.testing.assert_allclose(y, force * np.abs(receptance_mm[keep]), rtol=1e-13)
+    # a saved response has no model, hence no force: the FRF is refused until given one
+    saved = bd.load(out / "frf_EO1.npz")
+    with pytest.raises(ValueError, match=r"force amplitude is needed .* measured.at_force"):
+        saved.plot(measured=rig)
+    ax = saved.plot(measured=load_measurement(rig).at_force(force))
+    np.testing.assert_allclose(drawn[-1].get_ydata(), force * np.abs(receptance_mm[keep]), rtol=1e-13)
+    assert drawn[-1].axes is ax
+    plt.close("all")
 
 
 def test_the_readme_example_files_hold_the_reference_blade():
