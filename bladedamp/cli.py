@@ -559,7 +559,7 @@ def frf_command(args) -> int:
     if args.measured is not None:                 # read before the solve: a bad file stops at once
         from .measurement import load_measurement
 
-        measured = load_measurement(args.measured)
+        measured = load_measurement(args.measured, unit=args.measured_unit, record=args.measured_record)
     out = output_dir(output_folder(args), args.overwrite)
     progress, a = Progress(), design.analysis
     progress.compiling()
@@ -817,6 +817,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--measured", type=Path, metavar="FILE",
                    help="a measured response drawn on frf.png: a UFF 58 FRF or spectrum (one record), or a CSV\n"
                         "(frequency [Hz], re [m/N], im [m/N] or amplitude [mm]); an FRF times the design's excitation force")
+    p.add_argument("--measured-unit", metavar="UNIT", help="the unit of a --measured file that does not state it "
+                   "(e.g. m/s^2/N, g/N, mm)")
+    p.add_argument("--measured-record", metavar="K", type=int,
+                   help="which dataset 58 record of a --measured UFF file holding several (from 0)")
     out_arg(p, "results/<design file name>/frf")
 
     p = command("optimize", optimize_command, "optimal damper mass of a design",

@@ -263,6 +263,12 @@ def test_cli_bad_measured_file_is_one_line_exit_2(tmp_path, capsys):
     assert main(["frf", str(design), "--measured", str(bad), "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith(f"bladedamp frf: error: {bad}"), err
+    public = DATA / "pyuff_measurement.uff"          # three records, no units
+    for extra, what in ([[], "3 dataset 58 records match"], [["--measured-record", "1"], "the unit cannot be told"],
+                        [["--measured-record", "1", "--measured-unit", "m/s^3"], "not a response unit"]):
+        assert main(["frf", str(design), "--measured", str(public), *extra, "--out", str(tmp_path / "o")]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith(f"bladedamp frf: error: {public}") and what in err[0], err
     assert not (tmp_path / "o").exists()
 
 
