@@ -729,11 +729,27 @@ class ModalBlade:
             shapes are divided by sqrt(modal mass): mass-normalised, Eq. 2.
         units : "SI" for a file without a dataset 164 (unit system); default: the file's.
         """
-        from .measurement import load_modes, modal_blade_from_modes
+        from .measurement import load_modes
 
+        if not isinstance(points, dict) or any(p not in points for p in REQUIRED_POINTS):
+            raise ValueError(f"points must map the names {REQUIRED_POINTS} (and any others) to node numbers "
+                             f"(got {points!r})")
         modes = load_modes(path, units=units)
-        return modal_blade_from_modes(modes, points, positions=positions, damping_ratios=damping_ratios,
-                                      modal_masses=modal_masses, mode_names=mode_names)
+        normalised = modes.mass_normalised(modal_masses)
+        shapes, where = {}, {}
+        for name, node in points.items():
+            i = modes.node_index(node)
+            shapes[name] = normalised[i]
+            given = None if positions is None else positions.get(name)
+            where[name] = np.asarray(given, dtype=float) if given is not None else modes.coordinates[i]
+            if not np.all(np.isfinite(where[name])):
+                raise ValueError(f"{modes.source}: no position of node {node} (point {name!r}) in the file: give "
+                                 f"positions={{{name!r}: (x, y, z) in m, ...}}")
+        if damping_ratios is None and not np.any(modes.damping_ratios > 0):
+            raise ValueError(f"{modes.source}: the modes carry no damping (all ratios 0): give damping_ratios")
+        damping = modes.damping_ratios if damping_ratios is None else damping_ratios
+        return cls(natural_frequencies_hz=modes.natural_frequencies_hz, damping_ratios=damping,
+                   mode_shapes=shapes, points=where, mode_names=tuple(mode_names or ()))
 
     # -- linear reference solution -----------------------------------------------------
     def linear_frf(self, f_hz: np.ndarray, force: np.ndarray, at: str = "excitation",

@@ -410,7 +410,7 @@ def load_measurement(path, *, node=None, direction=None, record: int | None = No
 
     ``node``, ``direction`` ("+x", "-z", ...): choose the response of a UFF file holding several
     (or name the point of a CSV file); ``unit``: the unit of the file's values when the file does
-    not tell it (e.g. "m/s^2/N", "g"); ``record``: the index (from 0) of the dataset 58 record
+    not tell it (a unit given here is taken over the file's) (e.g. "m/s^2/N", "g"); ``record``: the index (from 0) of the dataset 58 record
     among the file's; ``as_displacement``: convert a velocity or acceleration to
     displacement (divided by i omega or -omega^2). Returns a :class:`MeasuredResponse` in SI.
     Raises a :class:`~bladedamp.io.FileReadError` (a ValueError) naming the file, the place in it
@@ -495,33 +495,6 @@ def load_modes(path, *, units: str | None = None) -> MeasuredModes:
                         coordinates[i] = np.array([s["x"][j], s["y"][j], s["z"][j]], dtype=float) / f_len
         return MeasuredModes(np.array([m[2] for m in modes]), np.array([m[4] for m in modes]), masses, nodes,
                              shapes, coordinates, str(path))
-
-
-def modal_blade_from_modes(modes: MeasuredModes, points: dict, *, positions: dict | None = None,
-                           damping_ratios=None, modal_masses=None, mode_names=()):
-    """The :class:`~bladedamp.blade.ModalBlade` of ``modes`` at the named ``points``
-    (name -> node number; "OL", "OR", "tip" and "excitation" required): see
-    :meth:`bladedamp.blade.ModalBlade.from_test` for the arguments."""
-    from .blade import REQUIRED_POINTS, ModalBlade
-
-    if not isinstance(points, dict) or any(p not in points for p in REQUIRED_POINTS):
-        raise ValueError(f"points must map the names {REQUIRED_POINTS} (and any others) to node numbers "
-                         f"(got {points!r})")
-    normalised = modes.mass_normalised(modal_masses)
-    shapes, where = {}, {}
-    for name, node in points.items():
-        i = modes.node_index(node)
-        shapes[name] = normalised[i]
-        given = None if positions is None else positions.get(name)
-        where[name] = np.asarray(given, dtype=float) if given is not None else modes.coordinates[i]
-        if not np.all(np.isfinite(where[name])):
-            raise ValueError(f"{modes.source}: no position of node {node} (point {name!r}) in the file: give "
-                             f"positions={{{name!r}: (x, y, z) in m, ...}}")
-    damping = modes.damping_ratios if damping_ratios is None else damping_ratios
-    if damping_ratios is None and not np.any(modes.damping_ratios > 0):
-        raise ValueError(f"{modes.source}: the modes carry no damping (all ratios 0): give damping_ratios")
-    return ModalBlade(natural_frequencies_hz=modes.natural_frequencies_hz, damping_ratios=damping,
-                      mode_shapes=shapes, points=where, mode_names=tuple(mode_names or ()))
 
 
 # ----- drawing beside a prediction -----------------------------------------------------------

@@ -225,6 +225,24 @@ def test_from_test_errors_name_the_file(tmp_path):
         bd.ModalBlade.from_test(path, {"tip": 13})
 
 
+def test_from_test_of_the_public_mode_file_needs_what_it_lacks():
+    """pyuff's UFF 55 file has no node coordinates, no modal mass and no damping: each is asked
+    for by name; given them, its one mode at four of its nodes makes a blade."""
+    path = DATA / "pyuff_uff55_translation_rotation.uff"
+    points = {"OL": 1, "OR": 2, "tip": 10, "excitation": 9}
+    where = {name: (0.01 * k, 0.0, 0.1) for k, name in enumerate(points)}
+    with pytest.raises(ValueError, match="no position of node 1 .point 'OL'"):
+        bd.ModalBlade.from_test(path, points, units="SI", modal_masses=1.0)
+    with pytest.raises(ValueError, match="no modal mass"):
+        bd.ModalBlade.from_test(path, points, units="SI", positions=where)
+    with pytest.raises(ValueError, match="carry no damping"):
+        bd.ModalBlade.from_test(path, points, units="SI", positions=where, modal_masses=2.0)
+    blade = bd.ModalBlade.from_test(path, points, units="SI", positions=where, modal_masses=4.0, damping_ratios=0.01)
+    modes = load_modes(path, units="SI")
+    assert blade.natural_frequencies_hz.tolist() == [97.013]
+    np.testing.assert_array_equal(blade.mode_shapes["tip"][:, 0], modes.shapes[modes.node_index(10), :, 0] / 2.0)
+
+
 # ----- bad files ------------------------------------------------------------------------------
 def test_bad_files_give_one_error_naming_the_file(tmp_path):
     good = write_58(tmp_path / "a.uff", H)
