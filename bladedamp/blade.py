@@ -710,6 +710,47 @@ class ModalBlade:
         return cls(natural_frequencies_hz=np.sqrt(lam) / (2.0 * np.pi), damping_ratios=damping,
                    mode_shapes=shapes, points=positions, mode_names=mode_names)
 
+    @classmethod
+    def from_test(cls, path, points: dict, *, positions: dict | None = None, damping_ratios=None,
+                  modal_masses=None, units: str | None = None, mode_names=()) -> "ModalBlade":
+        """A blade from measured (or exported) normal modes, UFF dataset 55 or 2414
+        (:func:`bladedamp.measurement.load_modes`), at named nodes.
+
+        points : point name -> node number of the file, for "OL", "OR", "tip", "excitation" (and any
+            other). Each point takes the node's six shape values (rotations zero where the file
+            gives translations only: then OL and OR do not rotate the damper contact).
+        positions : point name -> (3,) position [m] in the blade frame; default: the node's
+            coordinates from the file's dataset 15 or 2411 (ValueError if it has none).
+        damping_ratios : modal damping ratios [-] (scalar or (n_m,)); default: the file's viscous
+            damping ratios (ValueError if all are 0).
+        modal_masses : modal mass [kg] of each stored shape (scalar or (n_m,); 1.0 for shapes
+            mass-normalised in kg, 1000.0 for shapes mass-normalised in a file in mm, N, s and
+            tonnes); default: the file's (ValueError naming the mode where it gives none). The
+            shapes are divided by sqrt(modal mass): mass-normalised, Eq. 2.
+        units : "SI" for a file without a dataset 164 (unit system); default: the file's.
+        """
+        from .measurement import load_modes
+
+        if not isinstance(points, dict) or any(p not in points for p in REQUIRED_POINTS):
+            raise ValueError(f"points must map the names {REQUIRED_POINTS} (and any others) to node numbers "
+                             f"(got {points!r})")
+        modes = load_modes(path, units=units)
+        normalised = modes.mass_normalised(modal_masses)
+        shapes, where = {}, {}
+        for name, node in points.items():
+            i = modes.node_index(node)
+            shapes[name] = normalised[i]
+            given = None if positions is None else positions.get(name)
+            where[name] = np.asarray(given, dtype=float) if given is not None else modes.coordinates[i]
+            if not np.all(np.isfinite(where[name])):
+                raise ValueError(f"{modes.source}: no position of node {node} (point {name!r}) in the file: give "
+                                 f"positions={{{name!r}: (x, y, z) in m, ...}}")
+        if damping_ratios is None and not np.any(modes.damping_ratios > 0):
+            raise ValueError(f"{modes.source}: the modes carry no damping (all ratios 0): give damping_ratios")
+        damping = modes.damping_ratios if damping_ratios is None else damping_ratios
+        return cls(natural_frequencies_hz=modes.natural_frequencies_hz, damping_ratios=damping,
+                   mode_shapes=shapes, points=where, mode_names=tuple(mode_names or ()))
+
     # -- linear reference solution -----------------------------------------------------
     def linear_frf(self, f_hz: np.ndarray, force: np.ndarray, at: str = "excitation",
                    response_at: str = "tip") -> np.ndarray:

@@ -555,6 +555,11 @@ def frf_command(args) -> int:
     design = _load(args)
     if args.mistuned and design.mistuning is None:
         raise UsageError(f"{design.path}: --mistuned needs a [mistuning] table (std and seed, or kappa)")
+    measured = None
+    if args.measured is not None:                 # read before the solve: a bad file stops at once
+        from .measurement import load_measurement
+
+        measured = load_measurement(args.measured, unit=args.measured_unit, record=args.measured_record)
     out = output_dir(output_folder(args), args.overwrite)
     progress, a = Progress(), design.analysis
     progress.compiling()
@@ -573,7 +578,7 @@ def frf_command(args) -> int:
         progress(f"mistuned full assembly at EO = {design.disk.engine_order}")
         responses[f"mistuned_EO{design.disk.engine_order}"] = design.mistuned_disk().frequency_response(
             a.f_start_hz, a.f_end_hz, **checks, **a.options())
-    summary = frf_outputs(out, design, responses)
+    summary = frf_outputs(out, design, responses, measured=measured)
     for k, v in summary["responses"].items():      # each response's status first
         print(f"{k}: {v['status_message']}", file=sys.stderr)
     peaks = ", ".join(f"{k} {'largest amplitude at the range end' if v['peak_at_range_end'] else 'peak'} "
@@ -809,6 +814,13 @@ def build_parser() -> argparse.ArgumentParser:
                    help="skip the time integration at the peak of a complete branch (by default it runs, 5-31 s,\n"
                         "and gives a direct harmonic error estimate, or fails the branch where the vibration there does\n"
                         "not settle; not for solid FE blades with flexible platforms)")
+    p.add_argument("--measured", type=Path, metavar="FILE",
+                   help="a measured response drawn on frf.png: a UFF 58 FRF or spectrum (one record), or a CSV\n"
+                        "(frequency [Hz], re [m/N], im [m/N] or amplitude [mm]); an FRF times the design's excitation force")
+    p.add_argument("--measured-unit", metavar="UNIT", help="the unit of a --measured file that does not state it "
+                   "(e.g. m/s^2/N, g/N, mm)")
+    p.add_argument("--measured-record", metavar="K", type=int,
+                   help="which dataset 58 record of a --measured UFF file holding several (from 0)")
     out_arg(p, "results/<design file name>/frf")
 
     p = command("optimize", optimize_command, "optimal damper mass of a design",

@@ -1374,8 +1374,10 @@ class DiskResponse(FrequencyResponse):
         """(n,) first-harmonic tip amplitude |u_x| at every point [m] (its largest is the peak)."""
         return self.tip_amplitude[:, 0]
 
-    def plot(self, ax=None, *, direction: int = 0, label: str | None = None, **kwargs):
-        """Tip amplitude [mm] over frequency [Hz] (the paper's Fig. 4-6 style)."""
+    def plot(self, ax=None, *, direction: int = 0, label: str | None = None, measured=None, **kwargs):
+        """Tip amplitude [mm] over frequency [Hz] (the paper's Fig. 4-6 style). ``measured``: a
+        measurement or its file drawn beside it in mm (:func:`bladedamp.measurement.draw_measurement`;
+        an FRF times the disk's excitation force)."""
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -1393,4 +1395,8 @@ class DiskResponse(FrequencyResponse):
         ax.legend()
         if not self.success:
             ax.set_title(f"incomplete: {self.message}", fontsize=8)
+        if measured is not None:
+            from .measurement import draw_measurement
+
+            draw_measurement(ax, measured, model=self.disk)
         return ax

@@ -1355,10 +1355,13 @@ class MistunedResponse(FrequencyResponse):
         """|W_exc - W_visc - W_friction| / W_exc at every point (whole model)."""
         return np.abs(self.excitation_work - self.viscous_dissipation - self.dissipated_energy) / np.abs(self.excitation_work)
 
-    def plot(self, ax=None, *, tuned=None, direction: int = 0, highlight=None, title: str | None = None):
+    def plot(self, ax=None, *, tuned=None, direction: int = 0, highlight=None, title: str | None = None,
+             measured=None):
         """Tip amplitude of every blade [mm] over frequency [Hz] (the paper's Figs. 13-17);
         ``tuned``: a tuned DiskResponse drawn as a thick dashed line; ``highlight``: blade
-        indices (0-based) drawn in colour and labelled (default: largest and smallest peak)."""
+        indices (0-based) drawn in colour and labelled (default: largest and smallest peak);
+        ``measured``: a measurement or its file drawn beside them in mm
+        (:func:`bladedamp.measurement.draw_measurement`; an FRF times the excitation force)."""
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -1384,4 +1387,8 @@ class MistunedResponse(FrequencyResponse):
         ax.legend(fontsize=8)
         if not self.success:
             ax.set_title(f"incomplete: {self.message}", fontsize=8)
+        if measured is not None:
+            from .measurement import draw_measurement
+
+            draw_measurement(ax, measured, model=self.disk)
         return ax

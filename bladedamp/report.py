@@ -778,8 +778,10 @@ def write_summary(out: Path, command: str, design, lines: list, files: list, ana
     return path
 
 
-def frf_outputs(out: Path, design, responses: dict) -> dict:
-    """frf.png, frf_<label>.npz, results.json and summary.md of ``bladedamp frf``.
+def frf_outputs(out: Path, design, responses: dict, measured=None) -> dict:
+    """frf.png, frf_<label>.npz, results.json and summary.md of ``bladedamp frf``; ``measured``:
+    a :class:`~bladedamp.measurement.MeasuredResponse` drawn on frf.png (in mm; an FRF times the
+    design's excitation force).
     ``responses``: {label: DiskResponse or MistunedResponse}. Each response's entry and summary.md
     lead with its status (:attr:`~bladedamp.response.FrequencyResponse.status_message`); a largest
     amplitude at an end of the range is named so, not a peak. Returns the JSON summary."""
@@ -815,6 +817,10 @@ def frf_outputs(out: Path, design, responses: dict) -> dict:
     ax.set_ylabel("tip amplitude u_x [mm]")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
+    if measured is not None:
+        from .measurement import draw_measurement
+
+        draw_measurement(ax, measured, model=design.disk)
     ax.set_title(f"frequency response: {design.path.name if design.path else 'design'}")
     save_figure(fig, out / "frf.png")
     write_json(out / "results.json", summary)
