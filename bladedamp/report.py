@@ -999,7 +999,7 @@ def zzenf_outputs(out: Path, design, diagram) -> dict:
     for eo in diagram.engine_orders:
         k, d = nodal_diameter(eo, diagram.n_blades)
         lo, hi = diagram.excitation_hz(eo)
-        lines.append(f"| {eo} | {k} ({d}) | {lo:.4g}-{hi:.4g} |")
+        lines.append(f"| {eo} | {k} ({d}) | {lo:.4g}-{hi:.4g} |" if lo != hi else f"| {eo} | {k} ({d}) | {hi:.4g} |")
     lines += ["", f"Resonances the engine orders can reach up to {diagram.f_max_hz:g} Hz (the rotor speed at which "
               "EO x speed meets the natural frequency; stuck: with the preload of the highest speed):", ""]
     if crossings:
