@@ -349,7 +349,7 @@ def _fields() -> list[Field]:
         Field("disk", "n_blades", ref.N_BLADES, Number(2, 1000, integer=True), "-", "the paper's disk"),
         Field("disk", "engine_order", ref.ENGINE_ORDER,
               Either((Number(0, 500, integer=True), List(Number(0, 500, integer=True), increasing=True))), "-",
-              "EO >= 0, or a list (frf, eo-sweep and campbell run each; the others the first); EO mod n_blades sets "
+              "EO >= 0, or a list (frf, eo-sweep, zzenf and campbell use each; the others the first); EO mod n_blades sets "
               "the nodal diameter (forward, or backward above n_blades / 2), EO itself the rotor speed"),
         Field("disk", "gamma_left_deg", _tidy(np.degrees(ref.PLATFORM_ANGLE)), Number(0.0, 90.0, "neither"), "deg",
               "platform angle at OL (paper: 35 deg); a surface_file blade's OL face sets it"),
