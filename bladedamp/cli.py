@@ -4,6 +4,8 @@
   bladedamp frf design.toml           frequency response of the design's disk
   bladedamp optimize design.toml      optimal damper mass (and platform angle or contact height)
   bladedamp eo-sweep design.toml      optimal mass over engine orders
+  bladedamp zzenf design.toml         interference (ZZENF) diagram: natural frequencies per nodal diameter
+  bladedamp campbell design.toml      Campbell diagram: damped resonance at each engine order over rotor speed
   bladedamp montecarlo design.toml    Monte Carlo of randomly mistuned disks (Dask)
   bladedamp show design.toml          3D view of the resonance (standalone HTML)
   bladedamp reproduce                 the paper's results on the reference configuration
@@ -641,8 +643,8 @@ def eo_sweep_command(args) -> int:
     disk, a = _damped(design, "eo-sweep"), design.analysis
     eos = args.engine_orders or design.engine_orders
     for eo in eos:
-        if not 0 <= eo <= disk.n_blades // 2:
-            raise UsageError(f"--engine-orders {eo}: must be in [0, {disk.n_blades // 2}] (n_blades / 2)")
+        if eo < 0:
+            raise UsageError(f"--engine-orders {eo}: must be an integer >= 0")
     out = output_dir(output_folder(args), args.overwrite)
     progress = Progress()
     progress.compiling()
@@ -652,6 +654,88 @@ def eo_sweep_command(args) -> int:
     eo_sweep_outputs(out, design, sweep)
     return _done(out, t0, f"engine orders {', '.join(map(str, sweep.engine_orders))}: reductions "
                           f"{', '.join(f'{100 * r:.1f} %' for r in sweep.reduction)}")
+
+
+def _rotor_speed_range_hz(design, args, engine_orders) -> tuple[float, float]:
+    """The rotor-speed range [Hz] of zzenf and campbell: --speed-range-rpm, else the design's
+    fixed rotor speed, else the speeds at which the engine orders > 0 excite [analysis]
+    frequency_range_hz (f_start / largest EO to f_end / smallest EO), 10 % wider each side."""
+    if args.speed_range_rpm is not None:
+        lo, hi = args.speed_range_rpm
+        if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi):
+            raise UsageError(f"--speed-range-rpm {lo:g} {hi:g}: must be 0 < LOW <= HIGH rpm")
+        return lo / 60, hi / 60
+    if design.rotor_speed_hz is not None:
+        return design.rotor_speed_hz, design.rotor_speed_hz
+    moving = [eo for eo in engine_orders if eo > 0]
+    if not moving:
+        raise UsageError(f"{design.path}: [disk] engine_order holds EO = 0 only, whose excitation does not follow "
+                         "the rotor speed: give --speed-range-rpm LOW HIGH or an engine order > 0")
+    a = design.analysis
+    return 0.9 * a.f_start_hz / max(moving), 1.1 * a.f_end_hz / min(moving)
+
+
+def _top_frequency_hz(design, args) -> float:
+    if args.f_max_hz is None:
+        return 1.25 * design.analysis.f_end_hz
+    if not (math.isfinite(args.f_max_hz) and args.f_max_hz > 0):
+        raise UsageError(f"--f-max-hz {args.f_max_hz:g}: must be > 0 Hz")
+    return args.f_max_hz
+
+
+def zzenf_command(args) -> int:
+    """``bladedamp zzenf``: the interference (ZZENF) diagram of the design's disk."""
+    from .report import zzenf_outputs
+    from .studies.interference import interference_diagram
+
+    t0 = time.perf_counter()
+    design = _load(args)
+    speeds = _rotor_speed_range_hz(design, args, design.engine_orders)
+    f_max = _top_frequency_hz(design, args)
+    out = output_dir(output_folder(args), args.overwrite)
+    progress = Progress()
+    progress.compiling()
+    progress(f"natural frequencies of nodal diameters 0-{design.disk.n_blades // 2} at "
+             f"{60 * speeds[0]:.0f}-{60 * speeds[1]:.0f} rpm")
+    diagram = interference_diagram(design.disk, speeds, f_max, design.engine_orders)
+    summary = zzenf_outputs(out, design, diagram)
+    return _done(out, t0, f"{len(summary['crossings'])} possible resonances of engine orders "
+                          f"{', '.join(map(str, design.engine_orders))} up to {f_max:g} Hz")
+
+
+def campbell_command(args) -> int:
+    """``bladedamp campbell``: resonance crossings over rotor speed with the damped peak at each."""
+    import dataclasses
+
+    from .report import campbell_outputs
+    from .studies.interference import campbell_diagram
+
+    t0 = time.perf_counter()
+    design = _load(args)
+    _damped(design, "campbell")
+    if design.rotor_speed_hz is not None:
+        raise UsageError(f"{design.path}: [disk] rotor_speed_rpm fixes the rotor speed; campbell follows each engine "
+                         "order over rotor speed (set rotor_speed_rpm = \"auto\"; --speed-range-rpm sets the diagram's range)")
+    eos = tuple(sorted(set(args.engine_orders))) if args.engine_orders else design.engine_orders
+    for eo in eos:
+        if eo < 0:
+            raise UsageError(f"--engine-orders {eo}: must be an integer >= 0")
+    speeds = _rotor_speed_range_hz(design, args, eos)
+    f_max = _top_frequency_hz(design, args)
+    out = output_dir(output_folder(args), args.overwrite)
+    progress, a = Progress(), design.analysis
+    progress.compiling()
+    disk = dataclasses.replace(design.disk, engine_order=1, rotor_speed_hz=None)
+    diagram = campbell_diagram(disk, eos, a.f_range_hz, speeds, f_max, harmonics=(1,), progress=progress,
+                               max_step=a.max_step, harmonic_tolerance=a.harmonic_tolerance)
+    summary = campbell_outputs(out, design, diagram)
+    for c in summary["crossings"]:
+        print(f"EO {c['engine_order']}: {c['status_message']}", file=sys.stderr)
+    return _done(out, t0, ", ".join(
+        f"EO {c['engine_order']} peak {c['peak_amplitude_mm']:.4f} mm at {c['peak_frequency_hz']:.3f} Hz, "
+        f"{c['rotor_speed_rpm']:.0f} rpm" + ("" if c["found"] else " (no resonance found in the range)")
+        if c["peak_amplitude_mm"] is not None else f"EO {c['engine_order']} no point computed"
+        for c in summary["crossings"]) or "no engine order > 0: no crossing")
 
 
 def monte_carlo_command(args) -> int:
@@ -842,9 +926,37 @@ def build_parser() -> argparse.ArgumentParser:
                 "Writes eo_sweep.png, eo_sweep.npz, results.json, summary.md.")
     design_arg(p)
     p.add_argument("--engine-orders", type=int, nargs="+", metavar="EO",
-                   help="engine orders in [0, n_blades / 2] (default: the design's [disk] engine_order)")
+                   help="engine orders >= 0 (default: the design's [disk] engine_order)")
     processes_arg(p)
     out_arg(p, "results/<design file name>/eo-sweep")
+
+    def speed_args(p):
+        p.add_argument("--speed-range-rpm", type=float, nargs=2, metavar=("LOW", "HIGH"), default=None,
+                       help="rotor-speed range [rpm] (default: the design's fixed rotor_speed_rpm, else the speeds at\n"
+                            "which its engine orders excite [analysis] frequency_range_hz, 10 %% wider)")
+        p.add_argument("--f-max-hz", type=float, default=None,
+                       help="top of the diagram [Hz] (default: 1.25 x the end of [analysis] frequency_range_hz)")
+
+    p = command("zzenf", zzenf_command, "interference (ZZENF) diagram of a design",
+                "The natural frequencies of the disk per nodal diameter 0..n_blades/2 without dampers and with\n"
+                "the dampers stuck (at the lowest and highest rotor speed: the preload m R Omega^2 changes them),\n"
+                "and each engine order's excitation EO x rotor speed at its nodal diameter (EO mod n, folded to\n"
+                "n - (EO mod n) as a backward wave above n/2). Writes zzenf.png, results.json, summary.md.")
+    design_arg(p)
+    speed_args(p)
+    out_arg(p, "results/<design file name>/zzenf")
+
+    p = command("campbell", campbell_command, "Campbell diagram with the damped resonance at each engine order",
+                "Natural frequencies over rotor speed (without dampers; stuck at each engine order's nodal\n"
+                "diameter), the lines f = EO x rotor speed, and at each engine order > 0 the damped resonance:\n"
+                "the peak of its frequency response over [analysis] frequency_range_hz with the rotor speed\n"
+                "following the excitation, one harmonic (the one-harmonic estimate). Needs a damper and\n"
+                "rotor_speed_rpm = 'auto'. Writes campbell.png, results.json, summary.md.")
+    design_arg(p)
+    p.add_argument("--engine-orders", type=int, nargs="+", metavar="EO",
+                   help="engine orders >= 0 (default: the design's [disk] engine_order)")
+    speed_args(p)
+    out_arg(p, "results/<design file name>/campbell")
 
     p = command("montecarlo", monte_carlo_command, "Monte Carlo of randomly mistuned disks (Dask)",
                 "Peak amplification (largest blade over the tuned peak) of N disks with Gaussian frequency\n"

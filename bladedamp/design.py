@@ -411,7 +411,8 @@ def _fields() -> list[Field]:
         Field("disk", "n_blades", ref.N_BLADES, Number(2, 1000, integer=True), "-", "the paper's disk"),
         Field("disk", "engine_order", ref.ENGINE_ORDER,
               Either((Number(0, 500, integer=True), List(Number(0, 500, integer=True), increasing=True))), "-",
-              "EO in [0, n_blades / 2], or a list (frf and eo-sweep run each; the others the first)"),
+              "EO >= 0, or a list (frf, eo-sweep, zzenf and campbell use each; the others the first); EO mod n_blades sets "
+              "the nodal diameter (forward, or backward above n_blades / 2), EO itself the rotor speed"),
         Field("disk", "gamma_left_deg", _tidy(np.degrees(ref.PLATFORM_ANGLE)), Number(0.0, 90.0, "neither"), "deg",
               "platform angle at OL (paper: 35 deg); a surface_file blade's OL face sets it"),
         Field("disk", "gamma_right_deg", _tidy(np.degrees(ref.PLATFORM_ANGLE)), Number(0.0, 90.0, "neither"), "deg",
@@ -704,9 +705,6 @@ def _build(path: Path, v: dict, given: set, has_mistuning: bool) -> Design:
     d, k = v["disk"], v["damper"]
     n = d["n_blades"]
     eos = (d["engine_order"],) if isinstance(d["engine_order"], int) else tuple(d["engine_order"])
-    if max(eos) > n // 2:
-        raise _bad(path, "disk", "engine_order", d["engine_order"],
-                   f"an integer or a list of integers in [0, {n // 2}] (n_blades / 2)")
     damper = None
     if k["kind"] != "none":
         try:
