@@ -6,6 +6,7 @@
   bladedamp eo-sweep design.toml      optimal mass over engine orders
   bladedamp montecarlo design.toml    Monte Carlo of randomly mistuned disks (Dask)
   bladedamp show design.toml          3D view of the resonance (standalone HTML)
+  bladedamp compare a.toml b.toml     frequency responses of several designs in one figure
   bladedamp reproduce                 the paper's results on the reference configuration
   bladedamp precompile                compile every numba kernel once (after installing)
 
@@ -608,8 +609,12 @@ def show_command(args) -> int:
     design = _load(args)
     out = output_dir(args.out)
     a = design.analysis
-    Progress()(f"frequency response at EO = {design.disk.engine_order}, {a.f_start_hz:g}-{a.f_end_hz:g} Hz")
-    response = design.disk.frequency_response(a.f_start_hz, a.f_end_hz, **a.options())
+    if args.saved is not None:
+        response = saved_response(design, args.saved)
+        Progress()(f"frequency response at EO = {design.disk.engine_order} read from {args.saved}")
+    else:
+        Progress()(f"frequency response at EO = {design.disk.engine_order}, {a.f_start_hz:g}-{a.f_end_hz:g} Hz")
+        response = design.disk.frequency_response(a.f_start_hz, a.f_end_hz, **a.options())
     options = {} if args.layout is None else {"layout": args.layout}
     if design.blade_geometry is not None:
         options["blade_geometry"] = design.blade_geometry
@@ -617,6 +622,104 @@ def show_command(args) -> int:
     show(response, path=html, **options)
     show_outputs(out, design, response, html)
     return _done(out, t0, f"3D view of the resonance at {response.peak_frequency_hz:.3f} Hz in {html}")
+
+
+def compare_inputs(args) -> list:
+    """The designs of ``bladedamp compare``: each positional input (a design file, or a folder of
+    ``bladedamp frf`` results) and each ``--from`` folder, in that order, as
+    :class:`bladedamp.compare.Compared`; a folder's responses are read, a design file's left
+    empty (computed by :func:`compare_command` once every input is checked). UsageError for an
+    input that is neither."""
+    from .compare import Compared, design_of_saved, saved_frf
+    from .design import load_design
+
+    sources = [Path(p) for p in args.designs] + [Path(p) for p in (args.saved or ())]
+    if len(sources) < 2:
+        raise UsageError(f"give at least two designs to compare (design files or folders written by bladedamp frf; "
+                         f"got {len(sources)})")
+    entries = []
+    for source in sources:
+        if source.is_dir():
+            try:
+                responses, design_path, files = saved_frf(source)
+            except ValueError as exc:
+                raise UsageError(str(exc)) from None
+            design, note = design_of_saved(source, design_path)
+            name = design_path.stem if design_path is not None else source.name
+            entries.append(Compared(name, source, responses, design, files, note))
+        else:
+            if source.suffix.lower() != ".toml" and not source.exists():
+                raise UsageError(f"{source}: neither a design file (.toml) nor a folder of bladedamp frf results")
+            entries.append(Compared(source.stem, source, {}, load_design(source)))
+    names = [e.name for e in entries]
+    for e in entries:                  # the same stem twice (a design and its saved results): say which
+        if names.count(e.name) > 1:
+            e.name = f"{e.name} ({e.source})"
+    return entries
+
+
+def compare_command(args) -> int:
+    """``bladedamp compare``: the frequency responses of several designs in one figure and a
+    table of their peaks, resonance frequencies and reductions."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from .compare import compare_outputs, damper_free_key, undamped_responses
+
+    t0 = time.perf_counter()
+    entries = compare_inputs(args)
+    out = output_dir(args.out)
+    progress = Progress()
+    for e in entries:
+        if not e.responses:            # a design file: its tuned responses (no time integration checks)
+            a = e.design.analysis
+            for eo in e.design.engine_orders:
+                progress(f"{e.name}: frequency response at EO = {eo}, {a.f_start_hz:g}-{a.f_end_hz:g} Hz")
+                e.responses[f"EO{eo}"] = e.design.disk_at(eo).frequency_response(a.f_start_hz, a.f_end_hz,
+                                                                                **a.options())
+    known = [e for e in entries if e.design is not None]
+    keys = {damper_free_key(e.design) for e in known}
+    shared = len(known) == len(entries) and len(keys) == 1
+    undamped, by_key = {}, {}
+    for e in known:                    # one damper-free response per distinct blade, disk and excitation
+        key = damper_free_key(e.design)
+        if key not in by_key:
+            progress(f"damper-free reference of {e.name}")
+            by_key[key] = undamped_responses(e.design, list(e.responses))
+        for label in e.responses:
+            if label in by_key[key]:
+                undamped[e.name, label] = by_key[key][label]
+            else:
+                undamped[e.name, label] = undamped_responses(e.design, [label])[label]
+    summary = compare_outputs(out, entries, undamped, shared)
+    what = "; ".join(f"{row['design']} {row['response']} peak {row['peak_amplitude_mm']:.4f} mm at "
+                     f"{row['peak_frequency_hz']:.3f} Hz" for row in summary["designs"])
+    return _done(out, t0, what)
+
+
+def saved_response(design, folder: Path):
+    """The response of ``design``'s first engine order saved by ``bladedamp frf`` in ``folder``,
+    with the design's disk attached (for the 3D view). UsageError when the folder holds no such
+    results or they are of another design, or of the design before it was changed."""
+    import dataclasses
+
+    from .compare import saved_frf
+
+    try:
+        responses, design_path, _ = saved_frf(folder)
+    except ValueError as exc:
+        raise UsageError(f"--from {exc}") from None
+    if design_path is None or not design_path.exists() or design_path.resolve() != Path(design.path).resolve():
+        raise UsageError(f"--from {folder}: its results are of {design_path or 'an unnamed design'}, not of "
+                         f"{design.path}")
+    if Path(design.path).stat().st_mtime > (folder / "results.json").stat().st_mtime:
+        raise UsageError(f"--from {folder}: {design.path} was changed after the results were saved; run "
+                         f"bladedamp frf {design.path} again")
+    label = f"EO{design.disk.engine_order}"
+    if label not in responses:
+        raise UsageError(f"--from {folder}: no response at EO = {design.disk.engine_order} (holds "
+                         f"{', '.join(responses)})")
+    return dataclasses.replace(responses[label], disk=design.disk)
 
 
 def reproduce_command(args) -> int:
@@ -753,7 +856,21 @@ def build_parser() -> argparse.ArgumentParser:
     design_arg(p)
     p.add_argument("--layout", choices=("sector", "disk"), default=None,
                    help="sector (three blades) or disk (every blade); default: disk with a damper, sector without")
+    p.add_argument("--from", dest="saved", type=Path, default=None, metavar="DIR",
+                   help="read the frequency response that bladedamp frf saved in DIR (of this design file) instead of\n"
+                        "computing it again")
     out_arg(p, "results/show")
+
+    p = command("compare", compare_command, "frequency responses of several designs in one figure",
+                "Overlays the tip responses of two or more designs (design files, computed; or folders written by\n"
+                "bladedamp frf, read), the damper-free response dashed once when they share blade, disk and\n"
+                "excitation. Writes compare.png, compare.csv and compare.json (peak, resonance frequency and\n"
+                "reduction against the damper-free peak of every design) and summary.md.")
+    p.add_argument("designs", type=Path, nargs="*", metavar="DESIGN",
+                   help="design files (TOML) or folders of bladedamp frf results")
+    p.add_argument("--from", dest="saved", type=Path, action="append", metavar="DIR",
+                   help="a folder of bladedamp frf results to compare (repeatable)")
+    out_arg(p, "results/compare")
 
     p = command("reproduce", reproduce_command,
                 "reproduce the paper on the built-in reference configuration",
