@@ -7,6 +7,7 @@
   bladedamp montecarlo design.toml    Monte Carlo of randomly mistuned disks (Dask)
   bladedamp show design.toml          3D view of the resonance (standalone HTML)
   bladedamp compare a.toml b.toml     frequency responses of several designs in one figure
+  bladedamp app                       the damper-design dashboard in the browser (Voila)
   bladedamp reproduce                 the paper's results on the reference configuration
   bladedamp precompile                compile every numba kernel once (after installing)
 
@@ -722,6 +723,52 @@ def saved_response(design, folder: Path):
     return dataclasses.replace(responses[label], disk=design.disk)
 
 
+def app_command(args) -> int:
+    """``bladedamp app``: the damper-design dashboard served by Voila on localhost until Ctrl+C."""
+    import importlib.util
+    import signal
+    import subprocess
+
+    if importlib.util.find_spec("voila") is None:
+        raise UsageError("the app is served by voila, which is not installed: pip install 'bladedamp[app]'")
+    from .app import free_port, port_in_use, voila_command, wait_for_port
+
+    if args.port is not None:
+        if not 1024 <= args.port <= 65535:
+            raise UsageError(f"--port {args.port}: must be in [1024, 65535]")
+        if port_in_use(args.port):
+            raise UsageError(f"--port {args.port}: in use on 127.0.0.1; choose another or leave --port out")
+    port = args.port if args.port is not None else free_port()
+    url = f"http://127.0.0.1:{port}/"
+
+    def stop(signum, frame):           # a terminated command stops its server too
+        raise KeyboardInterrupt
+    previous = signal.signal(signal.SIGTERM, stop)
+    server = subprocess.Popen(voila_command(port))
+    try:
+        if not wait_for_port(port, 60.0, process=server):
+            server.terminate()
+            server.wait(10)
+            raise UsageError(f"voila did not start on port {port} (exit code {server.returncode}); see its messages above")
+        print(f"bladedamp app: the damper-design dashboard is at {url} (Ctrl+C stops it)", file=sys.stderr, flush=True)
+        if not args.no_browser:
+            import webbrowser
+
+            webbrowser.open(url)
+        server.wait()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        if server.poll() is None:
+            server.terminate()
+            try:
+                server.wait(10)
+            except subprocess.TimeoutExpired:
+                server.kill()
+        signal.signal(signal.SIGTERM, previous)
+    return 0
+
+
 def reproduce_command(args) -> int:
     """``bladedamp reproduce``."""
     reproduce(args.out, args.processes)
@@ -871,6 +918,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--from", dest="saved", type=Path, action="append", metavar="DIR",
                    help="a folder of bladedamp frf results to compare (repeatable)")
     out_arg(p, "results/compare")
+
+    p = command("app", app_command, "the damper-design dashboard in the browser (Voila)",
+                "Serves a teaching dashboard on this machine (127.0.0.1 only): damper type, mass, engine order,\n"
+                "friction coefficient and excitation as controls; the frequency response, the 3D contact view at\n"
+                "the resonance and the hysteresis loop of a contact point as views. Needs the app extra:\n"
+                "pip install 'bladedamp[app]'. Ctrl+C stops the server.")
+    p.add_argument("--port", type=int, default=None, help="the port, in [1024, 65535] (default: a free one)")
+    p.add_argument("--no-browser", action="store_true", help="print the address only, open no browser")
 
     p = command("reproduce", reproduce_command,
                 "reproduce the paper on the built-in reference configuration",
