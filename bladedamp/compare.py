@@ -153,7 +153,7 @@ def comparison_table(entries: list, undamped: dict) -> list[dict]:
                          "peak_amplitude_mm": 1e3 * peak, "peak_frequency_hz": f_peak,
                          "peak_at_range_end": bool(r.peak_at_range_end),
                          "undamped_peak_amplitude_mm": 1e3 * free_peak, "reduction_pct": 100 * reduction,
-                         "status": r.status.value if hasattr(r, "status") else None,
+                         "status": r.status.value, "status_message": r.status_message,
                          "read_from": [str(p) for p in e.files if p.name == f"frf_{label}.npz"] or None})
     return rows
 
@@ -229,6 +229,7 @@ def compare_outputs(out: Path, entries: list, undamped: dict, shared: bool) -> d
                      f"{fmt_number(row['reduction_pct'], '.1f', 'no reference')}"
                      f"{'' if row['reduction_pct'] is None or not np.isfinite(row['reduction_pct']) else ' %'} | "
                      f"`{row['source']}` |")
+    lines += ["", *[f"- **{row['design']} {row['response']}**: {row['status_message']}" for row in rows]]
     lines += ["", "Peaks: the largest first-harmonic tip amplitude u_x on each computed branch; reduction: "
               "1 - peak / the peak of the same design without its damper."]
     if shared:

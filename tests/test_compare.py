@@ -159,3 +159,27 @@ def test_compare_bad_inputs_one_line_exit_2(saved, tmp_path, capsys, case, needl
     assert main(["compare", *args, "--out", str(out)]) == 2
     _one_error_line(capsys, *needles)
     assert not out.exists()                    # checked before anything is computed or written
+
+
+def test_a_folder_whose_design_changed_since_has_no_damper_free_reference(saved, tmp_path):
+    """The damper-free reference of a saved result is computed from its design file only if that
+    file is not newer than the results: an edited design may no longer be the one solved."""
+    import os
+
+    root, designs, folders = saved
+    moved = tmp_path / "heavy_results"
+    shutil.copytree(folders["heavy"], moved)
+    edited = tmp_path / "heavy.toml"
+    edited.write_text(designs["heavy"].read_text())
+    summary = json.loads((moved / "results.json").read_text())
+    summary["design"] = str(edited)
+    (moved / "results.json").write_text(json.dumps(summary))
+    later = (moved / "results.json").stat().st_mtime + 60
+    os.utime(edited, (later, later))
+    out = tmp_path / "out"
+    assert main(["compare", str(folders["light"]), str(moved), "--out", str(out)]) == 0
+    rows = {r["design"]: r for r in json.loads((out / "compare.json").read_text())["designs"]}
+    assert rows["light"]["reduction_pct"] is not None and rows["heavy"]["reduction_pct"] is None
+    text = (out / "summary.md").read_text()
+    assert "was changed after the results were saved" in text and "no damper-free reference for heavy" in text
+    assert "no common damper-free response is drawn" in text
