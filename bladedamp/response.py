@@ -21,7 +21,8 @@ SAMPLING_FLOOR = 1e-6
 
 
 def physical_checks(omega, omega_range, dissipation, excitation_work, max_step=None,
-                    n_samples: int = 64, refine=None, work_bound=None) -> dict[str, str]:
+                    n_samples: int = 64, refine=None, work_bound=None,
+                    judge_solution_samples: bool = False) -> dict[str, str]:
     """Sanity of a branch beyond the energy balance (which holds for any harmonic truncation).
 
     ``omega`` (n,) [rad/s]; ``omega_range`` (start, end) [rad/s]; ``dissipation`` (n, m) energy
@@ -57,7 +58,12 @@ def physical_checks(omega, omega_range, dissipation, excitation_work, max_step=N
       (a 6.4 g wedge, (1,)) -1.2e-7 at 1024; inclined oscillators -3e-6..-3.5e-4 at 4096.
       Without ``refine`` the floor is the sampling error's order, -(2 pi / T)^2 of the
       excitation work (measured on a nearly stuck contact, EO 0 wedge: -2.6e-4 at T = 64,
-      -2.9e-5 at T = 256);
+      -2.9e-5 at T = 256). With ``judge_solution_samples`` the dissipation at the solve's own T
+      samples, which the result reports, is held to the same floor: a point below
+      -``SAMPLING_FLOOR`` of its energy scale there fails even where the refined value passes
+      (the AFT's energy error on the contact's own scale is then larger than the floor; more
+      samples cure it: :func:`sampled_response`), so a result that passes reports no
+      dissipation below -``SAMPLING_FLOOR`` of its energy scale;
     * ``step``: no step between neighbouring points longer in frequency than ``max_step``
       allows. Range and step are :func:`bladedamp.hbm.continuation.branch_checks`, the
       continuation's own contract, checked again on the result.
@@ -80,12 +86,18 @@ def physical_checks(omega, omega_range, dissipation, excitation_work, max_step=N
     if refine is None:
         bad, how = relative < -(2 * np.pi / n_samples) ** 2, ""
     else:
+        own = relative.copy()
         suspect = np.flatnonzero(relative < -ROUNDING)
         if suspect.size:
             fine = np.atleast_2d(np.asarray(refine(suspect), dtype=float).reshape(suspect.size, -1))
             relative[suspect] = (fine / scale[suspect]).min(axis=1, initial=0.0)
         bad = relative < -SAMPLING_FLOOR
         how = f", confirmed with {REFINE_SAMPLES_FACTOR * n_samples} AFT samples per period"
+        if judge_solution_samples and not bad.any() and (own < -SAMPLING_FLOOR).any():
+            bad, relative = own < -SAMPLING_FLOOR, own
+            how = (f" with {n_samples} AFT samples per period: the AFT's energy error, since with "
+                   f"{REFINE_SAMPLES_FACTOR * n_samples} on the same coefficients it is above -{SAMPLING_FLOOR:g} of "
+                   f"that scale; more samples per period cure it")
     if bad.any():
         of = "the excitation work" if work_bound is None else "the energy scale (excitation work or the contact's)"
         failed["dissipation"] = (f"negative friction dissipation at {int(bad.sum())} points "
@@ -123,11 +135,11 @@ def sampled_response(solve, n_samples, first: int, most: int, most_for_dissipati
     samples were chosen."""
     if n_samples is not None:
         return solve(n_samples)
-    n, tried, response, empty = int(first), [], None, None
+    n, tried, response, empty, stopped_by = int(first), [], None, None, ""
     while True:
         finer = solve(n)
         if response is not None and not len(finer.omega):
-            empty = n                                 # the coarser branch is kept
+            empty, stopped_by = n, finer.stopped_by   # the coarser branch is kept (and the stop, e.g. a budget)
             break
         response = finer
         if response.stopped_by:                       # stopped as the caller asked: no retry
@@ -143,7 +155,9 @@ def sampled_response(solve, n_samples, first: int, most: int, most_for_dissipati
     if failed_with:
         note += f"; AFT samples per period raised to {n_used} (the branch failed with {', '.join(failed_with)})"
     if empty is not None:
-        note += f"; with {empty} AFT samples per period the branch kept no point"
+        note += f"; with {empty} AFT samples per period the branch kept no point" + (f": {stopped_by}" if stopped_by else "")
+    if stopped_by:
+        return dataclasses.replace(response, message=response.message + note, success=False, stopped_by=stopped_by)
     return dataclasses.replace(response, message=response.message + note) if note else response
 
 
@@ -267,7 +281,8 @@ def range_end_of_largest(frequency_hz, amplitude) -> float | None:
     whose amplitude is within ``END_AMPLITUDE_RESOLUTION`` of the largest counts as holding it
     (both ends: the one with the larger amplitude). There the range holds no maximum: the curve
     still rises towards that end. ``amplitude`` (n, k): k curves (e.g. one per blade), the end
-    of the largest curve whose largest lies at an end. None for an empty branch."""
+    of the largest curve whose largest lies at an end. None for an empty branch, and for curves
+    that are zero everywhere (at rest: no resonance to miss)."""
     f, a = np.asarray(frequency_hz, dtype=float), np.asarray(amplitude, dtype=float)
     if not f.size:
         return None
@@ -276,6 +291,8 @@ def range_end_of_largest(frequency_hz, amplitude) -> float | None:
     low, high = f <= f.min() + same, f >= f.max() - same
     found = []
     for curve in a.T:
+        if not curve.max() > 0:
+            continue                     # no motion at all (a response at rest): no resonance anywhere
         best, end = max((float(curve[low].max()), float(f.min())), (float(curve[high].max()), float(f.max())))
         if best >= (1 - END_AMPLITUDE_RESOLUTION) * curve.max():
             found.append((best, end))
@@ -528,9 +545,13 @@ class FrequencyResponse(Saveable):
         """Excitation frequency of :attr:`peak_amplitude` [Hz] (the resonance)."""
         return self.peak()[0]
 
-    def plot(self, ax=None, *, dof=0, harmonic: int = 1, scale: float = 1.0, unit: str = "", **kwargs):
+    def plot(self, ax=None, *, dof=0, harmonic: int = 1, scale: float = 1.0, unit: str = "", measured=None,
+             **kwargs):
         """Plot |X_h| of ``dof`` over frequency [Hz] into ``ax`` (a new figure if None); returns
-        the axes. Every response class's ``plot`` takes ``ax`` first, options by keyword."""
+        the axes. Every response class's ``plot`` takes ``ax`` first, options by keyword.
+        ``measured``: a measured displacement (or velocity, acceleration) response or its file,
+        drawn times ``scale`` beside it (:func:`bladedamp.measurement.draw_measurement`; an FRF
+        needs its force: ``measured.at_force(F)``)."""
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -544,4 +565,8 @@ class FrequencyResponse(Saveable):
         if not self.success:
             ax.set_title(f"incomplete: {self.message}", fontsize=8)
         ax.legend()
+        if measured is not None:
+            from .measurement import draw_measurement
+
+            draw_measurement(ax, measured, scale=scale)
         return ax

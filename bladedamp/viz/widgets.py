@@ -36,7 +36,7 @@ from ..contact.point import SEPARATED, SLIP, STICK, point_contact_forces
 from ..hbm.fourier import HarmonicBasis
 from ..oscillator import FrictionOscillator
 
-__all__ = ["interactive_view", "hysteresis_loop", "hysteresis_figure", "describing_function", "describing_function_figure",
+__all__ = ["interactive_view", "interact_with_image", "hysteresis_loop", "hysteresis_figure", "describing_function", "describing_function_figure",
            "oscillator_comparison", "oscillator_figure", "DiskFRF", "DiskFRFCache", "DEFAULT_CACHE", "disk_frf",
            "undamped_frf", "disk_frf_figure", "mass_sweep_peaks", "mass_study_figure", "engine_order_figure",
            "contact_state_at_peak", "platform_angle_figure", "closed_form_jenkins"]
@@ -62,6 +62,42 @@ def interactive_view(callback):
         plt.show()
 
     return view
+
+
+def interact_with_image(callback, **controls):
+    """``ipywidgets.interact(callback, **controls)`` whose saved output also holds a still image.
+
+    The widget is displayed as one output whose MIME bundle carries the widget view and, beside
+    it, the PNG of the figure ``callback`` drew at the controls' initial values (its first
+    ``image/png`` display). A front end that draws the widget (a trusted notebook with a running
+    or saved widget state) shows the live sliders; one that does not (an untrusted notebook,
+    a static viewer) shows the PNG instead of the widget's ``interactive(children=...)`` text.
+    The callback runs once, as with ``interact``; its outputs go to the widget's output area.
+    Returns None (a returned widget would be displayed a second time)."""
+    import functools
+
+    from IPython.display import display
+    from IPython.utils.capture import capture_output
+    from ipywidgets import interactive
+
+    first = []
+
+    @functools.wraps(callback)
+    def view(*args, **kwargs):
+        if first:
+            return callback(*args, **kwargs)
+        with capture_output() as captured:
+            result = callback(*args, **kwargs)
+        first.append(captured)
+        captured.show()             # inside the widget's output area, as interact would show it
+        return result
+
+    widget = interactive(view, **controls)
+    bundle = widget._repr_mimebundle_()
+    images = [out.data["image/png"] for out in (first[0].outputs if first else []) if "image/png" in out.data]
+    if images:
+        bundle["image/png"] = images[0]
+    display(bundle, raw=True)
 
 
 def _figure(*args, **kwargs):
