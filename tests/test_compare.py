@@ -7,6 +7,7 @@ import csv
 import dataclasses
 import json
 import shutil
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -183,3 +184,17 @@ def test_a_folder_whose_design_changed_since_has_no_damper_free_reference(saved,
     text = (out / "summary.md").read_text()
     assert "was changed after the results were saved" in text and "no damper-free reference for heavy" in text
     assert "no common damper-free response is drawn" in text
+
+
+def test_compare_keeps_earlier_results_and_writes_results_compare_by_default(saved, tmp_path, capsys):
+    from bladedamp.cli import build_parser, output_folder
+
+    root, designs, folders = saved
+    assert output_folder(build_parser().parse_args(["compare", "a.toml", "b.toml"])) == Path("results/compare")
+    out = tmp_path / "earlier"
+    out.mkdir()
+    (out / "summary.md").write_text("the results of an earlier run")
+    capsys.readouterr()
+    assert main(["compare", str(designs["light"]), str(designs["heavy"]), "--out", str(out)]) == 2
+    _one_error_line(capsys, f"--out {out}", "not empty", "--overwrite")
+    assert (out / "summary.md").read_text() == "the results of an earlier run"
