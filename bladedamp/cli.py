@@ -8,6 +8,8 @@
   bladedamp campbell design.toml      Campbell diagram: damped resonance at each engine order over rotor speed
   bladedamp montecarlo design.toml    Monte Carlo of randomly mistuned disks (Dask)
   bladedamp show design.toml          3D view of the resonance (standalone HTML)
+  bladedamp compare a.toml b.toml     frequency responses of several designs in one figure
+  bladedamp app                       the damper-design dashboard in the browser (Voila)
   bladedamp reproduce                 the paper's results on the reference configuration
   bladedamp precompile                compile every numba kernel once (after installing)
 
@@ -807,9 +809,13 @@ def show_command(args) -> int:
     out = output_dir(output_folder(args), args.overwrite)
     a = design.analysis
     progress = Progress()
-    progress.compiling()
-    progress(f"frequency response at EO = {design.disk.engine_order}, {a.f_start_hz:g}-{a.f_end_hz:g} Hz")
-    response = design.disk.frequency_response(a.f_start_hz, a.f_end_hz, **a.options())
+    if args.saved is not None:
+        response = saved_response(design, args.saved)
+        progress(f"frequency response at EO = {design.disk.engine_order} read from {args.saved}")
+    else:
+        progress.compiling()
+        progress(f"frequency response at EO = {design.disk.engine_order}, {a.f_start_hz:g}-{a.f_end_hz:g} Hz")
+        response = design.disk.frequency_response(a.f_start_hz, a.f_end_hz, **a.options())
     options = {} if args.layout is None else {"layout": args.layout}
     if design.blade_geometry is not None:
         options["blade_geometry"] = design.blade_geometry
@@ -817,6 +823,152 @@ def show_command(args) -> int:
     show(response, path=html, **options)
     show_outputs(out, design, response, html)
     return _done(out, t0, f"3D view of the resonance at {response.peak_frequency_hz:.3f} Hz in {html}")
+
+
+def compare_inputs(args) -> list:
+    """The designs of ``bladedamp compare``: each positional input (a design file, or a folder of
+    ``bladedamp frf`` results) and each ``--from`` folder, in that order, as
+    :class:`bladedamp.compare.Compared`; a folder's responses are read, a design file's left
+    empty (computed by :func:`compare_command` once every input is checked). UsageError for an
+    input that is neither."""
+    from .compare import Compared, design_of_saved, saved_frf
+    from .design import load_design
+
+    sources = [Path(p) for p in args.designs] + [Path(p) for p in (args.saved or ())]
+    if len(sources) < 2:
+        raise UsageError(f"give at least two designs to compare (design files or folders written by bladedamp frf; "
+                         f"got {len(sources)})")
+    entries = []
+    for source in sources:
+        if source.is_dir():
+            try:
+                responses, design_path, files = saved_frf(source)
+            except ValueError as exc:
+                raise UsageError(str(exc)) from None
+            design, note = design_of_saved(source, design_path)
+            name = design_path.stem if design_path is not None else source.name
+            entries.append(Compared(name, source, responses, design, files, note))
+        else:
+            if source.suffix.lower() != ".toml" and not source.exists():
+                raise UsageError(f"{source}: neither a design file (.toml) nor a folder of bladedamp frf results")
+            entries.append(Compared(source.stem, source, {}, load_design(source)))
+    names = [e.name for e in entries]
+    for e in entries:                  # the same stem twice (a design and its saved results): say which
+        if names.count(e.name) > 1:
+            e.name = f"{e.name} ({e.source})"
+    return entries
+
+
+def compare_command(args) -> int:
+    """``bladedamp compare``: the frequency responses of several designs in one figure and a
+    table of their peaks, resonance frequencies and reductions."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from .compare import compare_outputs, damper_free_key, undamped_responses
+
+    t0 = time.perf_counter()
+    entries = compare_inputs(args)
+    out = output_dir(output_folder(args), args.overwrite)
+    progress = Progress()
+    if any(not e.responses for e in entries):
+        progress.compiling()
+    for e in entries:
+        if not e.responses:            # a design file: its tuned responses (no time integration checks)
+            a = e.design.analysis
+            for eo in e.design.engine_orders:
+                progress(f"{e.name}: frequency response at EO = {eo}, {a.f_start_hz:g}-{a.f_end_hz:g} Hz")
+                e.responses[f"EO{eo}"] = e.design.disk_at(eo).frequency_response(a.f_start_hz, a.f_end_hz,
+                                                                                **a.options())
+    known = [e for e in entries if e.design is not None]
+    keys = {damper_free_key(e.design) for e in known}
+    shared = len(known) == len(entries) and len(keys) == 1
+    undamped, by_key = {}, {}
+    for e in known:                    # one damper-free response per distinct blade, disk and excitation
+        key = damper_free_key(e.design)
+        if key not in by_key:
+            progress(f"damper-free reference of {e.name}")
+            by_key[key] = undamped_responses(e.design, list(e.responses))
+        for label in e.responses:
+            if label in by_key[key]:
+                undamped[e.name, label] = by_key[key][label]
+            else:
+                undamped[e.name, label] = undamped_responses(e.design, [label])[label]
+    summary = compare_outputs(out, entries, undamped, shared)
+    what = "; ".join(f"{row['design']} {row['response']} peak {row['peak_amplitude_mm']:.4f} mm at "
+                     f"{row['peak_frequency_hz']:.3f} Hz" for row in summary["designs"])
+    return _done(out, t0, what)
+
+
+def saved_response(design, folder: Path):
+    """The response of ``design``'s first engine order saved by ``bladedamp frf`` in ``folder``,
+    with the design's disk attached (for the 3D view). UsageError when the folder holds no such
+    results or they are of another design, or of the design before it was changed."""
+    import dataclasses
+
+    from .compare import saved_frf
+
+    try:
+        responses, design_path, _ = saved_frf(folder)
+    except ValueError as exc:
+        raise UsageError(f"--from {exc}") from None
+    if design_path is None or not design_path.exists() or design_path.resolve() != Path(design.path).resolve():
+        raise UsageError(f"--from {folder}: its results are of {design_path or 'an unnamed design'}, not of "
+                         f"{design.path}")
+    if Path(design.path).stat().st_mtime > (folder / "results.json").stat().st_mtime:
+        raise UsageError(f"--from {folder}: {design.path} was changed after the results were saved; run "
+                         f"bladedamp frf {design.path} again")
+    label = f"EO{design.disk.engine_order}"
+    if label not in responses:
+        raise UsageError(f"--from {folder}: no response at EO = {design.disk.engine_order} (holds "
+                         f"{', '.join(responses)})")
+    return dataclasses.replace(responses[label], disk=design.disk)
+
+
+def app_command(args) -> int:
+    """``bladedamp app``: the damper-design dashboard served by Voila on localhost until Ctrl+C."""
+    import importlib.util
+    import signal
+    import subprocess
+
+    if importlib.util.find_spec("voila") is None:
+        raise UsageError("the app is served by voila, which is not installed: pip install 'bladedamp[app]'")
+    from .app import free_port, port_in_use, voila_command, wait_for_port
+
+    if args.port is not None:
+        if not 1024 <= args.port <= 65535:
+            raise UsageError(f"--port {args.port}: must be in [1024, 65535]")
+        if port_in_use(args.port):
+            raise UsageError(f"--port {args.port}: in use on 127.0.0.1; choose another or leave --port out")
+    port = args.port if args.port is not None else free_port()
+    url = f"http://127.0.0.1:{port}/"
+
+    def stop(signum, frame):           # a terminated command stops its server too
+        raise KeyboardInterrupt
+    previous = signal.signal(signal.SIGTERM, stop)
+    server = subprocess.Popen(voila_command(port))
+    try:
+        if not wait_for_port(port, 60.0, process=server):
+            server.terminate()
+            server.wait(10)
+            raise UsageError(f"voila did not start on port {port} (exit code {server.returncode}); see its messages above")
+        print(f"bladedamp app: the damper-design dashboard is at {url} (Ctrl+C stops it)", file=sys.stderr, flush=True)
+        if not args.no_browser:
+            import webbrowser
+
+            webbrowser.open(url)
+        server.wait()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        if server.poll() is None:
+            server.terminate()
+            try:
+                server.wait(10)
+            except subprocess.TimeoutExpired:
+                server.kill()
+        signal.signal(signal.SIGTERM, previous)
+    return 0
 
 
 def reproduce_command(args) -> int:
@@ -992,7 +1144,29 @@ def build_parser() -> argparse.ArgumentParser:
     design_arg(p)
     p.add_argument("--layout", choices=("sector", "disk"), default=None,
                    help="sector (three blades) or disk (every blade); default: disk with a damper, sector without")
+    p.add_argument("--from", dest="saved", type=Path, default=None, metavar="DIR",
+                   help="read the frequency response that bladedamp frf saved in DIR (of this design file) instead of\n"
+                        "computing it again")
     out_arg(p, "results/<design file name>/show")
+
+    p = command("compare", compare_command, "frequency responses of several designs in one figure",
+                "Overlays the tip responses of two or more designs (design files, computed; or folders written by\n"
+                "bladedamp frf, read), the damper-free response dashed once when they share blade, disk and\n"
+                "excitation. Writes compare.png, compare.csv and compare.json (peak, resonance frequency and\n"
+                "reduction against the damper-free peak of every design) and summary.md.")
+    p.add_argument("designs", type=Path, nargs="*", metavar="DESIGN",
+                   help="design files (TOML) or folders of bladedamp frf results")
+    p.add_argument("--from", dest="saved", type=Path, action="append", metavar="DIR",
+                   help="a folder of bladedamp frf results to compare (repeatable)")
+    out_arg(p, "results/compare")
+
+    p = command("app", app_command, "the damper-design dashboard in the browser (Voila)",
+                "Serves a teaching dashboard on this machine (127.0.0.1 only): damper type, mass, engine order,\n"
+                "friction coefficient and excitation as controls; the frequency response, the 3D contact view at\n"
+                "the resonance and the hysteresis loop of a contact point as views. Needs the app extra:\n"
+                "pip install 'bladedamp[app]'. Ctrl+C stops the server.")
+    p.add_argument("--port", type=int, default=None, help="the port, in [1024, 65535] (default: a free one)")
+    p.add_argument("--no-browser", action="store_true", help="print the address only, open no browser")
 
     p = command("reproduce", reproduce_command,
                 "reproduce the paper on the built-in reference configuration",

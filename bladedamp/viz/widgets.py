@@ -410,17 +410,19 @@ class DiskFRFCache:
 
     # -- keys -------------------------------------------------------------------------
     @staticmethod
-    def family(kind, engine_order=1, gamma_right_deg=35.0, excitation=None, harmonics=(1,)):
+    def family(kind, engine_order=1, gamma_right_deg=35.0, excitation=None, harmonics=(1,),
+               friction_coefficient=None):
         """Everything but the mass (the blade's beam modes are built once per family)."""
         exc = None if excitation is None else tuple(float(v) for v in excitation)
-        return (kind, int(engine_order), round(float(gamma_right_deg), 6), exc, tuple(harmonics))
+        mu = None if friction_coefficient is None or kind is None else round(float(friction_coefficient), 6)
+        return (kind, int(engine_order), round(float(gamma_right_deg), 6), exc, tuple(harmonics), mu)
 
     def _disk(self, family, mass):
         """The family's reference disk with ``mass`` [kg]."""
         from ..reference import reference_disk
 
         if family not in self._base_disks:
-            kind, eo, gamma_r, exc, _ = family
+            kind, eo, gamma_r, exc, _, mu = family
             kw = {}
             if exc is not None:
                 kw["excitation"] = np.array(exc)
@@ -429,6 +431,9 @@ class DiskFRFCache:
             disk = reference_disk(kind, 1e-3, engine_order=eo, **kw)
             if gamma_r != 35.0:
                 disk = dataclasses.replace(disk, gamma_right=np.radians(gamma_r))
+            if mu is not None:
+                contact = dataclasses.replace(disk.damper.contact, friction_coefficient=mu)
+                disk = dataclasses.replace(disk, damper=dataclasses.replace(disk.damper, contact=contact))
             self._base_disks[family] = disk
         base = self._base_disks[family]
         if base.damper is None:
@@ -437,16 +442,20 @@ class DiskFRFCache:
 
     # -- public -----------------------------------------------------------------------
     def response(self, kind="cylinder", mass=1e-3, engine_order=1, gamma_right_deg=35.0, excitation=None,
-                 harmonics=(1,)) -> DiskFRF:
+                 harmonics=(1,), friction_coefficient=None) -> DiskFRF:
         """Frequency response of the reference disk with a ``kind`` damper of ``mass`` [kg]
-        (``kind=None``: no damper), at ``engine_order``, right platform angle [deg]."""
+        (``kind=None``: no damper), at ``engine_order``, right platform angle [deg], tip
+        ``excitation`` (6,) [N, N m] (None: the reference's), damper ``friction_coefficient``
+        mu [-] (None: the reference's)."""
         from ..studies.mass import IncompleteResponse, peak_response
 
         if kind not in (None, "cylinder", "wedge"):
             raise ValueError(f"kind must be None, 'cylinder' or 'wedge' (got {kind!r})")
         if kind is not None and not mass > 0:
             raise ValueError(f"mass must be > 0 kg (got {mass!r})")
-        fam = self.family(kind, engine_order, gamma_right_deg, excitation, harmonics)
+        if friction_coefficient is not None and not friction_coefficient >= 0:
+            raise ValueError(f"friction_coefficient must be >= 0 (got {friction_coefficient!r})")
+        fam = self.family(kind, engine_order, gamma_right_deg, excitation, harmonics, friction_coefficient)
         mass = 0.0 if kind is None else float(mass)
         key = fam + (float(f"{mass:.6g}"),)
         if key in self._memo:
