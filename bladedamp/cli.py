@@ -1072,13 +1072,16 @@ def build_parser() -> argparse.ArgumentParser:
     processes_arg(p)
     out_arg(p, "results/<design file name>/optimize")
 
+    def engine_orders_arg(p):
+        p.add_argument("--engine-orders", type=int, nargs="+", metavar="EO",
+                       help="engine orders >= 0 (default: the design's [disk] engine_order)")
+
     p = command("eo-sweep", eo_sweep_command, "optimal damper mass over engine orders",
                 "At each engine order the mass is re-optimised in [analysis] mass_range_g (Fig. 7, 8 of the\n"
                 "paper). EO = 0 runs at [disk] rotor_speed_eo0_rpm unless rotor_speed_rpm fixes the speed.\n"
                 "Writes eo_sweep.png, eo_sweep.npz, results.json, summary.md.")
     design_arg(p)
-    p.add_argument("--engine-orders", type=int, nargs="+", metavar="EO",
-                   help="engine orders >= 0 (default: the design's [disk] engine_order)")
+    engine_orders_arg(p)
     processes_arg(p)
     out_arg(p, "results/<design file name>/eo-sweep")
 
@@ -1105,8 +1108,7 @@ def build_parser() -> argparse.ArgumentParser:
                 "following the excitation, one harmonic (the one-harmonic estimate). Needs a damper and\n"
                 "rotor_speed_rpm = 'auto'. Writes campbell.png, results.json, summary.md.")
     design_arg(p)
-    p.add_argument("--engine-orders", type=int, nargs="+", metavar="EO",
-                   help="engine orders >= 0 (default: the design's [disk] engine_order)")
+    engine_orders_arg(p)
     speed_args(p)
     out_arg(p, "results/<design file name>/campbell")
 
