@@ -25,6 +25,8 @@ _LAZY = {
     "reference_disk": "reference",
     "FrequencyResponse": "response", "Status": "response",
     "load": "io", "save": "io",
+    "load_measurement": "measurement", "load_modes": "measurement", "MeasuredResponse": "measurement",
+    "MeasuredModes": "measurement",
     "load_design": "design",
     "nonlinear_mode": "hbm.nonlinear_modes",
     "precompile": "compilation",

@@ -4,8 +4,12 @@
   bladedamp frf design.toml           frequency response of the design's disk
   bladedamp optimize design.toml      optimal damper mass (and platform angle or contact height)
   bladedamp eo-sweep design.toml      optimal mass over engine orders
+  bladedamp zzenf design.toml         interference (ZZENF) diagram: natural frequencies per nodal diameter
+  bladedamp campbell design.toml      Campbell diagram: damped resonance at each engine order over rotor speed
   bladedamp montecarlo design.toml    Monte Carlo of randomly mistuned disks (Dask)
   bladedamp show design.toml          3D view of the resonance (standalone HTML)
+  bladedamp compare a.toml b.toml     frequency responses of several designs in one figure
+  bladedamp app                       the damper-design dashboard in the browser (Voila)
   bladedamp reproduce                 the paper's results on the reference configuration
   bladedamp precompile                compile every numba kernel once (after installing)
 
@@ -555,6 +559,11 @@ def frf_command(args) -> int:
     design = _load(args)
     if args.mistuned and design.mistuning is None:
         raise UsageError(f"{design.path}: --mistuned needs a [mistuning] table (std and seed, or kappa)")
+    measured = None
+    if args.measured is not None:                 # read before the solve: a bad file stops at once
+        from .measurement import load_measurement
+
+        measured = load_measurement(args.measured, unit=args.measured_unit, record=args.measured_record)
     out = output_dir(output_folder(args), args.overwrite)
     progress, a = Progress(), design.analysis
     progress.compiling()
@@ -573,7 +582,7 @@ def frf_command(args) -> int:
         progress(f"mistuned full assembly at EO = {design.disk.engine_order}")
         responses[f"mistuned_EO{design.disk.engine_order}"] = design.mistuned_disk().frequency_response(
             a.f_start_hz, a.f_end_hz, **checks, **a.options())
-    summary = frf_outputs(out, design, responses)
+    summary = frf_outputs(out, design, responses, measured=measured)
     for k, v in summary["responses"].items():      # each response's status first
         print(f"{k}: {v['status_message']}", file=sys.stderr)
     peaks = ", ".join(f"{k} {'largest amplitude at the range end' if v['peak_at_range_end'] else 'peak'} "
@@ -636,8 +645,8 @@ def eo_sweep_command(args) -> int:
     disk, a = _damped(design, "eo-sweep"), design.analysis
     eos = args.engine_orders or design.engine_orders
     for eo in eos:
-        if not 0 <= eo <= disk.n_blades // 2:
-            raise UsageError(f"--engine-orders {eo}: must be in [0, {disk.n_blades // 2}] (n_blades / 2)")
+        if eo < 0:
+            raise UsageError(f"--engine-orders {eo}: must be an integer >= 0")
     out = output_dir(output_folder(args), args.overwrite)
     progress = Progress()
     progress.compiling()
@@ -647,6 +656,88 @@ def eo_sweep_command(args) -> int:
     eo_sweep_outputs(out, design, sweep)
     return _done(out, t0, f"engine orders {', '.join(map(str, sweep.engine_orders))}: reductions "
                           f"{', '.join(f'{100 * r:.1f} %' for r in sweep.reduction)}")
+
+
+def _rotor_speed_range_hz(design, args, engine_orders) -> tuple[float, float]:
+    """The rotor-speed range [Hz] of zzenf and campbell: --speed-range-rpm, else the design's
+    fixed rotor speed, else the speeds at which the engine orders > 0 excite [analysis]
+    frequency_range_hz (f_start / largest EO to f_end / smallest EO), 10 % wider each side."""
+    if args.speed_range_rpm is not None:
+        lo, hi = args.speed_range_rpm
+        if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi):
+            raise UsageError(f"--speed-range-rpm {lo:g} {hi:g}: must be 0 < LOW <= HIGH rpm")
+        return lo / 60, hi / 60
+    if design.rotor_speed_hz is not None:
+        return design.rotor_speed_hz, design.rotor_speed_hz
+    moving = [eo for eo in engine_orders if eo > 0]
+    if not moving:
+        raise UsageError(f"{design.path}: [disk] engine_order holds EO = 0 only, whose excitation does not follow "
+                         "the rotor speed: give --speed-range-rpm LOW HIGH or an engine order > 0")
+    a = design.analysis
+    return 0.9 * a.f_start_hz / max(moving), 1.1 * a.f_end_hz / min(moving)
+
+
+def _top_frequency_hz(design, args) -> float:
+    if args.f_max_hz is None:
+        return 1.25 * design.analysis.f_end_hz
+    if not (math.isfinite(args.f_max_hz) and args.f_max_hz > 0):
+        raise UsageError(f"--f-max-hz {args.f_max_hz:g}: must be > 0 Hz")
+    return args.f_max_hz
+
+
+def zzenf_command(args) -> int:
+    """``bladedamp zzenf``: the interference (ZZENF) diagram of the design's disk."""
+    from .report import zzenf_outputs
+    from .studies.interference import interference_diagram
+
+    t0 = time.perf_counter()
+    design = _load(args)
+    speeds = _rotor_speed_range_hz(design, args, design.engine_orders)
+    f_max = _top_frequency_hz(design, args)
+    out = output_dir(output_folder(args), args.overwrite)
+    progress = Progress()
+    progress.compiling()
+    progress(f"natural frequencies of nodal diameters 0-{design.disk.n_blades // 2} at "
+             f"{60 * speeds[0]:.0f}-{60 * speeds[1]:.0f} rpm")
+    diagram = interference_diagram(design.disk, speeds, f_max, design.engine_orders)
+    summary = zzenf_outputs(out, design, diagram)
+    return _done(out, t0, f"{len(summary['crossings'])} possible resonances of engine orders "
+                          f"{', '.join(map(str, design.engine_orders))} up to {f_max:g} Hz")
+
+
+def campbell_command(args) -> int:
+    """``bladedamp campbell``: resonance crossings over rotor speed with the damped peak at each."""
+    import dataclasses
+
+    from .report import campbell_outputs
+    from .studies.interference import campbell_diagram
+
+    t0 = time.perf_counter()
+    design = _load(args)
+    _damped(design, "campbell")
+    if design.rotor_speed_hz is not None:
+        raise UsageError(f"{design.path}: [disk] rotor_speed_rpm fixes the rotor speed; campbell follows each engine "
+                         "order over rotor speed (set rotor_speed_rpm = \"auto\"; --speed-range-rpm sets the diagram's range)")
+    eos = tuple(sorted(set(args.engine_orders))) if args.engine_orders else design.engine_orders
+    for eo in eos:
+        if eo < 0:
+            raise UsageError(f"--engine-orders {eo}: must be an integer >= 0")
+    speeds = _rotor_speed_range_hz(design, args, eos)
+    f_max = _top_frequency_hz(design, args)
+    out = output_dir(output_folder(args), args.overwrite)
+    progress, a = Progress(), design.analysis
+    progress.compiling()
+    disk = dataclasses.replace(design.disk, engine_order=1, rotor_speed_hz=None)
+    diagram = campbell_diagram(disk, eos, a.f_range_hz, speeds, f_max, harmonics=(1,), progress=progress,
+                               max_step=a.max_step, harmonic_tolerance=a.harmonic_tolerance)
+    summary = campbell_outputs(out, design, diagram)
+    for c in summary["crossings"]:
+        print(f"EO {c['engine_order']}: {c['status_message']}", file=sys.stderr)
+    return _done(out, t0, ", ".join(
+        f"EO {c['engine_order']} peak {c['peak_amplitude_mm']:.4f} mm at {c['peak_frequency_hz']:.3f} Hz, "
+        f"{c['rotor_speed_rpm']:.0f} rpm" + ("" if c["found"] else " (no resonance found in the range)")
+        if c["peak_amplitude_mm"] is not None else f"EO {c['engine_order']} no point computed"
+        for c in summary["crossings"]) or "no engine order > 0: no crossing")
 
 
 def monte_carlo_command(args) -> int:
@@ -718,9 +809,13 @@ def show_command(args) -> int:
     out = output_dir(output_folder(args), args.overwrite)
     a = design.analysis
     progress = Progress()
-    progress.compiling()
-    progress(f"frequency response at EO = {design.disk.engine_order}, {a.f_start_hz:g}-{a.f_end_hz:g} Hz")
-    response = design.disk.frequency_response(a.f_start_hz, a.f_end_hz, **a.options())
+    if args.saved is not None:
+        response = saved_response(design, args.saved)
+        progress(f"frequency response at EO = {design.disk.engine_order} read from {args.saved}")
+    else:
+        progress.compiling()
+        progress(f"frequency response at EO = {design.disk.engine_order}, {a.f_start_hz:g}-{a.f_end_hz:g} Hz")
+        response = design.disk.frequency_response(a.f_start_hz, a.f_end_hz, **a.options())
     options = {} if args.layout is None else {"layout": args.layout}
     if design.blade_geometry is not None:
         options["blade_geometry"] = design.blade_geometry
@@ -728,6 +823,152 @@ def show_command(args) -> int:
     show(response, path=html, **options)
     show_outputs(out, design, response, html)
     return _done(out, t0, f"3D view of the resonance at {response.peak_frequency_hz:.3f} Hz in {html}")
+
+
+def compare_inputs(args) -> list:
+    """The designs of ``bladedamp compare``: each positional input (a design file, or a folder of
+    ``bladedamp frf`` results) and each ``--from`` folder, in that order, as
+    :class:`bladedamp.compare.Compared`; a folder's responses are read, a design file's left
+    empty (computed by :func:`compare_command` once every input is checked). UsageError for an
+    input that is neither."""
+    from .compare import Compared, design_of_saved, saved_frf
+    from .design import load_design
+
+    sources = [Path(p) for p in args.designs] + [Path(p) for p in (args.saved or ())]
+    if len(sources) < 2:
+        raise UsageError(f"give at least two designs to compare (design files or folders written by bladedamp frf; "
+                         f"got {len(sources)})")
+    entries = []
+    for source in sources:
+        if source.is_dir():
+            try:
+                responses, design_path, files = saved_frf(source)
+            except ValueError as exc:
+                raise UsageError(str(exc)) from None
+            design, note = design_of_saved(source, design_path)
+            name = design_path.stem if design_path is not None else source.name
+            entries.append(Compared(name, source, responses, design, files, note))
+        else:
+            if source.suffix.lower() != ".toml" and not source.exists():
+                raise UsageError(f"{source}: neither a design file (.toml) nor a folder of bladedamp frf results")
+            entries.append(Compared(source.stem, source, {}, load_design(source)))
+    names = [e.name for e in entries]
+    for e in entries:                  # the same stem twice (a design and its saved results): say which
+        if names.count(e.name) > 1:
+            e.name = f"{e.name} ({e.source})"
+    return entries
+
+
+def compare_command(args) -> int:
+    """``bladedamp compare``: the frequency responses of several designs in one figure and a
+    table of their peaks, resonance frequencies and reductions."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from .compare import compare_outputs, damper_free_key, undamped_responses
+
+    t0 = time.perf_counter()
+    entries = compare_inputs(args)
+    out = output_dir(output_folder(args), args.overwrite)
+    progress = Progress()
+    if any(not e.responses for e in entries):
+        progress.compiling()
+    for e in entries:
+        if not e.responses:            # a design file: its tuned responses (no time integration checks)
+            a = e.design.analysis
+            for eo in e.design.engine_orders:
+                progress(f"{e.name}: frequency response at EO = {eo}, {a.f_start_hz:g}-{a.f_end_hz:g} Hz")
+                e.responses[f"EO{eo}"] = e.design.disk_at(eo).frequency_response(a.f_start_hz, a.f_end_hz,
+                                                                                **a.options())
+    known = [e for e in entries if e.design is not None]
+    keys = {damper_free_key(e.design) for e in known}
+    shared = len(known) == len(entries) and len(keys) == 1
+    undamped, by_key = {}, {}
+    for e in known:                    # one damper-free response per distinct blade, disk and excitation
+        key = damper_free_key(e.design)
+        if key not in by_key:
+            progress(f"damper-free reference of {e.name}")
+            by_key[key] = undamped_responses(e.design, list(e.responses))
+        for label in e.responses:
+            if label in by_key[key]:
+                undamped[e.name, label] = by_key[key][label]
+            else:
+                undamped[e.name, label] = undamped_responses(e.design, [label])[label]
+    summary = compare_outputs(out, entries, undamped, shared)
+    what = "; ".join(f"{row['design']} {row['response']} peak {row['peak_amplitude_mm']:.4f} mm at "
+                     f"{row['peak_frequency_hz']:.3f} Hz" for row in summary["designs"])
+    return _done(out, t0, what)
+
+
+def saved_response(design, folder: Path):
+    """The response of ``design``'s first engine order saved by ``bladedamp frf`` in ``folder``,
+    with the design's disk attached (for the 3D view). UsageError when the folder holds no such
+    results or they are of another design, or of the design before it was changed."""
+    import dataclasses
+
+    from .compare import saved_frf
+
+    try:
+        responses, design_path, _ = saved_frf(folder)
+    except ValueError as exc:
+        raise UsageError(f"--from {exc}") from None
+    if design_path is None or not design_path.exists() or design_path.resolve() != Path(design.path).resolve():
+        raise UsageError(f"--from {folder}: its results are of {design_path or 'an unnamed design'}, not of "
+                         f"{design.path}")
+    if Path(design.path).stat().st_mtime > (folder / "results.json").stat().st_mtime:
+        raise UsageError(f"--from {folder}: {design.path} was changed after the results were saved; run "
+                         f"bladedamp frf {design.path} again")
+    label = f"EO{design.disk.engine_order}"
+    if label not in responses:
+        raise UsageError(f"--from {folder}: no response at EO = {design.disk.engine_order} (holds "
+                         f"{', '.join(responses)})")
+    return dataclasses.replace(responses[label], disk=design.disk)
+
+
+def app_command(args) -> int:
+    """``bladedamp app``: the damper-design dashboard served by Voila on localhost until Ctrl+C."""
+    import importlib.util
+    import signal
+    import subprocess
+
+    if importlib.util.find_spec("voila") is None:
+        raise UsageError("the app is served by voila, which is not installed: pip install 'bladedamp[app]'")
+    from .app import free_port, port_in_use, voila_command, wait_for_port
+
+    if args.port is not None:
+        if not 1024 <= args.port <= 65535:
+            raise UsageError(f"--port {args.port}: must be in [1024, 65535]")
+        if port_in_use(args.port):
+            raise UsageError(f"--port {args.port}: in use on 127.0.0.1; choose another or leave --port out")
+    port = args.port if args.port is not None else free_port()
+    url = f"http://127.0.0.1:{port}/"
+
+    def stop(signum, frame):           # a terminated command stops its server too
+        raise KeyboardInterrupt
+    previous = signal.signal(signal.SIGTERM, stop)
+    server = subprocess.Popen(voila_command(port))
+    try:
+        if not wait_for_port(port, 60.0, process=server):
+            server.terminate()
+            server.wait(10)
+            raise UsageError(f"voila did not start on port {port} (exit code {server.returncode}); see its messages above")
+        print(f"bladedamp app: the damper-design dashboard is at {url} (Ctrl+C stops it)", file=sys.stderr, flush=True)
+        if not args.no_browser:
+            import webbrowser
+
+            webbrowser.open(url)
+        server.wait()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        if server.poll() is None:
+            server.terminate()
+            try:
+                server.wait(10)
+            except subprocess.TimeoutExpired:
+                server.kill()
+        signal.signal(signal.SIGTERM, previous)
+    return 0
 
 
 def reproduce_command(args) -> int:
@@ -809,6 +1050,13 @@ def build_parser() -> argparse.ArgumentParser:
                    help="skip the time integration at the peak of a complete branch (by default it runs, 5-31 s,\n"
                         "and gives a direct harmonic error estimate, or fails the branch where the vibration there does\n"
                         "not settle; not for solid FE blades with flexible platforms)")
+    p.add_argument("--measured", type=Path, metavar="FILE",
+                   help="a measured response drawn on frf.png: a UFF 58 FRF or spectrum (one record), or a CSV\n"
+                        "(frequency [Hz], re [m/N], im [m/N] or amplitude [mm]); an FRF times the design's excitation force")
+    p.add_argument("--measured-unit", metavar="UNIT", help="the unit of a --measured file that does not state it "
+                   "(e.g. m/s^2/N, g/N, mm)")
+    p.add_argument("--measured-record", metavar="K", type=int,
+                   help="which dataset 58 record of a --measured UFF file holding several (from 0)")
     out_arg(p, "results/<design file name>/frf")
 
     p = command("optimize", optimize_command, "optimal damper mass of a design",
@@ -824,15 +1072,45 @@ def build_parser() -> argparse.ArgumentParser:
     processes_arg(p)
     out_arg(p, "results/<design file name>/optimize")
 
+    def engine_orders_arg(p):
+        p.add_argument("--engine-orders", type=int, nargs="+", metavar="EO",
+                       help="engine orders >= 0 (default: the design's [disk] engine_order)")
+
     p = command("eo-sweep", eo_sweep_command, "optimal damper mass over engine orders",
                 "At each engine order the mass is re-optimised in [analysis] mass_range_g (Fig. 7, 8 of the\n"
                 "paper). EO = 0 runs at [disk] rotor_speed_eo0_rpm unless rotor_speed_rpm fixes the speed.\n"
                 "Writes eo_sweep.png, eo_sweep.npz, results.json, summary.md.")
     design_arg(p)
-    p.add_argument("--engine-orders", type=int, nargs="+", metavar="EO",
-                   help="engine orders in [0, n_blades / 2] (default: the design's [disk] engine_order)")
+    engine_orders_arg(p)
     processes_arg(p)
     out_arg(p, "results/<design file name>/eo-sweep")
+
+    def speed_args(p):
+        p.add_argument("--speed-range-rpm", type=float, nargs=2, metavar=("LOW", "HIGH"), default=None,
+                       help="rotor-speed range [rpm] (default: the design's fixed rotor_speed_rpm, else the speeds at\n"
+                            "which its engine orders excite [analysis] frequency_range_hz, 10 %% wider)")
+        p.add_argument("--f-max-hz", type=float, default=None,
+                       help="top of the diagram [Hz] (default: 1.25 x the end of [analysis] frequency_range_hz)")
+
+    p = command("zzenf", zzenf_command, "interference (ZZENF) diagram of a design",
+                "The natural frequencies of the disk per nodal diameter 0..n_blades/2 without dampers and with\n"
+                "the dampers stuck (at the lowest and highest rotor speed: the preload m R Omega^2 changes them),\n"
+                "and each engine order's excitation EO x rotor speed at its nodal diameter (EO mod n, folded to\n"
+                "n - (EO mod n) as a backward wave above n/2). Writes zzenf.png, results.json, summary.md.")
+    design_arg(p)
+    speed_args(p)
+    out_arg(p, "results/<design file name>/zzenf")
+
+    p = command("campbell", campbell_command, "Campbell diagram with the damped resonance at each engine order",
+                "Natural frequencies over rotor speed (without dampers; stuck at each engine order's nodal\n"
+                "diameter), the lines f = EO x rotor speed, and at each engine order > 0 the damped resonance:\n"
+                "the peak of its frequency response over [analysis] frequency_range_hz with the rotor speed\n"
+                "following the excitation, one harmonic (the one-harmonic estimate). Needs a damper and\n"
+                "rotor_speed_rpm = 'auto'. Writes campbell.png, results.json, summary.md.")
+    design_arg(p)
+    engine_orders_arg(p)
+    speed_args(p)
+    out_arg(p, "results/<design file name>/campbell")
 
     p = command("montecarlo", monte_carlo_command, "Monte Carlo of randomly mistuned disks (Dask)",
                 "Peak amplification (largest blade over the tuned peak) of N disks with Gaussian frequency\n"
@@ -868,7 +1146,29 @@ def build_parser() -> argparse.ArgumentParser:
     design_arg(p)
     p.add_argument("--layout", choices=("sector", "disk"), default=None,
                    help="sector (three blades) or disk (every blade); default: disk with a damper, sector without")
+    p.add_argument("--from", dest="saved", type=Path, default=None, metavar="DIR",
+                   help="read the frequency response that bladedamp frf saved in DIR (of this design file) instead of\n"
+                        "computing it again")
     out_arg(p, "results/<design file name>/show")
+
+    p = command("compare", compare_command, "frequency responses of several designs in one figure",
+                "Overlays the tip responses of two or more designs (design files, computed; or folders written by\n"
+                "bladedamp frf, read), the damper-free response dashed once when they share blade, disk and\n"
+                "excitation. Writes compare.png, compare.csv and compare.json (peak, resonance frequency and\n"
+                "reduction against the damper-free peak of every design) and summary.md.")
+    p.add_argument("designs", type=Path, nargs="*", metavar="DESIGN",
+                   help="design files (TOML) or folders of bladedamp frf results")
+    p.add_argument("--from", dest="saved", type=Path, action="append", metavar="DIR",
+                   help="a folder of bladedamp frf results to compare (repeatable)")
+    out_arg(p, "results/compare")
+
+    p = command("app", app_command, "the damper-design dashboard in the browser (Voila)",
+                "Serves a teaching dashboard on this machine (127.0.0.1 only): damper type, mass, engine order,\n"
+                "friction coefficient and excitation as controls; the frequency response, the 3D contact view at\n"
+                "the resonance and the hysteresis loop of a contact point as views. Needs the app extra:\n"
+                "pip install 'bladedamp[app]'. Ctrl+C stops the server.")
+    p.add_argument("--port", type=int, default=None, help="the port, in [1024, 65535] (default: a free one)")
+    p.add_argument("--no-browser", action="store_true", help="print the address only, open no browser")
 
     p = command("reproduce", reproduce_command,
                 "reproduce the paper on the built-in reference configuration",

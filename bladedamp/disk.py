@@ -3,7 +3,7 @@
 Unknowns of one sector: the blade's modal coordinates q (Eq. 2) and the six rigid-body
 coordinates u_D of its damper (the damper between this blade, at its OL platform, and the
 next blade, at that blade's OR platform). Harmonic h of the next blade is this blade's
-times e^{i h dphi}, dphi = 2 pi EO / n (Eq. 25), so the relative motion at the contacts is
+times e^{i h dphi}, dphi = 2 pi EO / n (Eq. 25; :func:`nodal_diameter`), so the relative motion at the contacts is
 
     w_h = G_D u_D,h - G_P [Phi_OL ; e^{i h dphi} Phi_OR] q_h          (Eq. 6, 24)
 
@@ -376,6 +376,33 @@ def rotor_speed_in_hz(rotor_speed_hz):
     return float(rotor_speed_hz)
 
 
+def nodal_diameter(engine_order, n_blades) -> tuple[int, str]:
+    """The nodal diameter and travelling direction excited by engine order ``engine_order`` on a
+    disk of ``n_blades`` blades (the one place this mapping is made; every EO >= 0 is valid).
+
+    Blade j is excited with the phase j dphi, dphi = 2 pi EO / n (Eq. 25), which only depends on
+    r = EO mod n. Returns (k, direction): k = r and ``"forward"`` for 0 < r < n / 2; k = n - r
+    and ``"backward"`` for r > n / 2 (the same nodal diameter travelling against the rotation);
+    ``"standing"`` for r = 0 (k = 0: EO = 0, n, 2n, ...) and r = n / 2 (even n), where the phase
+    e^{i dphi} = +-1 is real. The excitation frequency and the rotor speed use the engine order
+    itself (Omega_R = Omega_E / EO, Eq. 3, 26), not k.
+    """
+    n = validation.integer("n_blades", n_blades, minimum=2)
+    eo = validation.integer("engine_order (EO)", engine_order, minimum=0)
+    r = eo % n
+    if r == 0 or 2 * r == n:
+        return r, "standing"
+    return (r, "forward") if 2 * r < n else (n - r, "backward")
+
+
+def interblade_phase(engine_order, n_blades) -> float:
+    """dphi [rad] in (-pi, pi] of engine order ``engine_order`` on ``n_blades`` blades (Eq. 25):
+    2 pi k / n for the nodal diameter k of :func:`nodal_diameter`, negative for a backward wave
+    (e^{i dphi} = e^{i 2 pi EO / n} exactly, with dphi = 0 at EO = 0, n, 2n, ...)."""
+    k, direction = nodal_diameter(engine_order, n_blades)
+    return (-2 if direction == "backward" else 2) * np.pi * k / int(n_blades)
+
+
 @dataclass
 class TunedDisk:
     """Tuned bladed disk with one damper per blade pair (cyclic symmetry, Eq. 21-25).
@@ -385,7 +412,8 @@ class TunedDisk:
     blade : ModalBlade (points OL, OR, tip, excitation)
     damper : CylinderDamper, WedgeDamper or None (mass 0 or None: no damper)
     n_blades : n >= 2
-    engine_order : EO in 0..n/2
+    engine_order : EO >= 0; the nodal diameter and travelling direction follow from EO mod n
+        (:func:`nodal_diameter`), the rotor speed Omega_E / EO from EO itself
     gamma_left, gamma_right : platform angles at OL and OR [rad], in (0, pi/2)
     damper_radius : R, distance of the damper's centre of gravity to the rotor axis [m]
     excitation : (6,) harmonic tip load (F_x, F_y, F_z, M_x, M_y, M_z) at the blade's
@@ -412,7 +440,7 @@ class TunedDisk:
     def __post_init__(self):
         self.rotor_speed_hz = rotor_speed_in_hz(self.rotor_speed_hz)
         validation.integer("n_blades", self.n_blades, minimum=2)
-        validation.integer("engine_order (EO)", self.engine_order, minimum=0, maximum=self.n_blades // 2)
+        self.engine_order = validation.integer("engine_order (EO)", self.engine_order, minimum=0)
         validation.in_range("gamma_left (platform angle, rad)", self.gamma_left, 0.0, np.pi / 2, closed="neither")
         validation.in_range("gamma_right (platform angle, rad)", self.gamma_right, 0.0, np.pi / 2, closed="neither")
         validation.positive("damper_radius R", self.damper_radius)
@@ -434,8 +462,13 @@ class TunedDisk:
 
     @property
     def interblade_phase(self) -> float:
-        """dphi = 2 pi EO / n [rad] (Eq. 25)."""
-        return 2 * np.pi * self.engine_order / self.n_blades
+        """dphi [rad] in (-pi, pi], e^{i dphi} = e^{i 2 pi EO / n} (Eq. 25; :func:`interblade_phase`)."""
+        return interblade_phase(self.engine_order, self.n_blades)
+
+    @property
+    def nodal_diameter(self) -> tuple[int, str]:
+        """(nodal diameter k, "forward" / "backward" / "standing") of the engine order (:func:`nodal_diameter`)."""
+        return nodal_diameter(self.engine_order, self.n_blades)
 
     @property
     def dof_names(self) -> tuple[str, ...]:
@@ -772,24 +805,34 @@ class TunedDisk:
         (:func:`bladedamp.hbm.nonlinear_modes.linear_stuck_mode`), nan where it cannot be
         computed. A friction-damped resonance lies between them (up to the damper's inertia);
         used to say where a resonance outside the range may lie (:func:`with_range_end_estimate`)."""
+        free, stuck = self.linear_natural_frequencies_up_to_hz(f_high_hz)
+        free = nearest_to_range(free, f_low_hz, f_high_hz)
+        return (free, free) if not self.has_damper else (free, nearest_to_range(stuck, f_low_hz, f_high_hz))
+
+    def linear_natural_frequencies_up_to_hz(self, f_max_hz: float) -> tuple[np.ndarray, np.ndarray]:
+        """(without dampers, dampers stuck): the natural frequencies [Hz], ascending, of the two
+        linear sector models of :meth:`linear_natural_frequencies_hz`: every one without dampers
+        (the blade's), and the stuck ones from the lowest up to the first above ``f_max_hz`` (the
+        stuck system depends on the nodal diameter of the engine order, its preload on the rotor
+        speed; empty without a damper; a repeated stuck mode ends the list)."""
         free_system = dataclasses.replace(self, damper=None).hbm_system((1,))
         M, K = (np.atleast_2d(m.toarray() if hasattr(m, "toarray") else np.asarray(m, dtype=float))
                 for m in (free_system.mass, free_system.stiffness))
         lam = scipy.linalg.eigvals(K, M)
         lam = np.real(lam[np.isfinite(lam) & (np.real(lam) > 0)])
-        free = nearest_to_range(np.sqrt(lam) / (2 * np.pi), f_low_hz, f_high_hz)
+        free = np.sort(np.sqrt(lam) / (2 * np.pi))
         if not self.has_damper:
-            return free, free
+            return free, np.zeros(0)
         system, stuck = self.hbm_system((1,)), []
-        for mode in range(system.n_dof):          # upwards until a mode lies above the range
+        for mode in range(system.n_dof):          # upwards until a mode lies above f_max_hz
             try:
                 omega = linear_stuck_mode(self, system, mode)[0]
             except (ValueError, np.linalg.LinAlgError):   # no such mode, or a repeated one
                 break
             stuck.append(omega / (2 * np.pi))
-            if stuck[-1] > f_high_hz:
+            if stuck[-1] > f_max_hz:
                 break
-        return free, nearest_to_range(stuck, f_low_hz, f_high_hz)
+        return free, np.array(stuck)
 
     def amplitude_stop(self, basis: HarmonicBasis, stop_above: float | None, direction: int = 0):
         """The continuation's ``stop_when`` for ``stop_above`` [m] (None: None): a message once the
@@ -1374,8 +1417,10 @@ class DiskResponse(FrequencyResponse):
         """(n,) first-harmonic tip amplitude |u_x| at every point [m] (its largest is the peak)."""
         return self.tip_amplitude[:, 0]
 
-    def plot(self, ax=None, *, direction: int = 0, label: str | None = None, **kwargs):
-        """Tip amplitude [mm] over frequency [Hz] (the paper's Fig. 4-6 style)."""
+    def plot(self, ax=None, *, direction: int = 0, label: str | None = None, measured=None, **kwargs):
+        """Tip amplitude [mm] over frequency [Hz] (the paper's Fig. 4-6 style). ``measured``: a
+        measurement or its file drawn beside it in mm (:func:`bladedamp.measurement.draw_measurement`;
+        an FRF times the disk's excitation force)."""
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -1393,4 +1438,8 @@ class DiskResponse(FrequencyResponse):
         ax.legend()
         if not self.success:
             ax.set_title(f"incomplete: {self.message}", fontsize=8)
+        if measured is not None:
+            from .measurement import draw_measurement
+
+            draw_measurement(ax, measured, model=self.disk)
         return ax

@@ -60,7 +60,7 @@ from .contact.point import MAX_PASSES, PERIODIC_TOL
 from .damper.kinetics import seat
 from .disk import (AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION, DAMPER_DOFS, STOP_CHECK_OFFSET_HZ,
                    DamperContacts, TunedDisk, contact_point_maps, contact_rows, damper_weighted_scales,
-                   fused_point_map_forces, peak_checked_response, point_map_forces, rest_response,
+                   fused_point_map_forces, interblade_phase, peak_checked_response, point_map_forces, rest_response,
                    rotor_speed_in_hz, time_at_peak, time_check_beyond, with_stop_check)
 from .hbm.accuracy import HARMONIC_TOLERANCE
 from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_POINT_BUDGET, Branch, Budget, continuation
@@ -820,7 +820,8 @@ class MistunedDisk:
 
     @property
     def interblade_phase(self) -> float:
-        return 2 * np.pi * self.engine_order / self.n_blades
+        """dphi [rad] in (-pi, pi] of the engine order (:func:`bladedamp.disk.interblade_phase`)."""
+        return interblade_phase(self.engine_order, self.n_blades)
 
     @property
     def active_dampers(self) -> list[int]:
@@ -948,7 +949,7 @@ class MistunedDisk:
         couplings = []
         if active:
             # each damper sampled on its own grid, shifted by its travelling-wave phase (exact tuned = cyclic at any T)
-            grid_phase = np.array([k * dphi for k in active]) if self.engine_order else None
+            grid_phase = np.array([k * dphi for k in active]) if dphi else None
             couplings.append(Coupling(AssemblyContacts(contacts, grid_phase=grid_phase), sparse_real_form(basis, contact_map),
                                       "damper contacts"))
         j1 = basis.cos_index(1)
@@ -1355,10 +1356,13 @@ class MistunedResponse(FrequencyResponse):
         """|W_exc - W_visc - W_friction| / W_exc at every point (whole model)."""
         return np.abs(self.excitation_work - self.viscous_dissipation - self.dissipated_energy) / np.abs(self.excitation_work)
 
-    def plot(self, ax=None, *, tuned=None, direction: int = 0, highlight=None, title: str | None = None):
+    def plot(self, ax=None, *, tuned=None, direction: int = 0, highlight=None, title: str | None = None,
+             measured=None):
         """Tip amplitude of every blade [mm] over frequency [Hz] (the paper's Figs. 13-17);
         ``tuned``: a tuned DiskResponse drawn as a thick dashed line; ``highlight``: blade
-        indices (0-based) drawn in colour and labelled (default: largest and smallest peak)."""
+        indices (0-based) drawn in colour and labelled (default: largest and smallest peak);
+        ``measured``: a measurement or its file drawn beside them in mm
+        (:func:`bladedamp.measurement.draw_measurement`; an FRF times the excitation force)."""
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -1384,4 +1388,8 @@ class MistunedResponse(FrequencyResponse):
         ax.legend(fontsize=8)
         if not self.success:
             ax.set_title(f"incomplete: {self.message}", fontsize=8)
+        if measured is not None:
+            from .measurement import draw_measurement
+
+            draw_measurement(ax, measured, model=self.disk)
         return ax

@@ -545,9 +545,13 @@ class FrequencyResponse(Saveable):
         """Excitation frequency of :attr:`peak_amplitude` [Hz] (the resonance)."""
         return self.peak()[0]
 
-    def plot(self, ax=None, *, dof=0, harmonic: int = 1, scale: float = 1.0, unit: str = "", **kwargs):
+    def plot(self, ax=None, *, dof=0, harmonic: int = 1, scale: float = 1.0, unit: str = "", measured=None,
+             **kwargs):
         """Plot |X_h| of ``dof`` over frequency [Hz] into ``ax`` (a new figure if None); returns
-        the axes. Every response class's ``plot`` takes ``ax`` first, options by keyword."""
+        the axes. Every response class's ``plot`` takes ``ax`` first, options by keyword.
+        ``measured``: a measured displacement (or velocity, acceleration) response or its file,
+        drawn times ``scale`` beside it (:func:`bladedamp.measurement.draw_measurement`; an FRF
+        needs its force: ``measured.at_force(F)``)."""
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -561,4 +565,8 @@ class FrequencyResponse(Saveable):
         if not self.success:
             ax.set_title(f"incomplete: {self.message}", fontsize=8)
         ax.legend()
+        if measured is not None:
+            from .measurement import draw_measurement
+
+            draw_measurement(ax, measured, scale=scale)
         return ax

@@ -587,7 +587,7 @@ def test_response_contact_quantities_of_all_points_at_once_equal_point_by_point(
 # 8. bad input
 # ---------------------------------------------------------------------------------------
 @pytest.mark.parametrize("call, match", [
-    (lambda: reference_disk("cylinder", 1e-3, engine_order=9), "engine_order"),
+    (lambda: reference_disk("cylinder", 1e-3, engine_order=2.5), "engine_order"),
     (lambda: reference_disk("cylinder", 1e-3, engine_order=-1), "engine_order"),
     (lambda: dataclasses.replace(reference_disk("cylinder"), gamma_left=0.0), "gamma_left"),
     (lambda: dataclasses.replace(reference_disk("cylinder"), gamma_right=np.pi / 2), "gamma_right"),
@@ -852,3 +852,59 @@ def test_a_response_without_the_harmonic_error_estimate_is_the_same_branch_and_s
     np.testing.assert_array_equal(bare.tip_amplitude, full.tip_amplitude)
     with pytest.raises(ValueError, match="estimate_harmonic_error"):
         disk.frequency_response(*F_RANGE, harmonics="auto", estimate_harmonic_error=False)
+
+
+# ---------------------------------------------------------------------------------------
+# 9. any engine order: nodal diameter from EO mod n, rotor speed from EO
+# ---------------------------------------------------------------------------------------
+@pytest.mark.parametrize("eo, n, expected", [
+    (0, 16, (0, "standing")), (1, 16, (1, "forward")), (7, 16, (7, "forward")), (8, 16, (8, "standing")),
+    (9, 16, (7, "backward")), (15, 16, (1, "backward")), (16, 16, (0, "standing")), (17, 16, (1, "forward")),
+    (41, 16, (7, "backward")), (2, 5, (2, "forward")), (3, 5, (2, "backward")), (10, 5, (0, "standing")),
+])
+def test_nodal_diameter_of_any_engine_order(eo, n, expected):
+    """k = EO mod n, folded to n - k (backward) above n / 2; the interblade phase has
+    e^{i dphi} = e^{i 2 pi EO / n} and lies in (-pi, pi], negative for a backward wave."""
+    from bladedamp.disk import interblade_phase, nodal_diameter
+    assert nodal_diameter(eo, n) == expected
+    dphi = interblade_phase(eo, n)
+    assert -np.pi < dphi <= np.pi
+    assert abs(np.exp(1j * dphi) - np.exp(2j * np.pi * eo / n)) < 1e-13
+    assert dphi == (2 * np.pi * expected[0] / n) * (-1 if expected[1] == "backward" else 1)
+
+
+def test_engine_order_sets_the_preload_and_the_nodal_diameter_only_its_phase():
+    """16 blades, EO 9 (nodal diameter 7 backward) and EO 16 (nodal diameter 0): accepted; the
+    centrifugal force is m R (Omega_E / EO)^2 with EO itself (Eq. 3, 26), written out here."""
+    m, f = 1e-3, 95.0
+    for eo in (9, 16, 25):
+        disk = reference_disk("cylinder", m, engine_order=eo)
+        force, dforce = disk.centrifugal_force(f)
+        omega_e = 2 * np.pi * f
+        assert force == pytest.approx(m * disk.damper_radius * (omega_e / eo) ** 2, rel=1e-14)
+        assert dforce == pytest.approx(2 * m * disk.damper_radius * omega_e / eo ** 2, rel=1e-14)
+    assert reference_disk("cylinder", m, engine_order=9).nodal_diameter == (7, "backward")
+    assert reference_disk("cylinder", m, engine_order=16).interblade_phase == 0.0
+
+
+def test_backward_wave_differs_from_forward_by_the_preload_only():
+    """4 blades, EO 3 (nodal diameter 1 backward) against EO 1 (forward). Without the damper's
+    inertia its mass enters only through the preload m R (Omega_E / EO)^2, so EO 3 with 9 times
+    the mass has EO 1's preload at every frequency; the reference disk is mirror-symmetric
+    (gamma_L = gamma_R, the beam blade symmetric about its axis), and the mirror image of a
+    backward wave is the forward one: the two frequency responses are equal to rounding.
+    With the same mass the preload differs (by 1/9) and so does the peak."""
+    def tuned(eo, mass):
+        return dataclasses.replace(reference_disk("cylinder", mass, engine_order=eo, damper_inertia=False),
+                                   n_blades=4)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        forward = tuned(1, 1e-3).frequency_response(92.0, 104.0, harmonics=(1,), max_step=0.05)
+        backward = tuned(3, 9e-3).frequency_response(92.0, 104.0, harmonics=(1,), max_step=0.05)
+        lighter = tuned(3, 1e-3).frequency_response(92.0, 104.0, harmonics=(1,), max_step=0.05)
+    assert forward.success and backward.success and lighter.success
+    assert tuned(3, 9e-3).centrifugal_force(97.0) == pytest.approx(tuned(1, 1e-3).centrifugal_force(97.0), rel=1e-14)
+    assert abs(backward.peak_amplitude - forward.peak_amplitude) < 1e-9 * forward.peak_amplitude
+    on_forward = np.interp(forward.frequency_hz, backward.frequency_hz, backward.tip_amplitude[:, 0])
+    assert np.abs(on_forward - forward.tip_amplitude[:, 0]).max() < 1e-6 * forward.peak_amplitude
+    assert abs(lighter.peak_amplitude - forward.peak_amplitude) > 0.1 * forward.peak_amplitude

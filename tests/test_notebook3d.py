@@ -58,8 +58,47 @@ def test_liftoff_callback_is_memoised_and_follows_the_physics():
         assert len(fig.axes) == 3                                  # OL, OR, colour bar
         assert "max r = %.2f" % ref.ratio[0].max() in fig.axes[0].get_title()
         np.testing.assert_allclose(fig.axes[0].collections[0].get_array(), ref.ratio[0])
+        # the one-harmonic map says so, with its own harmonic error estimate, and no warning text
+        assert np.isfinite(ref.harmonic_error) and ref.harmonic_error > 0
+        assert nb3.one_harmonic_label(ref.harmonic_error) in fig._suptitle.get_text()
     finally:
         plt.close(fig)
+
+
+def test_one_harmonic_label_states_the_error_and_what_to_do():
+    from bladedamp.hbm.accuracy import HARMONIC_TOLERANCE
+
+    assert "not estimated" in nb3.one_harmonic_label(float("nan"))
+    within = nb3.one_harmonic_label(0.5 * HARMONIC_TOLERANCE)
+    assert within.startswith("one-harmonic approximation") and "within 1 %" in within
+    above = nb3.one_harmonic_label(0.3)
+    assert "up to about 30 %" in above and "harmonics='auto'" in above
+    assert "Warning" not in above + within
+
+
+def _png_size(png: bytes):
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"
+    return int.from_bytes(png[16:20], "big"), int.from_bytes(png[20:24], "big")
+
+
+@pytest.mark.skipif(mv.chromium_executable() is None, reason="no chromium")
+def test_show_scene_leaves_a_still_and_says_how_to_go_live(cylinder_frf):
+    from IPython.core.interactiveshell import InteractiveShell
+    from IPython.utils.capture import capture_output
+
+    InteractiveShell.instance()
+    scene = mv.ods_scene(cylinder_frf, n_frames=6)
+    png = nb3.scene_snapshot(scene, size=(640, 360))
+    assert _png_size(png) == (640, 360)
+    image = plt.imread(__import__("io").BytesIO(png))
+    assert image[..., :3].reshape(-1, 3).std(axis=0).max() > 0.05        # something drawn, not a blank page
+    with capture_output() as shown:
+        live = nb3.show_scene(scene, height=360)
+    kinds = [list(out.data) for out in shown.outputs]
+    assert "image/png" in kinds[0] and "text/markdown" in kinds[1]
+    assert shown.outputs[1].data["text/markdown"] == nb3.LIVE_VIEW_HINT
+    assert "Trust Notebook" in nb3.LIVE_VIEW_HINT and "jupyter trust" in nb3.LIVE_VIEW_HINT
+    assert live.data == nb3.scene_iframe(scene, 360)
 
 
 def test_misfit_wedge_has_an_open_edge():

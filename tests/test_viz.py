@@ -168,8 +168,7 @@ def test_browser_renders_the_scene_and_its_animation(cylinder_frf, tmp_path):
     if mv.chromium_executable() is None:
         pytest.skip("no chromium on this machine (.ci/run installs the Debian package)")
     empty = mv.Scene()
-    empty.vis["/Grid"].set_property("visible", False)
-    empty.vis["/Axes"].set_property("visible", False)
+    mv.plain_stage(empty.vis)                                      # the scenes' own stage, nothing on it
     shots = {}
     # the whole sector in view (the close-up on a damper, the default, is checked in test_viz_contact.py)
     scenes = {"empty": empty,

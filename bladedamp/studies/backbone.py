@@ -101,8 +101,10 @@ class BackboneDesign(Saveable):
         the level [N] (right). ``axes``: a pair of axes (a new figure if None); returns the pair."""
         import matplotlib.pyplot as plt
 
+        from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
         if axes is None:
-            _, axes = plt.subplots(1, 2, figsize=(11, 4))
+            _, axes = plt.subplots(1, 2, figsize=(11, 4), constrained_layout=True)
         ax, ax2 = axes
         for j, level in enumerate(self.excitation_levels):
             ok = np.isfinite(self.reduction[:, j])
@@ -117,6 +119,10 @@ class BackboneDesign(Saveable):
         ax2.set_xlabel("excitation level [N]")
         ax2.set_ylabel("optimal damper mass [g]")
         ax2.grid(True, which="both", alpha=0.3)
+        for axis in (ax.xaxis, ax2.xaxis, ax2.yaxis):      # plain labels at 1, 2, 5 x 10^k, none between
+            axis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+            axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+            axis.set_minor_formatter(NullFormatter())
         return axes
 
 

@@ -131,7 +131,7 @@ def engine_order_sweep(disk: TunedDisk, engine_orders=range(0, 9), mass_bounds=(
     Parameters
     ----------
     disk : TunedDisk with a damper (its mass is the one thing not used: it is optimised)
-    engine_orders : EOs in 0..n/2 (non-empty)
+    engine_orders : EOs >= 0 (non-empty; above n/2 the backward waves, :func:`bladedamp.disk.nodal_diameter`)
     mass_bounds : (low, high) [kg], 0 < low < high
     rotor_speed_eo0_hz : rotor speed at EO = 0 [Hz] (> 0) if the disk has none; otherwise
         Omega_R = Omega_E / EO (or the disk's fixed rotor speed)
@@ -162,12 +162,11 @@ def engine_order_sweeps(disks, engine_orders=range(0, 9), mass_bounds=(1e-5, 2e-
         raise ValueError("disks must be a non-empty sequence of TunedDisk with a damper")
     for disk in disks:
         _check_disk(disk)
-    n_max = min(disk.n_blades for disk in disks) // 2
     eos = np.atleast_1d(np.asarray(list(engine_orders) if not np.isscalar(engine_orders) else [engine_orders]))
     if eos.size == 0:
-        raise ValueError(f"engine_orders must be a non-empty range of integers in [0, {n_max}]")
+        raise ValueError("engine_orders must be a non-empty range of integers >= 0")
     for eo in eos:
-        validation.integer("engine_orders", eo, minimum=0, maximum=n_max)
+        validation.integer("engine_orders", eo, minimum=0)
     bounds = _check_mass_bounds(mass_bounds)
     validation.positive("rotor_speed_eo0_hz", rotor_speed_eo0_hz)
     f_range = _check_f_range(f_range_hz)
@@ -433,6 +432,8 @@ class LiftoffMap(Saveable):
     static_approach : (2, P) a_static [m]
     normal_amplitude : (2, P) |w_zeta,1| [m]
     peak_frequency_hz : [Hz]; peak_amplitude : [m]; n_samples : time samples per period of the AFT
+    harmonic_error : the one-harmonic response's harmonic error estimate at its peak [-] (relative
+        change of the tip amplitude with the static term and more harmonics; NaN if not estimated)
     """
 
     xi_star: np.ndarray
@@ -445,6 +446,7 @@ class LiftoffMap(Saveable):
     peak_frequency_hz: float
     peak_amplitude: float
     n_samples: int
+    harmonic_error: float = float("nan")
 
     @property
     def lifts_off(self) -> np.ndarray:
@@ -491,7 +493,8 @@ def wedge_liftoff_map(disk: TunedDisk, f_range_hz=(90.0, 105.0)) -> LiftoffMap:
     min_a = a_t.min(axis=0)
     xi_s, eta_s = geometry.patches[0].normalised_coordinates
     return LiftoffMap(xi_s, eta_s, amplitude / a_static, (a_static - min_a) / a_static, min_a, a_static,
-                      amplitude, float(r.frequency_hz[i]), float(r.tip_amplitude[i, 0]), basis.n_samples)
+                      amplitude, float(r.frequency_hz[i]), float(r.tip_amplitude[i, 0]), basis.n_samples,
+                      float(r.harmonic_error))
 
 
 # ---------------------------------------------------------------------------------------

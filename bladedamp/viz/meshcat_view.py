@@ -75,6 +75,8 @@ STATE_COLORS = np.array([palette.rgb(c) for c in palette.CONTACT_STATES])   # st
 BLADE_COLOR = 0xb8c2cc
 PLATFORM_COLOR = 0x8796a6
 DAMPER_COLOR = 0xd4a017
+BACKGROUND_TOP = (0.97, 0.97, 0.97)      # rgb in [0, 1]: a neutral light grey
+BACKGROUND_BOTTOM = (0.82, 0.82, 0.82)
 ROOT = "bladedamp"
 _REPETITIONS = 100000   # set_animation(repetitions=0) never plays in meshcat 0.3.2: a large positive count
 
@@ -476,6 +478,15 @@ def _rigid(u, phi, about) -> np.ndarray:
 # --------------------------------------------------------------------------------------
 # scene builders
 # --------------------------------------------------------------------------------------
+def plain_stage(vis) -> None:
+    """No grid, no axes, and a light grey background instead of meshcat's blue gradient (a blue
+    behind the blades would read as the stick colour)."""
+    vis["/Grid"].set_property("visible", False)
+    vis["/Axes"].set_property("visible", False)
+    vis["/Background"].set_property("top_color", list(BACKGROUND_TOP))
+    vis["/Background"].set_property("bottom_color", list(BACKGROUND_BOTTOM))
+
+
 def _mesh_geometry(mesh, color=None):
     return mg.TriangularMeshGeometry(mesh.vertices, mesh.faces, color)
 
@@ -739,8 +750,7 @@ def ods_scene(result, index: int | None = None, frequency_hz: float | None = Non
     has_damper = disk.has_damper and data.states is not None
     scene = Scene()
     vis = scene.vis
-    vis["/Grid"].set_property("visible", False)
-    vis["/Axes"].set_property("visible", False)
+    plain_stage(vis)
 
     # a solid FE blade (bladedamp.solid.SolidModalBlade) brings its boundary surface and the
     # mode shapes there: drawn deformed (exact superposition) instead of the beam's segments
@@ -1200,8 +1210,7 @@ def contact_map_scene(result, index: int | None = None, frequency_hz: float | No
     data = cycle_data(result, index, frequency_hz)
     scene = Scene()
     vis = scene.vis
-    vis["/Grid"].set_property("visible", False)
-    vis["/Axes"].set_property("visible", False)
+    plain_stage(vis)
     origin = np.zeros(3)
     samples = _add_contact_maps(scene, data, origin, n_frames)
     anim = meshcat.animation.Animation(default_framerate=n_frames / period_s) if animate else None

@@ -1,10 +1,10 @@
 """Helpers of notebook 04 (contact in 3D): plain functions, values in, data or figures out.
 
-* :func:`embed_scene` / :func:`save_scene`: show a recorded meshcat :class:`~bladedamp.viz.Scene`
+* :func:`show_scene` (a PNG still, then the live view), :func:`embed_scene` / :func:`save_scene`: show a recorded meshcat :class:`~bladedamp.viz.Scene`
   in a notebook cell (an ``<iframe srcdoc>`` of its standalone HTML) or write it to a file and
   link it. Neither starts a meshcat server: the scene is recorded in-process.
 * :func:`wedge_disk`, :func:`liftoff_case`, :func:`liftoff_figure`: the reference wedge's
-  lift-off map (Fig. 9) for a contact height and tip excitation, memoised, so a slider moved
+  lift-off map (Fig. 9), labelled as the one-harmonic approximation it is (:func:`one_harmonic_label`) for a contact height and tip excitation, memoised, so a slider moved
   back answers at once (a new value costs one continuation run over a narrow window, ~1 s).
 * :func:`misfit_wedge_disk`: the wedge with one face angle off by a few degrees
   (:func:`bladedamp.geometry.misfit_gaps` -> ``TunedDisk(initial_gaps=...)``).
@@ -24,6 +24,7 @@ from __future__ import annotations
 import dataclasses
 import html as _html
 import os
+import subprocess
 from functools import lru_cache
 
 import numpy as np
@@ -49,6 +50,47 @@ def embed_scene(scene, height: int = 480):
     from IPython.display import HTML
 
     return HTML(scene_iframe(scene, height))
+
+
+#: what the still of a 3D view says under it, in a notebook
+LIVE_VIEW_HINT = ("A still of the 3D view. The live view below (drag to turn, scroll to zoom, the cycle "
+                  "animates) shows once the notebook is trusted: in JupyterLab File > Trust Notebook, or "
+                  "`jupyter trust` on the file; running the cell rebuilds it.")
+
+
+def scene_snapshot(scene, size=(900, 520)) -> bytes | None:
+    """PNG bytes of ``scene`` rendered by headless Chromium (software WebGL) at ``size`` (width,
+    height) [px], or None when no Chromium is installed or it drew nothing."""
+    import tempfile
+
+    from .meshcat_view import chromium_executable, screenshot
+
+    if chromium_executable() is None:
+        return None
+    with tempfile.TemporaryDirectory() as tmp:
+        page = scene.save_html(os.path.join(tmp, "scene.html"))
+        try:
+            png = screenshot(page, os.path.join(tmp, "scene.png"), size=size, virtual_time_ms=2000)
+        except (RuntimeError, OSError, subprocess.SubprocessError):
+            return None
+        with open(png, "rb") as f:
+            return f.read()
+
+
+def show_scene(scene, height: int = 480):
+    """Display a PNG still of ``scene`` (:func:`scene_snapshot`) with :data:`LIVE_VIEW_HINT` under
+    it, then return :func:`embed_scene`'s live view. The still is what a notebook shows where the
+    live view cannot be drawn (an untrusted notebook, a static viewer); without Chromium the
+    line says that no still was made."""
+    from IPython.display import Image, Markdown, display
+
+    png = scene_snapshot(scene, size=(900, height))
+    if png is not None:
+        display(Image(data=png, format="png"))
+        display(Markdown(LIVE_VIEW_HINT))
+    else:
+        display(Markdown("No still of the 3D view (it needs Chromium). " + LIVE_VIEW_HINT.split(". ", 1)[1]))
+    return embed_scene(scene, height)
 
 
 def save_scene(scene, path, text: str | None = None):
@@ -112,10 +154,24 @@ def liftoff_figure(contact_height_mm: float = 2.0, force_n: float = 0.1, mass_g:
         ax.set_xlim(-0.65, 0.65)
         ax.set_ylim(-0.65, 0.65)
     axes[0].set_ylabel("xi* = xi / h_C (across the height)")
-    fig.colorbar(sc, ax=axes, label="r = |w_zeta,1| / a_static  (r > 1, red ring: lifts off)")
+    fig.colorbar(sc, ax=axes, label="lift-off ratio r (red ring: r > 1)")
     fig.suptitle(f"wedge {mass_g:g} g, h_C = {contact_height_mm:g} mm, F_x = {force_n:g} N: "
-                 f"resonance {m.peak_frequency_hz:.2f} Hz, tip {1e3 * m.peak_amplitude:.3f} mm", fontsize=10)
+                 f"resonance {m.peak_frequency_hz:.2f} Hz, tip {1e3 * m.peak_amplitude:.3f} mm\n"
+                 + one_harmonic_label(m.harmonic_error), fontsize=10)
     return fig
+
+
+def one_harmonic_label(harmonic_error: float) -> str:
+    """One plain line naming a result of the one-harmonic model (the paper's) as the approximation
+    it is: how far its amplitudes may be off by the harmonic error estimate [-], and what to do."""
+    from ..hbm.accuracy import HARMONIC_TOLERANCE
+
+    if not np.isfinite(harmonic_error):
+        return "one-harmonic approximation (as in the paper); its error was not estimated"
+    if harmonic_error <= HARMONIC_TOLERANCE:
+        return f"one-harmonic approximation (as in the paper), within {100 * HARMONIC_TOLERANCE:g} % of the converged one"
+    return (f"one-harmonic approximation (as in the paper): amplitudes may be off by up to about "
+            f"{100 * harmonic_error:.0f} %; harmonics='auto' computes the converged ones")
 
 
 # --------------------------------------------------------------------------------------
