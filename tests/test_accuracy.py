@@ -373,3 +373,27 @@ def test_default_disk_frf_meets_the_tolerance(kind, mass, expected):
     assert not r.stopped_by                                     # the default budget is not met
     assert r.harmonic_error <= r.harmonic_tolerance == 0.01
     assert max(r.basis.harmonics) > 3 and max(r.basis.harmonics) <= max(expected)   # (0..3) is 2-5 % off
+
+
+def test_a_budget_that_runs_out_on_a_richer_set_keeps_the_complete_branch_of_the_poorer_one():
+    """The automatic choice never replaces a branch that reached the end of its range by a
+    partial one: where the budget runs out on the branch of a richer harmonic set, the answer is
+    the poorer set's complete branch with its own error estimate, OUT_OF_BUDGET (the search
+    stopped), the message naming the set that did not finish. The reference 1 g cylinder's (0, 1)
+    branch is above the 1 % tolerance (the automatic choice goes on to (0, 1, 2, 3)); a point
+    budget 10 points longer than that branch runs out on the (0, 1, 2, 3) branch."""
+    import bladedamp as bd
+    from bladedamp.response import Status
+
+    disk = bd.reference_disk("cylinder", 1e-3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        poorer = disk.frequency_response(90.0, 105.0, harmonics=(0, 1))
+        assert poorer.success and poorer.harmonic_error > poorer.harmonic_tolerance, poorer.message
+        r = disk.frequency_response(90.0, 105.0, point_budget=len(poorer.omega) + 10)
+    assert r.basis.harmonics == (0, 1) and r.status is Status.OUT_OF_BUDGET and not r.success
+    np.testing.assert_array_equal(r.omega, poorer.omega)
+    np.testing.assert_array_equal(r.coefficients, poorer.coefficients)
+    assert r.harmonic_error == poorer.harmonic_error
+    assert r.stopped_by.startswith("budget: ") and r.stopped_by in r.message
+    assert "harmonics (0, 1, 2, 3) stopped before the end of the range" in r.message

@@ -38,6 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..response import BUDGET_PREFIX
 from .continuation import newton
 from .fourier import HarmonicBasis
 from .linsolve import one_blas_thread
@@ -203,7 +204,11 @@ def converged_response(model, solve, harmonics="auto", tolerance: float = HARMON
 
     ``harmonics="auto"``: the sets of :func:`auto_sets` (``max_harmonic``) in turn until one meets
     ``tolerance``; otherwise the given set, checked once. A set whose branch fails (does not reach the end of the range) is
-    followed by the next richer one in the automatic choice. ``estimate=False`` (a given set
+    followed by the next richer one in the automatic choice. Where a budget
+    (:class:`~bladedamp.hbm.continuation.Budget`) stops a richer set's branch after a poorer
+    set's reached the end, or a stop leaves a richer set without a point, the poorer set's
+    branch is returned with its estimate, not ``success``, its ``stopped_by`` the stop's and its
+    message naming the set not finished. ``estimate=False`` (a given set
     only): no estimate (``harmonic_error`` NaN, ``harmonics_converged`` None: "not estimated"),
     for a study that estimates it on a representative case instead (the Monte Carlo's first disk)."""
     if isinstance(harmonics, str):
@@ -219,13 +224,18 @@ def converged_response(model, solve, harmonics="auto", tolerance: float = HARMON
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", AccuracyWarning)
                 response = solve(tuple(H))
-                if response.stopped_by and best is not None and not len(response.omega):
-                    # stopped before its first point (a budget that ran out): the branch of the
-                    # poorer set is kept, its status saying the search was stopped
+                ran_out = response.stopped_by.startswith(BUDGET_PREFIX)
+                if response.stopped_by and best is not None and (not len(response.omega)
+                                                                 or (ran_out and best[0].success)):
+                    # stopped before its first point, or a budget that ran out on a richer set's
+                    # branch after a poorer set's reached the end: the branch of the poorer set is
+                    # kept (a complete branch is never replaced by a partial one), its status
+                    # saying the search was stopped
                     kept = annotate(best[0], best[1], tolerance)
+                    what = (f"not computed: {response.stopped_by}" if not len(response.omega) else
+                            f"stopped before the end of the range: {response.stopped_by}")
                     return dataclasses.replace(kept, success=False, stopped_by=response.stopped_by,
-                                               message=f"{kept.message}; harmonics {tuple(H)} not computed: "
-                                                       f"{response.stopped_by}")
+                                               message=f"{kept.message}; harmonics {tuple(H)} {what}")
                 if response.stopped_by:
                     return response           # stopped as the caller asked: no estimate, no richer set
                 check = harmonic_error(model, response, n_points=n_points) if len(response.omega) else None
