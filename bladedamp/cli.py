@@ -446,6 +446,8 @@ def precompile_command(args) -> int:
 
 def frf_command(args) -> int:
     """``bladedamp frf``: the frequency response of the design at each of its engine orders."""
+    import dataclasses
+
     from .report import frf_outputs
 
     t0 = time.perf_counter()
@@ -469,7 +471,13 @@ def frf_command(args) -> int:
         progress(f"mistuned full assembly at EO = {design.disk.engine_order}")
         responses[f"mistuned_EO{design.disk.engine_order}"] = design.mistuned_disk().frequency_response(
             a.f_start_hz, a.f_end_hz, **checks, **a.options())
-    summary = frf_outputs(out, design, responses)
+    undamped = {}
+    if design.disk.has_damper:      # the damper-free reference of the figure: linear, one harmonic is exact
+        progress("damper-free reference responses")
+        for eo in design.engine_orders:
+            undamped[f"EO{eo}"] = dataclasses.replace(design.disk_at(eo), damper=None).frequency_response(
+                a.f_start_hz, a.f_end_hz, harmonics=(1,), max_step=a.max_step, estimate_harmonic_error=False)
+    summary = frf_outputs(out, design, responses, undamped)
     peaks = ", ".join(f"{k} peak {v['peak_amplitude_mm']:.4f} mm at {v['peak_frequency_hz']:.3f} Hz"
                       if v["peak_amplitude_mm"] is not None else f"{k} no points"
                       for k, v in summary["responses"].items())
@@ -500,7 +508,8 @@ def optimize_command(args) -> int:
     progress = Progress()
     options = dict(f_range_hz=a.f_range_hz, harmonics=a.study_harmonics)
     progress(f"optimal mass in {1e3 * a.mass_bounds[0]:g}-{1e3 * a.mass_bounds[1]:g} g")
-    optimum = optimal_mass(disk, a.mass_bounds, processes=args.processes, progress=progress.bar("mass grid"), **options)
+    optimum = optimal_mass(disk, a.mass_bounds, processes=args.processes, progress=progress.bar("mass grid"),
+                           complete_grid=True, **options)      # the whole curve for optimize.png
     angles = heights = None
     if args.gamma_right_deg:
         angles = platform_angle_study(disk, args.gamma_right_deg, mass_bounds=a.mass_bounds, processes=args.processes,
@@ -646,6 +655,13 @@ def _validate_flags(args) -> None:
             validation.integer("--seed", args.seed, minimum=0)
     except ValueError as exc:
         raise UsageError(str(exc)) from None
+    if hasattr(args, "format"):
+        from .plotting import check_figure_output
+
+        try:
+            args.format, args.dpi = check_figure_output(args.format, args.dpi)
+        except ValueError as exc:
+            raise UsageError(f"--{exc}") from None
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -665,6 +681,12 @@ def build_parser() -> argparse.ArgumentParser:
     def out_arg(p, default):
         p.add_argument("--out", type=Path, default=Path(default),
                        help=f"output folder, created if needed and checked before computing (default: {default})")
+
+    def figure_args(p):
+        p.add_argument("--format", default="png", metavar="FORMATS",
+                       help="file formats of the figures, comma-separated from png, svg, pdf (default: png)")
+        p.add_argument("--dpi", type=int, default=120,
+                       help="resolution of the PNG figures in dots per inch, in [10, 2400] (default: 120)")
 
     def processes_arg(p):
         p.add_argument("--processes", type=int, default=None,
@@ -692,6 +714,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "and gives a direct harmonic error estimate, or fails the branch where the vibration there does\n"
                         "not settle; not for solid FE blades with flexible platforms)")
     out_arg(p, "results/frf")
+    figure_args(p)
 
     p = command("optimize", optimize_command, "optimal damper mass of a design",
                 "The damper mass of the lowest resonance amplitude in [analysis] mass_range_g (global on a log\n"
@@ -705,6 +728,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="also optimise the mass at each of these wedge contact heights [mm], in (0, 100]")
     processes_arg(p)
     out_arg(p, "results/optimize")
+    figure_args(p)
 
     p = command("eo-sweep", eo_sweep_command, "optimal damper mass over engine orders",
                 "At each engine order the mass is re-optimised in [analysis] mass_range_g (Fig. 7, 8 of the\n"
@@ -715,6 +739,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="engine orders in [0, n_blades / 2] (default: the design's [disk] engine_order)")
     processes_arg(p)
     out_arg(p, "results/eo-sweep")
+    figure_args(p)
 
     p = command("montecarlo", monte_carlo_command, "Monte Carlo of randomly mistuned disks (Dask)",
                 "Peak amplification (largest blade over the tuned peak) of N disks with Gaussian frequency\n"
@@ -742,6 +767,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--tol", type=float, default=None,
                    help="continuation tolerance per disk, in (0, 1) (default 1e-6; 1e-10 for full FRF accuracy)")
     out_arg(p, "results/montecarlo")
+    figure_args(p)
 
     p = command("show", show_command, "3D view of a design's resonance (standalone HTML)",
                 "The operating deflection shape at the resonance with the contact states of every point, as an\n"
@@ -758,6 +784,7 @@ def build_parser() -> argparse.ArgumentParser:
                 "the paper's numbers, with a verdict per row. Writes summary.json, report.md and the figures.\n"
                 "About 2 min on two cores.")
     out_arg(p, "results")
+    figure_args(p)
     processes_arg(p)
 
     command("precompile", precompile_command, "compile every numba kernel once, ahead of the first run",
@@ -775,7 +802,12 @@ def main(argv=None) -> int:
 
     try:
         _validate_flags(args)
-        return args.run(args)
+        if not hasattr(args, "format"):
+            return args.run(args)
+        from .plotting import figure_output
+
+        with figure_output(args.format, args.dpi):
+            return args.run(args)
     except (DesignError, UsageError) as exc:
         print(f"bladedamp {args.command}: error: {exc}", file=sys.stderr)
         return 2

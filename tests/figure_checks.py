@@ -9,10 +9,13 @@ rules (:func:`check_figure` asserts the list is empty):
   figure texts, each legend as one box) overlap by more than :data:`OVERLAP_PX` in both
   directions, and every text box lies inside the figure (nothing cut at an edge);
 * visible series: every plotted series (a line or scatter in data coordinates; lines drawn in
-  axes coordinates such as ``axhline`` are references, not series) has a finite point inside the
+  axes coordinates such as ``axhline`` are references, not series, and a line without data is a
+  legend entry's proxy) has a finite point inside the
   axes' limits; a series of two or more points spans at least :data:`MIN_SPAN` of the axes'
-  height (not a flat line) and no point whose x is within the limits lies above or below the
-  y limits (not clipped);
+  height (not a flat line; markers without a line, such as the points of a search, and a
+  reference drawn with ``gid="reference"``, such as the damper-free level over engine order,
+  may be flat) and no point whose x is within the limits lies above or
+  below the y limits (not clipped);
 * title: the figure's titles (suptitle, every axes' titles) together name the design.
 
 The boxes are those of the texts actually drawn: :meth:`matplotlib.text.Text.draw` is watched
@@ -98,14 +101,16 @@ def overlap_problems(fig, renderer, drawn) -> list[str]:
 
 
 def _series(ax):
-    """[(name, xy (k, 2) data)] of the lines and scatters of ``ax`` drawn in data coordinates."""
+    """[(name, xy (k, 2) data, may be flat)] of the lines and scatters of ``ax`` drawn in data coordinates."""
     out = []
     for line in ax.get_lines():
         if line.get_visible() and line.get_transform() is ax.transData:
-            out.append((f"line {line.get_label()!r}", np.asarray(line.get_xydata(), dtype=float)))
+            flat_ok = line.get_gid() == "reference" or line.get_linestyle() in ("None", "", " ")
+            out.append((f"line {line.get_label()!r}", np.asarray(line.get_xydata(), dtype=float), flat_ok))
     for coll in ax.collections:
         if isinstance(coll, PathCollection) and coll.get_visible() and coll.get_offset_transform() is ax.transData:
-            out.append((f"scatter {coll.get_label()!r}", np.asarray(coll.get_offsets(), dtype=float)))
+            out.append((f"scatter {coll.get_label()!r}", np.asarray(coll.get_offsets(), dtype=float),
+                        coll.get_gid() == "reference"))
     return out
 
 
@@ -116,7 +121,9 @@ def series_problems(fig) -> list[str]:
         where = f"axes {k} ({ax.get_title() or 'untitled'})"
         (x0, x1), (y0, y1) = sorted(ax.get_xlim()), sorted(ax.get_ylim())
         to_axes = ax.transData + ax.transAxes.inverted()
-        for name, xy in _series(ax):
+        for name, xy, flat_ok in _series(ax):
+            if not len(xy):
+                continue            # a legend entry's proxy, no data
             xy = xy[np.all(np.isfinite(xy), axis=1)]
             if ax.get_xscale() == "log":
                 xy = xy[xy[:, 0] > 0]
@@ -134,7 +141,7 @@ def series_problems(fig) -> list[str]:
                 out.append(f"{where}: {name} is clipped ({int(np.sum(in_x & ~in_y))} points above or below "
                            f"the y limits {y0:.4g}-{y1:.4g})")
             shown = to_axes.transform(xy[in_x & in_y])
-            if len(np.unique(xy, axis=0)) >= 2 and np.ptp(shown[:, 1]) < MIN_SPAN:
+            if len(np.unique(xy, axis=0)) >= 2 and np.ptp(shown[:, 1]) < MIN_SPAN and not flat_ok:
                 out.append(f"{where}: {name} spans {100 * np.ptp(shown[:, 1]):.0f} % of the axes' height "
                            f"(at least {100 * MIN_SPAN:.0f} %): flat")
     return out

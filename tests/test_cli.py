@@ -352,3 +352,76 @@ def test_progress_bar_in_place_on_a_terminal_and_one_line_otherwise():
             tick(done, 10)
     assert log.getvalue().count("\n") == 1 and "mass sweep done (10)" in log.getvalue()
     assert "\r" in tty.getvalue() and "10/10" in tty.getvalue() and "mass sweep done (10)" in tty.getvalue()
+
+
+# ---------------------------------------------------------------------------------------
+# the commands' figures (tests/figure_checks.py through the saved_figures fixture)
+# ---------------------------------------------------------------------------------------
+def _png_size(path):
+    import matplotlib.image
+
+    height, width = matplotlib.image.imread(path).shape[:2]
+    return width, height
+
+
+def test_frf_figure_shows_the_undamped_response_dashed_and_the_annotated_peak(fast_design, tmp_path, saved_figures):
+    out = tmp_path / "frf"
+    assert main(["frf", str(fast_design), "--no-stop-check", "--no-peak-check", "--format", "png,svg,pdf",
+                 "--dpi", "60", "--out", str(out)]) == 0
+    summary, results = _outputs(out, "frf.png", "frf.svg", "frf.pdf", "summary.md", "results.json")
+    assert "`frf.png`, `frf.svg`, `frf.pdf`" in summary
+    assert (out / "frf.pdf").read_bytes().startswith(b"%PDF") and b"<svg" in (out / "frf.svg").read_bytes()
+    saved_figures.check("design")
+    _, titles, fig = saved_figures["frf"]
+    assert "cylinder damper 1 g, 16 blades" in titles[0] and "frf" not in titles[0]
+    w, h = fig.get_size_inches()
+    assert _png_size(out / "frf.png") == (round(60 * w), round(60 * h))          # --dpi respected
+    ax = fig.axes[0]
+    dashed = [line for line in ax.get_lines() if line.get_linestyle() == "--"]
+    assert len(dashed) == 1 and "no damper" in dashed[0].get_label()
+    # the damper-free peak is the reference calibration's 1.7 mm (bladedamp.reference)
+    assert dashed[0].get_ydata().max() == pytest.approx(1.7, rel=0.01)
+    r = results["responses"]["EO1"]
+    assert r["undamped_peak_amplitude_mm"] == pytest.approx(dashed[0].get_ydata().max())
+    notes = [t.get_text() for t in ax.texts]
+    assert notes == [f"peak {r['peak_amplitude_mm']:.3g} mm at {r['peak_frequency_hz']:.2f} Hz"]
+    marked = [line for line in ax.get_lines() if line.get_marker() == "o"]
+    assert len(marked) == 1 and marked[0].get_ydata()[0] == pytest.approx(r["peak_amplitude_mm"])
+
+
+def test_optimize_figure_draws_the_optimum_inside_the_curve_of_every_mass(fast_design, tmp_path, saved_figures):
+    out = tmp_path / "opt"
+    assert main(["optimize", str(fast_design), "--processes", "1", "--format", "svg", "--out", str(out)]) == 0
+    summary, results = _outputs(out, "optimize.svg", "summary.md", "results.json")
+    assert not (out / "optimize.png").exists() and "`optimize.svg`" in summary
+    saved_figures.check("design")
+    fig = saved_figures["optimize"][2]
+    ax = fig.axes[0]
+    assert ax.get_xscale() == "log"
+    m = results["mass"]
+    grid_m, grid_p = np.array(m["grid_mass_g"]), np.array(m["grid_peak_amplitude_mm"])
+    assert np.all(np.isfinite(grid_p))                 # the masses stopped by branch and bound were completed
+    curve = next(line for line in ax.get_lines() if "every mass evaluated" in line.get_label())
+    x, y = curve.get_xdata(), curve.get_ydata()
+    assert np.all(np.isin(np.round(grid_m, 9), np.round(x, 9)))                  # every grid mass on the curve
+    star = next(line for line in ax.get_lines() if line.get_marker() == "*")
+    xs, ys = star.get_xdata()[0], star.get_ydata()[0]
+    assert xs == pytest.approx(m["optimal_mass_g"]) and x.min() < xs < x.max()    # inside the curve
+    assert ys == pytest.approx(y.min())                # the lowest point of the curve it lies on
+    assert y[0] > 1.2 * ys and y[-1] > 1.1 * ys         # the rise on both sides of the optimum
+
+
+@pytest.mark.parametrize("args, needles", [(["--format", "png,jpg"], ["--format", "'jpg'", "png, svg, pdf"]),
+                                           (["--dpi", "0"], ["--dpi 0", "[10, 2400]"])])
+def test_bad_figure_options_exit_2_with_one_line(fast_design, tmp_path, capsys, args, needles):
+    assert main(["frf", str(fast_design), *args, "--out", str(tmp_path / "x")]) == 2
+    _one_error_line(capsys, *needles)
+    assert not (tmp_path / "x").exists()
+
+
+def test_every_command_that_draws_takes_format_and_dpi():
+    parser = build_parser()
+    for command in ("frf", "optimize", "eo-sweep", "montecarlo", "reproduce"):
+        args = parser.parse_args([command, "d.toml", "--format", "svg,pdf", "--dpi", "300"] if command != "reproduce"
+                                 else [command, "--format", "svg,pdf", "--dpi", "300"])
+        assert (args.format, args.dpi) == ("svg,pdf", 300), command

@@ -132,3 +132,15 @@ def test_log_axes_and_a_single_marker_pass():
     ax.set(xlabel="damper mass [g]", ylabel="peak [mm]", title="rotor A")
     fig.tight_layout()
     assert figure_problems(fig, "rotor A") == []
+
+
+def test_a_flat_reference_or_markers_may_be_flat_but_must_be_inside():
+    fig, ax, _ = good()
+    ax.plot(F, np.full_like(F, 1.0), ls="--", gid="reference", label="no damper, over frequency")
+    ax.plot([94.0, 95.0, 96.0], [1.5, 1.51, 1.5], "x", label="search points")
+    assert figure_problems(fig, "rotor A") == []
+    ax.plot(F, np.full_like(F, 1.0), ls="--", label="the same without its gid")
+    assert any("without its gid" in p and "flat" in p for p in figure_problems(fig, "rotor A"))
+    ax.plot([120.0], [1.0], "x", label="a marker outside")
+    ax.set_xlim(90.0, 100.0)
+    assert any("a marker outside" in p and "outside" in p for p in figure_problems(fig, "rotor A"))

@@ -23,10 +23,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import validation
+from .. import palette, validation
 from ..disk import TunedDisk
 from ..io import Saveable, npz_path
-from ..plotting import place_legend
+from ..plotting import place_legend, save_figure
 from ..mistuned import MistunedDisk, MistunedResponse
 
 PAPER_STD = 0.02
@@ -428,8 +428,7 @@ def plot_cases(cases: dict[str, MistuningCase], path=None):
     for ax, _ in zip(axes.ravel(), cases):
         place_legend(ax, fontsize=8)       # clear of every curve (the largest peak included)
     if path is not None:
-        fig.savefig(path, dpi=110)
-        plt.close(fig)
+        save_figure(fig, path)
     return fig
 
 
@@ -571,13 +570,13 @@ class MonteCarloResult(Saveable):
         if ax is None:
             _, ax = plt.subplots(figsize=(6, 4))
         a = self.amplification[self.valid]
-        ax.hist(a, bins=bins, color="C0", alpha=0.8)
+        ax.hist(a, bins=bins, color=palette.series(0), alpha=0.8)
         lo, hi = self.confidence_interval()
         ax.axvline(a.mean(), color="k", label=f"mean {a.mean():.3f} (95 % CI {lo:.3f}-{hi:.3f})")
-        ax.axvline(1.0, color="k", ls="--", lw=1, label="tuned")
-        ax.set_xlabel("peak amplification (max blade / tuned)")
-        ax.set_ylabel("disks")
-        ax.legend(fontsize=8)
+        ax.axvline(1.0, color=palette.UNDAMPED, ls="--", lw=1, label="tuned")
+        ax.set_xlabel("peak amplification, largest blade / tuned [-]")
+        ax.set_ylabel("number of disks [-]")
+        place_legend(ax, fontsize=8)
         return ax
 
 

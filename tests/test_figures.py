@@ -1,0 +1,179 @@
+"""Every figure the product draws outside the notebooks and the 3D view, checked by
+tests/figure_checks.py (units, no overlapping or cut text, every series visible, a title naming
+the design): the result classes' ``.plot()`` and the report's figures, on small results built
+from closed forms (no solve), and the figure helpers of bladedamp.plotting."""
+import dataclasses
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+from figure_checks import check_figure  # noqa: E402
+
+from bladedamp import report  # noqa: E402
+from bladedamp.plotting import DEFAULT_DPI, figure_output, save_figure  # noqa: E402
+from bladedamp.studies.design import ContactState, DesignMap, EngineOrderSweep, LiftoffMap, PlatformAngleStudy  # noqa: E402
+from bladedamp.studies.mass import MassOptimum, MassSweep  # noqa: E402
+from bladedamp.studies.mistuning import MonteCarloResult  # noqa: E402
+
+UNDAMPED = 1.7e-3
+
+
+def valley(mass, best=1e-3, depth=0.71):
+    """A resonance amplitude [m] over damper mass [kg] with its minimum at ``best``: the
+    undamped peak far from it on both sides (a light damper slips freely, a heavy one sticks)."""
+    return UNDAMPED * (1 - depth * np.exp(-(np.log10(mass / best) / 0.8) ** 2))
+
+
+@pytest.fixture(autouse=True)
+def close_figures():
+    yield
+    plt.close("all")
+
+
+def one(draw, figsize=(6.5, 4.5)):
+    fig, ax = plt.subplots(figsize=figsize)
+    draw(ax)
+    fig.tight_layout()
+    return fig, ax
+
+
+# ---------------------------------------------------------------------------------------
+# the result classes' plot()
+# ---------------------------------------------------------------------------------------
+def mass_sweep(kind="cylinder", best=1e-3):
+    m = np.logspace(-5, 0, 12)
+    return MassSweep(m, valley(m, best), np.full(12, 95.0), kind, UNDAMPED)
+
+
+def test_mass_sweep_plot():
+    fig, _ = one(mass_sweep().plot)
+    check_figure(fig, None)
+
+
+def engine_order_sweep():
+    eo = np.arange(0, 9)
+    mass = np.array([np.nan, 1.0, 1.5, 2.2, 3.0, 4.0, 5.2, 6.5, 8.0]) * 1e-3
+    undamped = np.full(9, UNDAMPED)
+    peak = np.where(np.isfinite(mass), 0.3 * UNDAMPED + 0.05e-3 * eo, UNDAMPED)
+    return EngineOrderSweep("cylinder", eo, mass, peak, undamped, 1 - peak / undamped, certified=np.ones(9, bool))
+
+
+def test_engine_order_sweep_plot():
+    fig, _ = one(engine_order_sweep().plot)
+    check_figure(fig, None)
+
+
+def platform_angle_study():
+    g = np.array([15.0, 25.0, 35.0, 45.0, 55.0, 65.0, 75.0, 85.0])
+    return PlatformAngleStudy("cylinder", 35.0, 1e-3, g, 1e-3 * (1 + g / 90), 1e-3 * (0.3 + 0.004 * g),
+                              1e-3 * (0.35 + 0.006 * g), UNDAMPED)
+
+
+def test_platform_angle_plot():
+    fig, _ = one(platform_angle_study().plot)
+    check_figure(fig, None)
+
+
+def contact_state(angle=35.0):
+    w = np.array([1.8 * np.exp(-0.6j), 0.6 * np.exp(-0.2j) * angle / 35])
+    f = np.array([0.9 * np.exp(-0.3j), 0.55 * np.exp(-0.1j)])
+    return ContactState(w, f, 1e-6 * w, 0.1 * f, np.array([1.0, 1.0]), np.array([1e5, 1e5]),
+                        np.array([0.5, 0.5]), 95.3, 0.5e-3)
+
+
+def test_contact_state_plot():
+    fig, _ = one(contact_state().plot, figsize=(5, 5))
+    check_figure(fig, None)
+
+
+def liftoff_map():
+    xi, eta = np.meshgrid([-0.4, -0.2, 0.0, 0.2, 0.4], [-0.4, -0.2, 0.0, 0.2, 0.4])
+    xi, eta = xi.ravel(), eta.ravel()
+    r = np.vstack([0.3 + 2.5 * np.abs(xi), 0.3 + 2.5 * np.abs(xi)])
+    P = xi.size
+    return LiftoffMap(xi, eta, r, r, np.zeros((2, P)), np.ones((2, P)), r, 95.5, 3e-4, 64)
+
+
+def test_liftoff_plot():
+    fig, _ = one(liftoff_map().plot)
+    check_figure(fig, None)
+
+
+def design_map(kind="cylinder", height=None):
+    masses = np.array([0.3, 0.5, 0.7, 1.0, 1.5, 2.0, 3.0]) * 1e-3
+    gammas = np.array([15.0, 35.0, 55.0, 85.0])
+    peaks = 1e-3 * (0.5 + 0.1 * np.log(masses / 5e-4)[None, :] ** 2 + 0.002 * (85 - gammas)[:, None])
+    return DesignMap(kind, height, masses, gammas, peaks, UNDAMPED)
+
+
+def test_design_map_plot():
+    fig, _ = one(design_map().plot)
+    check_figure(fig, None)
+
+
+def monte_carlo():
+    rng = np.random.default_rng(0)
+    kappa = 1 + 0.02 * rng.standard_normal((40, 16))
+    peaks = 0.5e-3 * (1 + 0.15 * rng.random((40, 16)))
+    return MonteCarloResult(kappa, peaks, np.full((40, 16), 95.0), 0.5e-3, [""] * 40, {"std": 0.02, "seed": 0})
+
+
+def test_monte_carlo_plot():
+    fig, _ = one(monte_carlo().plot)
+    check_figure(fig, None)
+
+
+# ---------------------------------------------------------------------------------------
+# the report's figures (bladedamp reproduce), written to files and checked as saved
+# ---------------------------------------------------------------------------------------
+def test_reproduce_study_figures(tmp_path, saved_figures):
+    sweeps = {"cylinder": mass_sweep(), "wedge": mass_sweep("wedge", 0.3e-3)}
+    optima = {k: MassOptimum(best, float(valley(np.array(best), best)), UNDAMPED, 20)
+              for k, best in (("cylinder", 1e-3), ("wedge", 0.3e-3))}
+    report.plot_mass_optimisation(sweeps, optima, tmp_path / "fig6.png")
+    report.plot_engine_orders({"cylinder": engine_order_sweep(),
+                               "wedge": dataclasses.replace(engine_order_sweep(), kind="wedge")},
+                              tmp_path / "fig7_8.png")
+    report.plot_platform_angles(platform_angle_study(), tmp_path / "fig10.png")
+    report.plot_contact_states({35.0: contact_state(), 85.0: contact_state(85.0)}, tmp_path / "fig11.png")
+    report.plot_liftoff(liftoff_map(), tmp_path / "fig9.png")
+    report.plot_design_maps([design_map(), design_map("wedge", 1e-3), design_map("wedge", 4e-3)],
+                            tmp_path / "design_map.png")
+    saved_figures.check("reference")
+
+
+def test_design_command_study_figures(tmp_path, saved_figures):
+    from bladedamp.design import reference_design
+
+    design = reference_design()
+    report.eo_sweep_outputs(tmp_path, design, engine_order_sweep())
+    report.montecarlo_outputs(tmp_path, design, monte_carlo(), ["montecarlo.npz"])
+    saved_figures.check("reference design")
+
+
+# ---------------------------------------------------------------------------------------
+# figure output: formats and resolution
+# ---------------------------------------------------------------------------------------
+def test_save_figure_writes_each_format_at_the_dpi(tmp_path):
+    import matplotlib.image
+
+    fig, _ = one(mass_sweep().plot, figsize=(4, 3))
+    with figure_output("png,svg,pdf", 50):
+        assert save_figure(fig, tmp_path / "a.png") == ["a.png", "a.svg", "a.pdf"]
+    assert matplotlib.image.imread(tmp_path / "a.png").shape[:2] == (150, 200)
+    assert (tmp_path / "a.pdf").read_bytes().startswith(b"%PDF") and b"<svg" in (tmp_path / "a.svg").read_bytes()
+    fig, _ = one(mass_sweep().plot, figsize=(4, 3))       # outside the block: PNG at the default dpi again
+    assert save_figure(fig, tmp_path / "b.png") == ["b.png"]
+    assert matplotlib.image.imread(tmp_path / "b.png").shape[:2] == (3 * DEFAULT_DPI, 4 * DEFAULT_DPI)
+
+
+@pytest.mark.parametrize("formats, dpi, needle", [("png,gif", 100, "'gif'"), ("", 100, "empty"),
+                                                  ("png", 0, "dpi 0"), ("png", 99.5, "dpi 99.5")])
+def test_figure_output_rejects_a_bad_format_or_dpi(formats, dpi, needle):
+    with pytest.raises(ValueError, match=needle):
+        with figure_output(formats, dpi):
+            pass
