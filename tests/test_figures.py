@@ -177,3 +177,42 @@ def test_figure_output_rejects_a_bad_format_or_dpi(formats, dpi, needle):
     with pytest.raises(ValueError, match=needle):
         with figure_output(formats, dpi):
             pass
+
+
+# ---------------------------------------------------------------------------------------
+# figures of frequency responses: one small solve of the reference disk (one harmonic)
+# ---------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def responses():
+    """(damped 1 g cylinder, damper-free) responses of the reference disk, 92-99 Hz, one harmonic."""
+    from bladedamp.reference import reference_disk
+
+    options = dict(harmonics=(1,), max_step=0.05, estimate_harmonic_error=False)
+    return (reference_disk("cylinder", 1e-3).frequency_response(92.0, 99.0, **options),
+            reference_disk(None).frequency_response(92.0, 99.0, **options))
+
+
+def test_disk_response_plot(responses):
+    damped, free = responses
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    free.plot(ax=ax)
+    damped.plot(ax=ax)
+    fig.tight_layout()
+    check_figure(fig, None)
+
+
+def test_frequency_response_plot_names_its_unit(responses):
+    from bladedamp.response import FrequencyResponse
+
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    FrequencyResponse.plot(responses[0], ax=ax, scale=1e3, unit="mm")
+    fig.tight_layout()
+    check_figure(fig, None)
+    assert ax.get_ylabel().endswith("[mm]")
+
+
+def test_reproduce_response_figures(responses, tmp_path, saved_figures):
+    damped, free = responses
+    report.plot_four_modes([(name, 0, free, damped) for name, *_ in report.PAPER["table1"]], tmp_path / "fig4.png")
+    report.plot_mass_variation(free, [(1e-3, damped)], tmp_path / "fig5.png")
+    saved_figures.check("reference")
