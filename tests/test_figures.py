@@ -216,3 +216,50 @@ def test_reproduce_response_figures(responses, tmp_path, saved_figures):
     report.plot_four_modes([(name, 0, free, damped) for name, *_ in report.PAPER["table1"]], tmp_path / "fig4.png")
     report.plot_mass_variation(free, [(1e-3, damped)], tmp_path / "fig5.png")
     saved_figures.check("reference")
+
+
+def test_backbone_design_plot():
+    from bladedamp.studies.backbone import BackboneDesign
+
+    m = np.logspace(-4, -2, 9)
+    levels = np.array([0.05, 0.1, 0.2])
+    best = 1e-3 * levels / 0.1                                         # the optimum grows with the level
+    peaks = np.stack([valley(m, b) * f / 0.1 for b, f in zip(best, levels)], axis=1)
+    undamped = UNDAMPED * levels / 0.1
+    study = BackboneDesign("cylinder", m, levels, peaks, np.full_like(peaks, 95.0), best,
+                           valley(best, best) * levels / 0.1, undamped, np.stack([best / 2, best * 2], axis=1), m)
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+    study.plot(axes=axes)
+    fig.tight_layout()
+    check_figure(fig, None)
+
+
+@pytest.fixture(scope="module")
+def mistuned():
+    """(mistuned 4-blade response, its tuned response), reference disk with the 1 g cylinder, one harmonic."""
+    from bladedamp.mistuned import MistunedDisk
+    from bladedamp.reference import reference_disk
+
+    tuned = dataclasses.replace(reference_disk("cylinder", 1e-3), n_blades=4)
+    options = dict(harmonics=(1,), max_step=0.1)
+    r = MistunedDisk.from_tuned(tuned, [1.03, 0.97, 1.02, 1.0]).frequency_response(97.0, 106.0, **options)
+    return r, tuned.frequency_response(97.0, 106.0, **options)
+
+
+def test_mistuned_response_plot(mistuned):
+    r, tuned = mistuned
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    r.plot(ax=ax, tuned=tuned, title="4 blades")
+    fig.tight_layout()
+    check_figure(fig, None)
+
+
+def test_mistuning_cases_figure(mistuned, tmp_path, saved_figures):
+    from bladedamp.studies.mistuning import MistuningCase, plot_cases
+
+    r, tuned = mistuned
+    kappa = np.array([1.03, 0.97, 1.02, 1.0])
+    cases = {key: MistuningCase(key, 1e-3, kappa, r, float(tuned.peak_amplitude), tuned)
+             for key in ("random_1g", "reordered_1g", "alternating_1g", "random_5g", "reordered_5g")}
+    plot_cases(cases, tmp_path / "fig13_17.png")
+    saved_figures.check("reference")

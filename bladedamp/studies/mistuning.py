@@ -424,6 +424,7 @@ def plot_cases(cases: dict[str, MistuningCase], path=None):
     for ax, (key, c) in zip(axes.ravel(), cases.items()):
         c.response.plot(ax=ax, tuned=c.tuned_response, title=re.sub(r"_(\d+)g$", r", \1 g", key))
     axes.ravel()[-1].axis("off")
+    fig.suptitle("Figs. 13-17: reference disk, mistuned blades (random, reordered, alternating)")
     fig.tight_layout()
     for ax, _ in zip(axes.ravel(), cases):
         place_legend(ax, fontsize=8)       # clear of every curve (the largest peak included)
