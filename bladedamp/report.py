@@ -626,7 +626,8 @@ def plot_stability_backbones(frfs: dict, converged: dict, modes: dict, path: Pat
     for ax, kind in zip(axes, kinds):
         top = 0.0
         any_unstable = False
-        for r, label, color in ((frfs[kind], "FRF, one harmonic", "C0"), (converged.get(kind), "FRF, converged", "C1")):
+        for r, label, color in ((frfs[kind], "FRF, one harmonic", palette.series(0)),
+                                (converged.get(kind), "FRF, converged", palette.series(1))):
             if r is None or not len(r.omega):
                 continue
             tip = 1e3 * r.tip_amplitude[:, 0]
@@ -634,7 +635,7 @@ def plot_stability_backbones(frfs: dict, converged: dict, modes: dict, path: Pat
                         label=f"{label} ({_harmonics(r.basis.harmonics)})")
             if r.stable is not None and not np.all(r.stable):
                 bad = ~np.asarray(r.stable, bool)        # circled: a fold at a corner is too narrow to see dashed
-                ax.plot(r.frequency_hz[bad], tip[bad], "o", mfc="none", mec="r", ms=7, label="_unstable points")
+                ax.plot(r.frequency_hz[bad], tip[bad], "o", mfc="none", mec=palette.SLIP, ms=7, label="_unstable points")
                 any_unstable = True
             top = max(top, float(tip.max()))
         mode = modes.get(kind)
@@ -648,7 +649,7 @@ def plot_stability_backbones(frfs: dict, converged: dict, modes: dict, path: Pat
                         label="peak by nonlinear-mode synthesis")
         handles, labels = ax.get_legend_handles_labels()
         if any_unstable:
-            handles.append(Line2D([], [], color="0.3", ls="--", marker="o", mfc="none", mec="r"))
+            handles.append(Line2D([], [], color="0.3", ls="--", marker="o", mfc="none", mec=palette.SLIP))
             labels.append("unstable (dashed, circled)")
         place_legend(ax, handles=handles, labels=labels, fontsize=8, loc="upper left")
         ax.set_xlabel("excitation frequency [Hz]")
@@ -659,7 +660,7 @@ def plot_stability_backbones(frfs: dict, converged: dict, modes: dict, path: Pat
     ax = axes[-1]
     for kind, mode in modes.items():
         tip = 1e3 * np.asarray(mode.output_amplitude)[:, 0]
-        line, = ax.semilogx(tip, 100 * np.asarray(mode.damping_ratio), label=kind)
+        line, = ax.semilogx(tip, 100 * np.asarray(mode.damping_ratio), color=palette.DAMPER.get(kind), label=kind)
         peak = mode.forced_peak()
         if peak["found"]:
             ax.axvline(1e3 * peak["output_amplitude"][0], color=line.get_color(), ls=":", lw=1.2,
@@ -669,6 +670,7 @@ def plot_stability_backbones(frfs: dict, converged: dict, modes: dict, path: Pat
     ax.set_title("1F nonlinear modes: damping over amplitude")
     ax.grid(True, which="both", alpha=0.3)
     place_legend(ax, fontsize=8)
+    fig.suptitle("reference disk: stability of the forced responses and the 1F nonlinear modes")
     save_figure(fig, path)
 
 

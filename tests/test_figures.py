@@ -263,3 +263,15 @@ def test_mistuning_cases_figure(mistuned, tmp_path, saved_figures):
              for key in ("random_1g", "reordered_1g", "alternating_1g", "random_5g", "reordered_5g")}
     plot_cases(cases, tmp_path / "fig13_17.png")
     saved_figures.check("reference")
+
+
+def test_stability_and_backbone_figure(tmp_path, saved_figures):
+    from bladedamp.hbm.nonlinear_modes import nonlinear_mode
+    from bladedamp.hbm.stability import with_stability
+    from bladedamp.reference import reference_disk
+
+    disk = reference_disk("cylinder", 1e-3)
+    r = disk.frequency_response(90.0, 100.0, harmonics=(1,), max_step=0.05, estimate_harmonic_error=False)
+    report.plot_stability_backbones({"cylinder": with_stability(disk, r)}, {},
+                                    {"cylinder": nonlinear_mode(disk, harmonics=(1,))}, tmp_path / "stability.png")
+    saved_figures.check("reference")
