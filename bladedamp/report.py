@@ -819,14 +819,24 @@ def plot_frf(ax, design, responses: dict, undamped: dict | None = None) -> None:
             top = max(top, float(free.max()))
         if len(tip):
             i = int(np.argmax(tip))
-            peaks.append((float(r.frequency_hz[i]), float(tip[i]), colour))
+            peaks.append((float(r.frequency_hz[i]), float(tip[i]), colour, "" if single else f"{shown.split(' (')[0]}: "))
             ax.plot(r.frequency_hz[i], tip[i], "o", ms=7, mfc="none", mec=colour, mew=1.6, label="_peak")
-    if peaks and top > 0 and max(p for _, p, _ in peaks) < 0.25 * top:
+    if not peaks:
+        return
+    log = top > 0 and max(p for _, p, _, _ in peaks) < 0.25 * top
+    if log:
         ax.set_yscale("log")
-    for k, (f, p, colour) in enumerate(peaks):       # annotations stacked beside their peaks
-        ax.annotate(f"peak {p:.3g} mm at {f:.2f} Hz", (f, p), xytext=(18, 18 + 16 * k), textcoords="offset points",
-                    fontsize=8, color=colour, va="bottom", bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="none",
-                                                                     alpha=0.85),
+    # room above the highest curve for the annotations, stacked, each beside its peak
+    low, high = ax.get_ylim()
+    highest = max([top] + [p for _, p, _, _ in peaks])
+    ax.set_ylim(low, highest * 3.0 ** (1 + 0.3 * len(peaks)) if log else
+                highest + (0.12 + 0.08 * len(peaks)) * (highest - low))
+    x0, x1 = ax.get_xlim()
+    for k, (f, p, colour, which) in enumerate(peaks):
+        right = f < x0 + 0.5 * (x1 - x0)
+        ax.annotate(f"{which}peak {p:.3g} mm at {f:.2f} Hz", (f, p), xytext=(15 if right else -15, 8 + 14 * k),
+                    textcoords="offset points", fontsize=8, color=colour, va="bottom", ha="left" if right else "right",
+                    bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="none", alpha=0.85),
                     arrowprops=dict(arrowstyle="-", color=colour, lw=0.8))
     ax.set_xlabel("excitation frequency [Hz]")
     ax.set_ylabel("tip amplitude u_x [mm]")

@@ -77,7 +77,8 @@ def text_boxes(fig, renderer, drawn) -> list[tuple[str, object]]:
     """[(what, Bbox in pixels)] of every drawn text, each legend as one box."""
     legends = [ax.get_legend() for ax in fig.axes if ax.get_legend() is not None] + list(fig.legends)
     inside_legend = {id(t) for lg in legends for t in [*lg.get_texts(), lg.get_title()]}
-    boxes = [(f"text {t.get_text()!r}", t.get_window_extent(renderer)) for t in drawn if id(t) not in inside_legend]
+    # Text's own box: an annotation's arrow is not text (Annotation.get_window_extent includes it)
+    boxes = [(f"text {t.get_text()!r}", Text.get_window_extent(t, renderer)) for t in drawn if id(t) not in inside_legend]
     boxes += [(f"legend ({', '.join(t.get_text() for t in lg.get_texts())})", lg.get_window_extent(renderer))
               for lg in legends if lg.get_visible()]
     return boxes

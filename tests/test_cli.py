@@ -218,13 +218,14 @@ def test_frf_checks_a_stopped_branch_by_time_integration_unless_told_not_to(smal
     assert asked == [(True, True), (False, True), (True, False)]
 
 
-def test_frf_mistuned_with_unit_kappa_is_the_tuned_response(small_design, tmp_path):
+def test_frf_mistuned_with_unit_kappa_is_the_tuned_response(small_design, tmp_path, saved_figures):
     path = tmp_path / "design.toml"
     path.write_text(small_design.read_text().replace("# kappa = [1.02, 0.98]", "kappa = [1.0, 1.0, 1.0, 1.0]")
                     .replace("std = 0.02\n", "").replace("seed = 2\n", ""))
     out = tmp_path / "frf"
     assert main(["frf", str(path), "--mistuned", "--out", str(out)]) == 0
     _, results = _outputs(out, "frf.png", "summary.md", "results.json", "frf_mistuned_EO1.npz")
+    saved_figures.check("design")          # two annotated peaks at the same point, stacked
     tuned, mistuned = results["responses"]["EO1"], results["responses"]["mistuned_EO1"]
     assert tuned["success"] and mistuned["success"]
     # the full assembly of identical blades is the cyclic model: same peak (continuation points differ)
@@ -232,13 +233,14 @@ def test_frf_mistuned_with_unit_kappa_is_the_tuned_response(small_design, tmp_pa
     assert mistuned["peak_frequency_hz"] == pytest.approx(tuned["peak_frequency_hz"], abs=0.05)
 
 
-def test_montecarlo_on_a_small_design(small_design, tmp_path):
+def test_montecarlo_on_a_small_design(small_design, tmp_path, saved_figures):
     from bladedamp.studies.mistuning import MonteCarloResult
 
     path = small_design
     out = tmp_path / "mc"
     assert main(["montecarlo", str(path), "--disks", "1", "--scheduler", "serial", "--out", str(out)]) == 0
     summary, _ = _outputs(out, "montecarlo.png", "summary.md", "montecarlo.npz")
+    saved_figures.check("design")
     result = MonteCarloResult.load(out / "montecarlo.npz")
     assert result.kappa.shape == (1, 4) and result.meta["seed"] == 2 and result.meta["std"] == 0.02
     # the damper still works on the mistuned 4-blade disk: every blade's peak stays well below the

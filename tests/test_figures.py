@@ -3,6 +3,7 @@ tests/figure_checks.py (units, no overlapping or cut text, every series visible,
 the design): the result classes' ``.plot()`` and the report's figures, on small results built
 from closed forms (no solve), and the figure helpers of bladedamp.plotting."""
 import dataclasses
+import warnings
 
 import matplotlib
 
@@ -242,8 +243,10 @@ def mistuned():
 
     tuned = dataclasses.replace(reference_disk("cylinder", 1e-3), n_blades=4)
     options = dict(harmonics=(1,), max_step=0.1)
-    r = MistunedDisk.from_tuned(tuned, [1.03, 0.97, 1.02, 1.0]).frequency_response(97.0, 106.0, **options)
-    return r, tuned.frequency_response(97.0, 106.0, **options)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")          # the one-harmonic accuracy is not what is tested here
+        r = MistunedDisk.from_tuned(tuned, [1.03, 0.97, 1.02, 1.0]).frequency_response(97.0, 106.0, **options)
+        return r, tuned.frequency_response(97.0, 106.0, **options)
 
 
 def test_mistuned_response_plot(mistuned):
