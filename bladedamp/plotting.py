@@ -166,15 +166,16 @@ def plain_log_ticks(axis) -> None:
 
 def reference_level(ax, value: float, label: str, unit: str = "mm", min_share: float = 1 / 3) -> None:
     """A damper-free reference level ``value`` (in the axes' y units) on ``ax``: a dashed
-    horizontal line in the palette's UNDAMPED colour when each series already drawn keeps at
-    least ``min_share`` of the y range with it; else (it would flatten them) no line, and a legend
+    horizontal line in the palette's UNDAMPED colour when each curve already drawn (a line of two
+    or more points; markers alone do not count) keeps at least ``min_share`` of the y range with it; else (it would flatten them) no line, and a legend
     entry that gives the value and says it lies above the axes. Call after the series, before
     the legend."""
     from . import palette
 
-    series = [np.asarray(line.get_ydata(), dtype=float) for line in ax.get_lines()
-              if line.get_transform() is ax.transData and line.get_gid() != "reference"]
-    series = [v[np.isfinite(v)] for v in series if np.any(np.isfinite(v))]
+    series = [np.asarray(line.get_ydata(), dtype=float) for line in ax.get_lines()       # curves, not markers
+              if line.get_transform() is ax.transData and line.get_gid() != "reference"
+              and line.get_linestyle() not in ("None", "", " ")]
+    series = [v[np.isfinite(v)] for v in series if np.sum(np.isfinite(v)) >= 2]
     text = f"{label} {value:.3g} {unit}"
     if series:
         low, high = min(min(v.min() for v in series), value), max(max(v.max() for v in series), value)

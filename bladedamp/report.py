@@ -955,7 +955,7 @@ def optimize_outputs(out: Path, design, optimum, angles=None, heights=None) -> d
     if heights is not None:
         h = np.array([x for x, _ in heights])
         p = np.array([o.peak_amplitude for _, o in heights])
-        axes[k].plot(1e3 * h, 1e3 * p, marker="o")
+        axes[k].plot(1e3 * h, 1e3 * p, marker="o", color=palette.DAMPER.get(design.disk.damper.kind))
         axes[k].set(xlabel="wedge contact height h_C [mm]", ylabel="resonance tip amplitude u_x [mm]",
                     title="contact height, mass re-optimised")
         axes[k].grid(True, alpha=0.3)

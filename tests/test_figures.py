@@ -278,3 +278,38 @@ def test_stability_and_backbone_figure(tmp_path, saved_figures):
     report.plot_stability_backbones({"cylinder": with_stability(disk, r)}, {},
                                     {"cylinder": nonlinear_mode(disk, harmonics=(1,))}, tmp_path / "stability.png")
     saved_figures.check("reference")
+
+
+def test_optimize_figure_with_platform_angles_and_contact_heights(tmp_path, saved_figures):
+    from bladedamp.design import reference_design
+
+    grid = np.logspace(-5, np.log10(2e-2), 15)
+    search = np.array([0.8e-3, 1.0e-3, 1.2e-3])
+    evaluated = np.sort(np.concatenate([grid, search]))
+    optimum = MassOptimum(1e-3, float(valley(np.array(1e-3))), UNDAMPED, 18, grid_mass=grid,
+                          grid_peak_amplitude=valley(grid), bracket=(0.6e-3, 1.6e-3), evaluated_mass=evaluated,
+                          evaluated_peak_amplitude=valley(evaluated))
+    heights = [(h, dataclasses.replace(optimum, peak_amplitude=optimum.peak_amplitude * (1 + 200 * h)))
+               for h in (1e-3, 2e-3, 4e-3)]
+    summary = report.optimize_outputs(tmp_path, reference_design(), optimum, platform_angle_study(), heights)
+    saved_figures.check("reference design")
+    fig = saved_figures["optimize"][2]
+    curve = next(line for line in fig.axes[0].get_lines() if "every mass evaluated" in line.get_label())
+    np.testing.assert_allclose(curve.get_xdata(), 1e3 * evaluated)             # every mass, the search's too
+    assert summary["mass"]["optimal_mass_g"] == pytest.approx(1.0)
+
+
+def test_reference_level_is_a_line_unless_it_would_flatten_a_curve():
+    from bladedamp.plotting import reference_level
+
+    fig, ax = plt.subplots()
+    ax.plot([1.0, 2.0, 3.0], [0.5, 1.0, 1.5])
+    ax.plot(2.0, 0.5, "*")                                  # a marker alone never decides
+    reference_level(ax, 1.7, "no damper")
+    assert [line.get_label() for line in ax.get_lines()][-1] == "no damper 1.7 mm"
+    fig, ax = plt.subplots()
+    ax.plot([1.0, 2.0, 3.0], [0.50, 0.52, 0.55])
+    reference_level(ax, 1.7, "no damper")
+    last = ax.get_lines()[-1]
+    assert last.get_label() == "no damper 1.7 mm (above the axes)" and len(last.get_xdata()) == 0
+    assert ax.get_ylim()[1] < 1.0
