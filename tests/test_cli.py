@@ -203,19 +203,21 @@ def test_frf_checks_a_stopped_branch_by_time_integration_unless_told_not_to(smal
     """``bladedamp frf`` asks the tuned responses for ``check_stop`` (the time integration beyond a
     branch that stops early, tested in test_disk.py) and ``check_peak`` (at the peak of a branch
     whose harmonic error the enriched set could not verify, tested in test_random_designs.py);
-    ``--no-stop-check`` and ``--no-peak-check`` turn them off, each alone."""
+    ``--no-stop-check`` and ``--no-peak-check`` turn them off, each alone. The damper-free
+    reference of frf.png (linear) is solved without either."""
     from bladedamp.disk import TunedDisk
 
-    asked, original = [], TunedDisk.frequency_response
+    asked, free, original = [], [], TunedDisk.frequency_response
 
     def spy(self, *args, **options):
-        asked.append((options.get("check_stop"), options.get("check_peak")))
+        (asked if self.has_damper else free).append((options.get("check_stop"), options.get("check_peak")))
         return original(self, *args, **options)
     monkeypatch.setattr(TunedDisk, "frequency_response", spy)
     assert main(["frf", str(small_design), "--out", str(tmp_path / "a")]) == 0
     assert main(["frf", str(small_design), "--no-stop-check", "--out", str(tmp_path / "b")]) == 0
     assert main(["frf", str(small_design), "--no-peak-check", "--out", str(tmp_path / "c")]) == 0
     assert asked == [(True, True), (False, True), (True, False)]
+    assert len(free) == 3 and not any(check for pair in free for check in pair)
 
 
 def test_frf_mistuned_with_unit_kappa_is_the_tuned_response(small_design, tmp_path, saved_figures):
