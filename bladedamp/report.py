@@ -622,6 +622,7 @@ def plot_stability_backbones(frfs: dict, converged: dict, modes: dict, path: Pat
     from .response import plot_branch
 
     kinds = list(frfs)
+    legends = []
     fig, axes = plt.subplots(1, len(kinds) + 1, figsize=(5.2 * (len(kinds) + 1), 4.4))
     for ax, kind in zip(axes, kinds):
         top = 0.0
@@ -651,7 +652,7 @@ def plot_stability_backbones(frfs: dict, converged: dict, modes: dict, path: Pat
         if any_unstable:
             handles.append(Line2D([], [], color="0.3", ls="--", marker="o", mfc="none", mec=palette.SLIP))
             labels.append("unstable (dashed, circled)")
-        place_legend(ax, handles=handles, labels=labels, fontsize=8, loc="upper left")
+        legends.append((ax, dict(handles=handles, labels=labels, fontsize=8, loc="upper left")))
         ax.set_xlabel("excitation frequency [Hz]")
         ax.set_ylabel("tip amplitude u_x [mm]")
         ax.set_title(f"{kind}" + (f" {1e3 * _mass_of(frfs[kind]):.3g} g" if _mass_of(frfs[kind]) else "")
@@ -669,8 +670,9 @@ def plot_stability_backbones(frfs: dict, converged: dict, modes: dict, path: Pat
     ax.set_ylabel("modal damping ratio [%]")
     ax.set_title("1F nonlinear modes: damping over amplitude")
     ax.grid(True, which="both", alpha=0.3)
-    place_legend(ax, fontsize=8)
     fig.suptitle("reference disk: stability of the forced responses and the 1F nonlinear modes")
+    for ax, options in legends + [(axes[-1], dict(fontsize=8))]:     # last: the layout is settled
+        place_legend(ax, **options)
     save_figure(fig, path)
 
 

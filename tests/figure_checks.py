@@ -16,6 +16,7 @@ rules (:func:`check_figure` asserts the list is empty):
   reference drawn with ``gid="reference"``, such as the damper-free level over engine order,
   may be flat) and no point whose x is within the limits lies above or
   below the y limits (not clipped);
+* legends: no legend hides a data point of an axes it lies over (twin axes included);
 * title: the figure's titles (suptitle, every axes' titles) together name the design.
 
 The boxes are those of the texts actually drawn: :meth:`matplotlib.text.Text.draw` is watched
@@ -148,6 +149,26 @@ def series_problems(fig) -> list[str]:
     return out
 
 
+def legend_problems(fig) -> list[str]:
+    """Legends that hide data points of any axes they lie over (twin axes included), counted
+    by :func:`bladedamp.plotting.legend_covers`."""
+    from bladedamp.plotting import legend_covers
+
+    out = []
+    for ax in fig.axes:
+        legend = ax.get_legend()
+        if legend is None or not legend.get_visible():
+            continue
+        box = legend.get_window_extent()
+        for other in _axes_of(fig):
+            if other.bbox.overlaps(box):
+                hidden = legend_covers(other, legend)
+                if hidden:
+                    out.append(f"the legend ({', '.join(t.get_text() for t in legend.get_texts())}) hides "
+                               f"{hidden} data points of axes {other.get_title() or other.get_ylabel()!r}")
+    return out
+
+
 def titles(fig) -> list[str]:
     """The suptitle and every axes' titles (left, centre, right) of ``fig``."""
     out = [fig.get_suptitle()] if fig.get_suptitle() else []
@@ -166,7 +187,8 @@ def figure_problems(fig, design: str | None) -> list[str]:
     """Every broken rule of the module's docstring, one line each; ``design``: the name a title
     must contain (None: the figure is part of a caller's, no title rule)."""
     renderer, drawn = drawn_texts(fig)
-    out = unit_problems(fig, drawn) + overlap_problems(fig, renderer, drawn) + series_problems(fig)
+    out = unit_problems(fig, drawn) + overlap_problems(fig, renderer, drawn) + series_problems(fig) \
+        + legend_problems(fig)
     if design is not None:
         out += title_problems(fig, design)
     return out

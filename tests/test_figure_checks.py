@@ -144,3 +144,10 @@ def test_a_flat_reference_or_markers_may_be_flat_but_must_be_inside():
     ax.plot([120.0], [1.0], "x", label="a marker outside")
     ax.set_xlim(90.0, 100.0)
     assert any("a marker outside" in p and "outside" in p for p in figure_problems(fig, "rotor A"))
+
+
+def test_a_legend_over_the_twin_axes_points_fails():
+    fig, ax, twin = good()
+    twin.plot([90.5, 91.0], [95.0, 96.0], "s", label="under the legend")     # top left, where the legend is
+    problems = figure_problems(fig, "rotor A")
+    assert any("hides" in p for p in problems), problems

@@ -114,7 +114,9 @@ class EngineOrderSweep(Saveable):
         ax2.set_ylabel("optimal damper mass [g]", color="0.35")
         plain_log_ticks(ax2.yaxis)
         handles = [h for a in (ax, ax2) for h in a.get_legend_handles_labels()[0]]
-        place_legend(ax, handles=handles, fontsize=8)
+        # below the axes: the twin axes' points would lie under a legend inside them
+        ax2.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=len(handles), fontsize=8,
+                   frameon=False)
         return ax
 
 
