@@ -155,12 +155,19 @@ def place_legend(ax, loc: str = "best", max_tries: int = 8, **kwargs):
 
 
 def plain_log_ticks(axis) -> None:
-    """Ticks of a logarithmic ``axis`` (``ax.xaxis`` or ``ax.yaxis``) at 1, 2, 5 per decade,
-    written as plain numbers ('0.5', '2', '10', not '5 x 10^-1'), no minor labels."""
+    """Ticks of a logarithmic ``axis`` (``ax.xaxis`` or ``ax.yaxis``) at 1, 2, 5 per decade
+    (labelled at the powers of ten only when the axis spans more than three decades), written as
+    plain numbers ('0.5', '2', '10', not '5 x 10^-1'), no minor labels."""
     from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
+    def label(value, _):
+        low, high = sorted(axis.get_view_interval())
+        mantissa = value / 10.0 ** np.floor(np.log10(value) + 1e-9)
+        if low > 0 and high / low > 1e3 and not np.isclose(mantissa, 1.0):
+            return ""
+        return f"{value:g}"
     axis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
-    axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    axis.set_major_formatter(FuncFormatter(label))
     axis.set_minor_formatter(NullFormatter())
 
 
