@@ -56,7 +56,9 @@ it has no CSV form.  A bad file raises ValueError naming the file, the key or
 column (and line) and what was expected.
 
 Reduced FE matrices (:meth:`ModalBlade.from_matrices`): Craig-Bampton or Guyan exports with
-the root clamped; the modes are computed and picked at the named points.
+the root clamped; the modes are computed and picked at the named points. :meth:`ModalBlade.from_file`
+reads them from Nastran OUTPUT4 / punch DMIG, Abaqus, MATLAB and Ansys files
+(:mod:`bladedamp.fe_formats`).
 
 The reference blade (:func:`bladedamp.reference.reference_blade`, calibrated on the paper)
 lives in :mod:`bladedamp.reference`; ``bladedamp.blade.reference_blade`` and
@@ -77,6 +79,7 @@ import scipy.sparse
 import scipy.sparse.linalg
 
 from bladedamp import validation as check
+from bladedamp.io import open_npz, reading
 
 # Points every ModalBlade must carry.
 REQUIRED_POINTS = ("OL", "OR", "tip", "excitation")
@@ -485,32 +488,76 @@ class ModalBlade:
 
     # -- files and FE matrices ---------------------------------------------------------
     @classmethod
-    def from_file(cls, path) -> "ModalBlade":
-        """Read a modal data file: ``.npz`` or ``.csv`` by the suffix of ``path``.
+    def from_file(cls, path, *, dof_map: dict | None = None, points: dict | None = None,
+                  n_modes: int | None = None, damping_ratios=None, rigid_links: dict | None = None,
+                  fixed_dofs=(), mass: str | None = None, stiffness: str | None = None,
+                  **matrix_options) -> "ModalBlade":
+        """Read a modal data file (``.npz``, ``.csv``) or the reduced mass and stiffness
+        matrices of an FE export (``.op4``, ``.pch``, ``.mtx``, ``.mat``, ``.full``), by the suffix of ``path``.
+
+        FE exports (formats: :mod:`bladedamp.fe_formats`): Nastran OUTPUT4 text or binary
+        (``.op4``), Nastran punch DMIG (``.pch``), Abaqus matrix output (``.mtx``: ``path`` is the
+        ``_STIF`` or the ``_MASS`` file, the other is found beside it), MATLAB v4-v7.3 (``.mat``),
+        Ansys ``.full`` (needs the ``ansys`` extra; its constrained DOF are left out).
+        The matrices go to :meth:`from_matrices`, whose arguments ``points``, ``n_modes`` and
+        ``damping_ratios`` are then required, and ``rigid_links``, ``mode_names``, ``solver``,
+        ``symmetry_tolerance`` may be given. The matrices must be in SI units.
+
+        ``dof_map`` and ``fixed_dofs`` name rows as the exporting code numbers them:
+
+        - files that label rows by node and DOF (DMIG: grid and component 1-6, 0 for a scalar
+          point; Abaqus MATRIX INPUT: node and DOF 1-6; Ansys: node and 1-6 for UX .. ROTZ): a point is ``node`` (its DOF 1-6, i.e.
+          ux, uy, uz, phix, phiy, phiz) or ``(node, dofs)`` with 6 or 3 DOF numbers in that
+          order, e.g. ``{"OL": 101, "tip": (250, (1, 2, 3)), ...}``; ``fixed_dofs`` is a list of
+          such entries, e.g. ``[1, 2, 3]`` clamps nodes 1-3.
+        - files that number rows only (OUTPUT4, MATLAB, Abaqus COORDINATE): 1-based row
+          numbers, e.g. ``{"OL": range(1, 7), ...}``, ``fixed_dofs=range(1, 73)``.
+
+        ``mass``, ``stiffness``: the matrix names in the file (default: the one of
+        :data:`bladedamp.fe_formats.DEFAULT_MASS_NAMES` / ``DEFAULT_STIFFNESS_NAMES`` present,
+        e.g. MAAX / KAAX, MAA / KAA, M / K); for Abaqus the other file's name.
+
+        A dof_map naming a node or row not in the file, a file that breaks its format, or
+        matrices that are unsymmetric, not positive (semi-)definite or have rigid-body modes
+        raise ValueError naming the file, the place (line, record, matrix) and what was expected.
+
+        Modal data files (``.npz``, ``.csv``):
 
         The formats (natural frequencies [Hz], damping ratios [-], point positions [m] and
         mass-normalised 6-DOF shapes [m/sqrt(kg), rad/sqrt(kg)] at OL, OR, tip, excitation
         and any extra points) are described in the module docstring of :mod:`bladedamp.blade`.
         A file that breaks them raises ValueError naming the file, the key or column (and
-        the line) and what was expected; a missing file raises FileNotFoundError. A solid FE
+        the line) and what was expected; a file that is missing (:class:`bladedamp.io.MissingFileError`,
+        also a FileNotFoundError), empty, truncated, corrupted, not an ``.npz`` archive or not
+        UTF-8 text raises one :class:`bladedamp.io.FileReadError` (a ValueError) naming the file
+        and what is wrong (:func:`bladedamp.io.reading`). A solid FE
         blade's ``.npz`` (format :data:`SOLID_NPZ_FORMAT`, :meth:`bladedamp.solid.SolidModalBlade.save`)
         gives a :class:`bladedamp.solid.SolidModalBlade` with its flexible platforms and surface.
         """
         path = Path(path)
+        from . import fe_formats
+        if path.suffix.lower().lstrip(".") in fe_formats.FE_SUFFIXES:
+            return _blade_from_fe_file(cls, path, dof_map, points, n_modes, damping_ratios, rigid_links,
+                                       fixed_dofs, mass, stiffness, matrix_options)
+        given = [k for k, v in dict(dof_map=dof_map, points=points, n_modes=n_modes, damping_ratios=damping_ratios,
+                                    rigid_links=rigid_links, mass=mass, stiffness=stiffness).items()
+                 if v is not None] + (["fixed_dofs"] if tuple(fixed_dofs) else []) + list(matrix_options)
+        if given:
+            raise ValueError(f"{path}: {given} apply to FE matrix files only "
+                             f"({sorted('.' + s for s in fe_formats.FE_SUFFIXES)}); a modal data file has its modes")
         kind = _modal_file_kind(path)
-        if not path.is_file():
-            raise FileNotFoundError(f"{path}: no such modal data file")
-        if kind == "npz":
-            fields, tag, extra = read_modal_npz(path)
-            if tag in SOLID_NPZ_FORMATS_READ:
-                from .solid import SolidModalBlade
-                return SolidModalBlade.from_npz_arrays(path, fields, extra)
-        else:
-            fields = _read_modal_csv(path)
-        try:
-            return cls(**fields)
-        except ValueError as err:
-            raise ValueError(f"{path}: {err}") from None
+        with reading(path, "modal data file"):
+            if kind == "npz":
+                fields, tag, extra = read_modal_npz(path)
+                if tag in SOLID_NPZ_FORMATS_READ:
+                    from .solid import SolidModalBlade
+                    return SolidModalBlade.from_npz_arrays(path, fields, extra)
+            else:
+                fields = _read_modal_csv(path)
+            try:
+                return cls(**fields)
+            except ValueError as err:
+                raise ValueError(f"{path}: {err}") from None
 
     def save(self, path) -> Path:
         """Write this blade to ``path``: ``.npz`` or ``.csv`` by its suffix (formats: module
@@ -663,6 +710,47 @@ class ModalBlade:
         return cls(natural_frequencies_hz=np.sqrt(lam) / (2.0 * np.pi), damping_ratios=damping,
                    mode_shapes=shapes, points=positions, mode_names=mode_names)
 
+    @classmethod
+    def from_test(cls, path, points: dict, *, positions: dict | None = None, damping_ratios=None,
+                  modal_masses=None, units: str | None = None, mode_names=()) -> "ModalBlade":
+        """A blade from measured (or exported) normal modes, UFF dataset 55 or 2414
+        (:func:`bladedamp.measurement.load_modes`), at named nodes.
+
+        points : point name -> node number of the file, for "OL", "OR", "tip", "excitation" (and any
+            other). Each point takes the node's six shape values (rotations zero where the file
+            gives translations only: then OL and OR do not rotate the damper contact).
+        positions : point name -> (3,) position [m] in the blade frame; default: the node's
+            coordinates from the file's dataset 15 or 2411 (ValueError if it has none).
+        damping_ratios : modal damping ratios [-] (scalar or (n_m,)); default: the file's viscous
+            damping ratios (ValueError if all are 0).
+        modal_masses : modal mass [kg] of each stored shape (scalar or (n_m,); 1.0 for shapes
+            mass-normalised in kg, 1000.0 for shapes mass-normalised in a file in mm, N, s and
+            tonnes); default: the file's (ValueError naming the mode where it gives none). The
+            shapes are divided by sqrt(modal mass): mass-normalised, Eq. 2.
+        units : "SI" for a file without a dataset 164 (unit system); default: the file's.
+        """
+        from .measurement import load_modes
+
+        if not isinstance(points, dict) or any(p not in points for p in REQUIRED_POINTS):
+            raise ValueError(f"points must map the names {REQUIRED_POINTS} (and any others) to node numbers "
+                             f"(got {points!r})")
+        modes = load_modes(path, units=units)
+        normalised = modes.mass_normalised(modal_masses)
+        shapes, where = {}, {}
+        for name, node in points.items():
+            i = modes.node_index(node)
+            shapes[name] = normalised[i]
+            given = None if positions is None else positions.get(name)
+            where[name] = np.asarray(given, dtype=float) if given is not None else modes.coordinates[i]
+            if not np.all(np.isfinite(where[name])):
+                raise ValueError(f"{modes.source}: no position of node {node} (point {name!r}) in the file: give "
+                                 f"positions={{{name!r}: (x, y, z) in m, ...}}")
+        if damping_ratios is None and not np.any(modes.damping_ratios > 0):
+            raise ValueError(f"{modes.source}: the modes carry no damping (all ratios 0): give damping_ratios")
+        damping = modes.damping_ratios if damping_ratios is None else damping_ratios
+        return cls(natural_frequencies_hz=modes.natural_frequencies_hz, damping_ratios=damping,
+                   mode_shapes=shapes, points=where, mode_names=tuple(mode_names or ()))
+
     # -- linear reference solution -----------------------------------------------------
     def linear_frf(self, f_hz: np.ndarray, force: np.ndarray, at: str = "excitation",
                    response_at: str = "tip") -> np.ndarray:
@@ -693,6 +781,44 @@ class ModalBlade:
 # --------------------------------------------------------------------------------------
 # Modal data files and FE matrices (helpers of ModalBlade.from_file / save / from_matrices)
 # --------------------------------------------------------------------------------------
+def _blade_from_fe_file(cls, path: Path, dof_map, points, n_modes, damping_ratios, rigid_links,
+                        fixed_dofs, mass, stiffness, matrix_options) -> "ModalBlade":
+    """ModalBlade.from_file for FE exports: read the matrices, turn the node/DOF names of
+    dof_map and fixed_dofs into rows, then from_matrices; errors name the file."""
+    from .fe_formats import read_fe_matrices
+    missing = [k for k, v in dict(dof_map=dof_map, points=points, n_modes=n_modes,
+                                  damping_ratios=damping_ratios).items() if v is None]
+    if missing:
+        raise ValueError(f"{path}: an FE matrix file needs {missing} (see ModalBlade.from_file)")
+    unknown = sorted(set(matrix_options) - {"mode_names", "solver", "symmetry_tolerance"})
+    if unknown:
+        raise ValueError(f"{path}: unknown options {unknown}; expected mode_names, solver, symmetry_tolerance")
+    fe = read_fe_matrices(path, mass=mass, stiffness=stiffness)
+    if not isinstance(dof_map, dict) or not dof_map:
+        raise ValueError(f"{path}: dof_map must be a non-empty dict: point name -> node/DOF (see ModalBlade.from_file)")
+    rows = {name: fe.row_indices(f"dof_map[{name!r}]", value) for name, value in dof_map.items()}
+    fixed_given = list(fixed_dofs) if not isinstance(fixed_dofs, range) else fixed_dofs
+    fixed = fe.row_indices("fixed_dofs", fixed_given) if len(fixed_given) else np.zeros(0, dtype=int)
+    m_diag = fe.mass.diagonal()
+    free = np.setdiff1d(np.arange(fe.n), fixed)
+    bad = free[m_diag[free] <= 0]
+    if bad.size:
+        raise ValueError(f"{path}: mass matrix {fe.names[0]}: {fe.describe_row(int(bad[0]))} has M = "
+                         f"{m_diag[bad[0]]:g}; expected a positive diagonal on the free DOF (clamp the row with "
+                         "fixed_dofs or condense it out)")
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            blade = cls.from_matrices(fe.mass, fe.stiffness, rows, points=points, n_modes=n_modes,
+                                      damping_ratios=damping_ratios, rigid_links=rigid_links, fixed_dofs=fixed,
+                                      **matrix_options)
+    except ValueError as err:
+        raise ValueError(f"{path}: matrices {fe.names[0]} (mass), {fe.names[1]} (stiffness): {err}") from None
+    for w in caught:                  # point the warnings at the caller of from_file
+        warnings.warn(f"{path}: {w.message}", w.category, stacklevel=3)
+    return blade
+
+
 def _modal_file_kind(path: Path) -> str:
     kind = path.suffix.lower().lstrip(".")
     if kind not in ("npz", "csv"):
@@ -706,15 +832,11 @@ def read_modal_npz(path) -> tuple[dict, str, dict]:
     file's ``format`` entry (:data:`MODAL_NPZ_FORMAT` when it has none, or
     :data:`SOLID_NPZ_FORMAT`); the other arrays (key -> array, read without pickle) are those
     beyond :data:`MODAL_NPZ_KEYS`, which only the solid format may have. ValueError naming the
-    file and the key for a file that breaks the format."""
+    file and the key for a file that breaks the format, :class:`bladedamp.io.FileReadError` (a
+    ValueError) naming the file for one that is missing, empty, truncated, corrupted or not an
+    ``.npz`` archive."""
     path = Path(path)
-    try:
-        data = np.load(path, allow_pickle=False)
-    except Exception as err:   # numpy raises several types for a file that is not an .npz
-        raise ValueError(f"{path}: not a readable .npz file ({err})") from None
-    if not isinstance(data, np.lib.npyio.NpzFile):
-        raise ValueError(f"{path}: expected an .npz archive of named arrays (got a single array)")
-    with data:
+    with reading(path, "modal data file"), open_npz(path) as data:
         keys = set(data.files)
 
         def array(key, kind):
@@ -771,8 +893,9 @@ def read_modal_npz(path) -> tuple[dict, str, dict]:
 
 
 def _read_modal_csv(path: Path) -> dict:
-    """ModalBlade fields from a .csv file, one row per (mode, point) (format: module docstring)."""
-    with open(path, newline="", encoding="utf-8-sig") as fh:
+    """ModalBlade fields from a .csv file, one row per (mode, point) (format: module docstring);
+    :class:`bladedamp.io.FileReadError` naming the file if it cannot be read as UTF-8 text."""
+    with reading(path, "modal data file"), open(path, newline="", encoding="utf-8-sig") as fh:
         numbered = [(n, line) for n, line in enumerate(fh, start=1)
                     if line.strip() and not line.lstrip().startswith("#")]
     if not numbered:

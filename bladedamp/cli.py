@@ -4,19 +4,27 @@
   bladedamp frf design.toml           frequency response of the design's disk
   bladedamp optimize design.toml      optimal damper mass (and platform angle or contact height)
   bladedamp eo-sweep design.toml      optimal mass over engine orders
+  bladedamp zzenf design.toml         interference (ZZENF) diagram: natural frequencies per nodal diameter
+  bladedamp campbell design.toml      Campbell diagram: damped resonance at each engine order over rotor speed
   bladedamp montecarlo design.toml    Monte Carlo of randomly mistuned disks (Dask)
   bladedamp show design.toml          3D view of the resonance (standalone HTML)
+  bladedamp compare a.toml b.toml     frequency responses of several designs in one figure
+  bladedamp app                       the damper-design dashboard in the browser (Voila)
   bladedamp reproduce                 the paper's results on the reference configuration
   bladedamp precompile                compile every numba kernel once (after installing)
 
-Each command on a design writes into --out: results (npz and results.json), PNG figures and a
-short summary.md. A bad design field or option ends with exit code 2 and one line naming it.
+Each command on a design writes into --out (default: results/<design file name>/<command>):
+results (npz and results.json), PNG figures and a short summary.md. A folder that holds files
+already is refused unless --overwrite is given, and init keeps an existing design file. A bad
+design field, an unreadable file or a bad option ends with exit code 2 and one line naming it.
 """
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
+import warnings
 from pathlib import Path
 
 # Nothing heavy at module level: `bladedamp --help` must not import numpy, numba or the models.
@@ -28,8 +36,8 @@ class UsageError(ValueError):
 
 class Progress:
     """Progress of a command on stderr: one line per step with the elapsed time; ``bar(study)``
-    gives a (done, total) callback drawn as a tqdm bar in place on a terminal, and as a single
-    line when the study is done otherwise (logs, CI), so a redirected run prints no bar lines."""
+    gives a (done, total) callback drawn as a ``tqdm.auto`` bar (:class:`bladedamp.progress.ProgressBar`)
+    in place on a terminal and none otherwise (logs, CI), and one line when the study is done."""
 
     def __init__(self, stream=None):
         self.start = time.perf_counter()
@@ -39,31 +47,101 @@ class Progress:
     def __call__(self, what: str):
         print(f"{time.perf_counter() - self.start:7.1f} s  {what}", file=self.stream, flush=True)
 
+    def compiling(self):
+        """One line before a command's first computation when numba's cache holds no compiled
+        kernel of bladedamp yet (:func:`bladedamp.compilation.cache_is_cold`)."""
+        from .compilation import COLD_COMPILE_SECONDS, cache_is_cold
+
+        if cache_is_cold():
+            self(f"compiling kernels once, about {COLD_COMPILE_SECONDS} s; `bladedamp precompile` does it ahead")
+
     def bar(self, study: str):
-        state = {}
+        from .progress import ProgressBar
+
+        bar = ProgressBar(study, file=self.stream, disable=not self.tty, leave=False)
 
         def tick(done, total):
-            if self.tty:
-                if "bar" not in state:
-                    from tqdm import tqdm
-
-                    state["bar"] = tqdm(total=total, desc=f"{study:<28s}", file=self.stream, leave=False,
-                                        bar_format="{desc} {bar} {n_fmt}/{total_fmt} [{elapsed}<{remaining}]")
-                state["bar"].n = done
-                state["bar"].refresh()
+            bar(done, total)
             if done >= total:
-                if "bar" in state:
-                    state.pop("bar").close()
                 self(f"{study} done ({total})")
         return tick
 
 
-def output_dir(path: Path) -> Path:
-    """``path`` created if needed and checked writable (before any computation); UsageError otherwise."""
+class Notes:
+    """The warnings raised while a command runs (the library's AccuracyWarning and
+    PlausibilityWarning, numpy's RuntimeWarning, numba's warnings, ...), collected instead of
+    printed with their category and source line: each distinct message is one plain line,
+    written to the command's summary.md and results.json (:meth:`write`) and printed at the end
+    of the run (:meth:`show`). Python's developer categories (DeprecationWarning,
+    PendingDeprecationWarning, ImportWarning, ResourceWarning) stay ignored, as they are by
+    default. ``Notes.current`` is the collection of the running command (None outside one)."""
+
+    current = None
+    IGNORED = (DeprecationWarning, PendingDeprecationWarning, ImportWarning, ResourceWarning)
+
+    def __init__(self):
+        self._catcher = warnings.catch_warnings(record=True)
+        self._records = []
+        self._printed = 0
+
+    def __enter__(self):
+        self._records = self._catcher.__enter__()
+        warnings.simplefilter("always")          # every occurrence: the duplicates are merged in lines()
+        for category in self.IGNORED:
+            warnings.simplefilter("ignore", category)
+        Notes.current = self
+        return self
+
+    def __exit__(self, *exc_info):
+        Notes.current = None
+        return self._catcher.__exit__(*exc_info)
+
+    def lines(self) -> list[str]:
+        """The distinct messages in the order they were first raised, each on one line."""
+        distinct = dict.fromkeys(" ".join(str(w.message).split()) for w in self._records)
+        return [line for line in distinct if line]
+
+    def write(self, out: Path) -> None:
+        """Add the messages to ``out``/summary.md (a Notes section) and ``out``/results.json (key
+        "notes"), where the command wrote those files; nothing without messages."""
+        import json
+
+        from .report import write_json
+
+        lines = self.lines()
+        if not lines:
+            return
+        summary, results = out / "summary.md", out / "results.json"
+        if summary.exists():
+            text = summary.read_text().rstrip("\n")
+            summary.write_text(text + "\n\n## Notes\n\n" + "".join(f"- {line}\n" for line in lines))
+        if results.exists():
+            data = json.loads(results.read_text())
+            data["notes"] = lines
+            write_json(results, data)
+
+    def show(self, stream=None) -> None:
+        """Print the messages not printed yet, one plain line each ("note: ...")."""
+        lines = self.lines()
+        for line in lines[self._printed:]:
+            print(f"note: {line}", file=stream if stream is not None else sys.stderr)
+        self._printed = len(lines)
+
+
+def output_dir(path: Path, overwrite: bool = False) -> Path:
+    """``path`` created if needed and checked writable (before any computation); UsageError if
+    it is a file, cannot be written, or already holds files or folders and ``overwrite`` is
+    False (a run never replaces results a user has without being told to; with ``overwrite``
+    the files of the same names are replaced and the others stay)."""
     import tempfile
 
     if path.exists() and not path.is_dir():
         raise UsageError(f"--out {path}: is a file, not a folder")
+    held = sorted(p.name for p in path.iterdir()) if path.is_dir() else []
+    if held and not overwrite:
+        shown = ", ".join(held[:3]) + (f" and {len(held) - 3} more" if len(held) > 3 else "")
+        raise UsageError(f"--out {path}: the folder is not empty ({shown}); choose another --out, or add "
+                         "--overwrite to replace the files of the same names")
     try:
         path.mkdir(parents=True, exist_ok=True)
         with tempfile.NamedTemporaryFile(dir=path, prefix=".bladedamp-write-test-"):
@@ -73,12 +151,31 @@ def output_dir(path: Path) -> Path:
     return path
 
 
+#: the output folder of every command without --out: results/<design file stem>/<command>,
+#: or this folder (the built-in reference configuration: reproduce, montecarlo without a design)
+RESULTS = Path("results")
+
+
+def output_folder(args) -> Path:
+    """The folder a command writes into: ``--out``, else ``results/<design file stem>/<command>``
+    (so that two designs never share one), ``results/<command>`` for montecarlo without a design
+    file and ``results`` for reproduce (the built-in reference configuration)."""
+    if args.out is not None:
+        return args.out
+    if args.command == "reproduce":
+        return RESULTS
+    design = getattr(args, "design", None)
+    return RESULTS / args.command if design is None else RESULTS / design.stem / args.command
+
+
 # ---------------------------------------------------------------------------------------
 # reproduce: the paper on the reference configuration
 # ---------------------------------------------------------------------------------------
-def reproduce(out: Path, processes: int | None = None) -> dict:
+def reproduce(out: Path, processes: int | None = None, overwrite: bool = False) -> dict:
     """The paper's results on the reference configuration: summary.json, report.md and the
-    figures in ``out``; ``processes``: worker processes of the studies (None: every core)."""
+    figures in ``out``; ``processes``: worker processes of the studies (None: every core);
+    ``overwrite``: replace the files of an earlier run in ``out`` (else a folder that holds
+    files is refused, :func:`output_dir`)."""
     import json
     import warnings
 
@@ -95,10 +192,11 @@ def reproduce(out: Path, processes: int | None = None) -> dict:
     from .studies.parallel import parallel_map
 
     warnings.simplefilter("ignore")
-    output_dir(out)
+    output_dir(out, overwrite)
     t_start = time.perf_counter()
     masses = np.array([0.02, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 1.0, 1.5, 2.0, 3.0, 5.0, 10.0, 100.0, 1000.0]) * 1e-3
     progress = Progress()
+    progress.compiling()
     timings = {}
 
     # -- undamped reference (calibration target 1) --
@@ -371,13 +469,18 @@ def _design_studies(out: Path, progress, processes, timings, optima: dict, sweep
 # the commands on a design file
 # ---------------------------------------------------------------------------------------
 def _load(args):
-    """The design of ``args.design`` (figures drawn off-screen)."""
+    """The design of ``args.design`` (figures drawn off-screen); a file that sets no key says so
+    in one line on stderr (it is the reference design)."""
     import matplotlib
 
     matplotlib.use("Agg")
     from .design import load_design
 
-    return load_design(args.design)
+    design = load_design(args.design)
+    if not design.keys_given:
+        print(f"bladedamp {args.command}: note: {args.design} sets no key: running the reference design "
+              f"(bladedamp init writes it with every key)", file=sys.stderr)
+    return design
 
 
 def _damped(design, command: str):
@@ -417,6 +520,10 @@ def _check_platform_angle_option(design, option: str, angles_deg) -> None:
 
 
 def _done(out: Path, t0: float, what: str) -> int:
+    """The last line of a command on a design (what it found, where it wrote), after the
+    run's warnings were added to its summary.md and results.json (:class:`Notes`)."""
+    if Notes.current is not None:
+        Notes.current.write(out)
     print(f"{what}; wrote {out / 'summary.md'}, results and figures in {out} ({time.perf_counter() - t0:.1f} s)",
           file=sys.stderr)
     return 0
@@ -426,7 +533,7 @@ def init_command(args) -> int:
     """``bladedamp init``: the reference design, every key commented."""
     from .design import write_template
 
-    path = write_template(args.design, overwrite=args.force)
+    path = write_template(args.design, overwrite=args.overwrite)
     print(f"wrote the reference design to {path}; edit it, then run: bladedamp frf {path}", file=sys.stderr)
     return 0
 
@@ -454,8 +561,14 @@ def frf_command(args) -> int:
     design = _load(args)
     if args.mistuned and design.mistuning is None:
         raise UsageError(f"{design.path}: --mistuned needs a [mistuning] table (std and seed, or kappa)")
-    out = output_dir(args.out)
+    measured = None
+    if args.measured is not None:                 # read before the solve: a bad file stops at once
+        from .measurement import load_measurement
+
+        measured = load_measurement(args.measured, unit=args.measured_unit, record=args.measured_record)
+    out = output_dir(output_folder(args), args.overwrite)
     progress, a = Progress(), design.analysis
+    progress.compiling()
     responses = {}
     # a branch that stops early is checked by time integration just beyond its stop (a minute or
     # more): its result then says whether a periodic motion exists there (TunedDisk / MistunedDisk.stop_check)
@@ -477,9 +590,13 @@ def frf_command(args) -> int:
         for eo in design.engine_orders:
             undamped[f"EO{eo}"] = dataclasses.replace(design.disk_at(eo), damper=None).frequency_response(
                 a.f_start_hz, a.f_end_hz, harmonics=(1,), max_step=a.max_step, estimate_harmonic_error=False)
-    summary = frf_outputs(out, design, responses, undamped)
-    peaks = ", ".join(f"{k} peak {v['peak_amplitude_mm']:.4f} mm at {v['peak_frequency_hz']:.3f} Hz"
-                      if v["peak_amplitude_mm"] is not None else f"{k} no points"
+    summary = frf_outputs(out, design, responses, undamped, measured=measured)
+    for k, v in summary["responses"].items():      # each response's status first
+        print(f"{k}: {v['status_message']}", file=sys.stderr)
+    peaks = ", ".join(f"{k} {'largest amplitude at the range end' if v['peak_at_range_end'] else 'peak'} "
+                      f"{v['peak_amplitude_mm']:.4f} mm at {v['peak_frequency_hz']:.3f} Hz"
+                      if v["peak_amplitude_mm"] is not None and math.isfinite(v["peak_amplitude_mm"])
+                      else f"{k} no peak: no point computed (summary.md says why)"
                       for k, v in summary["responses"].items())
     return _done(out, t0, peaks)
 
@@ -504,8 +621,9 @@ def optimize_command(args) -> int:
     for h in args.contact_height_mm or ():
         if not 0 < h <= 100:
             raise UsageError(f"--contact-height-mm {h:g}: must be in (0, 100] mm")
-    out = output_dir(args.out)
+    out = output_dir(output_folder(args), args.overwrite)
     progress = Progress()
+    progress.compiling()
     options = dict(f_range_hz=a.f_range_hz, harmonics=a.study_harmonics)
     progress(f"optimal mass in {1e3 * a.mass_bounds[0]:g}-{1e3 * a.mass_bounds[1]:g} g")
     optimum = optimal_mass(disk, a.mass_bounds, processes=args.processes, progress=progress.bar("mass grid"),
@@ -519,7 +637,8 @@ def optimize_command(args) -> int:
         for h in args.contact_height_mm:
             progress(f"optimal mass at h_C = {h:g} mm")
             heights.append((1e-3 * h, optimal_mass(with_contact_height(disk, 1e-3 * h), a.mass_bounds,
-                                                   processes=args.processes, **options)))
+                                                   processes=args.processes,
+                                                   progress=progress.bar(f"mass grid at h_C = {h:g} mm"), **options)))
     optimize_outputs(out, design, optimum, angles, heights)
     return _done(out, t0, f"optimal mass {1e3 * optimum.mass:.4g} g, peak {1e3 * optimum.peak_amplitude:.4f} mm, "
                           f"reduction {fmt_percent(optimum.reduction)}")
@@ -535,10 +654,11 @@ def eo_sweep_command(args) -> int:
     disk, a = _damped(design, "eo-sweep"), design.analysis
     eos = args.engine_orders or design.engine_orders
     for eo in eos:
-        if not 0 <= eo <= disk.n_blades // 2:
-            raise UsageError(f"--engine-orders {eo}: must be in [0, {disk.n_blades // 2}] (n_blades / 2)")
-    out = output_dir(args.out)
+        if eo < 0:
+            raise UsageError(f"--engine-orders {eo}: must be an integer >= 0")
+    out = output_dir(output_folder(args), args.overwrite)
     progress = Progress()
+    progress.compiling()
     sweep = engine_order_sweep(design.disk_at(1), sorted(set(eos)), a.mass_bounds, design.rotor_speed_eo0_hz, a.f_range_hz,
                                harmonics=a.study_harmonics, progress=progress.bar("engine orders"),
                                processes=args.processes)
@@ -547,12 +667,94 @@ def eo_sweep_command(args) -> int:
                           f"{', '.join(f'{100 * r:.1f} %' for r in sweep.reduction)}")
 
 
+def _rotor_speed_range_hz(design, args, engine_orders) -> tuple[float, float]:
+    """The rotor-speed range [Hz] of zzenf and campbell: --speed-range-rpm, else the design's
+    fixed rotor speed, else the speeds at which the engine orders > 0 excite [analysis]
+    frequency_range_hz (f_start / largest EO to f_end / smallest EO), 10 % wider each side."""
+    if args.speed_range_rpm is not None:
+        lo, hi = args.speed_range_rpm
+        if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi):
+            raise UsageError(f"--speed-range-rpm {lo:g} {hi:g}: must be 0 < LOW <= HIGH rpm")
+        return lo / 60, hi / 60
+    if design.rotor_speed_hz is not None:
+        return design.rotor_speed_hz, design.rotor_speed_hz
+    moving = [eo for eo in engine_orders if eo > 0]
+    if not moving:
+        raise UsageError(f"{design.path}: [disk] engine_order holds EO = 0 only, whose excitation does not follow "
+                         "the rotor speed: give --speed-range-rpm LOW HIGH or an engine order > 0")
+    a = design.analysis
+    return 0.9 * a.f_start_hz / max(moving), 1.1 * a.f_end_hz / min(moving)
+
+
+def _top_frequency_hz(design, args) -> float:
+    if args.f_max_hz is None:
+        return 1.25 * design.analysis.f_end_hz
+    if not (math.isfinite(args.f_max_hz) and args.f_max_hz > 0):
+        raise UsageError(f"--f-max-hz {args.f_max_hz:g}: must be > 0 Hz")
+    return args.f_max_hz
+
+
+def zzenf_command(args) -> int:
+    """``bladedamp zzenf``: the interference (ZZENF) diagram of the design's disk."""
+    from .report import zzenf_outputs
+    from .studies.interference import interference_diagram
+
+    t0 = time.perf_counter()
+    design = _load(args)
+    speeds = _rotor_speed_range_hz(design, args, design.engine_orders)
+    f_max = _top_frequency_hz(design, args)
+    out = output_dir(output_folder(args), args.overwrite)
+    progress = Progress()
+    progress.compiling()
+    progress(f"natural frequencies of nodal diameters 0-{design.disk.n_blades // 2} at "
+             f"{60 * speeds[0]:.0f}-{60 * speeds[1]:.0f} rpm")
+    diagram = interference_diagram(design.disk, speeds, f_max, design.engine_orders)
+    summary = zzenf_outputs(out, design, diagram)
+    return _done(out, t0, f"{len(summary['crossings'])} possible resonances of engine orders "
+                          f"{', '.join(map(str, design.engine_orders))} up to {f_max:g} Hz")
+
+
+def campbell_command(args) -> int:
+    """``bladedamp campbell``: resonance crossings over rotor speed with the damped peak at each."""
+    import dataclasses
+
+    from .report import campbell_outputs
+    from .studies.interference import campbell_diagram
+
+    t0 = time.perf_counter()
+    design = _load(args)
+    _damped(design, "campbell")
+    if design.rotor_speed_hz is not None:
+        raise UsageError(f"{design.path}: [disk] rotor_speed_rpm fixes the rotor speed; campbell follows each engine "
+                         "order over rotor speed (set rotor_speed_rpm = \"auto\"; --speed-range-rpm sets the diagram's range)")
+    eos = tuple(sorted(set(args.engine_orders))) if args.engine_orders else design.engine_orders
+    for eo in eos:
+        if eo < 0:
+            raise UsageError(f"--engine-orders {eo}: must be an integer >= 0")
+    speeds = _rotor_speed_range_hz(design, args, eos)
+    f_max = _top_frequency_hz(design, args)
+    out = output_dir(output_folder(args), args.overwrite)
+    progress, a = Progress(), design.analysis
+    progress.compiling()
+    disk = dataclasses.replace(design.disk, engine_order=1, rotor_speed_hz=None)
+    diagram = campbell_diagram(disk, eos, a.f_range_hz, speeds, f_max, harmonics=(1,), progress=progress,
+                               max_step=a.max_step, harmonic_tolerance=a.harmonic_tolerance)
+    summary = campbell_outputs(out, design, diagram)
+    for c in summary["crossings"]:
+        print(f"EO {c['engine_order']}: {c['status_message']}", file=sys.stderr)
+    return _done(out, t0, ", ".join(
+        f"EO {c['engine_order']} peak {c['peak_amplitude_mm']:.4f} mm at {c['peak_frequency_hz']:.3f} Hz, "
+        f"{c['rotor_speed_rpm']:.0f} rpm" + ("" if c["found"] else " (no resonance found in the range)")
+        if c["peak_amplitude_mm"] is not None else f"EO {c['engine_order']} no point computed"
+        for c in summary["crossings"]) or "no engine order > 0: no crossing")
+
+
 def monte_carlo_command(args) -> int:
     """``bladedamp montecarlo``: peak amplification of N mistuned disks (the design's, or the
     reference disk) on Dask."""
     import dataclasses
 
-    from .design import load_design, reference_design
+    from .design import reference_design
     from .report import montecarlo_outputs
     from .studies.mistuning import MONTE_CARLO_MAX_STEP, MONTE_CARLO_TOL, PAPER_STD, monte_carlo
 
@@ -570,7 +772,7 @@ def monte_carlo_command(args) -> int:
 
     matplotlib.use("Agg")
     if args.design is not None:
-        design = load_design(args.design)
+        design = _load(args)
     else:
         from .reference import reference_disk
 
@@ -578,11 +780,12 @@ def monte_carlo_command(args) -> int:
         design = dataclasses.replace(design, disk=reference_disk(args.damper or "cylinder",
                                                                  1e-3 * (1.0 if args.mass is None else args.mass)))
     disk = _damped(design, "montecarlo")
-    out = output_dir(args.out)
+    out = output_dir(output_folder(args), args.overwrite)
     file_mistuning = design.mistuning if args.design is not None else None
     std = args.std if args.std is not None else (file_mistuning.std if file_mistuning else PAPER_STD)
     seed = args.seed if args.seed is not None else (file_mistuning.seed if file_mistuning else 0)
     progress = Progress()
+    progress.compiling()
     result = monte_carlo(disk, args.disks, std=std, seed=seed, harmonics=design.analysis.study_harmonics,
                          scheduler=None if args.scheduler == "local" else args.scheduler, n_workers=args.workers,
                          progress=progress.bar("Monte Carlo disks"), out=None,
@@ -612,10 +815,16 @@ def show_command(args) -> int:
 
     t0 = time.perf_counter()
     design = _load(args)
-    out = output_dir(args.out)
+    out = output_dir(output_folder(args), args.overwrite)
     a = design.analysis
-    Progress()(f"frequency response at EO = {design.disk.engine_order}, {a.f_start_hz:g}-{a.f_end_hz:g} Hz")
-    response = design.disk.frequency_response(a.f_start_hz, a.f_end_hz, **a.options())
+    progress = Progress()
+    if args.saved is not None:
+        response = saved_response(design, args.saved)
+        progress(f"frequency response at EO = {design.disk.engine_order} read from {args.saved}")
+    else:
+        progress.compiling()
+        progress(f"frequency response at EO = {design.disk.engine_order}, {a.f_start_hz:g}-{a.f_end_hz:g} Hz")
+        response = design.disk.frequency_response(a.f_start_hz, a.f_end_hz, **a.options())
     options = {} if args.layout is None else {"layout": args.layout}
     if design.blade_geometry is not None:
         options["blade_geometry"] = design.blade_geometry
@@ -625,9 +834,155 @@ def show_command(args) -> int:
     return _done(out, t0, f"3D view of the resonance at {response.peak_frequency_hz:.3f} Hz in {html}")
 
 
+def compare_inputs(args) -> list:
+    """The designs of ``bladedamp compare``: each positional input (a design file, or a folder of
+    ``bladedamp frf`` results) and each ``--from`` folder, in that order, as
+    :class:`bladedamp.compare.Compared`; a folder's responses are read, a design file's left
+    empty (computed by :func:`compare_command` once every input is checked). UsageError for an
+    input that is neither."""
+    from .compare import Compared, design_of_saved, saved_frf
+    from .design import load_design
+
+    sources = [Path(p) for p in args.designs] + [Path(p) for p in (args.saved or ())]
+    if len(sources) < 2:
+        raise UsageError(f"give at least two designs to compare (design files or folders written by bladedamp frf; "
+                         f"got {len(sources)})")
+    entries = []
+    for source in sources:
+        if source.is_dir():
+            try:
+                responses, design_path, files = saved_frf(source)
+            except ValueError as exc:
+                raise UsageError(str(exc)) from None
+            design, note = design_of_saved(source, design_path)
+            name = design_path.stem if design_path is not None else source.name
+            entries.append(Compared(name, source, responses, design, files, note))
+        else:
+            if source.suffix.lower() != ".toml" and not source.exists():
+                raise UsageError(f"{source}: neither a design file (.toml) nor a folder of bladedamp frf results")
+            entries.append(Compared(source.stem, source, {}, load_design(source)))
+    names = [e.name for e in entries]
+    for e in entries:                  # the same stem twice (a design and its saved results): say which
+        if names.count(e.name) > 1:
+            e.name = f"{e.name} ({e.source})"
+    return entries
+
+
+def compare_command(args) -> int:
+    """``bladedamp compare``: the frequency responses of several designs in one figure and a
+    table of their peaks, resonance frequencies and reductions."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from .compare import compare_outputs, damper_free_key, undamped_responses
+
+    t0 = time.perf_counter()
+    entries = compare_inputs(args)
+    out = output_dir(output_folder(args), args.overwrite)
+    progress = Progress()
+    if any(not e.responses for e in entries):
+        progress.compiling()
+    for e in entries:
+        if not e.responses:            # a design file: its tuned responses (no time integration checks)
+            a = e.design.analysis
+            for eo in e.design.engine_orders:
+                progress(f"{e.name}: frequency response at EO = {eo}, {a.f_start_hz:g}-{a.f_end_hz:g} Hz")
+                e.responses[f"EO{eo}"] = e.design.disk_at(eo).frequency_response(a.f_start_hz, a.f_end_hz,
+                                                                                **a.options())
+    known = [e for e in entries if e.design is not None]
+    keys = {damper_free_key(e.design) for e in known}
+    shared = len(known) == len(entries) and len(keys) == 1
+    undamped, by_key = {}, {}
+    for e in known:                    # one damper-free response per distinct blade, disk and excitation
+        key = damper_free_key(e.design)
+        if key not in by_key:
+            progress(f"damper-free reference of {e.name}")
+            by_key[key] = undamped_responses(e.design, list(e.responses))
+        for label in e.responses:
+            if label in by_key[key]:
+                undamped[e.name, label] = by_key[key][label]
+            else:
+                undamped[e.name, label] = undamped_responses(e.design, [label])[label]
+    summary = compare_outputs(out, entries, undamped, shared)
+    what = "; ".join(f"{row['design']} {row['response']} peak {row['peak_amplitude_mm']:.4f} mm at "
+                     f"{row['peak_frequency_hz']:.3f} Hz" for row in summary["designs"])
+    return _done(out, t0, what)
+
+
+def saved_response(design, folder: Path):
+    """The response of ``design``'s first engine order saved by ``bladedamp frf`` in ``folder``,
+    with the design's disk attached (for the 3D view). UsageError when the folder holds no such
+    results or they are of another design, or of the design before it was changed."""
+    import dataclasses
+
+    from .compare import saved_frf
+
+    try:
+        responses, design_path, _ = saved_frf(folder)
+    except ValueError as exc:
+        raise UsageError(f"--from {exc}") from None
+    if design_path is None or not design_path.exists() or design_path.resolve() != Path(design.path).resolve():
+        raise UsageError(f"--from {folder}: its results are of {design_path or 'an unnamed design'}, not of "
+                         f"{design.path}")
+    if Path(design.path).stat().st_mtime > (folder / "results.json").stat().st_mtime:
+        raise UsageError(f"--from {folder}: {design.path} was changed after the results were saved; run "
+                         f"bladedamp frf {design.path} again")
+    label = f"EO{design.disk.engine_order}"
+    if label not in responses:
+        raise UsageError(f"--from {folder}: no response at EO = {design.disk.engine_order} (holds "
+                         f"{', '.join(responses)})")
+    return dataclasses.replace(responses[label], disk=design.disk)
+
+
+def app_command(args) -> int:
+    """``bladedamp app``: the damper-design dashboard served by Voila on localhost until Ctrl+C."""
+    import importlib.util
+    import signal
+    import subprocess
+
+    if importlib.util.find_spec("voila") is None:
+        raise UsageError("the app is served by voila, which is not installed: pip install 'bladedamp[app]'")
+    from .app import free_port, port_in_use, voila_command, wait_for_port
+
+    if args.port is not None:
+        if not 1024 <= args.port <= 65535:
+            raise UsageError(f"--port {args.port}: must be in [1024, 65535]")
+        if port_in_use(args.port):
+            raise UsageError(f"--port {args.port}: in use on 127.0.0.1; choose another or leave --port out")
+    port = args.port if args.port is not None else free_port()
+    url = f"http://127.0.0.1:{port}/"
+
+    def stop(signum, frame):           # a terminated command stops its server too
+        raise KeyboardInterrupt
+    previous = signal.signal(signal.SIGTERM, stop)
+    server = subprocess.Popen(voila_command(port))
+    try:
+        if not wait_for_port(port, 60.0, process=server):
+            server.terminate()
+            server.wait(10)
+            raise UsageError(f"voila did not start on port {port} (exit code {server.returncode}); see its messages above")
+        print(f"bladedamp app: the damper-design dashboard is at {url} (Ctrl+C stops it)", file=sys.stderr, flush=True)
+        if not args.no_browser:
+            import webbrowser
+
+            webbrowser.open(url)
+        server.wait()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        if server.poll() is None:
+            server.terminate()
+            try:
+                server.wait(10)
+            except subprocess.TimeoutExpired:
+                server.kill()
+        signal.signal(signal.SIGTERM, previous)
+    return 0
+
+
 def reproduce_command(args) -> int:
     """``bladedamp reproduce``."""
-    reproduce(args.out, args.processes)
+    reproduce(output_folder(args), args.processes, args.overwrite)
     return 0
 
 
@@ -679,8 +1034,12 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("design", type=Path, help="the design file (TOML; write one with: bladedamp init design.toml)")
 
     def out_arg(p, default):
-        p.add_argument("--out", type=Path, default=Path(default),
-                       help=f"output folder, created if needed and checked before computing (default: {default})")
+        p.add_argument("--out", type=Path, default=None,
+                       help=f"output folder, created if needed and checked before computing; one that holds files\n"
+                            f"is refused unless --overwrite is given (default: {default})")
+        p.add_argument("--overwrite", action="store_true",
+                       help="write into an --out folder that holds files already, replacing the files of the same\n"
+                            "names (the others stay)")
 
     def figure_args(p):
         p.add_argument("--format", default="png", metavar="FORMATS",
@@ -697,7 +1056,7 @@ def build_parser() -> argparse.ArgumentParser:
                 "and the reason for its value beside it. Edit it, then run e.g.: bladedamp frf design.toml")
     p.add_argument("design", type=Path, nargs="?", default=Path("design.toml"),
                    help="the file to write (default: design.toml)")
-    p.add_argument("--force", action="store_true", help="overwrite the file if it exists")
+    p.add_argument("--overwrite", "--force", action="store_true", help="replace the file if it exists")
 
     p = command("frf", frf_command, "frequency response of a design",
                 "Harmonic balance and arc-length continuation over [analysis] frequency_range_hz at every\n"
@@ -713,7 +1072,14 @@ def build_parser() -> argparse.ArgumentParser:
                    help="skip the time integration at the peak of a complete branch (by default it runs, 5-31 s,\n"
                         "and gives a direct harmonic error estimate, or fails the branch where the vibration there does\n"
                         "not settle; not for solid FE blades with flexible platforms)")
-    out_arg(p, "results/frf")
+    p.add_argument("--measured", type=Path, metavar="FILE",
+                   help="a measured response drawn on frf.png: a UFF 58 FRF or spectrum (one record), or a CSV\n"
+                        "(frequency [Hz], re [m/N], im [m/N] or amplitude [mm]); an FRF times the design's excitation force")
+    p.add_argument("--measured-unit", metavar="UNIT", help="the unit of a --measured file that does not state it "
+                   "(e.g. m/s^2/N, g/N, mm)")
+    p.add_argument("--measured-record", metavar="K", type=int,
+                   help="which dataset 58 record of a --measured UFF file holding several (from 0)")
+    out_arg(p, "results/<design file name>/frf")
     figure_args(p)
 
     p = command("optimize", optimize_command, "optimal damper mass of a design",
@@ -727,18 +1093,50 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--contact-height-mm", type=float, nargs="+", metavar="MM",
                    help="also optimise the mass at each of these wedge contact heights [mm], in (0, 100]")
     processes_arg(p)
-    out_arg(p, "results/optimize")
+    out_arg(p, "results/<design file name>/optimize")
     figure_args(p)
+
+    def engine_orders_arg(p):
+        p.add_argument("--engine-orders", type=int, nargs="+", metavar="EO",
+                       help="engine orders >= 0 (default: the design's [disk] engine_order)")
 
     p = command("eo-sweep", eo_sweep_command, "optimal damper mass over engine orders",
                 "At each engine order the mass is re-optimised in [analysis] mass_range_g (Fig. 7, 8 of the\n"
                 "paper). EO = 0 runs at [disk] rotor_speed_eo0_rpm unless rotor_speed_rpm fixes the speed.\n"
                 "Writes eo_sweep.png, eo_sweep.npz, results.json, summary.md.")
     design_arg(p)
-    p.add_argument("--engine-orders", type=int, nargs="+", metavar="EO",
-                   help="engine orders in [0, n_blades / 2] (default: the design's [disk] engine_order)")
+    engine_orders_arg(p)
     processes_arg(p)
-    out_arg(p, "results/eo-sweep")
+    out_arg(p, "results/<design file name>/eo-sweep")
+    figure_args(p)
+
+    def speed_args(p):
+        p.add_argument("--speed-range-rpm", type=float, nargs=2, metavar=("LOW", "HIGH"), default=None,
+                       help="rotor-speed range [rpm] (default: the design's fixed rotor_speed_rpm, else the speeds at\n"
+                            "which its engine orders excite [analysis] frequency_range_hz, 10 %% wider)")
+        p.add_argument("--f-max-hz", type=float, default=None,
+                       help="top of the diagram [Hz] (default: 1.25 x the end of [analysis] frequency_range_hz)")
+
+    p = command("zzenf", zzenf_command, "interference (ZZENF) diagram of a design",
+                "The natural frequencies of the disk per nodal diameter 0..n_blades/2 without dampers and with\n"
+                "the dampers stuck (at the lowest and highest rotor speed: the preload m R Omega^2 changes them),\n"
+                "and each engine order's excitation EO x rotor speed at its nodal diameter (EO mod n, folded to\n"
+                "n - (EO mod n) as a backward wave above n/2). Writes zzenf.png, results.json, summary.md.")
+    design_arg(p)
+    speed_args(p)
+    out_arg(p, "results/<design file name>/zzenf")
+    figure_args(p)
+
+    p = command("campbell", campbell_command, "Campbell diagram with the damped resonance at each engine order",
+                "Natural frequencies over rotor speed (without dampers; stuck at each engine order's nodal\n"
+                "diameter), the lines f = EO x rotor speed, and at each engine order > 0 the damped resonance:\n"
+                "the peak of its frequency response over [analysis] frequency_range_hz with the rotor speed\n"
+                "following the excitation, one harmonic (the one-harmonic estimate). Needs a damper and\n"
+                "rotor_speed_rpm = 'auto'. Writes campbell.png, results.json, summary.md.")
+    design_arg(p)
+    engine_orders_arg(p)
+    speed_args(p)
+    out_arg(p, "results/<design file name>/campbell")
     figure_args(p)
 
     p = command("montecarlo", monte_carlo_command, "Monte Carlo of randomly mistuned disks (Dask)",
@@ -766,7 +1164,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "0.05 for full FRF accuracy)")
     p.add_argument("--tol", type=float, default=None,
                    help="continuation tolerance per disk, in (0, 1) (default 1e-6; 1e-10 for full FRF accuracy)")
-    out_arg(p, "results/montecarlo")
+    out_arg(p, "results/<design file name>/montecarlo, or results/montecarlo without a design")
     figure_args(p)
 
     p = command("show", show_command, "3D view of a design's resonance (standalone HTML)",
@@ -776,7 +1174,30 @@ def build_parser() -> argparse.ArgumentParser:
     design_arg(p)
     p.add_argument("--layout", choices=("sector", "disk"), default=None,
                    help="sector (three blades) or disk (every blade); default: disk with a damper, sector without")
-    out_arg(p, "results/show")
+    p.add_argument("--from", dest="saved", type=Path, default=None, metavar="DIR",
+                   help="read the frequency response that bladedamp frf saved in DIR (of this design file) instead of\n"
+                        "computing it again")
+    out_arg(p, "results/<design file name>/show")
+
+    p = command("compare", compare_command, "frequency responses of several designs in one figure",
+                "Overlays the tip responses of two or more designs (design files, computed; or folders written by\n"
+                "bladedamp frf, read), the damper-free response dashed once when they share blade, disk and\n"
+                "excitation. Writes compare.png, compare.csv and compare.json (peak, resonance frequency and\n"
+                "reduction against the damper-free peak of every design) and summary.md.")
+    p.add_argument("designs", type=Path, nargs="*", metavar="DESIGN",
+                   help="design files (TOML) or folders of bladedamp frf results")
+    p.add_argument("--from", dest="saved", type=Path, action="append", metavar="DIR",
+                   help="a folder of bladedamp frf results to compare (repeatable)")
+    out_arg(p, "results/compare")
+    figure_args(p)
+
+    p = command("app", app_command, "the damper-design dashboard in the browser (Voila)",
+                "Serves a teaching dashboard on this machine (127.0.0.1 only): damper type, mass, engine order,\n"
+                "friction coefficient and excitation as controls; the frequency response, the 3D contact view at\n"
+                "the resonance and the hysteresis loop of a contact point as views. Needs the app extra:\n"
+                "pip install 'bladedamp[app]'. Ctrl+C stops the server.")
+    p.add_argument("--port", type=int, default=None, help="the port, in [1024, 65535] (default: a free one)")
+    p.add_argument("--no-browser", action="store_true", help="print the address only, open no browser")
 
     p = command("reproduce", reproduce_command,
                 "reproduce the paper on the built-in reference configuration",
@@ -787,8 +1208,10 @@ def build_parser() -> argparse.ArgumentParser:
     figure_args(p)
     processes_arg(p)
 
+    from .compilation import COLD_COMPILE_SECONDS
+
     command("precompile", precompile_command, "compile every numba kernel once, ahead of the first run",
-            "numba compiles bladedamp's kernels on their first call (about 10-20 s of CPU once per machine and\n"
+            f"numba compiles bladedamp's kernels on their first call (about {COLD_COMPILE_SECONDS} s once per machine and\n"
             "user) and keeps them in ~/.cache/bladedamp/numba. Run this once after installing (a lab machine, a\n"
             "Docker image) and no later run pays it; running it again only loads the cache.")
     return parser
@@ -796,21 +1219,27 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv=None) -> int:
     """Run ``bladedamp`` with ``argv`` (default: the command line); returns the exit code
-    (0 done, 2 a user error, printed as one line on stderr)."""
+    (0 done, 2 a user error: a bad option or output folder, a design file or another file that
+    cannot be read or has a bad value; printed as one line on stderr). The warnings raised on
+    the way are printed last, one plain line each (:class:`Notes`)."""
     args = build_parser().parse_args(argv)
-    from .design import DesignError
+    from .io import FileReadError
 
-    try:
-        _validate_flags(args)
-        if not hasattr(args, "format"):
-            return args.run(args)
-        from .plotting import figure_output
+    with Notes() as notes:
+        try:
+            _validate_flags(args)
+            if not hasattr(args, "format"):
+                code = args.run(args)
+            else:
+                from .plotting import figure_output
 
-        with figure_output(args.format, args.dpi):
-            return args.run(args)
-    except (DesignError, UsageError) as exc:
-        print(f"bladedamp {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+                with figure_output(args.format, args.dpi):
+                    code = args.run(args)
+        except (FileReadError, UsageError) as exc:     # a design file or another file, an option
+            print(f"bladedamp {args.command}: error: {exc}", file=sys.stderr)
+            code = 2
+        notes.show()
+    return code
 
 
 if __name__ == "__main__":

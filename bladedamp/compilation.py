@@ -18,8 +18,46 @@ reference disk's FRF, a mistuned FRF and the time integrations compile nothing.
 """
 from __future__ import annotations
 
+import hashlib
+import os
+import sys
 import time
 import warnings
+
+# [s] compiling every kernel on an empty cache: bladedamp.precompile() took 27.5-31 s on the
+# 2-core machine (benchmarks/README.md, "Start-up and the numba compile cost"); a command
+# compiles the kernels it uses, at most that
+COLD_COMPILE_SECONDS = 30
+
+
+def kernel_cache_folders() -> list[str]:
+    """The folders where numba keeps (or would keep) the compiled kernels of this copy of
+    bladedamp, one per source folder of the package: inside numba's cache folder
+    (``NUMBA_CACHE_DIR``, which bladedamp points at its per-user cache), a folder named as numba
+    names it (the source folder's name, "_", the SHA-1 of its absolute path); without a cache
+    folder, the source folders' ``__pycache__``."""
+    numba_config = sys.modules.get("numba.core.config")
+    cache_dir = getattr(numba_config, "CACHE_DIR", None) or os.environ.get("NUMBA_CACHE_DIR")
+    package = os.path.dirname(os.path.abspath(__file__))
+    sources = [root for root, dirs, files in os.walk(package)
+               if "__pycache__" not in root.split(os.sep) and any(f.endswith(".py") for f in files)]
+    if not cache_dir:
+        return [os.path.join(source, "__pycache__") for source in sources]
+    return [os.path.join(cache_dir, f"{os.path.basename(source)}_{hashlib.sha1(source.encode()).hexdigest()}")
+            for source in sources]
+
+
+def cache_is_cold() -> bool:
+    """True when numba's cache holds no compiled kernel of this copy of bladedamp (no index
+    file ``*.nbi`` in :func:`kernel_cache_folders`): the first kernel call of the process then
+    compiles, about ``COLD_COMPILE_SECONDS`` in all. Does not import numba."""
+    for folder in kernel_cache_folders():
+        try:
+            if any(name.endswith(".nbi") for name in os.listdir(folder)):
+                return False
+        except OSError:
+            continue
+    return True
 
 
 def _oscillator_paths():

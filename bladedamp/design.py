@@ -8,7 +8,10 @@ is part of every key's name. Every key is optional: a missing key takes the refe
 so a file holding only ``[damper]`` / ``mass_g = 2.0`` is the reference disk with a 2 g damper.
 Unknown tables and keys are errors (a typo must not pass silently).
 
-A blade of your own is modal data (``[blade] modal_file``) or a closed surface mesh meshed as a
+A blade of your own is modal data (``[blade] modal_file``), reduced FE matrices (``modal_file``
+an ``.op4``, ``.pch``, ``.mtx``, ``.mat`` or ``.full`` file with ``[blade.fe]`` and the point tables
+``[blade.fe.OL]``, ``[blade.fe.OR]``, ``[blade.fe.tip]``, ``[blade.fe.excitation]``, optionally
+``[blade.fe.platform]``; :meth:`bladedamp.blade.ModalBlade.from_file`) or a closed surface mesh meshed as a
 solid FE blade (``[blade] model = "solid"``, ``surface_file``, ``surface_units`` and the named
 regions ``[blade.regions.clamp]``, ``[blade.regions.OL]``, ``[blade.regions.OR]``, optionally
 ``[blade.regions.tip]``, each a plane or its own surface file; :class:`bladedamp.solid.SurfaceBladeGeometry`);
@@ -28,10 +31,13 @@ from pathlib import Path
 
 import numpy as np
 
+from .fe_formats import FE_SUFFIXES
+from .io import FileReadError, reading
 
-class DesignError(ValueError):
+
+class DesignError(FileReadError):
     """A design file that cannot be read or has a bad field; the message is one line naming the
-    file, the key, the value and the allowed range."""
+    file and what is wrong (the key, the value and the allowed range for a bad field)."""
 
 
 class _Bad(Exception):
@@ -96,8 +102,10 @@ class Boolean:
 
 @dataclass(frozen=True)
 class Text:
+    what: str = "a file path in quotes (relative to the design file)"
+
     def describe(self, unit: str = "") -> str:
-        return "a file path in quotes (relative to the design file)"
+        return self.what
 
     def __call__(self, v):
         if not isinstance(v, str) or not v.strip():
@@ -186,6 +194,14 @@ TABLES = {
                         "it). The examples are the reference blade's.",
     "blade.regions.tip": "surface_file only, optional: the tip face (mode names, the tip point), as a plane or a "
                          "file; default the flat top face at the surface's largest z.",
+    "blade.fe": "FE matrix files only ([blade] modal_file ending in .op4, .pch, .mtx, .mat or .full; see "
+                "ModalBlade.from_file and the README): which matrices, which DOF are clamped. The point tables "
+                "[blade.fe.OL], [blade.fe.OR], [blade.fe.tip] and [blade.fe.excitation] are then required, "
+                "[blade.fe.platform] optional.",
+    **{f"blade.fe.{name}": f"FE matrix files only: the point {name} by node and DOF as the exporting program numbers "
+                           "them (node, dofs) or by row numbers (rows), or rigidly linked to another point (link), "
+                           "and its position."
+       for name in ("OL", "OR", "tip", "excitation", "platform")},
     "damper": "The underplatform damper between neighbouring blades: kind, geometry, mass and contact.",
     "disk": "The tuned bladed disk: blades, engine order(s), platform angles, damper radius, excitation, speed.",
     "mistuning": "Blade frequency mistuning kappa (f_0 -> kappa f_0 for every mode of a blade); remove this table "
@@ -206,6 +222,51 @@ SURFACE_GAMMA_TOLERANCE_DEG = 0.01
 REGION_TOLERANCE_MM = 0.01
 # [blade.beam] keys that apply to a surface_file blade (the others are the built-in blade's geometry)
 SURFACE_BEAM_KEYS = ("youngs_modulus_gpa", "poisson_ratio", "density_kg_m3", "tip_point_mm", "excitation_point_mm")
+
+
+# the points of an FE matrix blade (tables [blade.fe.<name>]); platform is optional
+FE_POINTS = ("OL", "OR", "tip", "excitation", "platform")
+# what [blade.fe] mass / stiffness allow
+MATRIX_NAME = "a name in quotes (Abaqus: a file name beside modal_file)"
+
+
+def _fe_fields(g) -> list[Field]:
+    """The keys of [blade.fe] and [blade.fe.<point>] (an FE matrix file as [blade] modal_file;
+    examples from the reference blade ``g``, a BeamBladeGeometry)."""
+    pts = {k: [round(1e3 * float(x), 6) + 0.0 for x in p] for k, p in g.points().items()}      # [mm]
+    index = Number(-1e9, 1e9, integer=True)
+    row = Number(1, 1e9, integer=True)
+    rows = [
+        Field("blade.fe", "mass", None, Text(MATRIX_NAME), "-",
+              "the mass matrix's name in the file (Abaqus: the mass file); default MAAX, MAA, M or MASS, whichever "
+              "the file holds (Abaqus: the _MASS file beside the _STIF one)", example="MAA"),
+        Field("blade.fe", "stiffness", None, Text(MATRIX_NAME), "-",
+              "the stiffness matrix's name in the file (Abaqus: the stiffness file); default KAAX, KAA, K or "
+              "STIFFNESS", example="KAA"),
+        Field("blade.fe", "fixed_nodes", None, List(index), "-",
+              "files that label rows by node (DMIG, Abaqus, Ansys): nodes clamped, all their DOF (e.g. the root "
+              "of a model exported free)", example=[1]),
+        Field("blade.fe", "fixed_rows", None, List(row), "-",
+              "files that number rows only (OUTPUT4, MATLAB): 1-based rows clamped", example=[1, 2, 3, 4, 5, 6]),
+    ]
+    for name in FE_POINTS:
+        table = f"blade.fe.{name}"
+        example = pts["platform"] if name == "platform" else pts[name]
+        rows += [
+            Field(table, "node", None, index, "-", "the point's node (grid) number in the file", example=101),
+            Field(table, "dofs", None, List(Number(0, 6, integer=True)), "-",
+                  "with node: its DOF numbers in the order ux, uy, uz, phix, phiy, phiz (1-6) or ux, uy, uz "
+                  "(1-3); default 1-6", example=[1, 2, 3, 4, 5, 6]),
+            Field(table, "rows", None, List(row), "-", "instead of node: the 1-based rows of its 6 or 3 DOF",
+                  example=[1, 2, 3, 4, 5, 6]),
+            Field(table, "link", None, Choice(FE_POINTS), "-",
+                  "instead of node or rows: rigidly attached to this 6-DOF point (e.g. OL and OR to platform)",
+                  example="platform"),
+            Field(table, "position_mm", None, List(Number(-1e4, 1e4), 3), "mm",
+                  "the point's position in the blade frame (x circumferential, y axial, z radial); required",
+                  example=example),
+        ]
+    return rows
 
 
 def _region_fields(g) -> list[Field]:
@@ -287,7 +348,8 @@ def _fields() -> list[Field]:
     rows = [
         Field("blade", "modal_file", None, Text(), "-",
               "modal data at named points (npz or CSV, see ModalBlade.from_file) instead of the beam model; "
-              "needs OL, OR, tip and excitation", example="my_blade.npz"),
+              "needs OL, OR, tip and excitation; or reduced FE matrices (.op4, .pch, .mtx, .mat, .full) with "
+              "[blade.fe] and its point tables, n_modes and damping_ratio", example="my_blade.npz"),
         Field("blade", "model", "beam", Choice(("beam", "solid")), "-",
               "beam: the paper's beam FE model, rigid platforms at OL / OR; solid: 3D quadratic tetrahedra of the "
               "same geometry ([blade.beam] sections and material, the platform faces at [disk] gamma_left_deg / "
@@ -305,7 +367,8 @@ def _fields() -> list[Field]:
               "solid model only: gmsh's element size; 6 mm: 28 800 DOF, the damped 1F peak 0.06 % in amplitude "
               "and 0.11 % in frequency from the 4.5 mm mesh's (README, flexible platforms)"),
         Field("blade", "n_modes", 4, Number(1, 40, integer=True), "-",
-              "beam or solid model: 4 gives the paper's modes 1F, 2F, 1T, 1E; otherwise the lowest n by frequency"),
+              "beam or solid model: 4 gives the paper's modes 1F, 2F, 1T, 1E; otherwise (and for FE matrix files) "
+              "the lowest n by frequency"),
         Field("blade", "natural_frequencies_hz", list(freqs), Either((Choice(("model",)), List(Number(0.0, 1e6, "right")))),
               "Hz", "the paper's Table 1 (the beam or solid FE gives the shapes); 'model' keeps the model's or the "
               "file's own frequencies (the default with modal_file or surface_file); one per mode"),
@@ -318,6 +381,7 @@ def _fields() -> list[Field]:
         Field("blade.beam", "excitation_point_mm", None, List(Number(-1e4, 1e4), 3), "mm",
               "where the excitation acts; default the tip point", example=[0.0, 0.0, 200.0]),
         *_region_fields(g),
+        *_fe_fields(g),
         Field("damper", "kind", "cylinder", Choice(("cylinder", "wedge", "none")), "-",
               "cylinder (rolls at EO = 0) or wedge (flat faces of height h_C); none: no damper"),
         Field("damper", "mass_g", 1.0, Number(0.0, 1000.0, "right"), "g",
@@ -347,7 +411,8 @@ def _fields() -> list[Field]:
         Field("disk", "n_blades", ref.N_BLADES, Number(2, 1000, integer=True), "-", "the paper's disk"),
         Field("disk", "engine_order", ref.ENGINE_ORDER,
               Either((Number(0, 500, integer=True), List(Number(0, 500, integer=True), increasing=True))), "-",
-              "EO in [0, n_blades / 2], or a list (frf and eo-sweep run each; the others the first)"),
+              "EO >= 0, or a list (frf, eo-sweep, zzenf and campbell use each; the others the first); EO mod n_blades sets "
+              "the nodal diameter (forward, or backward above n_blades / 2), EO itself the rotor speed"),
         Field("disk", "gamma_left_deg", _tidy(np.degrees(ref.PLATFORM_ANGLE)), Number(0.0, 90.0, "neither"), "deg",
               "platform angle at OL (paper: 35 deg); a surface_file blade's OL face sets it"),
         Field("disk", "gamma_right_deg", _tidy(np.degrees(ref.PLATFORM_ANGLE)), Number(0.0, 90.0, "neither"), "deg",
@@ -455,7 +520,7 @@ def write_template(path, overwrite: bool = False) -> Path:
     cannot be written."""
     path = Path(path)
     if path.exists() and not overwrite:
-        raise DesignError(f"{path}: exists already (choose another name, or overwrite it with --force)")
+        raise DesignError(f"{path}: exists already (choose another name, or replace it with --overwrite)")
     try:
         path.write_text(template())
     except OSError as exc:
@@ -523,7 +588,8 @@ class Design:
     [Hz], None for 'auto' (Omega_E / EO);
     values : {table: {key: value}} in the file's units, every key (defaults filled in);
     path : the file (None: the reference design); blade_geometry : the BeamBladeGeometry of a
-    beam or parametric solid blade (None for modal data from a file and a surface_file blade)
+    beam or parametric solid blade (None for modal data from a file and a surface_file blade);
+    keys_given : the (table, key) pairs the file sets (empty: the file is the reference design)
     """
     disk: object
     engine_orders: tuple
@@ -534,6 +600,7 @@ class Design:
     values: dict = field(repr=False, default_factory=dict)
     path: Path | None = None
     blade_geometry: object = None
+    keys_given: frozenset = frozenset()
 
     def disk_at(self, engine_order: int):
         """The design's disk at another engine order (at EO = 0 with the speed rotor_speed_eo0_hz
@@ -609,44 +676,49 @@ def _bad(path, table, key, value, allowed) -> DesignError:
 def load_design(path) -> Design:
     """Read a design file (TOML) into the models: a :class:`Design` with ``.disk`` (TunedDisk),
     ``.mistuned_disk()`` and ``.analysis``. Raises :class:`DesignError` (a ValueError) with one
-    line naming the file, key, value and allowed range for a bad field, an unknown key, a file
-    that is missing or not TOML."""
+    line naming the file, key, value and allowed range for a bad field or an unknown key, and
+    naming the file and what is wrong for a file that is missing, a folder, unreadable, not UTF-8
+    text (a byte-order mark is allowed) or not TOML (:func:`bladedamp.io.reading`). A file that
+    sets no key (empty, only comments or table headers) is the reference design:
+    ``Design.keys_given`` is then empty."""
     path = Path(path)
-    try:
-        with open(path, "rb") as fh:
-            raw = tomllib.load(fh)
-    except FileNotFoundError:
+    if not path.exists():
         raise DesignError(f"{path}: no such design file (write the reference design with: "
-                          f"bladedamp init {path})") from None
-    except IsADirectoryError:
-        raise DesignError(f"{path}: is a folder, not a design file") from None
-    except OSError as exc:
-        raise DesignError(f"{path}: cannot read the design file ({exc.strerror or exc})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise DesignError(f"{path}: not valid TOML ({exc})") from None
+                          f"bladedamp init {path})")
+    with reading(path, "design file (TOML)", DesignError):
+        try:
+            raw = tomllib.loads(path.read_bytes().decode("utf-8-sig"))
+        except tomllib.TOMLDecodeError as exc:
+            raise DesignError(f"{path}: not valid TOML ({exc})") from None
     values, given = _read_values(path, raw)
-    return _build(path, values, given, "mistuning" in raw)
+    design = _build(path, values, given, "mistuning" in raw)
+    design.keys_given = frozenset(given)
+    return design
 
 
 def _build(path: Path, v: dict, given: set, has_mistuning: bool) -> Design:
     """The models of checked values ``v``; the checks that involve two keys are made here."""
-    from .damper.geometry import ContactProperties, CylinderDamper, WedgeDamper
+    from .damper.geometry import MIN_DAMPER_MASS, ContactProperties, CylinderDamper, WedgeDamper
     from .disk import TunedDisk
 
     blade, geometry = _build_blade(path, v, given)
     d, k = v["disk"], v["damper"]
     n = d["n_blades"]
     eos = (d["engine_order"],) if isinstance(d["engine_order"], int) else tuple(d["engine_order"])
-    if max(eos) > n // 2:
-        raise _bad(path, "disk", "engine_order", d["engine_order"],
-                   f"an integer or a list of integers in [0, {n // 2}] (n_blades / 2)")
     damper = None
     if k["kind"] != "none":
-        contact = ContactProperties(k["friction_coefficient"], k["tangential_stiffness_per_length_n_per_m2"],
-                                    k["normal_to_tangential_stiffness"], k["roughness_exponent"],
-                                    k["roughness_reference_load_n"], k["points_along_length"],
-                                    k["points_across_height"])
+        try:
+            contact = ContactProperties(k["friction_coefficient"], k["tangential_stiffness_per_length_n_per_m2"],
+                                        k["normal_to_tangential_stiffness"], k["roughness_exponent"],
+                                        k["roughness_reference_load_n"], k["points_along_length"],
+                                        k["points_across_height"])
+        except ValueError as exc:       # a combination of keys (each in its own range) that is no contact
+            raise DesignError(f"{path}: [damper]: {exc}") from None
         mass, length = 1e-3 * k["mass_g"], 1e-3 * k["length_mm"]
+        if mass < MIN_DAMPER_MASS:
+            raise _bad(path, "damper", "mass_g", k["mass_g"],
+                       f"in [{1e3 * MIN_DAMPER_MASS:g}, 1000] g (a lighter damper's limit is the disk without one: "
+                       f"kind = \"none\")")
         damper = (CylinderDamper(mass, 1e-3 * k["cylinder_radius_mm"], length, contact) if k["kind"] == "cylinder"
                   else WedgeDamper(mass, 1e-3 * k["contact_height_mm"], length, contact))
     speed = None if d["rotor_speed_rpm"] == "auto" else d["rotor_speed_rpm"] / 60.0      # rpm -> Hz
@@ -813,6 +885,39 @@ def _platform_angles_of(path: Path, v: dict, given: set, gammas: dict, what: str
         v["disk"][key] = face
 
 
+def _fe_options(path: Path, v: dict, given: set, n_modes: int, damping) -> dict:
+    """ModalBlade.from_file's options for an FE matrix file of [blade.fe] and [blade.fe.<point>]."""
+    fe = v["blade.fe"]
+    dof_map, points, links = {}, {}, {}
+    for name in FE_POINTS:
+        table = f"blade.fe.{name}"
+        p = v[table]
+        keys = [k for k in ("node", "rows", "link") if (table, k) in given]
+        if not any(t == table for t, _ in given):
+            if name == "platform":
+                continue
+            raise DesignError(f"{path}: [{table}] is required with an FE matrix file as [blade] modal_file: give "
+                              "node (or rows, or link) and position_mm")
+        if len(keys) != 1:
+            raise DesignError(f"{path}: [{table}] needs exactly one of node, rows or link (got "
+                              f"{', '.join(keys) or 'none'})")
+        if (table, "dofs") in given and keys != ["node"]:
+            raise DesignError(f"{path}: [{table}] dofs applies with node only: remove it")
+        if p["position_mm"] is None:
+            raise DesignError(f"{path}: [{table}] position_mm is required: the point's position [mm]")
+        points[name] = 1e-3 * np.array(p["position_mm"])
+        if keys == ["node"]:
+            dof_map[name] = (p["node"], tuple(p["dofs"] or (1, 2, 3, 4, 5, 6)))
+        elif keys == ["rows"]:
+            dof_map[name] = list(p["rows"])
+        else:
+            links[name] = p["link"]
+    fixed = list(fe["fixed_nodes"] or ()) + list(fe["fixed_rows"] or ())
+    return dict(dof_map=dof_map, points=points, rigid_links=links or None, n_modes=n_modes,
+                damping_ratios=damping, fixed_dofs=fixed,
+                mass=fe["mass"], stiffness=fe["stiffness"])
+
+
 def _build_blade(path: Path, v: dict, given: set):
     """(ModalBlade, BeamBladeGeometry or None) of [blade] and [blade.beam] (and [blade.regions.*]
     for a surface_file blade). A blade with its own platform faces sets v["disk"]'s platform angles
@@ -825,6 +930,11 @@ def _build_blade(path: Path, v: dict, given: set):
     surface = b["surface_file"] is not None
     if surface and b["modal_file"] is not None:
         raise DesignError(f"{path}: [blade] surface_file and modal_file are two different blades: give one of them")
+    fe_keys = sorted((t, k) for t, k in given if t == "blade.fe" or t.startswith("blade.fe."))
+    if fe_keys and (b["modal_file"] is None
+                    or Path(b["modal_file"]).suffix.lower().lstrip(".") not in FE_SUFFIXES):
+        raise DesignError(f"{path}: [{fe_keys[0][0]}] {fe_keys[0][1]} applies to an FE matrix file as [blade] "
+                          f"modal_file (ending in {', '.join('.' + x for x in FE_SUFFIXES)}): add it or remove the key")
     if surface and not solid:
         raise DesignError(f"{path}: [blade] surface_file is meshed as a solid FE blade: add model = \"solid\" to "
                           "[blade] (or remove surface_file)")
@@ -839,16 +949,18 @@ def _build_blade(path: Path, v: dict, given: set):
         if solid:
             raise DesignError(f"{path}: [blade] model = 'solid' builds the blade from [blade.beam]; with "
                               "modal_file remove model (or modal_file)")
+        fe_file = Path(b["modal_file"]).suffix.lower().lstrip(".") in FE_SUFFIXES
         beam_keys = sorted(k for t, k in given if t == "blade.beam")
-        if beam_keys or ("blade", "n_modes") in given:
+        if beam_keys or (("blade", "n_modes") in given and not fe_file):
             key = f"[blade.beam] {beam_keys[0]}" if beam_keys else "[blade] n_modes"
             raise DesignError(f"{path}: {key} applies to the beam model only; with [blade] modal_file remove it")
         if not hasattr(ModalBlade, "from_file"):
             raise DesignError(f"{path}: [blade] modal_file needs ModalBlade.from_file, which this bladedamp "
                               "version does not have")
         file = _relative(path, b["modal_file"])
+        options = _fe_options(path, v, given, b["n_modes"], damping) if fe_file else {}
         try:
-            blade = ModalBlade.from_file(file)
+            blade = ModalBlade.from_file(file, **options)
         except (OSError, ValueError, KeyError) as exc:
             raise DesignError(f"{path}: [blade] modal_file = {_toml(b['modal_file'])}: {exc}") from None
         faces = getattr(blade, "face_fields", {})        # a solid blade's file: its flexible platforms

@@ -3,7 +3,7 @@
 Unknowns of one sector: the blade's modal coordinates q (Eq. 2) and the six rigid-body
 coordinates u_D of its damper (the damper between this blade, at its OL platform, and the
 next blade, at that blade's OR platform). Harmonic h of the next blade is this blade's
-times e^{i h dphi}, dphi = 2 pi EO / n (Eq. 25), so the relative motion at the contacts is
+times e^{i h dphi}, dphi = 2 pi EO / n (Eq. 25; :func:`nodal_diameter`), so the relative motion at the contacts is
 
     w_h = G_D u_D,h - G_P [Phi_OL ; e^{i h dphi} Phi_OR] q_h          (Eq. 6, 24)
 
@@ -28,6 +28,7 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.linalg
 
 from . import validation
 from .blade import ModalBlade
@@ -38,12 +39,14 @@ from .contact.point import (MAX_PASSES, PERIODIC_TOL, PointContactSamples, dampe
 from .damper.geometry import CylinderDamper, DamperGeometry, WedgeDamper
 from .damper.kinetics import centrifugal_force, seat
 from .hbm.accuracy import HARMONIC_TOLERANCE, AccuracyWarning, converged_response
-from .hbm.continuation import continuation
+from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_POINT_BUDGET, Branch, Budget, continuation
+from .hbm.nonlinear_modes import linear_stuck_mode
 from .hbm.peaks import PeakSolver, first_harmonic_output
 from .hbm.start import robust_start
 from .hbm.fourier import HarmonicBasis
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import REFINE_SAMPLES_FACTOR, FrequencyResponse, physical_checks, with_checks, plot_branch, sampled_response
+from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, nearest_to_range, physical_checks, plot_branch,
+                       sampled_response, with_checks, with_range_end_estimate)
 
 DAMPER_DOFS = ("uD_x", "uD_y", "uD_z", "phiD_x", "phiD_y", "phiD_z")
 # the automatic AFT sampling of a disk's branch (TunedDisk and MistunedDisk) may grow the samples
@@ -373,6 +376,33 @@ def rotor_speed_in_hz(rotor_speed_hz):
     return float(rotor_speed_hz)
 
 
+def nodal_diameter(engine_order, n_blades) -> tuple[int, str]:
+    """The nodal diameter and travelling direction excited by engine order ``engine_order`` on a
+    disk of ``n_blades`` blades (the one place this mapping is made; every EO >= 0 is valid).
+
+    Blade j is excited with the phase j dphi, dphi = 2 pi EO / n (Eq. 25), which only depends on
+    r = EO mod n. Returns (k, direction): k = r and ``"forward"`` for 0 < r < n / 2; k = n - r
+    and ``"backward"`` for r > n / 2 (the same nodal diameter travelling against the rotation);
+    ``"standing"`` for r = 0 (k = 0: EO = 0, n, 2n, ...) and r = n / 2 (even n), where the phase
+    e^{i dphi} = +-1 is real. The excitation frequency and the rotor speed use the engine order
+    itself (Omega_R = Omega_E / EO, Eq. 3, 26), not k.
+    """
+    n = validation.integer("n_blades", n_blades, minimum=2)
+    eo = validation.integer("engine_order (EO)", engine_order, minimum=0)
+    r = eo % n
+    if r == 0 or 2 * r == n:
+        return r, "standing"
+    return (r, "forward") if 2 * r < n else (n - r, "backward")
+
+
+def interblade_phase(engine_order, n_blades) -> float:
+    """dphi [rad] in (-pi, pi] of engine order ``engine_order`` on ``n_blades`` blades (Eq. 25):
+    2 pi k / n for the nodal diameter k of :func:`nodal_diameter`, negative for a backward wave
+    (e^{i dphi} = e^{i 2 pi EO / n} exactly, with dphi = 0 at EO = 0, n, 2n, ...)."""
+    k, direction = nodal_diameter(engine_order, n_blades)
+    return (-2 if direction == "backward" else 2) * np.pi * k / int(n_blades)
+
+
 @dataclass
 class TunedDisk:
     """Tuned bladed disk with one damper per blade pair (cyclic symmetry, Eq. 21-25).
@@ -382,7 +412,8 @@ class TunedDisk:
     blade : ModalBlade (points OL, OR, tip, excitation)
     damper : CylinderDamper, WedgeDamper or None (mass 0 or None: no damper)
     n_blades : n >= 2
-    engine_order : EO in 0..n/2
+    engine_order : EO >= 0; the nodal diameter and travelling direction follow from EO mod n
+        (:func:`nodal_diameter`), the rotor speed Omega_E / EO from EO itself
     gamma_left, gamma_right : platform angles at OL and OR [rad], in (0, pi/2)
     damper_radius : R, distance of the damper's centre of gravity to the rotor axis [m]
     excitation : (6,) harmonic tip load (F_x, F_y, F_z, M_x, M_y, M_z) at the blade's
@@ -409,7 +440,7 @@ class TunedDisk:
     def __post_init__(self):
         self.rotor_speed_hz = rotor_speed_in_hz(self.rotor_speed_hz)
         validation.integer("n_blades", self.n_blades, minimum=2)
-        validation.integer("engine_order (EO)", self.engine_order, minimum=0, maximum=self.n_blades // 2)
+        self.engine_order = validation.integer("engine_order (EO)", self.engine_order, minimum=0)
         validation.in_range("gamma_left (platform angle, rad)", self.gamma_left, 0.0, np.pi / 2, closed="neither")
         validation.in_range("gamma_right (platform angle, rad)", self.gamma_right, 0.0, np.pi / 2, closed="neither")
         validation.positive("damper_radius R", self.damper_radius)
@@ -431,8 +462,13 @@ class TunedDisk:
 
     @property
     def interblade_phase(self) -> float:
-        """dphi = 2 pi EO / n [rad] (Eq. 25)."""
-        return 2 * np.pi * self.engine_order / self.n_blades
+        """dphi [rad] in (-pi, pi], e^{i dphi} = e^{i 2 pi EO / n} (Eq. 25; :func:`interblade_phase`)."""
+        return interblade_phase(self.engine_order, self.n_blades)
+
+    @property
+    def nodal_diameter(self) -> tuple[int, str]:
+        """(nodal diameter k, "forward" / "backward" / "standing") of the engine order (:func:`nodal_diameter`)."""
+        return nodal_diameter(self.engine_order, self.n_blades)
 
     @property
     def dof_names(self) -> tuple[str, ...]:
@@ -601,6 +637,35 @@ class TunedDisk:
 
         return approach
 
+    def check_bounded(self, f_start_hz: float, f_end_hz: float) -> None:
+        """ValueError where no bounded periodic response exists in ``f_start_hz``..``f_end_hz``
+        [Hz]: a blade mode j with zero modal damping, a modal force phi_j^T F != 0, its natural
+        frequency f_0j inside the range, and no damper acting on it (no damper, or rigid
+        platforms that do not move at OL and OR in that mode). Its modal equation is then
+        q_j'' + omega_0j^2 q_j = phi_j^T F cos(Omega t) alone, whose amplitude grows without
+        bound at Omega = omega_0j. (With a damper on that mode the bound of its friction forces
+        is no closed form: the normal loads vary with the motion.)"""
+        blade = self.blade
+        force = blade.shape("excitation").T @ self.excitation                 # (nm,) modal forces [N]
+        lo, hi = min(f_start_hz, f_end_hz), max(f_start_hz, f_end_hz)
+        if self.has_damper:
+            if blade.flexible_platform:
+                return
+            at_damper = np.abs(np.vstack([blade.shape("OL"), blade.shape("OR")])).max(axis=0) > 0
+        else:
+            at_damper = np.zeros(blade.n_modes, dtype=bool)
+        f0 = np.asarray(blade.natural_frequencies_hz, dtype=float)
+        free = (blade.damping_ratios == 0) & (force != 0) & ~at_damper & (f0 >= lo) & (f0 <= hi)
+        if np.any(free):
+            j = int(np.flatnonzero(free)[0])
+            name = blade.mode_names[j] if len(blade.mode_names) else str(j + 1)
+            why = "the disk has no damper" if not self.has_damper else "the damper's platforms do not move in it"
+            raise ValueError(
+                f"no bounded response: blade mode {name} has damping_ratios = 0, a modal force "
+                f"{force[j]:.6g} N and its natural frequency {f0[j]:.6g} Hz inside the range {f_start_hz:g}-"
+                f"{f_end_hz:g} Hz, and {why}: its amplitude grows without bound there; give the mode a damping "
+                f"ratio > 0 or a range without {f0[j]:.6g} Hz")
+
     def static_normal_loads(self, f_hz: float) -> np.ndarray:
         """Static normal loads (N_OL, N_OR) [N] from frictionless seating under F_CG at the
         excitation frequency ``f_hz`` [Hz]."""
@@ -613,6 +678,7 @@ class TunedDisk:
                            max_harmonic: int = 7, extra_couplings=None, stop_above: float | None = None,
                            stop_direction: int = 0, estimate_harmonic_error: bool = True,
                            check_stop: bool = False, check_peak: bool = False,
+                           cpu_budget_s: float = DEFAULT_CPU_BUDGET_S, point_budget: int = DEFAULT_POINT_BUDGET,
                            **continuation_options) -> "DiskResponse":
         """Forced response from ``f_start_hz`` to ``f_end_hz`` [Hz] by continuation.
 
@@ -627,7 +693,11 @@ class TunedDisk:
         result above the tolerance says so).
         ``max_step`` is the largest arc-length step in scaled units (the frequency range is 1;
         smaller: more points). The result is ``success`` only if the branch reached the end and
-        passed :func:`bladedamp.response.physical_checks`. ``n_samples``: AFT samples per period;
+        passed :func:`bladedamp.response.physical_checks`; a range where no bounded response
+        exists (:meth:`check_bounded`) is refused with a ValueError before any solve. Without
+        dynamic excitation (``excitation`` zero, no ``extra_couplings``) the response is rest,
+        exactly (:func:`rest_response`).
+        ``n_samples``: AFT samples per period;
         None (default): the basis default, and once four times more if that branch fails
         (:func:`bladedamp.response.sampled_response`; ``AUTO_SAMPLES_GROWTH``), once more again
         if it reached the end and failed only the dissipation check (``AUTO_SAMPLES_GROWTH_DISSIPATION``).
@@ -654,18 +724,26 @@ class TunedDisk:
         for 16 blades on 2 cores), and only for a branch that stopped before the end of its range;
         rigid platforms and no ``extra_couplings`` (what ``time_response`` models).
         ``check_peak``: for a branch that reached the end of the range, integrate the full
-        assembly in time at the peak's frequency (:meth:`peak_check`): where that motion is
+        assembly in time at the peak's frequency, started on the branch's own state there
+        (:meth:`peak_check`): where that motion is
         periodic (or the blades settle while a damper keeps rolling), its difference from the
         branch is a direct harmonic error estimate (the only one where the enriched set's Newton
         fails at the peak, typically with the damper separated most of the period); where the
         vibration does not settle, the response fails (:func:`with_peak_check`; its
         ``peak_check`` keeps the integration). One time integration (1-3 s for 4 blades, 5-31 s
         for 16 on 2 cores); the same restrictions as ``check_stop``.
+        ``cpu_budget_s`` [s] and ``point_budget``: the CPU time (``time.process_time``) and the
+        continuation points this whole analysis may spend, the time integrations of
+        ``check_stop`` and ``check_peak`` excepted (:class:`bladedamp.hbm.continuation.Budget`;
+        defaults ``DEFAULT_CPU_BUDGET_S``, ``DEFAULT_POINT_BUDGET``). Where it runs out the branch
+        ends there with every point it has, status ``OUT_OF_BUDGET`` (not ``success``), and
+        ``stopped_by`` and the message say what ran out and at which frequency.
         """
         validation.positive("f_start_hz", f_start_hz)
         validation.positive("f_end_hz", f_end_hz)
         if f_start_hz == f_end_hz:
             raise ValueError("f_end_hz must differ from f_start_hz")
+        self.check_bounded(f_start_hz, f_end_hz)
         w0, w1 = 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz
         if stop_above is not None:
             validation.positive("stop_above", stop_above)
@@ -679,6 +757,10 @@ class TunedDisk:
                 raise ValueError(f"{name} integrates the disk in time, which models rigid platforms only: "
                                  f"use blade.rigid_platform_blade() or {name}=False")
         model = self if extra_couplings is None else WithCouplings(self, extra_couplings)
+        if not np.any(self.excitation) and extra_couplings is None:
+            return rest_response(self, w0, w1, max_step, harmonic_tolerance,
+                                 lambda system, branch: DiskResponse.from_branch(self, system, branch))
+        budget = Budget(cpu_budget_s, point_budget)
 
         def solve(H):
             first = HarmonicBasis(tuple(H)).n_samples
@@ -693,7 +775,7 @@ class TunedDisk:
                                   start_at_end=lambda: self.start_solution(system, w1, scales),
                                   retry_x_scale=self.retry_scales(system, scales),
                                   stop_when=self.amplitude_stop(system.basis, stop_above, stop_direction),
-                                  **continuation_options)
+                                  budget=budget, **continuation_options)
             response = DiskResponse.from_branch(self, system, branch)
             T = system.basis.n_samples
 
@@ -709,11 +791,48 @@ class TunedDisk:
                                                          response.excitation_work, max_step, T, refine,
                                                          points_dissipation(response, "point_work_bound")))
 
-        response = converged_response(model, solve, harmonics, harmonic_tolerance, max_harmonic,
-                                      estimate=estimate_harmonic_error)
         can_check = extra_couplings is None and not self.blade.flexible_platform
-        response = with_peak_check(self, response, check_peak, harmonic_tolerance, can_check)
-        return with_stop_check(self, response, f_start_hz, check_stop)
+        response = peak_checked_response(self, model, solve, harmonics, harmonic_tolerance, max_harmonic,
+                                         estimate_harmonic_error, check_peak, can_check)
+        return with_range_end_estimate(self, with_stop_check(self, response, f_start_hz, check_stop))
+
+    def linear_natural_frequencies_hz(self, f_low_hz: float, f_high_hz: float) -> tuple[float, float]:
+        """(without dampers, dampers stuck): the natural frequency [Hz] of each linear sector
+        model (engine order ``engine_order``) nearest the range [``f_low_hz``, ``f_high_hz``]
+        (:func:`bladedamp.response.nearest_to_range`). Without dampers: the generalised eigenvalues
+        of the blade's stiffness and mass; stuck: the zero-amplitude linearisation at the static
+        state, each mode at its own frequency when the preload follows the rotor speed
+        (:func:`bladedamp.hbm.nonlinear_modes.linear_stuck_mode`), nan where it cannot be
+        computed. A friction-damped resonance lies between them (up to the damper's inertia);
+        used to say where a resonance outside the range may lie (:func:`with_range_end_estimate`)."""
+        free, stuck = self.linear_natural_frequencies_up_to_hz(f_high_hz)
+        free = nearest_to_range(free, f_low_hz, f_high_hz)
+        return (free, free) if not self.has_damper else (free, nearest_to_range(stuck, f_low_hz, f_high_hz))
+
+    def linear_natural_frequencies_up_to_hz(self, f_max_hz: float) -> tuple[np.ndarray, np.ndarray]:
+        """(without dampers, dampers stuck): the natural frequencies [Hz], ascending, of the two
+        linear sector models of :meth:`linear_natural_frequencies_hz`: every one without dampers
+        (the blade's), and the stuck ones from the lowest up to the first above ``f_max_hz`` (the
+        stuck system depends on the nodal diameter of the engine order, its preload on the rotor
+        speed; empty without a damper; a repeated stuck mode ends the list)."""
+        free_system = dataclasses.replace(self, damper=None).hbm_system((1,))
+        M, K = (np.atleast_2d(m.toarray() if hasattr(m, "toarray") else np.asarray(m, dtype=float))
+                for m in (free_system.mass, free_system.stiffness))
+        lam = scipy.linalg.eigvals(K, M)
+        lam = np.real(lam[np.isfinite(lam) & (np.real(lam) > 0)])
+        free = np.sort(np.sqrt(lam) / (2 * np.pi))
+        if not self.has_damper:
+            return free, np.zeros(0)
+        system, stuck = self.hbm_system((1,)), []
+        for mode in range(system.n_dof):          # upwards until a mode lies above f_max_hz
+            try:
+                omega = linear_stuck_mode(self, system, mode)[0]
+            except (ValueError, np.linalg.LinAlgError):   # no such mode, or a repeated one
+                break
+            stuck.append(omega / (2 * np.pi))
+            if stuck[-1] > f_max_hz:
+                break
+        return free, np.array(stuck)
 
     def amplitude_stop(self, basis: HarmonicBasis, stop_above: float | None, direction: int = 0):
         """The continuation's ``stop_when`` for ``stop_above`` [m] (None: None): a message once the
@@ -837,8 +956,10 @@ class TunedDisk:
     def time_response(self, f_hz, **options):
         """Steady state at each excitation frequency ``f_hz`` [Hz] (scalar or array) by time
         integration of the full assembly (``MistunedDisk.from_tuned(self)``: every blade and
-        damper written out, no cyclic reduction), from the static equilibrium under F_CG (Eq. 26);
-        see :func:`bladedamp.timedomain.disk_time_response` for ``options``.
+        damper written out, no cyclic reduction), from the static equilibrium under F_CG (Eq. 26)
+        or a harmonic solution's state (``start_coefficients`` of the full assembly:
+        :func:`bladedamp.hbm.monodromy.full_assembly_coefficients`); see
+        :func:`bladedamp.timedomain.disk_time_response` for ``options``.
         Returns a :class:`bladedamp.timedomain.DiskTimeResponse` (tip amplitudes of every blade)."""
         from .mistuned import MistunedDisk
         from .timedomain import disk_time_response
@@ -861,7 +982,9 @@ class TunedDisk:
 
     def peak_check(self, response: "DiskResponse", **options):
         """:meth:`time_response` at the frequency of ``response``'s peak (the point of the
-        largest first-harmonic tip amplitude in any direction), ``options`` going to it: what
+        largest first-harmonic tip amplitude in any direction), started on the branch's state
+        there (``start="hbm"``, default) or from the static equilibrium (``start="static"``;
+        :func:`time_at_peak`), the other ``options`` going to it: what
         ``frequency_response(..., check_peak=True)`` runs (:func:`with_peak_check`)."""
         return time_at_peak(self, response, **options)
 
@@ -879,12 +1002,27 @@ def peak_index(model, response) -> int:
     return int(np.argmax(model.output_amplitudes(response.coefficients, response.basis).max(axis=1)))
 
 
-def time_at_peak(model, response, **options):
+def time_at_peak(model, response, start: str = "hbm", **options):
     """``model.time_response`` at the frequency of ``response``'s peak (:func:`peak_index`): the
-    ``peak_check`` of both models."""
+    ``peak_check`` of both models. ``start``: "hbm" (default) starts on the peak's harmonic
+    solution (displacements and velocities from its Fourier series at t = 0, every friction
+    slider from the contact's return map over one period of its motion:
+    :func:`bladedamp.hbm.monodromy.orbit_state`), so the run tests that branch; a harmonic set
+    without the static harmonic 0 (the dampers seated beforehand, not in the solution) starts
+    from the static equilibrium instead. "static": from the static equilibrium under F_CG, the
+    motion a run-up from rest reaches. The result's ``start`` says which."""
+    from .hbm import monodromy
+
+    if start not in ("hbm", "static"):
+        raise ValueError(f"start must be 'hbm' (the HBM solution's state) or 'static' (the static equilibrium), "
+                         f"got {start!r}")
     if not len(response.omega):
         raise ValueError("peak_check needs a response with at least one point")
-    return model.time_response(response.frequency_hz[peak_index(model, response)], **options)
+    k = peak_index(model, response)
+    if start == "hbm" and response.basis.has_static and monodromy.supports(model):
+        X = monodromy.full_assembly_coefficients(model, response.coefficients[k], response.basis)
+        options = dict(options, start_coefficients=X[None], start_basis=response.basis)
+    return model.time_response(response.frequency_hz[k], **options)
 
 
 def time_check_beyond(model, response, offset_hz: float = STOP_CHECK_OFFSET_HZ, f_start_hz: float | None = None,
@@ -904,6 +1042,23 @@ def time_check_beyond(model, response, offset_hz: float = STOP_CHECK_OFFSET_HZ, 
     return model.time_response(response.frequency_hz[k] + direction * offset_hz, **options)
 
 
+def rest_response(model, omega_start: float, omega_end: float, max_step: float, tolerance: float, respond):
+    """The exact response of a disk (``model``: a TunedDisk or MistunedDisk) without dynamic
+    excitation over ``omega_start``..``omega_end`` [rad/s]: every blade and damper at rest (each
+    harmonic of the motion zero; the preload holds the dampers on their platforms), at points
+    ``max_step`` of the range apart. Zero motion solves the first-harmonic residual (the
+    contacts' forces are then constant and have no first harmonic; to rounding), so the response
+    is ``success`` with a harmonic error of 0 (no harmonic set moves), computed with harmonics
+    (1,) whatever set was asked for. ``respond(system, branch)`` makes the model's response."""
+    system = model.hbm_system((1,))
+    n = int(np.ceil(1.0 / max_step)) + 1
+    omega = np.linspace(omega_start, omega_end, n)
+    branch = Branch(omega, np.zeros((n, system.n_unknowns)), np.zeros(n, dtype=int), True,
+                    "no dynamic excitation (excitation is zero): every blade and damper at rest at every frequency")
+    return dataclasses.replace(respond(system, branch), harmonic_error=0.0, harmonic_tolerance=tolerance,
+                               harmonics_converged=True)
+
+
 def with_stop_check(model, response, f_start_hz: float, check_stop: bool):
     """``response`` of ``model.frequency_response`` (a :class:`TunedDisk` or
     :class:`~bladedamp.mistuned.MistunedDisk`) with its stop note (:func:`with_stop_note`): with
@@ -914,12 +1069,32 @@ def with_stop_check(model, response, f_start_hz: float, check_stop: bool):
     return with_stop_note(response, f_start_hz, check)
 
 
+def peak_checked_response(model, system_model, solve, harmonics, tolerance: float, max_harmonic: int, estimate: bool,
+                          check_peak: bool, can_check: bool):
+    """The response of ``model.frequency_response`` (a :class:`TunedDisk` or
+    :class:`~bladedamp.mistuned.MistunedDisk`) before its stop check: the branches of ``solve``
+    with their harmonic error estimate (:func:`~bladedamp.hbm.accuracy.converged_response` on
+    ``system_model``), then :func:`with_peak_check`. One accuracy warning per call: where the
+    peak check runs, its verdict (which includes the estimate) replaces the estimate's
+    AccuracyWarning; every other warning raised on the way is raised again at the caller of
+    ``frequency_response``."""
+    with warnings.catch_warnings(record=True) as raised:
+        response = converged_response(system_model, solve, harmonics, tolerance, max_harmonic, estimate=estimate)
+    response = with_peak_check(model, response, check_peak, tolerance, can_check)
+    for w in raised:
+        if response.peak_check is None or not issubclass(w.category, AccuracyWarning):
+            warnings.warn(w.message, w.category, stacklevel=3)     # this function, frequency_response, its caller
+    return response
+
+
 def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMONIC_TOLERANCE,
                     can_check: bool = True):
     """``response`` of ``model.frequency_response`` (a :class:`TunedDisk` or
     :class:`~bladedamp.mistuned.MistunedDisk`) with its peak checked by time integration, with
     ``check_peak`` and a branch that reached the end of its range: ``model.peak_check``, the full
-    assembly integrated at the peak's frequency from the static equilibrium.
+    assembly integrated at the peak's frequency, started on the branch's own state there
+    (:func:`time_at_peak`; from the static equilibrium for a harmonic set without the static
+    term), so it tests that branch; the message says which start it used.
 
     * Periodic there: the largest difference of the first-harmonic tip amplitudes (every blade,
       x, y, z) relative to the branch's peak amplitude is a second harmonic error estimate, a
@@ -933,6 +1108,11 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
       reference 1 g cylinder in its slip range, 95.1-96.1 Hz: tests/test_timedomain_disk.py, where
       the HBM is within 2 % of the mean tip amplitudes): compared as above, with the time
       integration's mean tip amplitudes, and the message says the damper drifts.
+    * Periodic or drifting, but farther from the branch than its one-period defect allows for a
+      motion that stays on it (:func:`orbit_departure`): the motion left the branch for a
+      coexisting one. A note, not a harmonic error estimate (``harmonic_error`` and
+      ``harmonics_converged`` stay the enriched set's); ``peak_check(result, start='static')``
+      gives the motion reached from rest.
     * Not settled or unstable there (the vibration does not settle: random disks 51 and 87,
       cylinders of 7.1 and 3.4 g at EO 7 and 8, whose (0, 1) branches reach the end unverified,
       the damper separated 87 and 19 % of the period): the branch's peak is not a motion the disk
@@ -957,14 +1137,26 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
     check = model.peak_check(response)
     f, peak = check.frequency_hz[0], max(float(at_peak.max()), 1e-300)
     separated = 100 * check.point_state[0][..., 2].mean()
-    where = f"at the peak, {f:.4f} Hz, the time integration of the full assembly (from the static equilibrium)"
+    on_orbit = check.start is not None and check.start[0] == "HBM solution"
+    origin = ("started on the HBM solution's state: displacements, velocities and the sliders' states over one "
+              "period of its motion" if on_orbit else "from the static equilibrium" +
+              ("" if response.basis.has_static else ": the harmonic set has no static term to start on"))
+    where = f"at the peak, {f:.4f} Hz, the time integration of the full assembly ({origin})"
     status = check.status[0]
     if status not in ("periodic", "drifting"):
         found = (f"{where} finds no periodic motion ({check.message[0]}; the damper's contact points separated "
                  f"{separated:.0f} % of the period): the branch's peak is not a motion the disk settles on")
-        warnings.warn(found, AccuracyWarning, stacklevel=3)
+        warnings.warn(found, AccuracyWarning, stacklevel=4)   # with_peak_check, peak_checked_response, the model, the caller
         return dataclasses.replace(with_checks(response, {"peak_time_check": found}), peak_check=check)
     direct = float(np.abs(model.time_output_amplitudes(check)[0] - at_peak).max() / peak)
+    if on_orbit:
+        left = orbit_departure(model, check, at_peak, peak, direct, tolerance)
+        if left is not None:
+            note = (f"{where} leaves the branch for a coexisting periodic motion {left}; the branch's peak is not the "
+                    "motion a disk started on it keeps (an unstable or coexisting solution): this is no harmonic error "
+                    "estimate, peak_check(result, start='static') gives the motion reached from rest")
+            warnings.warn(note, AccuracyWarning, stacklevel=3)
+            return dataclasses.replace(response, peak_check=check, message=response.message + "; " + note)
     error = max(direct, enriched) if np.isfinite(enriched) else direct
     met = error <= tolerance
     motion = ("settles on a periodic motion" if status == "periodic" else
@@ -974,9 +1166,33 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
             f"contact points separated {separated:.0f} % of the period): harmonic error estimate {100 * error:.2g} %, "
             + ("within" if met else "above") + f" the tolerance {100 * tolerance:.2g} %")
     if not met:
-        warnings.warn(note, AccuracyWarning, stacklevel=3)
+        warnings.warn(note, AccuracyWarning, stacklevel=4)
     return dataclasses.replace(response, harmonic_error=error, harmonic_tolerance=tolerance, harmonics_converged=met,
                                peak_check=check, message=response.message + "; " + note)
+
+
+def orbit_departure(model, check, at_peak, peak: float, direct: float, tolerance: float) -> str | None:
+    """Whether the time integration ``check``, started on the HBM solution at the peak (tip
+    amplitudes ``at_peak``, ``model.output_amplitudes``' order, largest ``peak`` [m]), left that
+    branch for another periodic motion; its settled tip amplitudes differ from the branch's by
+    ``direct`` (relative to ``peak``). A solution of truncation error e is a fixed point of the
+    period map only to within its one-period defect d_1 (the first period's first harmonics'
+    largest difference from the branch's, relative to ``peak``); where the period map contracts
+    at least as fast as the slowest viscously damped blade mode decays, rho = exp(-sigma T) per
+    period (``check.decay_rate`` = sigma; friction only adds dissipation), the motion it settles
+    on lies within d_1 / (1 - rho) of the start (the contraction's fixed-point bound). A settled
+    motion farther than that and than ``tolerance`` is another motion: returns what says so (the
+    numbers), else None."""
+    if not np.isfinite(check.decay_rate) or check.decay_rate <= 0 or not len(check.tip_history[0]):
+        return None
+    first = dataclasses.replace(check, tip_amplitude=np.abs(check.tip_history[0][:1]))
+    defect = float(np.abs(model.time_output_amplitudes(first)[0] - at_peak).max() / peak)
+    bound = defect / -np.expm1(-check.decay_rate * 2 * np.pi / check.omega[0])
+    if direct <= max(bound, tolerance):
+        return None
+    return (f"{100 * direct:.3g} % from the branch's first-harmonic tip amplitudes, beyond the {100 * bound:.3g} % "
+            f"that the branch's one-period defect ({100 * defect:.3g} % in the first period) allows for a motion "
+            f"that stays on it (the blades' slowest viscous decay, {check.decay_rate:.3g} 1/s)")
 
 
 def stop_verdict(check, harmonics) -> str:
@@ -1197,8 +1413,14 @@ class DiskResponse(FrequencyResponse):
         """|W_exc - W_visc - W_friction| / W_exc at every point."""
         return np.abs(self.excitation_work - self.viscous_dissipation - self.dissipated_energy) / np.abs(self.excitation_work)
 
-    def plot(self, ax=None, *, direction: int = 0, label: str | None = None, **kwargs):
-        """Tip amplitude [mm] over frequency [Hz] (the paper's Fig. 4-6 style)."""
+    def peak_curve(self) -> np.ndarray:
+        """(n,) first-harmonic tip amplitude |u_x| at every point [m] (its largest is the peak)."""
+        return self.tip_amplitude[:, 0]
+
+    def plot(self, ax=None, *, direction: int = 0, label: str | None = None, measured=None, **kwargs):
+        """Tip amplitude [mm] over frequency [Hz] (the paper's Fig. 4-6 style). ``measured``: a
+        measurement or its file drawn beside it in mm (:func:`bladedamp.measurement.draw_measurement`;
+        an FRF times the disk's excitation force)."""
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -1216,4 +1438,8 @@ class DiskResponse(FrequencyResponse):
         ax.legend()
         if not self.success:
             ax.set_title(f"incomplete: {self.message}", fontsize=8)
+        if measured is not None:
+            from .measurement import draw_measurement
+
+            draw_measurement(ax, measured, model=self.disk)
         return ax

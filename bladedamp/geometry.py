@@ -116,6 +116,14 @@ class SectorLayout:
         """(2, 3) contact centres on one blade in its own frame: its OL face centre and its OR face centre."""
         return np.array([points["OL"] + self.platform_offsets[0], points["OR"] + self.platform_offsets[1]])
 
+    def contact_points(self) -> np.ndarray:
+        """(2, P, 3) positions of the point contacts of the OL and OR patches in blade i's frame [m]:
+        the contact centre plus xi e_xi + eta e_eta of every point (the patch's own coordinates,
+        e_xi and e_eta the rows of its contact frame); subtract ``damper_cg`` for the damper's
+        frame, add (pitch, 0, 0) to the OR points for blade i + 1's own frame."""
+        return np.array([c + np.outer(p.xi, R[0]) + np.outer(p.eta, R[1])
+                         for c, R, p in zip(self.contact_centres, self.frames, self.geometry.patches)])
+
 
 def sector_layout(points, damper, gamma_left: float, gamma_right: float) -> SectorLayout:
     """Layout of the unrolled sector from the blade's named points (OL, OR) and the damper."""

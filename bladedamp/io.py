@@ -34,10 +34,14 @@ engine order, blades) under ``models`` -> ``disk`` in the JSON for the reader, a
 """
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import importlib
 import json
 import math
+import struct
+import zipfile
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -46,6 +50,112 @@ FORMAT_VERSION = 1
 META_KEY = "__bladedamp__"
 #: fields that hold a model, not data: stored as absent, loaded as None (see the module docstring)
 MODEL_FIELDS = ("disk", "system")
+
+
+# ----- reading files: one error naming the file -------------------------------------------
+class FileReadError(ValueError):
+    """A file that cannot be read as what it should be: missing, a folder, unreadable, empty,
+    truncated or corrupted, of another kind, not UTF-8 text, or with broken content. The message
+    is one line that names the file and says what is wrong. Every reader of the package raises
+    it (:func:`reading`)."""
+
+
+class MissingFileError(FileReadError, FileNotFoundError):
+    """A file that does not exist: a :class:`FileReadError` that is also a FileNotFoundError."""
+
+
+class WrongKindError(FileReadError, TypeError):
+    """A saved result of another class than the one asked for: a :class:`FileReadError` that is
+    also a TypeError."""
+
+
+#: what a reader raises on a file's bad content (a NameError or an ImportError is a bug, not the file's)
+CONTENT_ERRORS = (OSError, ValueError, LookupError, TypeError, AttributeError, EOFError, RecursionError,
+                  NotImplementedError, zipfile.BadZipFile, zlib.error, struct.error)
+
+
+@contextlib.contextmanager
+def reading(path, what: str, error: type = FileReadError):
+    """The boundary of a file reader: whatever goes wrong in the ``with`` block while reading
+    ``path`` (a ``what``, e.g. "saved bladedamp result") is raised as one ``error`` (a
+    :class:`FileReadError` or a subclass) whose one-line message names the file and says what
+    is wrong: no such file (:class:`MissingFileError` for the default ``error``), a folder, not
+    readable (permissions), empty, not UTF-8 text, truncated or corrupted (a zip archive's bad
+    CRC or lost end, a cut compressed stream), broken JSON, a missing entry, or the raw error's
+    type and text. A ValueError whose message already names the file keeps its message; an
+    ``error`` raised inside passes unchanged."""
+    try:
+        yield
+    except error:
+        raise
+    except CONTENT_ERRORS as exc:
+        path = Path(path)
+        problem, known = _file_problem(path, what, exc)
+        message = " ".join((problem if str(path) in problem else f"{path}: {problem}").split())   # one line
+        kind = MissingFileError if error is FileReadError and problem.startswith("no such") else error
+        if known:
+            raise kind(message) from None
+        raise kind(message) from exc
+
+
+def _file_problem(path: Path, what: str, exc: BaseException) -> tuple[str, bool]:
+    """(what is wrong with the file ``path`` that made a reader raise ``exc``, whether that is
+    fully said without ``exc``'s traceback)."""
+    if not path.exists():
+        return f"no such {what}", True
+    if path.is_dir():
+        return f"is a folder, not a {what}", True
+    if isinstance(exc, OSError) and not isinstance(exc, FileNotFoundError):
+        return f"cannot read the {what} ({exc.strerror or exc})", True
+    try:
+        if path.stat().st_size == 0:
+            return f"empty (0 bytes), not a {what}", True
+    except OSError:
+        pass
+    if isinstance(exc, UnicodeDecodeError):
+        return f"not a readable {what}: not UTF-8 text (byte {exc.object[exc.start]:#04x} at offset {exc.start})", True
+    if isinstance(exc, ValueError) and not isinstance(exc, json.JSONDecodeError) and str(path) in str(exc):
+        return str(exc), True
+    if isinstance(exc, (zipfile.BadZipFile, zlib.error, EOFError, struct.error, NotImplementedError)):
+        return f"truncated or corrupted, not a readable {what} ({exc})", True
+    if isinstance(exc, json.JSONDecodeError):
+        return f"not a readable {what}: broken JSON ({exc})", True
+    if isinstance(exc, KeyError):
+        return f"not a readable {what}: no entry {exc}", True
+    if type(exc) is ValueError:                      # a reader's own check, without the file's name
+        return f"not a readable {what}: {exc}", True
+    return f"not a readable {what} ({type(exc).__name__}: {exc})", False
+
+
+#: the first bytes of a zip archive (an .npz): a local file header, or the end record of an empty one
+ZIP_MAGIC = (b"PK\x03\x04", b"PK\x05\x06")
+
+
+def open_npz(path) -> "np.lib.npyio.NpzFile":
+    """``np.load(path, allow_pickle=False)`` of an ``.npz`` archive (use it in a ``with`` block
+    inside :func:`reading`, which reads its arrays lazily); ValueError naming the file for one
+    that is not a zip archive (text, a single ``.npy`` array, any other bytes)."""
+    path = Path(path)
+    with open(path, "rb") as fh:
+        head = fh.read(4)
+    if head not in ZIP_MAGIC:
+        kind = "nothing" if not head else "a single .npy array" if head.startswith(b"\x93NUM") else \
+            "text" if _is_text(path) else f"other bytes ({head!r}...)"
+        raise ValueError(f"{path}: not a readable .npz file (it holds {kind}, not a zip archive of arrays)")
+    return np.load(path, allow_pickle=False)       # a zip archive: np.load gives an NpzFile
+
+
+def _is_text(path: Path) -> bool:
+    """Whether the first kilobyte of ``path`` decodes as UTF-8 without control bytes (but tab, newlines)."""
+    with open(path, "rb") as fh:
+        chunk = fh.read(1024)
+    try:
+        text = chunk.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        if exc.start < len(chunk) - 3:         # not just a character cut at the end of the chunk
+            return False
+        text = chunk[:exc.start].decode("utf-8")
+    return not any(ord(c) < 32 and c not in "\t\r\n" for c in text)
 
 
 class Saveable:
@@ -58,10 +168,11 @@ class Saveable:
 
     @classmethod
     def load(cls, path):
-        """Read a result saved by :meth:`save`; raises TypeError if the file holds another class."""
+        """Read a result saved by :meth:`save`: :func:`load`'s errors, and :class:`WrongKindError`
+        (a ValueError and a TypeError) naming the file if it holds another class."""
         result = load(path)
         if not isinstance(result, cls):
-            raise TypeError(f"{path} holds a {type(result).__qualname__}, not a {cls.__qualname__}")
+            raise WrongKindError(f"{npz_path(path)}: holds a {type(result).__qualname__}, not a {cls.__qualname__}")
         return result
 
 
@@ -240,9 +351,12 @@ def _resolve(name: str):
     module, _, qualname = name.partition(":")
     if not (module == "bladedamp" or module.startswith("bladedamp.")):
         raise ValueError(f"a saved result's class must come from bladedamp (got {name!r})")
-    obj = importlib.import_module(module)
-    for part in qualname.split("."):
-        obj = getattr(obj, part)
+    try:
+        obj = importlib.import_module(module)
+        for part in qualname.split("."):
+            obj = getattr(obj, part)
+    except (ImportError, AttributeError):
+        raise ValueError(f"a saved result's class {name!r} does not exist in this bladedamp") from None
     if not (isinstance(obj, type) and dataclasses.is_dataclass(obj)):
         raise ValueError(f"{name!r} is not a result class")
     return obj
@@ -268,23 +382,27 @@ def load(path):
     suffix works too); returns an object of the class stored in the file, with ``disk=None``.
     A blade's modal data file (``ModalBlade.save``, a ``format`` entry naming a blade format) gives
     the blade (:meth:`bladedamp.blade.ModalBlade.from_file`: a solid FE blade's a SolidModalBlade).
-    Raises FileNotFoundError naming the file, ValueError for a file that is not a saved result."""
+    Raises :class:`FileReadError` (a ValueError) naming the file for a file that is missing
+    (:class:`MissingFileError`, also a FileNotFoundError), empty, truncated or corrupted, not an
+    ``.npz``, not a saved result, or with broken metadata or a missing array (:func:`reading`)."""
     from .blade import MODAL_NPZ_FORMAT, SOLID_NPZ_FORMATS_READ, ModalBlade
 
     path = npz_path(path)
-    if not path.exists():
-        raise FileNotFoundError(f"no saved result at {path}")
-    with np.load(path, allow_pickle=False) as z:
-        files = set(z.files)
-        if META_KEY in files:
-            meta = json.loads(str(z[META_KEY][()]))
-            if meta.get("format", 0) > FORMAT_VERSION:
-                raise ValueError(f"{path} has format {meta.get('format')}; this bladedamp reads up to {FORMAT_VERSION}")
-            arrays = {k: z[k] for k in z.files if k != META_KEY}
-        blade = META_KEY not in files and "format" in files and z["format"].dtype.kind == "U"
-        tag = str(z["format"]) if blade else None
-    if META_KEY not in files:
-        if tag in (MODAL_NPZ_FORMAT, *SOLID_NPZ_FORMATS_READ):   # a blade's modal data file
-            return ModalBlade.from_file(path)
-        raise ValueError(f"{path} is not a saved bladedamp result (no {META_KEY} entry)")
-    return _rebuild(meta, "", arrays)
+    with reading(path, "saved bladedamp result"):
+        with open_npz(path) as z:
+            files = set(z.files)
+            if META_KEY in files:
+                meta = json.loads(str(z[META_KEY][()]))
+                if not isinstance(meta, dict):
+                    raise ValueError(f"{path}: entry {META_KEY!r} must be a JSON object (got {type(meta).__name__})")
+                if meta.get("format", 0) > FORMAT_VERSION:
+                    raise ValueError(f"{path} has format {meta.get('format')}; this bladedamp reads up to "
+                                     f"{FORMAT_VERSION}")
+                arrays = {k: z[k] for k in z.files if k != META_KEY}
+            blade = META_KEY not in files and "format" in files and z["format"].dtype.kind == "U"
+            tag = str(z["format"]) if blade else None
+        if META_KEY not in files:
+            if tag in (MODAL_NPZ_FORMAT, *SOLID_NPZ_FORMATS_READ):   # a blade's modal data file
+                return ModalBlade.from_file(path)
+            raise ValueError(f"{path} is not a saved bladedamp result (no {META_KEY} entry)")
+        return _rebuild(meta, "", arrays)

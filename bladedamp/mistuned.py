@@ -60,10 +60,10 @@ from .contact.point import MAX_PASSES, PERIODIC_TOL
 from .damper.kinetics import seat
 from .disk import (AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION, DAMPER_DOFS, STOP_CHECK_OFFSET_HZ,
                    DamperContacts, TunedDisk, contact_point_maps, contact_rows, damper_weighted_scales,
-                   fused_point_map_forces, point_map_forces, rotor_speed_in_hz, time_at_peak, time_check_beyond,
-                   with_peak_check, with_stop_check)
-from .hbm.accuracy import HARMONIC_TOLERANCE, converged_response
-from .hbm.continuation import Branch, continuation
+                   fused_point_map_forces, interblade_phase, peak_checked_response, point_map_forces, rest_response,
+                   rotor_speed_in_hz, time_at_peak, time_check_beyond, with_stop_check)
+from .hbm.accuracy import HARMONIC_TOLERANCE
+from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_POINT_BUDGET, Branch, Budget, continuation
 from .hbm.start import robust_start
 from .hbm.linsolve import BlockCondensation, BlockRing, one_blas_thread
 from .hbm.linsolve import factorize as lu_factorize
@@ -820,7 +820,8 @@ class MistunedDisk:
 
     @property
     def interblade_phase(self) -> float:
-        return 2 * np.pi * self.engine_order / self.n_blades
+        """dphi [rad] in (-pi, pi] of the engine order (:func:`bladedamp.disk.interblade_phase`)."""
+        return interblade_phase(self.engine_order, self.n_blades)
 
     @property
     def active_dampers(self) -> list[int]:
@@ -948,7 +949,7 @@ class MistunedDisk:
         couplings = []
         if active:
             # each damper sampled on its own grid, shifted by its travelling-wave phase (exact tuned = cyclic at any T)
-            grid_phase = np.array([k * dphi for k in active]) if self.engine_order else None
+            grid_phase = np.array([k * dphi for k in active]) if dphi else None
             couplings.append(Coupling(AssemblyContacts(contacts, grid_phase=grid_phase), sparse_real_form(basis, contact_map),
                                       "damper contacts"))
         j1 = basis.cos_index(1)
@@ -1030,6 +1031,7 @@ class MistunedDisk:
                            max_step: float = 0.02, tuned_peak_amplitude: float | None = None,
                            harmonic_tolerance: float = HARMONIC_TOLERANCE, max_harmonic: int = 3,
                            estimate_harmonic_error: bool = True, check_stop: bool = False, check_peak: bool = False,
+                           cpu_budget_s: float = DEFAULT_CPU_BUDGET_S, point_budget: int = DEFAULT_POINT_BUDGET,
                            **continuation_options) -> "MistunedResponse":
         """Forced response of every blade from ``f_start_hz`` to ``f_end_hz`` [Hz] by continuation.
 
@@ -1053,7 +1055,18 @@ class MistunedDisk:
         A failed branch without it says how to tell. ``check_peak``: for a branch that reached the
         end, the time integration at the peak's frequency gives a direct harmonic error estimate,
         or fails the response where the vibration there does not settle, as
-        :meth:`TunedDisk.frequency_response` (:meth:`peak_check`, :func:`~bladedamp.disk.with_peak_check`)."""
+        :meth:`TunedDisk.frequency_response` (:meth:`peak_check`, :func:`~bladedamp.disk.with_peak_check`).
+        Without dynamic excitation (``excitation`` zero) the response is rest, exactly
+        (:func:`~bladedamp.disk.rest_response`). Without dampers, a range holding the natural
+        frequency of an excited blade mode without modal damping has no bounded response and is
+        refused with a ValueError (:meth:`TunedDisk.check_bounded` of each blade).
+        ``cpu_budget_s`` [s] and ``point_budget``: the CPU time (``time.process_time``) and the
+        continuation points this whole analysis may spend, the time integrations of
+        ``check_stop`` and ``check_peak`` excepted (:class:`bladedamp.hbm.continuation.Budget`;
+        defaults ``DEFAULT_CPU_BUDGET_S``, ``DEFAULT_POINT_BUDGET``). Where it runs out the branch
+        ends there with every point it has, status ``OUT_OF_BUDGET`` (not ``success``), and
+        ``stopped_by`` and the message say what ran out and at which frequency.
+        """
         validation.positive("f_start_hz", f_start_hz)
         validation.positive("f_end_hz", f_end_hz)
         if f_start_hz == f_end_hz:
@@ -1062,7 +1075,14 @@ class MistunedDisk:
             if on and any(b.flexible_platform for b in self.blades):
                 raise ValueError(f"{name} integrates the disk in time, which models rigid platforms only: "
                                  f"use rigid-platform blades or {name}=False")
+        if not self.active_dampers:         # every blade on its own: as a tuned disk without damper
+            for sector in self.sectors:
+                sector.check_bounded(f_start_hz, f_end_hz)
         w0, w1 = 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz
+        if not np.any(self.excitation):
+            return rest_response(self, w0, w1, max_step, harmonic_tolerance, lambda system, branch:
+                                 MistunedResponse.from_branch(self, system, branch, tuned_peak_amplitude))
+        budget = Budget(cpu_budget_s, point_budget)
 
         def solve(H):
             first = self.default_samples(H)
@@ -1075,7 +1095,8 @@ class MistunedDisk:
             x0 = self.start_solution(system, w0, scales)
             branch = continuation(system.residual, x0, w0, w1, x_scale=scales, factorize=system.factorize,
                                   max_step=max_step, start_at_end=lambda: self.start_solution(system, w1, scales),
-                                  retry_x_scale=self.retry_scales(system, scales), **continuation_options)
+                                  retry_x_scale=self.retry_scales(system, scales), budget=budget,
+                                  **continuation_options)
             response = MistunedResponse.from_branch(self, system, branch, tuned_peak_amplitude)
             T = system.basis.n_samples
 
@@ -1087,10 +1108,9 @@ class MistunedDisk:
                                                          response.excitation_work, max_step, T, refine,
                                                          response.damper_work_bound))
 
-        response = converged_response(self, solve, harmonics, harmonic_tolerance, max_harmonic,
-                                      estimate=estimate_harmonic_error)
         can_check = not any(b.flexible_platform for b in self.blades)
-        response = with_peak_check(self, response, check_peak, harmonic_tolerance, can_check)
+        response = peak_checked_response(self, self, solve, harmonics, harmonic_tolerance, max_harmonic,
+                                         estimate_harmonic_error, check_peak, can_check)
         return with_stop_check(self, response, f_start_hz, check_stop)
 
     def peak_check(self, response: "MistunedResponse", **options):
@@ -1212,7 +1232,8 @@ class MistunedDisk:
     def time_response(self, f_hz, **options):
         """Steady state of every blade at each excitation frequency ``f_hz`` [Hz] (scalar or
         array) by time integration of the full assembly (``len(blades) == n_blades``), from the
-        static equilibrium under F_CG (Eq. 26); see :func:`bladedamp.timedomain.disk_time_response`.
+        static equilibrium under F_CG (Eq. 26) or a harmonic solution's state
+        (``start_coefficients``); see :func:`bladedamp.timedomain.disk_time_response`.
         Returns a :class:`bladedamp.timedomain.DiskTimeResponse`."""
         from .timedomain import disk_time_response
 
@@ -1268,7 +1289,7 @@ class MistunedResponse(FrequencyResponse):
                    branch.turning_points, tip_amplitude=tip, excitation_work=np.array(exc),
                    viscous_dissipation=np.array(visc), dissipated_energy=diss.sum(axis=1), damper_dissipation=diss,
                    damper_work_bound=bound,
-                   tuned_peak_amplitude=tuned_peak_amplitude, disk=disk)
+                   tuned_peak_amplitude=tuned_peak_amplitude, disk=disk, stopped_by=branch.stopped_by)
 
     @property
     def n_sector(self) -> int:
@@ -1319,11 +1340,10 @@ class MistunedResponse(FrequencyResponse):
         """(s,) frequency of each blade's peak [Hz] (parabola-refined, as :attr:`peak_amplitude`)."""
         return self.peaks()[1]
 
-    @property
-    def peak_at_range_end(self) -> np.ndarray:
-        """(s,) bool: the blade's largest amplitude is at an end of the computed range."""
-        i = np.argmax(self.tip_amplitude[:, :, 0], axis=0)
-        return (i == 0) | (i == len(self.omega) - 1)
+    def peak_curve(self) -> np.ndarray:
+        """(n, s) first-harmonic tip amplitude |u_x| of every blade at every point [m]: the
+        response's :attr:`peak_at_range_end` when any blade's largest lies at an end of the range."""
+        return self.tip_amplitude[:, :, 0]
 
     def amplification(self, tuned_peak_amplitude: float | None = None) -> np.ndarray:
         """(s,) peak of each blade over the tuned disk's peak."""
@@ -1336,10 +1356,13 @@ class MistunedResponse(FrequencyResponse):
         """|W_exc - W_visc - W_friction| / W_exc at every point (whole model)."""
         return np.abs(self.excitation_work - self.viscous_dissipation - self.dissipated_energy) / np.abs(self.excitation_work)
 
-    def plot(self, ax=None, *, tuned=None, direction: int = 0, highlight=None, title: str | None = None):
+    def plot(self, ax=None, *, tuned=None, direction: int = 0, highlight=None, title: str | None = None,
+             measured=None):
         """Tip amplitude of every blade [mm] over frequency [Hz] (the paper's Figs. 13-17);
         ``tuned``: a tuned DiskResponse drawn as a thick dashed line; ``highlight``: blade
-        indices (0-based) drawn in colour and labelled (default: largest and smallest peak)."""
+        indices (0-based) drawn in colour and labelled (default: largest and smallest peak);
+        ``measured``: a measurement or its file drawn beside them in mm
+        (:func:`bladedamp.measurement.draw_measurement`; an FRF times the excitation force)."""
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -1368,4 +1391,8 @@ class MistunedResponse(FrequencyResponse):
         ax.legend(fontsize=8)
         if not self.success:
             ax.set_title(f"incomplete: {self.message}", fontsize=8)
+        if measured is not None:
+            from .measurement import draw_measurement
+
+            draw_measurement(ax, measured, model=self.disk)
         return ax

@@ -19,12 +19,13 @@ from . import validation
 from .contact.laws import LinearNormalLaw
 from .contact.point import PointContactElement
 from .hbm.accuracy import HARMONIC_TOLERANCE, converged_response
-from .hbm.continuation import continuation
+from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_POINT_BUDGET, Budget, continuation
 from .hbm.start import robust_start
 from .hbm.elements import CubicSpring
 from .hbm.fourier import HarmonicBasis
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import REFINE_SAMPLES_FACTOR, FrequencyResponse, physical_checks, sampled_response, with_checks
+from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, physical_checks, sampled_response, with_checks,
+                       with_range_end_estimate)
 from .timedomain import TimeResponse, oscillator_steady_state
 
 # most AFT samples per period the automatic sampling may choose (sampled_response; one DOF:
@@ -86,6 +87,46 @@ class FrictionOscillator:
         """mu N0 [N]."""
         return self.friction_coefficient * self.normal_load
 
+    @property
+    def stuck_contact_stiffness(self) -> float:
+        """The stuck contact's stiffness along the motion, k_T cos^2(alpha) + k_N sin^2(alpha) [N/m]."""
+        return self.contact_stiffness * np.cos(self.contact_angle) ** 2 \
+            + self.normal_stiffness * np.sin(self.contact_angle) ** 2
+
+    def linear_natural_frequencies_hz(self, f_low_hz: float = 0.0, f_high_hz: float = 0.0) -> tuple[float, float]:
+        """(without the contact, contact stuck): sqrt(k / m) / 2 pi and sqrt((k + k_stuck) / m) / 2 pi
+        [Hz], the natural frequencies of the two linear systems (one each: the range is not
+        needed); the friction-damped resonance lies between them."""
+        return (float(np.sqrt(self.stiffness / self.mass) / (2 * np.pi)),
+                float(np.sqrt((self.stiffness + self.stuck_contact_stiffness) / self.mass) / (2 * np.pi)))
+
+    @property
+    def friction_limit(self) -> float:
+        """4 mu N0 / pi [N]: the largest first-harmonic amplitude of a contact force bounded by
+        mu N0 (a square wave of height mu N0), the most forcing a constant normal load can hold."""
+        return 4 * self.slip_force / np.pi
+
+    def check_bounded(self, f_start_hz: float, f_end_hz: float) -> None:
+        """ValueError where no bounded periodic response exists in ``f_start_hz``..``f_end_hz``
+        [Hz]: no viscous damping, a constant normal load (contact_angle 0), a linear spring
+        (cubic_stiffness 0), |F| above :attr:`friction_limit`, and the natural frequency without
+        the contact, sqrt(k / m) / 2 pi (:meth:`linear_natural_frequencies_hz`), inside the range.
+        At that frequency the mass and spring forces cancel in the first harmonic, so the contact
+        force alone must balance F, and its first harmonic is at most 4 mu N0 / pi: no periodic
+        motion exists there, and the amplitude grows without bound as the excitation frequency
+        approaches it (Den Hartog's undamped friction oscillator)."""
+        f_n = self.linear_natural_frequencies_hz()[0]
+        if not (self.damping == 0.0 and self.contact_angle == 0.0 and self.cubic_stiffness == 0.0
+                and abs(self.forcing) > self.friction_limit
+                and min(f_start_hz, f_end_hz) <= f_n <= max(f_start_hz, f_end_hz)):
+            return
+        raise ValueError(
+            f"no bounded response: with damping = 0 N s/m the forcing |F| = {abs(self.forcing):.6g} N exceeds the "
+            f"friction limit 4 mu N0 / pi = {self.friction_limit:.6g} N (mu = {self.friction_coefficient:g}, "
+            f"N0 = {self.normal_load:g} N), so the amplitude grows without bound at the natural frequency "
+            f"sqrt(k / m) / (2 pi) = {f_n:.6g} Hz, inside the range {f_start_hz:g}-{f_end_hz:g} Hz; give damping > 0, "
+            f"a forcing of at most {self.friction_limit:.6g} N, or a range without {f_n:.6g} Hz")
+
     def linear_amplitude(self, f_hz, stuck: bool) -> np.ndarray:
         """Amplitude of the linear system with the contact stuck or absent (k) [m] at the
         excitation frequencies ``f_hz`` [Hz] (scalar or array; same shape).
@@ -97,9 +138,7 @@ class FrictionOscillator:
     def _linear_amplitude(self, omega, stuck: bool) -> np.ndarray:
         """:meth:`linear_amplitude` at angular frequencies ``omega`` [rad/s]."""
         omega = np.asarray(omega, dtype=float)
-        stuck_k = self.contact_stiffness * np.cos(self.contact_angle) ** 2 \
-            + self.normal_stiffness * np.sin(self.contact_angle) ** 2
-        k = self.stiffness + (stuck_k if stuck else 0.0)
+        k = self.stiffness + (self.stuck_contact_stiffness if stuck else 0.0)
         return np.abs(self.forcing / (k - self.mass * omega ** 2 + 1j * self.damping * omega))
 
     # ----- harmonic balance -----------------------------------------------------------
@@ -122,6 +161,7 @@ class FrictionOscillator:
 
     def frequency_response(self, f_start_hz: float, f_end_hz: float, harmonics="auto", n_samples=None,
                            harmonic_tolerance: float = HARMONIC_TOLERANCE, max_harmonic: int = 9,
+                           cpu_budget_s: float = DEFAULT_CPU_BUDGET_S, point_budget: int = DEFAULT_POINT_BUDGET,
                            **continuation_options) -> FrequencyResponse:
         """FRF by harmonic balance and pseudo-arclength continuation from ``f_start_hz`` to
         ``f_end_hz`` [Hz] (as :meth:`bladedamp.disk.TunedDisk.frequency_response`; the result's
@@ -137,13 +177,26 @@ class FrictionOscillator:
         fails, up to ``MAX_AUTO_SAMPLES``). ``continuation_options`` go to
         :func:`bladedamp.hbm.continuation.continuation` (``max_step`` sets the point density).
         The result is ``success`` only if the branch reached the end and passed
-        :func:`bladedamp.response.physical_checks`.
+        :func:`bladedamp.response.physical_checks`, with the contact's dissipation judged at the
+        solve's own samples (``judge_solution_samples``): a successful result's contact
+        dissipation is at least -``SAMPLING_FLOOR`` (:mod:`bladedamp.response`) of each point's
+        energy scale, the larger of the excitation work and the contact's work bound (its AFT
+        energy error); where it is not, the samples grow as above.
+        A range where no bounded response exists (:meth:`check_bounded`) is refused with a
+        ValueError before any solve.
+        ``cpu_budget_s`` [s] and ``point_budget``: the CPU time (``time.process_time``) and the
+        continuation points this whole analysis may spend (:class:`bladedamp.hbm.continuation.Budget`;
+        defaults ``DEFAULT_CPU_BUDGET_S``, ``DEFAULT_POINT_BUDGET``). Where it runs out the branch
+        ends there with every point it has, status ``OUT_OF_BUDGET`` (not ``success``), and
+        ``stopped_by`` and the message say what ran out and at which frequency.
         """
         validation.positive("f_start_hz", f_start_hz)
         validation.positive("f_end_hz", f_end_hz)
         if f_start_hz == f_end_hz:
             raise ValueError("f_end_hz must differ from f_start_hz")
+        self.check_bounded(f_start_hz, f_end_hz)
         omega_start, omega_end = 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz
+        budget = Budget(cpu_budget_s, point_budget)
         scale = self.unknown_scales(None, omega_start, omega_end)
 
         def solve(H):
@@ -157,10 +210,11 @@ class FrictionOscillator:
             x0 = self._start_solution(system, omega_start, scale)
             branch = continuation(system.residual, x0, omega_start, omega_end, x_scale=scale,
                                   start_at_end=lambda: self._start_solution(system, omega_end, scale),
-                                  **continuation_options)
+                                  budget=budget, **continuation_options)
             C = system.basis.n_coeffs
             response = FrequencyResponse(branch.omega, branch.x.reshape(-1, C, 1), system.basis, ("x",),
-                                         branch.success, branch.message, branch.iterations, branch.turning_points)
+                                         branch.success, branch.message, branch.iterations, branch.turning_points,
+                                         stopped_by=branch.stopped_by)
             # per point: the excitation work, and the contact's dissipation and energy scale (one AFT)
             work = np.array([system.excitation_work(x, w) for x, w in zip(branch.x, branch.omega)])
             energies = np.array([[sum(e) for e in system.element_energies(x, w)]
@@ -173,9 +227,10 @@ class FrictionOscillator:
 
             return with_checks(response, physical_checks(branch.omega, (omega_start, omega_end), energies[:, :1],
                                                          work, continuation_options.get("max_step") or 0.02,
-                                                         T, refine, energies[:, 1:]))
+                                                         T, refine, energies[:, 1:], judge_solution_samples=True))
 
-        return converged_response(self, solve, harmonics, harmonic_tolerance, max_harmonic)
+        return with_range_end_estimate(self, converged_response(self, solve, harmonics, harmonic_tolerance,
+                                                                max_harmonic))
 
     def _start_solution(self, system: HarmonicBalanceSystem, omega: float, scale: float) -> np.ndarray:
         """Solution at the first frequency by :func:`bladedamp.hbm.start.robust_start`: damped

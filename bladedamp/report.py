@@ -732,7 +732,8 @@ def save_result(result, path: Path) -> str | None:
 def describe_disk(disk) -> str:
     """One line: blades, engine order, damper and platform angles of a TunedDisk."""
     damper = "no damper" if not disk.has_damper else f"{disk.damper.kind} damper {1e3 * disk.damper.mass:.4g} g"
-    return (f"{disk.n_blades} blades, EO = {disk.engine_order}, {damper}, platform angles "
+    k, direction = disk.nodal_diameter
+    return (f"{disk.n_blades} blades, EO = {disk.engine_order} (nodal diameter {k}, {direction}), {damper}, platform angles "
             f"{np.degrees(disk.gamma_left):.4g} / {np.degrees(disk.gamma_right):.4g} deg, "
             f"R = {1e3 * disk.damper_radius:.4g} mm")
 
@@ -821,7 +822,9 @@ def plot_frf(ax, design, responses: dict, undamped: dict | None = None) -> None:
             top = max(top, float(free.max()))
         if len(tip):
             i = int(np.argmax(tip))
-            peaks.append((float(r.frequency_hz[i]), float(tip[i]), colour, "" if single else f"{shown.split(' (')[0]}: "))
+            which = "" if single else f"{shown.split(' (')[0]}: "
+            what = "largest amplitude (at the range end)" if getattr(r, "peak_at_range_end", False) else "peak"
+            peaks.append((float(r.frequency_hz[i]), float(tip[i]), colour, f"{which}{what}"))
             ax.plot(r.frequency_hz[i], tip[i], "o", ms=7, mfc="none", mec=colour, mew=1.6, label="_peak")
     if not peaks:
         return
@@ -836,7 +839,7 @@ def plot_frf(ax, design, responses: dict, undamped: dict | None = None) -> None:
     x0, x1 = ax.get_xlim()
     for k, (f, p, colour, which) in enumerate(peaks):
         right = f < x0 + 0.5 * (x1 - x0)
-        ax.annotate(f"{which}peak {p:.3g} mm at {f:.2f} Hz", (f, p), xytext=(15 if right else -15, 8 + 14 * k),
+        ax.annotate(f"{which} {p:.3g} mm at {f:.2f} Hz", (f, p), xytext=(15 if right else -15, 8 + 14 * k),
                     textcoords="offset points", fontsize=8, color=colour, va="bottom", ha="left" if right else "right",
                     bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="none", alpha=0.85),
                     arrowprops=dict(arrowstyle="-", color=colour, lw=0.8))
@@ -845,14 +848,17 @@ def plot_frf(ax, design, responses: dict, undamped: dict | None = None) -> None:
     ax.grid(True, which="both", alpha=0.3)
 
 
-def frf_outputs(out: Path, design, responses: dict, undamped: dict | None = None) -> dict:
+def frf_outputs(out: Path, design, responses: dict, undamped: dict | None = None, measured=None) -> dict:
     """frf.png (and the other formats of :func:`bladedamp.plotting.figure_output`),
     frf_<label>.npz, results.json and summary.md of ``bladedamp frf``. ``responses``: {label:
     DiskResponse or MistunedResponse}; ``undamped``: {label: the damper-free DiskResponse},
-    drawn dashed. Returns the JSON summary."""
+    drawn dashed; ``measured``: a :class:`~bladedamp.measurement.MeasuredResponse` drawn on
+    frf.png (in mm; an FRF times the design's excitation force). Each response's entry and
+    summary.md lead with its status (:attr:`~bladedamp.response.FrequencyResponse.status_message`);
+    a largest amplitude at an end of the range is named so, not a peak. Returns the JSON summary."""
     import matplotlib.pyplot as plt
 
-    rows, files, summary = [], [], {"design": design.path, "responses": {}}
+    leads, rows, files, summary = [], [], [], {"design": design.path, "responses": {}}
     for label, r in responses.items():
         tip = _tip_x(r)
         saved = save_result(r, out / f"frf_{label}")
@@ -863,24 +869,33 @@ def frf_outputs(out: Path, design, responses: dict, undamped: dict | None = None
         peak, f_peak = (float(tip[i]), float(r.frequency_hz[i])) if len(tip) else (float("nan"), float("nan"))
         check = getattr(r, "peak_check", None)          # the time integration at the peak (check_peak)
         timed = None if check is None else str(check.status[0])
+        at_end = bool(r.peak_at_range_end)
         summary["responses"][label] = {
+            "status": r.status.value, "status_message": r.status_message, "peak_at_range_end": at_end,
+            "linear_natural_frequencies_hz": list(r.linear_natural_frequencies_hz),
             "success": bool(r.success), "message": r.message, "harmonics": list(r.basis.harmonics),
             "harmonic_error_pct": 100 * err, "peak_amplitude_mm": 1e3 * peak, "peak_frequency_hz": f_peak,
             "peak_time_check": timed, "frequency_hz": r.frequency_hz, "tip_amplitude_x_mm": 1e3 * tip}
         if undamped and label in undamped and len(undamped[label].omega):
             summary["responses"][label]["undamped_peak_amplitude_mm"] = 1e3 * float(_tip_x(undamped[label]).max())
-        rows.append(f"| {label} | {'yes' if r.success else 'no: ' + r.message} | {tuple(r.basis.harmonics)} | "
-                    f"{'not estimated' if not np.isfinite(err) else f'{100 * err:.2g} %'} | {_mm(peak)} | "
+        leads.append(f"- **{label}**: {r.status_message}")
+        rows.append(f"| {label} | {r.status.value} | {tuple(r.basis.harmonics)} | "
+                    f"{'not estimated' if not np.isfinite(err) else f'{100 * err:.2g} %'} | {_mm(peak)}"
+                    f"{' (largest amplitude at the range end)' if at_end else ''} | "
                     f"{'-' if not np.isfinite(f_peak) else f'{f_peak:.3f} Hz'} | {timed or '-'} |")
     fig, ax = plt.subplots(figsize=(7.5, 4.8))
     plot_frf(ax, design, responses, undamped)
+    if measured is not None:
+        from .measurement import draw_measurement
+
+        draw_measurement(ax, measured, model=design.disk)
     ax.set_title(design_title(design, "frequency response"))
     place_legend(ax, fontsize=8)
     files[:0] = save_figure(fig, out / "frf.png")
     write_json(out / "results.json", summary)
     files.append("results.json")
-    lines = ["| response | complete | harmonics | harmonic error | peak u_x | at | time integration at the peak |",
-             "|---|---|---|---|---|---|---|", *rows]
+    lines = [*leads, "", "| response | status | harmonics | harmonic error | peak u_x | at | "
+             "time integration at the peak |", "|---|---|---|---|---|---|---|", *rows]
     write_summary(out, "frf", design, lines, files)
     return summary
 
@@ -1047,3 +1062,104 @@ def show_outputs(out: Path, design, response, html: Path) -> None:
     lines = [f"3D view of the operating deflection shape at the resonance, {response.peak_frequency_hz:.3f} Hz "
              f"(peak u_x {_mm(response.peak_amplitude)}): open `{html.name}` in a browser (standalone, no server).", ""]
     write_summary(out, "show", design, lines, files)
+
+
+def zzenf_outputs(out: Path, design, diagram) -> dict:
+    """zzenf.png, results.json and summary.md of ``bladedamp zzenf`` (an
+    :class:`~bladedamp.studies.interference.InterferenceDiagram`). Returns the JSON summary."""
+    import matplotlib.pyplot as plt
+
+    from .disk import nodal_diameter
+
+    fig, ax = plt.subplots(figsize=(9.5, 5))
+    diagram.plot(ax=ax)
+    rpm = 60 * diagram.rotor_speeds_hz
+    speeds = f"{rpm[0]:.0f} rpm" if rpm[0] == rpm[-1] else f"{rpm[0]:.0f}-{rpm[-1]:.0f} rpm"
+    ax.set_title(f"Interference diagram, {diagram.n_blades} blades, rotor speed {speeds}", fontsize=10)
+    save_figure(fig, out / "zzenf.png")
+    crossings = diagram.crossings()
+    summary = {"design": design.path, "n_blades": diagram.n_blades, "nodal_diameters": diagram.nodal_diameters,
+               "rotor_speeds_rpm": rpm, "f_max_hz": diagram.f_max_hz,
+               "free_natural_frequencies_hz": diagram.free_hz[diagram.free_hz <= diagram.f_max_hz],
+               "stuck_natural_frequencies_hz": {f"{r:.0f} rpm": diagram.stuck_hz[:, i].T
+                                                for i, r in enumerate(rpm)},
+               "stuck_natural_frequencies_layout": "per speed: one list per mode, one value per nodal diameter",
+               "engine_orders": {str(eo): {"nodal_diameter": k, "direction": d,
+                                           "excitation_hz": list(diagram.excitation_hz(eo))}
+                                 for eo in diagram.engine_orders for k, d in [nodal_diameter(eo, diagram.n_blades)]},
+               "crossings": [{**c, "free_speed_rpm": 60 * c["free_speed_hz"], "stuck_speed_rpm": 60 * c["stuck_speed_hz"]}
+                             for c in crossings]}
+    write_json(out / "results.json", summary)
+    lines = ["Natural frequencies of the tuned disk's linear sector models per nodal diameter: without dampers "
+             "(the blade's own, the same at every nodal diameter) and with the dampers stuck, at the lowest and "
+             f"the highest rotor speed ({speeds}; the preload m R Omega^2 stiffens the stuck contacts). "
+             "A friction-damped resonance lies between the two (up to the damper's inertia). Engine order EO "
+             "excites nodal diameter EO mod n (n - (EO mod n), a backward wave, above n / 2) at EO x rotor speed.",
+             "", "| EO | nodal diameter | excitation [Hz] |", "|---|---|---|"]
+    for eo in diagram.engine_orders:
+        k, d = nodal_diameter(eo, diagram.n_blades)
+        lo, hi = diagram.excitation_hz(eo)
+        lines.append(f"| {eo} | {k} ({d}) | {lo:.4g}-{hi:.4g} |" if lo != hi else f"| {eo} | {k} ({d}) | {hi:.4g} |")
+    lines += ["", f"Resonances the engine orders can reach up to {diagram.f_max_hz:g} Hz (the rotor speed at which "
+              "EO x speed meets the natural frequency; stuck: with the preload of the highest speed):", ""]
+    if crossings:
+        lines += ["| EO | nodal diameter | mode | no dampers [Hz] | at [rpm] | dampers stuck [Hz] | at [rpm] |",
+                  "|---|---|---|---|---|---|---|"]
+        for c in crossings:
+            lines.append(f"| {c['engine_order']} | {c['nodal_diameter']} ({c['direction']}) | {c['mode']} | "
+                         f"{c['free_hz']:.4g} | {60 * c['free_speed_hz']:.0f} | {fmt_number(c['stuck_hz'], '.4g')} | "
+                         f"{fmt_number(60 * c['stuck_speed_hz'], '.0f')} |")
+    else:
+        lines.append("none in the speed range.")
+    write_summary(out, "zzenf", design, lines, ["zzenf.png", "results.json"],
+                  f"Speed range {speeds}, diagram up to {diagram.f_max_hz:g} Hz.")
+    return plain(summary)
+
+
+def campbell_outputs(out: Path, design, diagram) -> dict:
+    """campbell.png, results.json and summary.md of ``bladedamp campbell`` (a
+    :class:`~bladedamp.studies.interference.CampbellDiagram`). Returns the JSON summary."""
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(9.5, 5))
+    diagram.plot(ax=ax)
+    harmonics = sorted({c.harmonics for c in diagram.crossings})
+    estimate = " (one-harmonic estimate)" if harmonics == [(1,)] else ""
+    ax.set_title(f"Campbell diagram, {diagram.n_blades} blades: damped peak u_x at each crossing{estimate}",
+                 fontsize=10)
+    save_figure(fig, out / "campbell.png")
+    rows = []
+    for c in diagram.crossings:
+        rows.append({"engine_order": c.engine_order, "nodal_diameter": c.nodal_diameter, "direction": c.direction,
+                     "peak_amplitude_mm": 1e3 * c.peak_amplitude, "peak_frequency_hz": c.peak_frequency_hz,
+                     "rotor_speed_rpm": 60 * c.rotor_speed_hz, "free_hz": c.free_hz, "stuck_hz": c.stuck_hz,
+                     "f_range_hz": list(c.f_range_hz), "harmonics": list(c.harmonics), "status": c.status,
+                     "status_message": c.status_message, "peak_at_range_end": c.peak_at_range_end, "found": c.found})
+    summary = plain({"design": design.path, "n_blades": diagram.n_blades, "engine_orders": diagram.engine_orders,
+                     "rotor_speeds_rpm": 60 * diagram.rotor_speeds_hz, "f_max_hz": diagram.f_max_hz,
+                     "free_natural_frequencies_hz": diagram.free_hz[diagram.free_hz <= diagram.f_max_hz],
+                     "stuck_natural_frequencies_hz": {str(eo): s.T for eo, s in diagram.stuck_hz.items()},
+                     "stuck_natural_frequencies_layout": "per engine order: one list per mode, one value per rotor speed",
+                     "crossings": rows})
+    write_json(out / "results.json", summary)
+    lines = [f"Damped resonance at each engine order > 0: the peak of the tuned disk's frequency response over "
+             f"the design's frequency range, with the rotor speed following the excitation (Omega = Omega_E / EO), "
+             f"so the response runs along the engine-order line. Harmonics {', '.join(map(str, harmonics))}"
+             f"{': the one-harmonic estimate, whose peak may differ by several per cent from a richer harmonic set' if estimate else ''}.",
+             "", "| EO | nodal diameter | peak u_x | at [Hz] | rotor speed [rpm] | no dampers [Hz] | dampers stuck [Hz] | status |",
+             "|---|---|---|---|---|---|---|---|"]
+    for c in diagram.crossings:
+        peak = _mm(c.peak_amplitude) if c.found else (f"{_mm(c.peak_amplitude)} at the range end, no resonance"
+                                                      if c.peak_at_range_end else _mm(c.peak_amplitude))
+        lines.append(f"| {c.engine_order} | {c.nodal_diameter} ({c.direction}) | {peak} | "
+                     f"{fmt_number(c.peak_frequency_hz, '.3f')} | {fmt_number(60 * c.rotor_speed_hz, '.0f')} | "
+                     f"{fmt_number(c.free_hz, '.4g')} | {fmt_number(c.stuck_hz, '.4g')} | {c.status} |")
+    lines += ["", *[f"EO {c.engine_order}: {c.status_message}" for c in diagram.crossings]]
+    if any(eo == 0 for eo in diagram.engine_orders):
+        lines.append("EO 0: a static load (f = 0) has no crossing.")
+    rpm = 60 * diagram.rotor_speeds_hz
+    write_summary(out, "campbell", design, lines, ["campbell.png", "results.json"],
+                  f"Analysis: {design.analysis.f_start_hz:g}-{design.analysis.f_end_hz:g} Hz per engine order, "
+                  f"max_step {design.analysis.max_step:g}; diagram {rpm[0]:.0f}-{rpm[-1]:.0f} rpm, up to "
+                  f"{diagram.f_max_hz:g} Hz.")
+    return summary

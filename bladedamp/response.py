@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import dataclasses
+import enum
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -20,7 +21,8 @@ SAMPLING_FLOOR = 1e-6
 
 
 def physical_checks(omega, omega_range, dissipation, excitation_work, max_step=None,
-                    n_samples: int = 64, refine=None, work_bound=None) -> dict[str, str]:
+                    n_samples: int = 64, refine=None, work_bound=None,
+                    judge_solution_samples: bool = False) -> dict[str, str]:
     """Sanity of a branch beyond the energy balance (which holds for any harmonic truncation).
 
     ``omega`` (n,) [rad/s]; ``omega_range`` (start, end) [rad/s]; ``dissipation`` (n, m) energy
@@ -56,7 +58,12 @@ def physical_checks(omega, omega_range, dissipation, excitation_work, max_step=N
       (a 6.4 g wedge, (1,)) -1.2e-7 at 1024; inclined oscillators -3e-6..-3.5e-4 at 4096.
       Without ``refine`` the floor is the sampling error's order, -(2 pi / T)^2 of the
       excitation work (measured on a nearly stuck contact, EO 0 wedge: -2.6e-4 at T = 64,
-      -2.9e-5 at T = 256);
+      -2.9e-5 at T = 256). With ``judge_solution_samples`` the dissipation at the solve's own T
+      samples, which the result reports, is held to the same floor: a point below
+      -``SAMPLING_FLOOR`` of its energy scale there fails even where the refined value passes
+      (the AFT's energy error on the contact's own scale is then larger than the floor; more
+      samples cure it: :func:`sampled_response`), so a result that passes reports no
+      dissipation below -``SAMPLING_FLOOR`` of its energy scale;
     * ``step``: no step between neighbouring points longer in frequency than ``max_step``
       allows. Range and step are :func:`bladedamp.hbm.continuation.branch_checks`, the
       continuation's own contract, checked again on the result.
@@ -79,12 +86,18 @@ def physical_checks(omega, omega_range, dissipation, excitation_work, max_step=N
     if refine is None:
         bad, how = relative < -(2 * np.pi / n_samples) ** 2, ""
     else:
+        own = relative.copy()
         suspect = np.flatnonzero(relative < -ROUNDING)
         if suspect.size:
             fine = np.atleast_2d(np.asarray(refine(suspect), dtype=float).reshape(suspect.size, -1))
             relative[suspect] = (fine / scale[suspect]).min(axis=1, initial=0.0)
         bad = relative < -SAMPLING_FLOOR
         how = f", confirmed with {REFINE_SAMPLES_FACTOR * n_samples} AFT samples per period"
+        if judge_solution_samples and not bad.any() and (own < -SAMPLING_FLOOR).any():
+            bad, relative = own < -SAMPLING_FLOOR, own
+            how = (f" with {n_samples} AFT samples per period: the AFT's energy error, since with "
+                   f"{REFINE_SAMPLES_FACTOR * n_samples} on the same coefficients it is above -{SAMPLING_FLOOR:g} of "
+                   f"that scale; more samples per period cure it")
     if bad.any():
         of = "the excitation work" if work_bound is None else "the energy scale (excitation work or the contact's)"
         failed["dissipation"] = (f"negative friction dissipation at {int(bad.sum())} points "
@@ -122,11 +135,11 @@ def sampled_response(solve, n_samples, first: int, most: int, most_for_dissipati
     samples were chosen."""
     if n_samples is not None:
         return solve(n_samples)
-    n, tried, response, empty = int(first), [], None, None
+    n, tried, response, empty, stopped_by = int(first), [], None, None, ""
     while True:
         finer = solve(n)
         if response is not None and not len(finer.omega):
-            empty = n                                 # the coarser branch is kept
+            empty, stopped_by = n, finer.stopped_by   # the coarser branch is kept (and the stop, e.g. a budget)
             break
         response = finer
         if response.stopped_by:                       # stopped as the caller asked: no retry
@@ -142,7 +155,9 @@ def sampled_response(solve, n_samples, first: int, most: int, most_for_dissipati
     if failed_with:
         note += f"; AFT samples per period raised to {n_used} (the branch failed with {', '.join(failed_with)})"
     if empty is not None:
-        note += f"; with {empty} AFT samples per period the branch kept no point"
+        note += f"; with {empty} AFT samples per period the branch kept no point" + (f": {stopped_by}" if stopped_by else "")
+    if stopped_by:
+        return dataclasses.replace(response, message=response.message + note, success=False, stopped_by=stopped_by)
     return dataclasses.replace(response, message=response.message + note) if note else response
 
 
@@ -177,6 +192,185 @@ def with_checks(response, failed: dict):
     message = response.message + "; failed checks: " + "; ".join(f"{k}: {v}" for k, v in failed.items())
     return dataclasses.replace(response, success=False, message=message, failed_checks=dict(failed),
                                reached_end=response.reached_range_end)
+
+
+class Status(enum.Enum):
+    """What a frequency response can be trusted for: one value per result, derived from its
+    fields by :func:`response_status` (:attr:`FrequencyResponse.status`). The value is the
+    short name; :attr:`explanation` says in one sentence what it means and what to do."""
+
+    COMPLETE_VERIFIED = "complete, verified"
+    COMPLETE_UNVERIFIED = "complete, unverified"
+    COMPLETE_ABOVE_TOLERANCE = "complete, above tolerance"
+    CHECK_FAILED = "check failed"
+    STOPPED = "stopped"
+    OUT_OF_BUDGET = "out of budget"
+
+    @property
+    def complete(self) -> bool:
+        """Whether the branch reached the end of its range with every check passing: the
+        statuses of a ``success`` response."""
+        return self in (Status.COMPLETE_VERIFIED, Status.COMPLETE_UNVERIFIED, Status.COMPLETE_ABOVE_TOLERANCE)
+
+    @property
+    def explanation(self) -> str:
+        """What the status means and what to do, one sentence."""
+        return STATUS_EXPLANATIONS[self]
+
+
+STATUS_EXPLANATIONS = {
+    Status.COMPLETE_VERIFIED: "the branch reached the end of the range, every check passed and the harmonic "
+                              "truncation's error of the first-harmonic amplitudes is estimated within its "
+                              "tolerance: the curve holds to that tolerance",
+    Status.COMPLETE_UNVERIFIED: "the branch reached the end of the range, but the error of its harmonic "
+                                "truncation was not estimated or could not be checked, so its peak may be off by "
+                                "more than the tolerance (a one-harmonic curve by tens of percent): run with "
+                                "harmonics='auto' or a richer set such as (0, 1, 2, 3), or check the peak by "
+                                "time integration (check_peak=True)",
+    Status.COMPLETE_ABOVE_TOLERANCE: "the branch reached the end of the range, but the estimated error of its "
+                                     "harmonic truncation is above the tolerance, so its amplitudes may be off by "
+                                     "about that much: run with more harmonics (harmonics='auto' with a larger "
+                                     "max_harmonic, or a richer set)",
+    Status.CHECK_FAILED: "the branch reached the end of the range but failed a physical check (failed_checks "
+                         "says which), so its numbers are not to be trusted: raise the AFT samples (n_samples) "
+                         "or shorten the steps (max_step), or look at the design where the check failed",
+    Status.STOPPED: "the branch did not reach the end of the range (a caller's stop condition, a failed check "
+                    "or a Newton failure; the message says which), so it covers part of the range only and its "
+                    "largest amplitude need not be the resonance: shorten the steps (max_step), or check the "
+                    "stop by time integration (check_stop=True)",
+    Status.OUT_OF_BUDGET: "the branch ran out of its point or CPU budget before the end of the range, so it "
+                          "covers part of the range only: raise the budget or narrow the range",
+}
+
+#: a response whose ``stopped_by`` starts with this word ran out of its point or CPU budget
+BUDGET_PREFIX = "budget"
+# An end point's amplitude within this fraction of the largest counts as the largest (the
+# continuation solves each point to a scaled tolerance of 1e-10: two points that differ by
+# less than 1e-8 of the peak are not told apart)
+END_AMPLITUDE_RESOLUTION = 1e-8
+
+
+def response_status(response) -> Status:
+    """The :class:`Status` of ``response`` (any frequency response) from the fields it has:
+
+    * ``stopped_by`` starting with ``"budget"``: OUT_OF_BUDGET;
+    * no point, another ``stopped_by``, or the end of the range not reached
+      (:attr:`FrequencyResponse.reached_range_end`): STOPPED;
+    * the end reached, not ``success`` (a physical check failed): CHECK_FAILED;
+    * else, from ``harmonic_error`` e and ``harmonic_tolerance`` tol: e or tol not finite (not
+      estimated, or the enriched solve failed: not verified) COMPLETE_UNVERIFIED; e <= tol
+      COMPLETE_VERIFIED; e > tol COMPLETE_ABOVE_TOLERANCE.
+
+    ``success`` is True exactly for the three COMPLETE statuses (:attr:`Status.complete`)."""
+    stopped_by = response.stopped_by or ""
+    if stopped_by.startswith(BUDGET_PREFIX):
+        return Status.OUT_OF_BUDGET
+    if not len(response.omega) or stopped_by or not response.reached_range_end:
+        return Status.STOPPED
+    if not response.success:
+        return Status.CHECK_FAILED
+    error, tolerance = float(response.harmonic_error), float(response.harmonic_tolerance)
+    if not (np.isfinite(error) and np.isfinite(tolerance)):
+        return Status.COMPLETE_UNVERIFIED
+    return Status.COMPLETE_VERIFIED if error <= tolerance else Status.COMPLETE_ABOVE_TOLERANCE
+
+
+def range_end_of_largest(frequency_hz, amplitude) -> float | None:
+    """The end of the computed range [Hz] (the lowest or highest of ``frequency_hz`` (n,)) at
+    which the largest of ``amplitude`` (n,) lies, or None when it lies inside: a point at an end
+    whose amplitude is within ``END_AMPLITUDE_RESOLUTION`` of the largest counts as holding it
+    (both ends: the one with the larger amplitude). There the range holds no maximum: the curve
+    still rises towards that end. ``amplitude`` (n, k): k curves (e.g. one per blade), the end
+    of the largest curve whose largest lies at an end. None for an empty branch, and for curves
+    that are zero everywhere (at rest: no resonance to miss)."""
+    f, a = np.asarray(frequency_hz, dtype=float), np.asarray(amplitude, dtype=float)
+    if not f.size:
+        return None
+    a = a.reshape(f.size, -1)
+    same = 1e-12 * max(float(np.abs(f).max()), 1e-300)          # the same frequency, to rounding
+    low, high = f <= f.min() + same, f >= f.max() - same
+    found = []
+    for curve in a.T:
+        if not curve.max() > 0:
+            continue                     # no motion at all (a response at rest): no resonance anywhere
+        best, end = max((float(curve[low].max()), float(f.min())), (float(curve[high].max()), float(f.max())))
+        if best >= (1 - END_AMPLITUDE_RESOLUTION) * curve.max():
+            found.append((best, end))
+    return max(found)[1] if found else None
+
+
+def range_end_note(response) -> str:
+    """The sentence of a response whose largest amplitude lies at an end of its range
+    (:attr:`FrequencyResponse.peak_at_range_end`; '' otherwise): not a resonance, which may lie
+    outside the range, and where, from ``linear_natural_frequencies_hz`` (the natural
+    frequencies nearest the range of the linear systems without the friction contacts and with
+    them stuck) when the model gave them. A friction contact's tangential stiffness lies between
+    none and the stuck one, so its resonance lies between these two frequencies (up to the shift
+    of the contact's own inertia)."""
+    f = response.frequency_hz
+    end = range_end_of_largest(f, response.peak_curve())
+    if end is None:
+        return ""
+    side = "above" if end == f.max() and f.max() > f.min() else "below"
+    note = (f"the largest amplitude is at the end of the computed range ({end:.6g} Hz), not a resonance: the "
+            f"resonance may lie {side} the range")
+    bounds = tuple(response.linear_natural_frequencies_hz or ())
+    if len(bounds) == 2 and all(np.isfinite(bounds)):
+        free, stuck = bounds
+        note += (f", between the natural frequencies of the linear systems without the friction contacts "
+                 f"({free:.6g} Hz) and with them stuck ({stuck:.6g} Hz)")
+    return note + "; compute over a wider range"
+
+
+def status_message(response) -> str:
+    """One sentence that leads a response's report: its :class:`Status` (short name), the
+    particulars (the harmonic error against its tolerance, the reason of a stop, the failed
+    checks), the status's explanation, and :func:`range_end_note` when the largest amplitude
+    lies at an end of the range."""
+    status = response_status(response)
+    error, tolerance = float(response.harmonic_error), float(response.harmonic_tolerance)
+    if status is Status.COMPLETE_VERIFIED or status is Status.COMPLETE_ABOVE_TOLERANCE:
+        relation = "within" if status is Status.COMPLETE_VERIFIED else "above"
+        detail = (f"harmonic error estimate {100 * error:.2g} % {relation} the tolerance {100 * tolerance:.2g} % "
+                  f"(harmonics {tuple(response.basis.harmonics)})")
+    elif status is Status.COMPLETE_UNVERIFIED:
+        detail = (f"harmonic error not estimated (harmonics {tuple(response.basis.harmonics)})"
+                  if response.harmonics_converged is None else
+                  f"harmonic error not verified (harmonics {tuple(response.basis.harmonics)})")
+    elif status is Status.CHECK_FAILED:
+        detail = "failed checks: " + "; ".join(f"{k}: {v}" for k, v in response.failed_checks.items())
+    elif status is Status.OUT_OF_BUDGET or response.stopped_by:
+        detail = response.stopped_by
+    else:
+        detail = response.message
+    sentence = f"{status.value}: {detail}; {status.explanation}"
+    note = range_end_note(response)
+    return f"{sentence}; {note}." if note else f"{sentence}."
+
+
+def with_range_end_estimate(model, response):
+    """``response`` with, when its largest amplitude lies at an end of its range, the model's
+    linear natural frequencies nearest the range (``model.linear_natural_frequencies_hz(f_low,
+    f_high) -> (without contacts, contacts stuck)`` [Hz]) stored as
+    ``linear_natural_frequencies_hz`` and :func:`range_end_note` added to the message; any other
+    response (and one that did not reach the end of its range: its status says so) unchanged."""
+    if not (response.peak_at_range_end and response.reached_range_end):
+        return response
+    f = response.frequency_hz
+    bounds = tuple(float(b) for b in model.linear_natural_frequencies_hz(float(f.min()), float(f.max())))
+    response = dataclasses.replace(response, linear_natural_frequencies_hz=bounds)
+    return dataclasses.replace(response, message=f"{response.message}; {range_end_note(response)}")
+
+
+def nearest_to_range(frequencies_hz, f_low: float, f_high: float) -> float:
+    """The one of ``frequencies_hz`` nearest the interval [``f_low``, ``f_high``] [Hz] (inside
+    it: distance 0, the lowest of those); nan if there is none."""
+    f = np.asarray(frequencies_hz, dtype=float).ravel()
+    f = f[np.isfinite(f)]
+    if not f.size:
+        return float("nan")
+    distance = np.maximum(f_low - f, 0.0) + np.maximum(f - f_high, 0.0)
+    return float(f[np.lexsort((f, distance))[0]])
 
 
 def plot_branch(ax, x, y, stable=None, **kwargs):
@@ -231,6 +425,12 @@ class FrequencyResponse(Saveable):
     stopped_by : why a stop condition the caller gave ended the branch (e.g. ``stop_above`` of
         :meth:`TunedDisk.frequency_response`), '' if none did; such a response is not
         ``success``, and is not retried or enriched
+    linear_natural_frequencies_hz : (without the friction contacts, with them stuck): the natural
+        frequencies [Hz] nearest the range of the model's two linear systems, given when the
+        largest amplitude lies at an end of the range (:func:`with_range_end_estimate`), else ()
+
+    Derived, for every response (saved ones too): :attr:`status` (a :class:`Status`),
+    :attr:`status_message` and :attr:`peak_at_range_end`.
     """
 
     omega: np.ndarray
@@ -251,6 +451,30 @@ class FrequencyResponse(Saveable):
     bifurcations: dict = field(default_factory=dict)
     stability_method: str = ""
     stopped_by: str = ""
+    linear_natural_frequencies_hz: tuple = ()
+
+    @property
+    def status(self) -> Status:
+        """What the response can be trusted for (:func:`response_status`)."""
+        return response_status(self)
+
+    @property
+    def status_message(self) -> str:
+        """The sentence that leads the response's report (:func:`status_message`)."""
+        return status_message(self)
+
+    @property
+    def peak_at_range_end(self) -> bool:
+        """Whether the largest first-harmonic output amplitude (:meth:`peak_curve`)
+        lies at the first or last frequency of the range (:func:`range_end_of_largest`): then it
+        is no resonance, and :attr:`status_message` says where the resonance may lie."""
+        return range_end_of_largest(self.frequency_hz, self.peak_curve()) is not None
+
+    def peak_curve(self) -> np.ndarray:
+        """(n,) the output's first-harmonic amplitude at every point, whose largest is the peak:
+        here |X_1| of the first DOF [SI]; the disks' the tip amplitude u_x [m] ((n, s), one
+        column per blade, for a mistuned disk)."""
+        return self.harmonic_amplitude(0, 1)
 
     @property
     def reached_range_end(self) -> bool:
@@ -321,11 +545,15 @@ class FrequencyResponse(Saveable):
         """Excitation frequency of :attr:`peak_amplitude` [Hz] (the resonance)."""
         return self.peak()[0]
 
-    def plot(self, ax=None, *, dof=0, harmonic: int = 1, scale: float = 1.0, unit: str = "m", **kwargs):
+    def plot(self, ax=None, *, dof=0, harmonic: int = 1, scale: float = 1.0, unit: str = "m", measured=None,
+             **kwargs):
         """Plot ``scale`` |X_h| of ``dof`` over frequency [Hz] into ``ax`` (a new figure if None);
         ``unit``: the unit of the plotted values, shown in brackets on the axis (default m, the
         SI unit of a displacement DOF at ``scale`` 1; e.g. ``scale=1e3, unit="mm"``). Returns
-        the axes. Every response class's ``plot`` takes ``ax`` first, options by keyword."""
+        the axes. Every response class's ``plot`` takes ``ax`` first, options by keyword.
+        ``measured``: a measured displacement (or velocity, acceleration) response or its file,
+        drawn times ``scale`` beside it (:func:`bladedamp.measurement.draw_measurement`; an FRF
+        needs its force: ``measured.at_force(F)``)."""
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -339,4 +567,8 @@ class FrequencyResponse(Saveable):
         if not self.success:
             ax.set_title(f"incomplete: {self.message}", fontsize=8)
         ax.legend()
+        if measured is not None:
+            from .measurement import draw_measurement
+
+            draw_measurement(ax, measured, scale=scale)
         return ax

@@ -123,7 +123,7 @@ import scipy.sparse.linalg
 from . import validation as check
 from .blade import (SHIFT_INVERT_SIGMA, SOLID_NPZ_FORMAT, BeamBladeGeometry, ModalBlade, PAPER_MODE_ORDER,
                     platform_section)
-from .io import decode_value, encode_value
+from .io import MissingFileError, decode_value, encode_value
 
 __all__ = ["FE_HINT", "SOLID_NPZ_FORMAT", "SolidBladeGeometry", "SurfaceBladeGeometry", "PlaneRegion", "SurfacePatch",
            "SolidMesh", "SolidModes", "ContactFaceModes", "ContactFaceField", "BladeSurface", "SolidModalBlade",
@@ -903,7 +903,9 @@ class SurfaceBladeGeometry:
 
 
 def _load_surface(name: str, surface):
-    """A trimesh.Trimesh from a path or a Trimesh (ValueError naming ``name`` otherwise)."""
+    """A trimesh.Trimesh from a path or a Trimesh: ValueError naming ``name`` and the file for a
+    file trimesh cannot read or that holds no triangles (:class:`bladedamp.io.MissingFileError`,
+    a ValueError and a FileNotFoundError, for a missing file)."""
     import trimesh
     if isinstance(surface, trimesh.Trimesh):
         return surface
@@ -911,7 +913,7 @@ def _load_surface(name: str, surface):
     if not isinstance(surface, (str, os.PathLike)):
         raise ValueError(f"{name} must be a path of an STL file or a trimesh.Trimesh (got {type(surface).__name__})")
     if not os.path.exists(surface):
-        raise FileNotFoundError(f"{name}: no file {os.fspath(surface)!r}")
+        raise MissingFileError(f"{name}: no file {os.fspath(surface)!r}")
     try:
         mesh = trimesh.load(surface, force="mesh")
     except Exception as err:          # trimesh raises many kinds on a broken file

@@ -15,6 +15,7 @@ frequencies for comparison.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 from functools import cached_property
 
 import numpy as np
@@ -582,9 +583,18 @@ class DiskTimeResponse(Saveable):
     damper_drift : (n, n_d, 6) change of that mean in the last period [m, rad per period]
     point_state : (n, P, 3) share of the last period each point sticks, slips, is separated
     steps_per_period : S; time_step : (n,) [s]
-    static_state : (n, N) static equilibrium under F_CG the run started from
+    static_state : (n, N) static equilibrium under F_CG
     tip_history : n arrays (periods, s, 3) complex, the first harmonic of every period (settling)
     damper_history : n arrays (periods, n_d, 6), the period mean of the damper coordinates
+    start : (n,) the state the run started from: "static equilibrium" (at rest under F_CG) or
+        "HBM solution" (on the orbit of a harmonic solution, ``start_coefficients``)
+    residual_drift : (n,) where the first harmonics had not settled to ``tol`` after
+        ``max_periods``: the bound on the last block mean's distance from the limit of the
+        period-to-period map, relative to the amplitude (:func:`map_convergence`; inf where it
+        does not converge); NaN where not needed
+    decay_rate : the slowest viscous decay rate of the blade modes, sigma = min c_q / (2 m_q) =
+        min zeta omega_n [1/s] (0 if a mode is undamped): a transient of that mode decays as
+        exp(-sigma t)
     """
 
     omega: np.ndarray
@@ -608,6 +618,9 @@ class DiskTimeResponse(Saveable):
     static_state: np.ndarray
     tip_history: list
     damper_history: list
+    start: np.ndarray | None = None
+    residual_drift: np.ndarray | None = None
+    decay_rate: float = np.nan
 
     @property
     def frequency_hz(self) -> np.ndarray:
@@ -673,6 +686,49 @@ def _drift_verdict(means, scale, tol):
     return int(d), int(a), float(rate[d, a])
 
 
+class MapConvergence(NamedTuple):
+    """The convergence of a time integration's period-to-period map (:func:`map_convergence`)."""
+    converged: bool
+    residual: float          # bound on the last block mean's distance from the limit, relative to the amplitude
+    contraction: float       # q, per block
+    block: int               # L, periods per block
+    change: float            # c_2, the mean change per period over the last block, relative
+    change_before: float     # c_1, the same over the block before
+
+
+def map_convergence(history, decay_per_period: float, settle_tol: float, fluctuation_tol: float) -> MapConvergence:
+    """Whether the period-to-period map of a time integration converges (a
+    :class:`MapConvergence`) from ``history`` (p, ...) complex, the first
+    harmonics of p consecutive periods. The means over the last three blocks of L = p // 4
+    periods (a mean averages out a fluctuation from period to period) differ by D_1 (older) and
+    D_2 (newer), relative to the largest first harmonic, and the mean change from one period to
+    the next is c_1 over the middle block and c_2 over the last. A transient that decays at least
+    geometrically by q per block leaves the newest mean at most D_2 q / (1 - q) from the limit
+    (the geometric tail); q is the larger of the observed D_2 / D_1 and exp(-sigma T L), the
+    decay over a block of the slowest viscously damped blade mode (``decay_per_period`` = sigma T,
+    sigma = zeta omega_n [1/s] of that mode, T the period; friction only adds damping). The
+    transient's share of the per-period change shrinks by q per block too, on top of a fluctuation
+    that does not decay (the dampers ringing on their contact springs) of at most
+    ``fluctuation_tol``: c_2 <= q c_1 + fluctuation_tol. A motion that is not periodic (a damper
+    hopping) keeps changing from period to period by about as much in every block, c_2 about
+    c_1 above the fluctuation, and fails it, whatever its block means do. Converged when q < 1,
+    c_2 <= q c_1 + fluctuation_tol and the residual drift is at most ``settle_tol``."""
+    p = len(history)
+    L = p // 4
+    if L < 1:
+        return MapConvergence(False, np.inf, np.inf, L, np.inf, np.inf)
+    means = [np.mean(history[p - (j + 1) * L:p - j * L], axis=0) for j in (2, 1, 0)]
+    amp = max(np.abs(means[-1]).max(), 1e-300)
+    d1 = np.abs(means[1] - means[0]).max() / amp
+    d2 = np.abs(means[2] - means[1]).max() / amp
+    steps = np.abs(np.diff(history[p - 2 * L - 1:], axis=0)).reshape(2 * L, -1).max(axis=1) / amp
+    c1, c2 = steps[:L].mean(), steps[L:].mean()
+    q = max(d2 / max(d1, 1e-300), float(np.exp(-decay_per_period * L)))
+    residual = d2 * q / (1 - q) if q < 1 else np.inf
+    return MapConvergence(bool(residual <= settle_tol and c2 <= q * c1 + fluctuation_tol), float(residual), float(q), L,
+                          float(c2), float(c1))
+
+
 def row_nonzeros(A):
     """(nnz (n, r) int64, columns (n, r, c) int64) of the rows of a stack of matrices (n, r, c):
     the sparsity arguments (t_nnz, t_col of ``Tb``; b_nnz, b_col of ``B``) of :func:`disk_period`."""
@@ -687,7 +743,8 @@ def row_nonzeros(A):
 
 def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max_periods: int = 4000,
                        n_stable: int = 5, drift_periods: int = 40, steps_per_period: int | None = None,
-                       stability_margin: float = 0.8, fluctuation_tol: float = 2e-4) -> DiskTimeResponse:
+                       stability_margin: float = 0.8, fluctuation_tol: float = 2e-4, settle_tol: float = 1e-3,
+                       start_coefficients=None, start_basis=None) -> DiskTimeResponse:
     """Steady-state forced response of a full-assembly MistunedDisk by time integration.
 
     Each frequency f_hz [Hz] is a separate run: the assembly starts at rest in its static
@@ -695,7 +752,13 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
     the run; :func:`_static_state`: frictionless seating on the flexible blades, every slider
     at its point's tangential displacement, so no tangential force), then the harmonic
     excitation of the HBM (blade k's tip load f cos(Omega t + k dphi), dphi = 2 pi EO / n, as
-    :meth:`MistunedDisk.hbm_system`) is switched on at t = 0. Central differences
+    :meth:`MistunedDisk.hbm_system`) is switched on at t = 0. Or, with ``start_coefficients``
+    (n, C, N) (one harmonic solution of the full assembly per frequency, in ``start_basis``,
+    which has the static harmonic), each run starts on that solution's orbit
+    (:func:`bladedamp.hbm.monodromy.orbit_state`: displacement and previous step from the
+    Fourier series, every friction slider from the contact's periodic return map over one period
+    of the motion), so it tests that branch: a motion that stays on it settles within the
+    harmonic truncation error of it. Central differences
     (:func:`disk_period`), ``steps_per_period`` steps, the same for every frequency of the
     call (default: the more of MIN_STEPS_PER_PERIOD = 512, for accuracy, and the steps at
     ``stability_margin`` x the stability limit 2 / omega_max of the stuck linearised assembly;
@@ -723,7 +786,17 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
     fluctuation is at most ``fluctuation_tol`` per period; the tip amplitudes are then that
     mean (a beat of the transient averages out of it).
 
-    Status "not settled" after ``max_periods``; "unstable" if the integration diverges.
+    First harmonics still changing by more than ``tol`` after ``max_periods`` periods are judged
+    by the convergence of the period-to-period map (:func:`map_convergence`): a lightly damped
+    transient decays as exp(-zeta omega_n t), so its share left after max_periods may well
+    exceed ``tol`` per period while the motion converges. When the means of the first harmonics
+    over the last blocks of max_periods / 4 periods approach their limit geometrically and the
+    residual drift (the distance of the last block's mean from that limit, bounded with the
+    slowest contraction of the observed one and the blades' viscous decay) is at most
+    ``settle_tol`` of the amplitude, the motion is periodic (or drifting, if a damper's mean
+    moves steadily), its tip amplitudes the last block's mean; else status "not settled", with
+    the residual drift in the message: no periodic motion within ``max_periods``. "unstable" if
+    the integration diverges.
 
     Returns a :class:`DiskTimeResponse`.
     """
@@ -739,13 +812,24 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
     drift_periods = validation.integer("drift_periods", drift_periods, minimum=2)
     validation.in_range("stability_margin", stability_margin, 0.0, 1.0, closed="right")
     validation.in_range("fluctuation_tol", fluctuation_tol, 0.0, 0.1, closed="right")
+    validation.in_range("settle_tol", settle_tol, 0.0, 0.1, closed="right")
     if disk.n_sector != disk.n_blades:
         raise ValueError(f"time_response integrates the full assembly: len(blades) must equal n_blades "
                          f"({disk.n_blades}), got a cyclic sector of {disk.n_sector}")
     arrays = assembly_arrays(disk)
     system = arrays.system
+    damped = arrays.c_q > 0
+    decay_rate = float((arrays.c_q[damped] / (2 * arrays.m_q[damped])).min()) if damped.all() else 0.0
     N, C = system.n_dof, system.basis.n_coeffs
     omega = 2 * np.pi * f_hz
+    if start_coefficients is not None:
+        if start_basis is None or not start_basis.has_static:
+            raise ValueError("start_basis must be the HarmonicBasis of start_coefficients, with the static harmonic 0 "
+                             "(the time integration seats the dampers under F_CG)")
+        start_coefficients = np.asarray(start_coefficients, dtype=float)
+        if start_coefficients.shape != (f_hz.size, start_basis.n_coeffs, N):
+            raise ValueError(f"start_coefficients must have the shape (n_f, C, N) = ({f_hz.size}, "
+                             f"{start_basis.n_coeffs}, {N}) of the full assembly, got {start_coefficients.shape}")
     loads, statics = [], []
     w_max = 0.0
     for w in omega:
@@ -771,7 +855,9 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
                status=np.empty(n, dtype=object), message=np.empty(n, dtype=object), settling=np.zeros(n),
                damper_mean=np.zeros((n, nd, 6)), damper_drift=np.zeros((n, nd, 6)), point_state=np.zeros((n, P, 3)),
                time_step=2 * np.pi / omega / steps, static_state=np.array(statics), tip_history=[],
-               damper_history=[])
+               damper_history=[], start=np.array(["static equilibrium" if start_coefficients is None else
+                                                  "HBM solution"] * n, dtype=object),
+               residual_drift=np.full(n, np.nan), decay_rate=decay_rate)
     t_nnz, t_col, b_nnz, b_col = arrays.sparsity
     tip_dft = np.zeros((s, 3, 2))
     damper_mean = np.zeros((nd, 6))
@@ -781,10 +867,17 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
     energies = np.zeros(2)
     for i, w in enumerate(omega):
         f = loads[i]
-        x = statics[i].copy()
-        x_prev = x.copy()
-        slider = np.ascontiguousarray((arrays.point_map @ x).reshape(P, 3)[:, :2]) if P else np.zeros((0, 2))
         dt = 2 * np.pi / w / steps
+        if start_coefficients is None:
+            x = statics[i].copy()
+            x_prev = x.copy()
+            slider = np.ascontiguousarray((arrays.point_map @ x).reshape(P, 3)[:, :2]) if P else np.zeros((0, 2))
+        else:
+            from .hbm.monodromy import orbit_state
+
+            z, _ = orbit_state(arrays, start_coefficients[i], start_basis, w, dt)
+            x, x_prev = z[:N].copy(), z[N:2 * N].copy()
+            slider = np.ascontiguousarray(z[2 * N:].reshape(P, 2))
         X_old, mean_old = None, None
         stable = 0
         changes = []
@@ -874,8 +967,43 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
                        f"after {p} periods")
             break
         else:
-            message = (f"not settled: first harmonics changed by {change:.2g} per period "
-                       f"(tol {tol:g}) after {max_periods} periods")
+            # the period-to-period map after max_periods: converging (a lightly damped transient)
+            # or not (no periodic motion)
+            p = max_periods
+            verdict = _drift_verdict(np.array(mean_hist[-drift_periods - 1:]), np.repeat(scale, 3), tol) \
+                if nd and p > drift_periods else None
+            conv = map_convergence(np.array(tip_hist), decay_rate * 2 * np.pi / w, settle_tol, fluctuation_tol)
+            converged, residual, q, L = conv.converged, conv.residual, conv.contraction, conv.block
+            out["residual_drift"][i] = residual
+            how = (f"the period-to-period map converges: the first harmonics' means over the last blocks of {L} "
+                   f"periods approach their limit by a factor {q:.3g} per block (the slowest blade mode's viscous "
+                   f"decay alone gives {np.exp(-decay_rate * 2 * np.pi / w * L):.3g}), a residual drift of "
+                   f"{residual:.2g} of the amplitude, within settle_tol {settle_tol:g}; the first harmonics still "
+                   f"change by {change:.2g} per period (tol {tol:g}) after {p} periods, and the tip amplitudes are "
+                   f"the mean over the last {L} periods")
+            if converged and verdict is None:
+                X, window = np.mean(tip_hist[-L:], axis=0), L
+                status = "periodic"
+                message = f"periodic: {how}"
+            elif converged:
+                X, window = np.mean(tip_hist[-L:], axis=0), L
+                d, a, rate = verdict
+                kind = "rotation" if a >= 3 else "translation"
+                status = "drifting"
+                message = (f"drifting: damper {kind} {_DOF[a]} grows by {rate:.3g} {'rad' if a >= 3 else 'm'} per "
+                           f"period (damper {disk.active_dampers[d]}, {100 * abs(rate) / scale[a // 3]:.3g} % of the "
+                           f"dampers' {kind} amplitude, steadily over the last {drift_periods} periods) while {how}")
+            else:
+                message = (f"not settled: first harmonics changed by {change:.2g} per period (tol {tol:g}) after {p} "
+                           f"periods, and the period-to-period map does not converge to settle_tol {settle_tol:g}: "
+                           + (f"the means over the last blocks of {L} periods approach a limit by a factor {q:.3g} "
+                              f"per block, a residual drift of {residual:.2g} of the amplitude, and the first "
+                              f"harmonics change by {conv.change:.2g} per period over the last block against "
+                              f"{conv.change_before:.2g} over the one before (a converging transient's change "
+                              f"shrinks by that factor, on top of a fluctuation of at most fluctuation_tol "
+                              f"{fluctuation_tol:g})"
+                              if q < 1 else f"the means over the last blocks of {L} periods move apart (a factor "
+                              f"{q:.3g} per block)"))
         out["tip_harmonic"][i] = X
         # the works of the last period, or their mean over the same periods as a mean first harmonic
         # (a fluctuating motion's last period stores or releases energy: measured 5.8e-3 of the

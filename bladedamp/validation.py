@@ -78,8 +78,8 @@ class PlausibilityWarning(UserWarning):
 
 
 def _outside_caller_level() -> int:
-    """The ``stacklevel`` of the first frame outside bladedamp (and outside dataclass-generated
-    code), so that a warning points at the user's line."""
+    """The ``stacklevel`` of the first frame outside bladedamp and outside the dataclasses module
+    (its ``replace`` and the ``__init__`` it generates), so that a warning points at the user's line."""
     import os
     import sys
 
@@ -88,7 +88,8 @@ def _outside_caller_level() -> int:
     while frame is not None:
         filename = frame.f_code.co_filename
         generated = filename.startswith("<") and frame.f_code.co_name == "__init__"    # a dataclass's __init__
-        if not (filename.startswith(package) or generated):
+        dataclasses = frame.f_globals.get("__name__") == "dataclasses"                # dataclasses.replace
+        if not (filename.startswith(package) or generated or dataclasses):
             return level
         frame, level = frame.f_back, level + 1
     return 1

@@ -370,5 +370,6 @@ def test_default_disk_frf_meets_the_tolerance(kind, mass, expected):
         warnings.simplefilter("error", AccuracyWarning)       # a default above the tolerance fails here
         r = bd.reference_disk(kind, mass).frequency_response(90.0, 105.0)
     assert r.success and r.harmonics_converged
+    assert not r.stopped_by                                     # the default budget is not met
     assert r.harmonic_error <= r.harmonic_tolerance == 0.01
     assert max(r.basis.harmonics) > 3 and max(r.basis.harmonics) <= max(expected)   # (0..3) is 2-5 % off

@@ -83,3 +83,30 @@ def test_precompile_reports_each_group_and_the_cli_runs_it(capsys):
     assert cli.main(["precompile"]) == 0
     err = capsys.readouterr().err
     assert "disk kernels ready" in err and "later processes only load them" in err
+
+
+def _cold(xdg, code=""):
+    """In a new process on the per-user cache under ``xdg`` (XDG_CACHE_HOME, no NUMBA_CACHE_DIR):
+    ``code``, then cache_is_cold() and what the CLI's compile notice prints."""
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    env.update(XDG_CACHE_HOME=str(xdg), PYTHONPATH=ROOT)
+    probe = (code + "\nimport io\nfrom bladedamp.compilation import cache_is_cold\nfrom bladedamp.cli import Progress\n"
+             "s = io.StringIO(); Progress(s).compiling(); print(cache_is_cold(), repr(s.getvalue()))")
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, env=env)
+    assert out.returncode == 0, out.stderr[-3000:]
+    return out.stdout.strip().splitlines()[-1]
+
+
+def test_a_cold_cache_is_detected_and_announced_once(tmp_path):
+    """An empty per-user cache (XDG_CACHE_HOME a new folder) is cold and the commands say so in
+    one line; once numba has written one kernel of bladedamp there (a real compile, of the
+    smallest kernel) it is not, and they say nothing."""
+    from bladedamp.compilation import COLD_COMPILE_SECONDS
+
+    cold = _cold(tmp_path)
+    assert cold.startswith("True ") and cold.count("\\n") == 1, cold
+    assert f"compiling kernels once, about {COLD_COMPILE_SECONDS} s; `bladedamp precompile` does it ahead" in cold
+    warm = _cold(tmp_path, "import numpy as np\nfrom bladedamp.hbm.linsolve import permutation_sign\n"
+                           "permutation_sign(np.arange(3))")
+    assert warm == "False ''", warm
+    assert list((tmp_path / "bladedamp" / "numba").glob("*/*.nbi"))      # numba wrote it where we looked

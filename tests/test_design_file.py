@@ -125,7 +125,7 @@ def test_every_check_describes_what_it_allows():
     ("[dampr]\nmass_g = 1.0\n", r"unknown table or key 'dampr' \(did you mean damper\?\)"),
     ("n_blades = 16\n", "unknown table or key 'n_blades'"),
     ("damper = 3\n", r"damper must be a table \[damper\]"),
-    ("[disk]\nengine_order = 9\n", r"\[disk\] engine_order = 9 .* \[0, 8\]"),
+    ("[disk]\nengine_order = -1\n", r"\[disk\] engine_order = -1 .* \[0, 500\]"),
     ("[disk]\nengine_order = [2, 1]\n", r"\[disk\] engine_order = \[2, 1\] .* strictly increasing"),
     ("[disk]\nexcitation_n_nm = [0.1, 0.0]\n", r"\[disk\] excitation_n_nm = \[0.1, 0.0\] .* list of 6"),
     ("[analysis]\nharmonics = [0, 2]\n", r"harmonics = \[0, 2\] .* containing 1"),
@@ -177,6 +177,23 @@ def test_wedge_angles_speed_and_engine_orders_in_si(tmp_path):
     assert eo2.engine_order == 2 and eo2.rotor_speed_hz is None       # 'auto': Omega_E / EO
     assert design.analysis.harmonics == (0, 1, 3) and design.analysis.study_harmonics == (0, 1, 3)
     assert design.analysis.mass_bounds == pytest.approx((1e-4, 5e-3))
+
+
+def test_engine_orders_above_half_the_blades(tmp_path):
+    """16 blades, engine_order = [7, 9, 16, 17]: accepted; EO 9 is nodal diameter 7 backward
+    with the preload of EO 9 (m R (Omega_E / 9)^2, not EO 7's), EO 16 nodal diameter 0 with a
+    rotor speed Omega_E / 16, EO 17 nodal diameter 1 forward."""
+    design = load_design(_write(tmp_path, "[disk]\nengine_order = [7, 9, 16, 17]\n"))
+    assert design.engine_orders == (7, 9, 16, 17)
+    expected = {7: (7, "forward"), 9: (7, "backward"), 16: (0, "standing"), 17: (1, "forward")}
+    f = 97.0
+    for eo, nd in expected.items():
+        disk = design.disk_at(eo)
+        assert disk.nodal_diameter == nd and disk.rotor_speed_hz is None
+        force = disk.centrifugal_force(f)[0]
+        assert force == pytest.approx(disk.damper.mass * disk.damper_radius * (2 * np.pi * f / eo) ** 2, rel=1e-14)
+    assert design.disk_at(16).interblade_phase == 0.0
+    assert design.disk_at(9).interblade_phase == pytest.approx(-design.disk_at(7).interblade_phase, rel=1e-15)
 
 
 def test_no_damper_and_a_fixed_rotor_speed(tmp_path):

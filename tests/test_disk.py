@@ -587,7 +587,7 @@ def test_response_contact_quantities_of_all_points_at_once_equal_point_by_point(
 # 8. bad input
 # ---------------------------------------------------------------------------------------
 @pytest.mark.parametrize("call, match", [
-    (lambda: reference_disk("cylinder", 1e-3, engine_order=9), "engine_order"),
+    (lambda: reference_disk("cylinder", 1e-3, engine_order=2.5), "engine_order"),
     (lambda: reference_disk("cylinder", 1e-3, engine_order=-1), "engine_order"),
     (lambda: dataclasses.replace(reference_disk("cylinder"), gamma_left=0.0), "gamma_left"),
     (lambda: dataclasses.replace(reference_disk("cylinder"), gamma_right=np.pi / 2), "gamma_right"),
@@ -734,6 +734,7 @@ def test_check_peak_estimates_the_harmonic_error_by_time_integration(monkeypatch
     assert checked.harmonic_error == max(direct, plain.harmonic_error) and checked.harmonics_converged is False
     assert mistuned.harmonic_error == pytest.approx(checked.harmonic_error, rel=0.02)
     assert mistuned.peak_check.status[0] == "drifting"
+    assert check.start[0] == mistuned.peak_check.start[0] == "HBM solution"      # both start on their branch
     monkeypatch.setattr(TunedDisk, "time_response", lambda *a, **k: pytest.fail("no time integration expected"))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -747,6 +748,57 @@ def test_check_peak_estimates_the_harmonic_error_by_time_integration(monkeypatch
         disk.peak_check(DiskResponse(np.zeros(0), np.zeros((0, 3, 1)), HarmonicBasis((1,)), ("q",), False, ""))
     with pytest.raises(ValueError, match="check_peak .*extra_couplings"):
         disk.frequency_response(90.0, 100.0, check_peak=True, extra_couplings=lambda basis: [])
+    with pytest.raises(ValueError, match="start must be"):
+        disk.peak_check(plain, start="rest")
+
+
+def test_check_peak_starts_on_the_hbm_solution(monkeypatch):
+    """The peak check starts the time integration on the branch's own state at the peak
+    (displacements and velocities from the Fourier series, the sliders from the contact's return
+    map over one period: bladedamp.hbm.monodromy.orbit_state), so it tests that branch. The
+    4-blade disk with the 1 g cylinder, (0, 1): the first period reproduces the branch's
+    first-harmonic tip amplitudes to its one-period defect (measured 0.14 %), and the motion it
+    settles on (the cylinder rolling, "drifting") lies within the stated truncation error of the
+    branch (the enriched set's estimate, 4.0 %; measured 4.1 %), far inside the distance a motion
+    on the branch may settle at (the defect / (1 - exp(-sigma T)), sigma the blades' slowest
+    viscous decay): the same motion, no coexisting one; the message says which start it used.
+    The integration from the static equilibrium reaches the same motion. A motion farther than
+    that bound (the settled amplitudes replaced by half the branch's) is reported as a coexisting
+    motion, a note that leaves the harmonic error estimate the enriched set's."""
+    from bladedamp.disk import TunedDisk, orbit_departure
+
+    disk = dataclasses.replace(reference_disk("cylinder", 1e-3), n_blades=4)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        plain = disk.frequency_response(97.0, 106.0, harmonics=(0, 1))
+        checked = disk.frequency_response(97.0, 106.0, harmonics=(0, 1), check_peak=True)
+        rest = disk.peak_check(plain, start="static")
+    check = checked.peak_check
+    assert list(check.start) == ["HBM solution"] and list(rest.start) == ["static equilibrium"]
+    assert "started on the HBM solution's state" in checked.message
+    k = int(np.argmax(checked.tip_amplitude.max(axis=1)))
+    branch, peak = checked.tip_amplitude[k], checked.tip_amplitude[k].max()
+    first = np.abs(check.tip_history[0][0]).max(axis=0)
+    defect = np.abs(first - branch).max() / peak
+    settled = np.abs(check.tip_amplitude[0].max(axis=0) - branch).max() / peak
+    sigma_t = check.decay_rate * 2 * np.pi / check.omega[0]
+    assert sigma_t == pytest.approx(1e-3 * 95.0 / check.frequency_hz[0] * 2 * np.pi, rel=1e-6)
+    assert defect < 0.01 and settled <= 1.25 * plain.harmonic_error and settled < defect / -np.expm1(-sigma_t)
+    assert orbit_departure(disk, check, branch, peak, settled, 0.01) is None
+    assert checked.harmonic_error == pytest.approx(max(settled, plain.harmonic_error), rel=1e-9)
+    assert rest.status[0] == check.status[0] == "drifting"
+    assert np.abs(rest.tip_amplitude[0] - check.tip_amplitude[0]).max() / peak < 2e-3
+    # a motion that left the branch: half its amplitudes, beyond the bound
+    far = dataclasses.replace(check, tip_amplitude=0.5 * check.tip_amplitude)
+    note = orbit_departure(disk, far, branch, peak, 0.5, 0.01)
+    assert note is not None and "beyond the" in note
+    monkeypatch.setattr(TunedDisk, "peak_check", lambda self, response, **k: far)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        left = disk.frequency_response(97.0, 106.0, harmonics=(0, 1), check_peak=True)
+    assert "leaves the branch for a coexisting periodic motion" in left.message
+    assert left.harmonic_error == plain.harmonic_error and left.harmonics_converged is plain.harmonics_converged
+    assert left.peak_check is far
 
 
 def test_stop_check_bad_input():
@@ -800,3 +852,59 @@ def test_a_response_without_the_harmonic_error_estimate_is_the_same_branch_and_s
     np.testing.assert_array_equal(bare.tip_amplitude, full.tip_amplitude)
     with pytest.raises(ValueError, match="estimate_harmonic_error"):
         disk.frequency_response(*F_RANGE, harmonics="auto", estimate_harmonic_error=False)
+
+
+# ---------------------------------------------------------------------------------------
+# 9. any engine order: nodal diameter from EO mod n, rotor speed from EO
+# ---------------------------------------------------------------------------------------
+@pytest.mark.parametrize("eo, n, expected", [
+    (0, 16, (0, "standing")), (1, 16, (1, "forward")), (7, 16, (7, "forward")), (8, 16, (8, "standing")),
+    (9, 16, (7, "backward")), (15, 16, (1, "backward")), (16, 16, (0, "standing")), (17, 16, (1, "forward")),
+    (41, 16, (7, "backward")), (2, 5, (2, "forward")), (3, 5, (2, "backward")), (10, 5, (0, "standing")),
+])
+def test_nodal_diameter_of_any_engine_order(eo, n, expected):
+    """k = EO mod n, folded to n - k (backward) above n / 2; the interblade phase has
+    e^{i dphi} = e^{i 2 pi EO / n} and lies in (-pi, pi], negative for a backward wave."""
+    from bladedamp.disk import interblade_phase, nodal_diameter
+    assert nodal_diameter(eo, n) == expected
+    dphi = interblade_phase(eo, n)
+    assert -np.pi < dphi <= np.pi
+    assert abs(np.exp(1j * dphi) - np.exp(2j * np.pi * eo / n)) < 1e-13
+    assert dphi == (2 * np.pi * expected[0] / n) * (-1 if expected[1] == "backward" else 1)
+
+
+def test_engine_order_sets_the_preload_and_the_nodal_diameter_only_its_phase():
+    """16 blades, EO 9 (nodal diameter 7 backward) and EO 16 (nodal diameter 0): accepted; the
+    centrifugal force is m R (Omega_E / EO)^2 with EO itself (Eq. 3, 26), written out here."""
+    m, f = 1e-3, 95.0
+    for eo in (9, 16, 25):
+        disk = reference_disk("cylinder", m, engine_order=eo)
+        force, dforce = disk.centrifugal_force(f)
+        omega_e = 2 * np.pi * f
+        assert force == pytest.approx(m * disk.damper_radius * (omega_e / eo) ** 2, rel=1e-14)
+        assert dforce == pytest.approx(2 * m * disk.damper_radius * omega_e / eo ** 2, rel=1e-14)
+    assert reference_disk("cylinder", m, engine_order=9).nodal_diameter == (7, "backward")
+    assert reference_disk("cylinder", m, engine_order=16).interblade_phase == 0.0
+
+
+def test_backward_wave_differs_from_forward_by_the_preload_only():
+    """4 blades, EO 3 (nodal diameter 1 backward) against EO 1 (forward). Without the damper's
+    inertia its mass enters only through the preload m R (Omega_E / EO)^2, so EO 3 with 9 times
+    the mass has EO 1's preload at every frequency; the reference disk is mirror-symmetric
+    (gamma_L = gamma_R, the beam blade symmetric about its axis), and the mirror image of a
+    backward wave is the forward one: the two frequency responses are equal to rounding.
+    With the same mass the preload differs (by 1/9) and so does the peak."""
+    def tuned(eo, mass):
+        return dataclasses.replace(reference_disk("cylinder", mass, engine_order=eo, damper_inertia=False),
+                                   n_blades=4)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        forward = tuned(1, 1e-3).frequency_response(92.0, 104.0, harmonics=(1,), max_step=0.05)
+        backward = tuned(3, 9e-3).frequency_response(92.0, 104.0, harmonics=(1,), max_step=0.05)
+        lighter = tuned(3, 1e-3).frequency_response(92.0, 104.0, harmonics=(1,), max_step=0.05)
+    assert forward.success and backward.success and lighter.success
+    assert tuned(3, 9e-3).centrifugal_force(97.0) == pytest.approx(tuned(1, 1e-3).centrifugal_force(97.0), rel=1e-14)
+    assert abs(backward.peak_amplitude - forward.peak_amplitude) < 1e-9 * forward.peak_amplitude
+    on_forward = np.interp(forward.frequency_hz, backward.frequency_hz, backward.tip_amplitude[:, 0])
+    assert np.abs(on_forward - forward.tip_amplitude[:, 0]).max() < 1e-6 * forward.peak_amplitude
+    assert abs(lighter.peak_amplitude - forward.peak_amplitude) > 0.1 * forward.peak_amplitude

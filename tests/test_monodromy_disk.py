@@ -306,3 +306,23 @@ def test_with_stability_takes_method_monodromy_on_a_disk(reference4):
     assert mono.stability_method == "monodromy" and det.stability_method == "determinant sign"
     assert mono.stable.all() and det.stable.all()
     assert mono.floquet_exponents.shape[0] == len(short.omega)
+
+
+def test_with_stability_raises_the_monodromy_warning_once_per_call(reference4):
+    """At the 4-blade disk's 102.3 Hz resonance the cylinder keeps rolling (the peak check's
+    "drifting", test_disk.py): the monodromy of each HBM state warns that it is not a periodic
+    orbit. ``with_stability`` over three such points raises that AccuracyWarning once, at the
+    caller's line, saying at how many points; each point alone warns (the count can fail)."""
+    from bladedamp.hbm.accuracy import AccuracyWarning
+    from bladedamp.hbm.stability import with_stability
+
+    disk, _ = reference4
+    r = quiet_frf(disk, 102.2, 102.4, harmonics=(0, 1, 2, 3))
+    i = int(np.argmin(np.abs(r.frequency_hz - 102.3)))
+    three = dataclasses.replace(r, omega=r.omega[i - 1:i + 2], coefficients=r.coefficients[i - 1:i + 2])
+    with warnings.catch_warnings(record=True) as raised:
+        warnings.simplefilter("always")
+        with_stability(disk, three, method="monodromy")
+    assert [w.category for w in raised] == [AccuracyWarning], [str(w.message) for w in raised]
+    assert raised[0].filename == __file__
+    assert "phi_y" in str(raised[0].message) and "(the same at 2 more of the branch's 3 points)" in str(raised[0].message)

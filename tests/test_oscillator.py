@@ -236,3 +236,49 @@ def test_time_response_with_a_cubic_spring_matches_the_hbm_off_the_fold():
     started = osc.time_response([frf.frequency_hz[k]], steps_per_period=1000, max_periods=400,
                                 initial_displacement=x[0], initial_velocity=v[0])
     assert started.converged[0] and started.amplitude[0] == pytest.approx(a_hbm, rel=1e-2)
+
+
+def test_negative_contact_dissipation_grows_the_aft_samples():
+    """A friction contact cannot give energy back over a period (bladedamp.response.physical_checks
+    has the argument), so a negative contact dissipation in a result is the AFT's sampling error.
+    Random oscillator 12 of test_random_designs.py (inclined contact, (0, 1, 2, 3)): with 256 AFT
+    samples per period its branch reaches the end with the contact dissipation down to -0.1 % of
+    the excitation work (-6.4e-5 of the contact's own energy scale, its work bound), which 16 x the
+    samples on the same coefficients resolve to >= 0: the result itself would report a negative
+    dissipation. Judged at the solve's own samples it fails the dissipation check (the AFT's
+    energy error), and the automatic samples grow until every point's contact dissipation is at
+    least -SAMPLING_FLOOR of its energy scale (the larger of the excitation work and the work
+    bound), as re-evaluated here with 16 x the samples, which also resolve it to >= 0 within
+    that floor."""
+    import sys
+    from pathlib import Path
+    sys.path.insert(0, str(Path(__file__).parent))
+    from test_random_designs import MAX_POINTS, oscillator_design
+
+    from bladedamp.response import SAMPLING_FLOOR
+
+    d = oscillator_design(12)
+    osc = FrictionOscillator(**d["params"])
+    f0, f1 = d["omega_start"] / (2 * np.pi), d["omega_end"] / (2 * np.pi)
+
+    def own_and_fine(r):
+        """(own, 16 x samples) contact dissipation per point relative to its energy scale."""
+        system = osc.hbm_system(r.basis.harmonics, r.basis.n_samples)
+        fine = osc.hbm_system(r.basis.harmonics, 16 * r.basis.n_samples)
+        e = osc.energy_balance(r)
+        bound = np.array([sum(system.element_work_bound(X.ravel(), w)) for X, w in zip(r.coefficients, r.omega)])
+        scale = np.maximum(np.abs(e[:, 0]), bound)
+        d_fine = np.array([sum(fine.element_dissipation(X.ravel(), w)) for X, w in zip(r.coefficients, r.omega)])
+        return e[:, 2] / scale, d_fine / scale, e[:, 2] / np.abs(e[:, 0])
+
+    coarse = osc.frequency_response(f0, f1, harmonics=(0, 1, 2, 3), n_samples=256, max_step=d["max_step"],
+                                    max_points=MAX_POINTS)
+    own, fine, of_work = own_and_fine(coarse)
+    assert coarse.reached_range_end and of_work.min() < -1e-4 and own.min() < -SAMPLING_FLOOR
+    assert fine.min() > -SAMPLING_FLOOR                      # the coefficients are fine: a sampling error
+    assert not coarse.success and "dissipation" in coarse.failed_checks
+    assert "the AFT's energy error" in coarse.failed_checks["dissipation"]
+    auto = osc.frequency_response(f0, f1, harmonics=(0, 1, 2, 3), max_step=d["max_step"], max_points=MAX_POINTS)
+    own, fine, _ = own_and_fine(auto)
+    assert auto.success and auto.basis.n_samples > 256 and "AFT samples per period raised" in auto.message
+    assert own.min() >= -SAMPLING_FLOOR and fine.min() >= -SAMPLING_FLOOR

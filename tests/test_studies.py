@@ -367,3 +367,23 @@ def test_liftoff_plot(liftoff_maps):
     import matplotlib
     matplotlib.use("Agg")
     assert liftoff_maps[0.07][1].plot() is not None
+
+
+def test_the_mass_grid_ends_are_the_bounds_and_warn_nothing():
+    """exp(log(1e-5)) is 9.999999999999997e-06: a grid built in log(mass) would try a damper
+    below its own lower bound (and below the plausible 1e-5 kg); its ends are the bounds."""
+    from bladedamp.studies.mass import log_mass_grid, with_mass
+    from bladedamp.validation import PlausibilityWarning
+
+    assert np.exp(np.log(1e-5)) < 1e-5                      # the rounding the grid must not pass on
+    loggrid, masses = log_mass_grid((1e-5, 2e-2))
+    assert masses[0] == 1e-5 and masses[-1] == 2e-2 and len(masses) == 15      # 4 per decade, 3.3 decades
+    np.testing.assert_allclose(np.log(masses), loggrid, rtol=4 * np.finfo(float).eps)   # exp, log: an ulp each
+    disk = reference_disk("cylinder")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", PlausibilityWarning)
+        for m in masses:
+            with_mass(disk, float(m))
+    with pytest.warns(PlausibilityWarning, match="damper mass = 1e-07 kg") as caught:
+        with_mass(disk, 1e-7)                                  # below: warned, at this line
+    assert caught[0].filename == __file__

@@ -21,7 +21,7 @@ from bladedamp.disk import TunedDisk
 from bladedamp.mistuned import MistunedDisk
 from bladedamp.reference import (DAMPER_RADIUS, EXCITATION_FX, PLATFORM_ANGLE, reference_contact,
                                  reference_damper)
-from bladedamp.timedomain import DiskTimeResponse, _drift_verdict, hbm_tip_at
+from bladedamp.timedomain import DiskTimeResponse, _drift_verdict, hbm_tip_at, map_convergence
 
 # The HBM harmonics of the validation: None is frequency_response's default ("auto", the
 # harmonics chosen to its tolerance). Forcing (1,) here must make the wedge test fail.
@@ -205,6 +205,66 @@ def test_drift_verdict():
     slow = base.copy()
     slow[:, 0, 4] = 1e-9 * p[:, 0, 0]                               # below 10 tol of the amplitude
     assert _drift_verdict(slow, scale, 1e-5) is None
+
+
+def test_map_convergence_bounds_the_residual_drift():
+    """The convergence of the period-to-period map: first harmonics approaching their limit as a
+    damped transient (geometric decay of the distance, with a period-2 ringing that never decays,
+    as the dampers on their contact springs, within the accepted fluctuation) converge, and the
+    residual drift it states bounds the last block mean's true distance from the limit; a
+    transient not yet decayed, a ringing beyond the accepted fluctuation, a motion that keeps
+    changing (random first harmonics, as a damper hopping) or moves steadily do not converge."""
+    p, tol, fluct = 800, 1e-3, 2e-4
+    k = np.arange(p)[:, None]
+    limit = np.array([1.0 + 0.5j, 0.2 - 0.1j])
+    ringing = 1e-4 * (-1.0) ** k
+    verdicts = []
+    for rate in (2e-3, 6e-3, 2e-2):                     # sigma T per period
+        h = limit + 0.3 * np.exp(-rate * k) * np.exp(0.05j * k) + ringing
+        converged, residual, q, L, _, _ = map_convergence(h, 1e-3, tol, fluct)
+        true = np.abs(h[-L:].mean(axis=0) - limit).max() / np.abs(limit).max()
+        assert L == p // 4 and true <= residual, (rate, true, residual)
+        verdicts.append(converged)
+    # 0.3 exp(-1.6) = 6 % of the transient left after 800 periods: not converged; exp(-16): converged
+    assert verdicts[0] is False and verdicts[2] is True
+    assert not map_convergence(h + 10 * ringing, 1e-3, tol, fluct).converged   # ringing 1e-3 > fluctuation_tol
+    rng = np.random.default_rng(3)
+    hopping = limit * (1 + 0.05 * rng.standard_normal((p, 1)))
+    assert not map_convergence(hopping, 1e-3, tol, fluct).converged
+    walking = limit * (1 + 1e-4 * k)
+    assert not map_convergence(walking, 1e-3, tol, fluct).converged
+    assert not map_convergence(h[:3], 1e-3, tol, fluct).converged      # no block to judge
+
+
+def test_a_lightly_damped_transient_is_periodic_not_unsettled():
+    """The stop check's "not settled" must mean no periodic motion. The 4-blade disk with the 1 g
+    cylinder at 101 Hz (blade damping ratio 1e-3: the transient from rest decays as
+    exp(-zeta omega_n t), 0.6 % per period, and beats): after 600 periods the first harmonics
+    still change by more than tol per period (the criterion of consecutive settled periods says
+    "not settled"), but the period-to-period map converges: status "periodic", its residual
+    drift stated, and the tip amplitudes (the mean of the last block) lie within that residual
+    drift of the motion a 1500-period run settles on (there by the strict criterion, whose own
+    remaining transient is at most tol / (1 - exp(-sigma T)) with its trend <= tol per period),
+    and within 2 % of the HBM (the case the verdict must accept). With too few periods for the map to converge, "not settled" with the residual drift."""
+    disk = small_disk(reference_damper("cylinder", 1e-3))
+    short = disk.time_response(101.0, max_periods=600)
+    long = disk.time_response(101.0, max_periods=1500)
+    print(short.message[0], long.message[0], sep="\n")
+    assert long.periodic[0] and long.periods[0] < 1500 and np.isnan(long.residual_drift[0])
+    assert short.periods[0] == 600 and short.settling[0] > 1e-5     # the old criterion: not settled
+    assert short.status[0] == "periodic" and "residual drift" in short.message[0]
+    drift = short.residual_drift[0]
+    assert 0 < drift <= 1e-3
+    sigma_t = short.decay_rate * 2 * np.pi / short.omega[0]
+    assert sigma_t == pytest.approx(1e-3 * 95.0 / 101.0 * 2 * np.pi, rel=1e-6)   # zeta omega_1 T
+    a_short, a_long = short.tip_amplitude[0].max(axis=0)[0], long.tip_amplitude[0].max(axis=0)[0]
+    assert abs(a_short - a_long) / a_long <= drift + 1e-5 / -np.expm1(-sigma_t)
+    # and the HBM ((0, 1, 2, 3), 0.036 % from (0, ..., 5) at the peak) agrees: measured 0.06 %
+    hbm = hbm_tip(disk, [101.0], (0, 1, 2, 3))[0, 0]
+    assert abs(a_short - hbm) / hbm < 0.02
+    early = disk.time_response(101.0, max_periods=300)
+    assert early.status[0] == "not settled" and "residual drift" in early.message[0]
+    assert early.residual_drift[0] > 1e-3
 
 
 @pytest.mark.parametrize("call,match", [

@@ -24,7 +24,7 @@ def cylinder_frf():
 
 @pytest.fixture(scope="module")
 def ods(cylinder_frf):
-    return mv.ods_scene(cylinder_frf, n_frames=N_FRAMES)
+    return mv.ods_scene(cylinder_frf, n_frames=N_FRAMES, contact_maps=True)
 
 
 def test_blade_deflection_matches_the_mode_shapes_at_the_known_points():
@@ -117,7 +117,7 @@ def test_static_html_is_standalone_and_starts_no_server(cylinder_frf, tmp_path):
     scene = mv.contact_map_scene(cylinder_frf, n_frames=4)
     path = scene.save_html(tmp_path / "map.html")
     html = open(path, encoding="utf-8").read()
-    assert "MeshCat.Viewer" in html and html.count("handle_command_bytearray") > 10
+    assert "MeshCat.Viewer" in html and html.count("fetch(\"data:application/octet-binary;base64,") > 10
     assert scene._window.server_proc is None
     shown = mv.show(cylinder_frf, path=tmp_path / "ods.html", n_frames=4)
     assert isinstance(shown, mv.Scene) and (tmp_path / "ods.html").stat().st_size > len(html) // 2
@@ -168,13 +168,13 @@ def test_browser_renders_the_scene_and_its_animation(cylinder_frf, tmp_path):
     if mv.chromium_executable() is None:
         pytest.skip("no chromium on this machine (.ci/run installs the Debian package)")
     empty = mv.Scene()
-    empty.vis["/Grid"].set_property("visible", False)
-    empty.vis["/Axes"].set_property("visible", False)
+    mv.plain_stage(empty.vis)                                      # the scenes' own stage, nothing on it
     shots = {}
+    # the whole sector in view (the close-up on a damper, the default, is checked in test_viz_contact.py)
     scenes = {"empty": empty,
-              "phase0": mv.ods_scene(cylinder_frf, animate=False, phase=0.5 * np.pi, n_frames=N_FRAMES),
-              "phase1": mv.ods_scene(cylinder_frf, animate=False, phase=1.5 * np.pi, n_frames=N_FRAMES)}
-    animated = mv.ods_scene(cylinder_frf, n_frames=N_FRAMES, period_s=2.0)
+              "phase0": mv.ods_scene(cylinder_frf, animate=False, phase=0.5 * np.pi, n_frames=N_FRAMES, view="whole"),
+              "phase1": mv.ods_scene(cylinder_frf, animate=False, phase=1.5 * np.pi, n_frames=N_FRAMES, view="whole")}
+    animated = mv.ods_scene(cylinder_frf, n_frames=N_FRAMES, period_s=2.0, view="whole")
     for name, scene in scenes.items():
         html = scene.save_html(tmp_path / f"{name}.html")
         shots[name] = _pixels(mv.screenshot(html, tmp_path / f"{name}.png", virtual_time_ms=2000))
@@ -201,7 +201,10 @@ def test_show_defaults_to_the_whole_disk_with_its_dampers_and_the_maps_beside_it
     assert info["layout"] == "disk" and len(info["blades"]) == n
     paths = scene.paths()
     assert all(f"/meshcat/bladedamp/dampers/damper_{k:02d}/body/mesh" in paths for k in range(n))
-    # the maps and their legend lie right of the blade tips' circle: they cross no blade
+    # the contact is painted on damper 0's faces, not drawn beside the disk (no maps by default)
+    assert list(info["paint"]["dampers"]) == [0] and not any("contact_map" in p for p in paths)
+    # asked for, the maps and their legend lie right of the blade tips' circle: they cross no blade
+    info = mv.show(cylinder_frf, n_frames=4, contact_maps=True).info
     r_tip = info["root_radius"] + bgeo.reference_blade_geometry().total_length
     x0 = info["map_origin"][0]
     assert x0 > r_tip

@@ -257,3 +257,40 @@ def test_mistuning_explorer_figure_matches_the_study_and_memoises():
     plt.close(fig)
     with pytest.raises(ValueError, match="pattern must be one of"):
         ex.figure("sorted")
+
+
+# ----- the saved still of an interactive figure ---------------------------------------------
+def test_interact_with_image_saves_the_first_figure_beside_the_widget():
+    """The displayed bundle holds the widget view and the PNG the callback showed at the
+    controls' initial values; the callback runs once, with those values."""
+    import io
+
+    pytest.importorskip("ipywidgets")
+    from IPython.core.interactiveshell import InteractiveShell
+    from IPython.display import Image, display
+    from IPython.utils.capture import capture_output
+    from ipywidgets import FloatSlider
+
+    InteractiveShell.instance()
+    calls = []
+
+    def callback(amplitude_mm=0.1):
+        calls.append(amplitude_mm)
+        fig, ax = plt.subplots(figsize=(2, 1))
+        ax.plot([0, amplitude_mm])
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png")
+        plt.close(fig)
+        display(Image(data=buf.getvalue(), format="png"))
+
+    with capture_output() as shown:
+        assert W.interact_with_image(callback, amplitude_mm=FloatSlider(value=0.3, min=0.1, max=1.0)) is None
+    assert calls == [0.3]
+    bundles = [out.data for out in shown.outputs if "application/vnd.jupyter.widget-view+json" in out.data]
+    assert len(bundles) == 1
+    png = bundles[0].get("image/png")
+    assert png is not None
+    import base64
+
+    drawn = base64.b64decode(png) if isinstance(png, str) else png
+    assert drawn[:8] == b"\x89PNG\r\n\x1a\n"

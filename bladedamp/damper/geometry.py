@@ -60,6 +60,20 @@ def contact_frame(normal: np.ndarray) -> np.ndarray:
     return np.array([xi, eta, normal])
 
 
+# Contact stiffness per unit contact length [N/m per m] a damper contact can have; a value
+# outside is refused (ValueError), not warned about: far outside, the model stops being a contact
+# and the continuation finds no end (a tangential stiffness of 1e-6 N/m^2, with the default
+# k_N / k_T, ran past 60 CPU s). Upper end: a line contact between steel bodies is about pi E*/4
+# per unit length over a logarithmic factor, E* = 1.15e11 Pa for steel on steel, so 1e10-1e11; a
+# stiffness two decades above E* is no contact (the normal and the tangential stiffness). Lower
+# end (normal stiffness only): the reference contact (k_T 1.7e7, k_N 2.1e7 N/m^2) is soft because
+# it lumps the platforms' local flexibility; at 1e5 N/m^2 the reference 1 g cylinder's
+# centrifugal preload at 100 Hz (m R Omega^2 = 39 N over l_C = 20 mm) would press it 2 cm into
+# the platform, ten times its radius. The tangential stiffness has no lower end: k_T -> 0 is the
+# frictionless limit of a contact (its normal springs stay), which the nonlinear modes use.
+CONTACT_STIFFNESS_PER_LENGTH_RANGE = (1.0e5, 1.0e13)       # N/m per m
+
+
 @dataclass(frozen=True)
 class ContactProperties:
     """Contact parameters shared by both contacts of a damper.
@@ -88,6 +102,18 @@ class ContactProperties:
         validation.nonnegative("friction_coefficient (mu)", self.friction_coefficient)
         validation.positive("tangential_stiffness_per_length", self.tangential_stiffness_per_length)
         validation.positive("normal_to_tangential_stiffness", self.normal_to_tangential_stiffness)
+        low, high = CONTACT_STIFFNESS_PER_LENGTH_RANGE
+        if self.tangential_stiffness_per_length > high:
+            raise ValueError(f"tangential_stiffness_per_length must be in (0, {high:g}] N/m per m of contact length "
+                             f"(got {self.tangential_stiffness_per_length!r}; a steel line contact is 1e10-1e11)")
+        normal = self.normal_to_tangential_stiffness * self.tangential_stiffness_per_length
+        if not low <= normal <= high:
+            raise ValueError(f"the normal contact stiffness per length, normal_to_tangential_stiffness x "
+                             f"tangential_stiffness_per_length = {self.normal_to_tangential_stiffness!r} x "
+                             f"{self.tangential_stiffness_per_length!r} = {normal:.3g} N/m per m, must be in the "
+                             f"plausible range [{low:g}, {high:g}] N/m per m of contact length (a steel line contact "
+                             f"is 1e10-1e11; softer values lump the platforms' flexibility; below {low:g} the "
+                             f"centrifugal preload presses a damper centimetres into its platform)")
         validation.in_range("roughness_exponent", self.roughness_exponent, 1.0, 5.0)
         validation.positive("roughness_reference_load", self.roughness_reference_load)
         validation.integer("points_along_length", self.points_along_length, minimum=1)
@@ -187,6 +213,31 @@ DAMPER_MASS_RANGE = (1.0e-5, 0.1)        # kg
 DAMPER_LENGTH_RANGE = (1.0e-4, 0.1)      # m
 
 
+# The lightest damper modelled [kg]; 0 means no damper. A damper's centrifugal preload
+# m R Omega^2 (every force its contacts can carry) and its inertia vanish with its mass, so the
+# limit of a vanishing mass is the disk without a damper (mass = 0), which the model gives
+# exactly. Approaching that limit the contact forces sink below the solver's resolution (the
+# default FRF of the reference disk with 1e-9 kg kept no point: Newton did not converge at the
+# start), while the answer has long reached the limit: on the reference cylinder at EO 1
+# (harmonics (1,)) 1e-6, 1e-7 and 1e-8 kg give peaks 0.13 %, 0.013 % and 0.0012 % below the
+# damper-free 1.6996 mm, in proportion to the mass; the reference wedge (harmonics (0, 1))
+# 0.49 % and 0.059 % at 1e-6 and 1e-7 kg. 1e-7 kg (0.1 mg), two decades below
+# DAMPER_MASS_RANGE, is within 0.02 % (cylinder) and 0.1 % (wedge) of the limit there. (Without
+# the static harmonic, the paper's (1,), the wedge's mean position is held at its seating, and a
+# vanishing wedge still squeezes between the platforms: 9 % below the limit at 1e-7 kg, which its
+# harmonic error estimate, 10 %, reports.)
+MIN_DAMPER_MASS = 1.0e-7
+
+
+def _check_mass(mass: float) -> None:
+    """ValueError unless ``mass`` [kg] is 0 (no damper) or at least MIN_DAMPER_MASS."""
+    validation.nonnegative("damper mass", mass)
+    if 0 < mass < MIN_DAMPER_MASS:
+        raise ValueError(f"damper mass must be 0 (no damper) or in [{MIN_DAMPER_MASS:g}, inf) kg (got {mass!r}): the "
+                         "preload of a lighter damper, and every force its contacts carry, vanish with its mass; its "
+                         "limit is the disk without a damper, mass = 0")
+
+
 def _check_plausible_damper(mass: float, lengths: dict) -> None:
     validation.plausible("damper mass", mass, *DAMPER_MASS_RANGE, "kg", "underplatform dampers weigh 0.01 g to 100 g")
     for name, value in lengths.items():
@@ -211,7 +262,7 @@ class CylinderDamper:
     contact: ContactProperties = field(default_factory=ContactProperties)
 
     def __post_init__(self):
-        validation.nonnegative("damper mass", self.mass)
+        _check_mass(self.mass)
         validation.positive("cylinder radius", self.radius)
         validation.positive("damper length l_C", self.length)
         _check_plausible_damper(self.mass, {"cylinder radius": self.radius, "damper length l_C": self.length})
@@ -257,7 +308,7 @@ class WedgeDamper:
     kind = "wedge"
 
     def __post_init__(self):
-        validation.nonnegative("damper mass", self.mass)
+        _check_mass(self.mass)
         if self.contact_height is None:
             raise ValueError("contact_height h_C of a wedge damper must be given, in (0, inf) m")
         validation.positive("contact_height h_C", self.contact_height)

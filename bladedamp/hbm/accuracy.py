@@ -219,6 +219,13 @@ def converged_response(model, solve, harmonics="auto", tolerance: float = HARMON
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", AccuracyWarning)
                 response = solve(tuple(H))
+                if response.stopped_by and best is not None and not len(response.omega):
+                    # stopped before its first point (a budget that ran out): the branch of the
+                    # poorer set is kept, its status saying the search was stopped
+                    kept = annotate(best[0], best[1], tolerance)
+                    return dataclasses.replace(kept, success=False, stopped_by=response.stopped_by,
+                                               message=f"{kept.message}; harmonics {tuple(H)} not computed: "
+                                                       f"{response.stopped_by}")
                 if response.stopped_by:
                     return response           # stopped as the caller asked: no estimate, no richer set
                 check = harmonic_error(model, response, n_points=n_points) if len(response.omega) else None

@@ -15,6 +15,7 @@ and the same factorisation gives the corrector's update and the next tangent.
 from __future__ import annotations
 
 import copy
+import time
 import warnings
 from dataclasses import dataclass, field
 
@@ -118,6 +119,54 @@ def _det_sign(A, solve=None) -> int:
 # cylinder on the beam blade's own frequencies, (0, ..., 5), came back to a point 9 steps
 # earlier at 95.39 Hz and then reached the end), a loop returns at every step
 MAX_REVISITS = 200
+
+
+# The default budget of one analysis (a model's frequency_response): CPU seconds
+# (time.process_time, every thread of the process) and continuation points kept, summed over
+# every branch it computes (both ends, retries, finer samples, richer harmonic sets). A budget is
+# a guard against a run without end, not a cost target. CPU: random tuned disks that reach their
+# end took up to 108 CPU s with the default frequency_response (median 1.4 s); 600 s leaves a
+# margin of more than five. Points: the per-branch cap max_points (5000, a quarter for the
+# retry) times the branches of the automatic choices (at most 5 harmonic sets x 4 sample counts
+# x 4 branches) stays below 10^6, so the default point budget binds only where max_points is
+# raised; a smaller one caps an analysis by its points.
+DEFAULT_CPU_BUDGET_S = 600.0
+DEFAULT_POINT_BUDGET = 1_000_000
+
+
+class Budget:
+    """What one analysis may spend: ``cpu_seconds`` of CPU time (``time.process_time``, counted
+    from when the budget is made) and ``max_points`` continuation points kept, over every
+    :func:`continuation` it is passed to. :meth:`spend` counts a point and says when the budget
+    has run out; the continuation then ends its branch there, keeping its points, with the
+    message as ``Branch.stopped_by`` (a terminal stop: no retry)."""
+
+    def __init__(self, cpu_seconds: float = DEFAULT_CPU_BUDGET_S, max_points: int = DEFAULT_POINT_BUDGET):
+        self.cpu_seconds = validation.positive("cpu_budget_s (CPU seconds)", cpu_seconds)
+        self.max_points = validation.integer("point_budget (continuation points)", max_points, minimum=1)
+        self.started = time.process_time()
+        self.points = 0
+
+    def cpu_used(self) -> float:
+        """CPU seconds spent since the budget was made."""
+        return time.process_time() - self.started
+
+    def exhausted(self, omega: float) -> str:
+        """'' while the budget lasts; otherwise what ran out, at the angular frequency ``omega``
+        [rad/s] (reported in Hz), starting with "budget" (the word by which
+        :func:`bladedamp.response.response_status` tells it from a caller's stop): "budget: 300
+        CPU s ran out at 97.3 Hz" or "budget: 5000 continuation points ran out at 97.3 Hz"."""
+        where = f"{omega / (2 * np.pi):.6g} Hz"
+        if self.points >= self.max_points:
+            return f"budget: {self.max_points} continuation points ran out at {where}"
+        if self.cpu_used() > self.cpu_seconds:
+            return f"budget: {self.cpu_seconds:g} CPU s ran out at {where}"
+        return ""
+
+    def spend(self, omega: float) -> str:
+        """Count one point kept at ``omega`` [rad/s]; :meth:`exhausted` after it."""
+        self.points += 1
+        return self.exhausted(omega)
 
 
 class ConvergenceWarning(UserWarning):
@@ -250,7 +299,7 @@ RETRY_POINTS_FRACTION = 4
 def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=None,
                  step=None, max_step=None, min_step=None, max_points=5000, tol=1e-10,
                  max_corrector=12, target_iterations=5, factorize=lu_factorize, leave_margin=0.0,
-                 start_at_end=None, retry_x_scale=None, stop_when=None, chord=False):
+                 start_at_end=None, retry_x_scale=None, stop_when=None, chord=False, budget=None):
     """Pseudo-arclength continuation of R(x, omega) = 0 from ``omega_start`` to ``omega_end``.
 
     Every branch it returns keeps the contract of :func:`branch_checks` (``Branch.checks``):
@@ -306,6 +355,13 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         and evaluates a new one where they do not. The points meet the same tolerance; the
         next tangent comes from the last factorisation (at an earlier iterate of the same
         corrector). ``fun`` must then accept a third argument ``jacobian``.
+    budget : :class:`Budget` or None (default: no budget beyond ``max_points`` per branch): the
+        CPU time and points the caller's whole analysis may spend, shared by every branch it
+        computes. Checked at every point kept (the first included); where it has run out the
+        branch ends there, unsuccessful, its points kept, with what ran out and where as
+        ``Branch.stopped_by`` and in the message (a terminal event like ``stop_when``: no branch
+        from the end, no retry). A branch started after the budget ran out keeps no point. The
+        point that lands on ``omega_end`` completes the branch whatever the budget.
 
     The steps are the methods of :class:`ArcLengthContinuation`, in the order they are tried
     from each point: the predictor-corrector along the tangent with shorter steps
@@ -328,8 +384,10 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         raise ValueError("x0 (initial guess) must be finite")
     if stop_when is not None and not callable(stop_when):
         raise ValueError(f"stop_when must be a callable (x, omega) -> str or None, or None (got {stop_when!r})")
+    if budget is not None and not isinstance(budget, Budget):
+        raise ValueError(f"budget must be a bladedamp.hbm.continuation.Budget or None (got {budget!r})")
     options = (step, max_step, min_step, max_points, tol, max_corrector, target_iterations, factorize, stop_when,
-               bool(chord))
+               bool(chord), budget)
     if start_at_end is None and retry_x_scale is None:
         return ArcLengthContinuation(fun, x0, omega_start, omega_end, x_scale, residual_scale, *options).run()
     with warnings.catch_warnings(record=True) as first_warnings:
@@ -341,7 +399,7 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
         with warnings.catch_warnings(record=True) as retry_warnings:
             warnings.simplefilter("always", ConvergenceWarning)
             retry_options = (step, max_step, min_step, max(2, max_points // RETRY_POINTS_FRACTION), tol, max_corrector,
-                             target_iterations, factorize, stop_when, bool(chord))
+                             target_iterations, factorize, stop_when, bool(chord), budget)
             retried = _both_ends(fun, x0, omega_start, omega_end, retry_x_scale, residual_scale, retry_options,
                                  start_at_end)
             if retried.success:
@@ -415,8 +473,10 @@ class ArcLengthContinuation:
     range's width: ``y = (x / x_scale, omega / w_scale)``."""
 
     def __init__(self, fun, x0, omega_start, omega_end, x_scale, residual_scale, step, max_step, min_step,
-                 max_points, tol, max_corrector, target_iterations, factorize, stop_when=None, chord=False):
+                 max_points, tol, max_corrector, target_iterations, factorize, stop_when=None, chord=False,
+                 budget=None):
         self.fun, self.factorize, self.stop_when, self.chord = fun, factorize, stop_when, chord
+        self.budget = budget
         self.omega_start, self.omega_end = omega_start, omega_end
         self.step, self.max_step, self.min_step, self.max_points = step, max_step, min_step, max_points
         self.tol, self.max_corrector, self.target_iterations = tol, max_corrector, target_iterations
@@ -850,17 +910,27 @@ class ArcLengthContinuation:
         return Branch(Y[:, n], Y[:, :n], np.array(self.its, dtype=int), success, message, turning, checks,
                       self.stopped_by)
 
-    def stop_event(self) -> str:
-        """``stop_when`` at the last point kept ('' without it); records it as ``stopped_by``."""
-        if self.stop_when is None or not self.points:
+    def stop_event(self, at_end: bool = False) -> str:
+        """``stop_when`` at the last point kept, then the budget (which it charges one point; it
+        does not stop the point at the end of the range, ``at_end``); '' if neither stops the
+        branch. Records it as ``stopped_by``."""
+        if not self.points:
             return ""
         last = self.points[-1]
-        self.stopped_by = str(self.stop_when(last[:self.n].copy(), float(last[self.n])) or "")
+        if self.stop_when is not None:
+            self.stopped_by = str(self.stop_when(last[:self.n].copy(), float(last[self.n])) or "")
+        if not self.stopped_by and self.budget is not None:
+            spent = self.budget.spend(float(last[self.n]))
+            self.stopped_by = "" if at_end else spent
         return self.stopped_by
 
     # ----- the run -----------------------------------------------------------------------
     def run(self) -> Branch:
         n = self.n
+        ran_out = self.budget.exhausted(self.omega_start) if self.budget is not None else ""
+        if ran_out:
+            self.stopped_by = ran_out
+            return self.finish(False, f"not started at omega = {self.omega_start:.6g} rad/s: {ran_out}")
         first = newton(self.fun, self.x0, self.omega_start, self.x_scale, self.residual_scale, tol=self.tol,
                        factorize=self.factorize)
         if not first.converged:
@@ -930,7 +1000,7 @@ class ArcLengthContinuation:
                     _warn(message, 3)
                     break
                 success, message = True, "reached the end of the frequency range"
-                if self.stop_event():
+                if self.stop_event(at_end=True):
                     success, message = False, f"stopped at omega_end = {self.omega_end:.6g} rad/s: {self.stopped_by}"
                 break
             tangent_prev = None if tangent is None else tangent * self.scale()

@@ -295,6 +295,28 @@ def _disk_sliders(arrays, X, basis):
     return sliders, amplitude
 
 
+def orbit_state(arrays, X, basis, omega: float, dt: float):
+    """(z (2 N + 2 P,), the tangential point motion's amplitude [m]) the state of the
+    central-difference integration (:func:`bladedamp.timedomain.disk_period`, time step ``dt``
+    [s]) on the periodic orbit of the full assembly's harmonic solution X (C, N) in ``basis``
+    (with the static harmonic) at ``omega`` [rad/s], at t = 0: z = (x(0), x(-dt), slider
+    positions (P, 2) row-major), x from the Fourier series and every friction slider from the
+    contact's periodic return map over one period of that motion (the AFT's, see the module
+    docstring); ``arrays`` the assembly's :class:`~bladedamp.timedomain.AssemblyArrays`. The
+    start of the monodromy's period map and of a time integration that tests the orbit
+    (``disk_time_response(..., start_coefficients=...)``)."""
+    sliders, slider_amp = _disk_sliders(arrays, X, basis)
+    z = np.concatenate([_evaluate(X, basis, 0.0), _evaluate(X, basis, -omega * dt), sliders.ravel()])
+    return z, slider_amp
+
+
+def full_assembly_coefficients(model, coefficients, basis) -> np.ndarray:
+    """:func:`assembly_coefficients` of ``model`` (a TunedDisk or a full-assembly MistunedDisk)
+    on its full assembly (``MistunedDisk.from_tuned`` for a TunedDisk): (C, N)."""
+    full, _ = _disk_assembly(model)
+    return assembly_coefficients(model, full, coefficients, basis)
+
+
 class DiskMonodromy(NamedTuple):
     """The monodromy of a bladed disk's HBM orbit (:func:`disk_monodromy`); m = 2 N + 2 P."""
     matrix: np.ndarray               # (m, m) d P(z) / d z by central differences, state (x_0, x_-1, s)
@@ -336,8 +358,7 @@ def disk_monodromy(model, coefficients, basis, omega: float, steps: int | None =
         raise ValueError(f"steps (per period) must be >= {limit} for the explicit scheme at {omega / (2 * np.pi):.6g} Hz "
                          f"(omega_max = {w_max:.4g} rad/s; got {steps})")
     dt = T / steps
-    sliders, slider_amp = _disk_sliders(arrays, X, basis)
-    z = np.concatenate([_evaluate(X, basis, 0.0), _evaluate(X, basis, -omega * dt), sliders.ravel()])
+    z, slider_amp = orbit_state(arrays, X, basis, omega, dt)
     # the FD step of each component: FD_STEP x its kind's vibration amplitude on the orbit
     samples = basis.synthesis @ X                                   # (T, N)
     amp = np.abs(samples - samples.mean(axis=0)).max(axis=0)

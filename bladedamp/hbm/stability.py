@@ -92,6 +92,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -508,14 +509,23 @@ def with_stability(model, response, method: str = "auto"):
     ``floquet_exponents``, ``bifurcations`` and ``stability_method`` filled in
     (:func:`branch_stability` on the model's harmonic balance of the response's basis).
     ``bifurcations`` holds the stability changes by kind and the branch points; the time spent
-    is in ``bifurcations["seconds"]``."""
+    is in ``bifurcations["seconds"]``. A warning raised at several points of the branch (the
+    monodromy's AccuracyWarning where the HBM state is not a periodic orbit) is raised once, at
+    the caller's line, the first point's message with the number of points that raised it."""
     if not len(response.omega):
         return response
     basis = response.basis
     system = model.hbm_system(basis.harmonics, basis.n_samples)
     w = response.omega
     scales = model.unknown_scales(system, float(w.min()), float(w.max()))
-    st = branch_stability(system, response.coefficients, w, scales, method=method, model=model)
+    with warnings.catch_warnings(record=True) as raised:
+        st = branch_stability(system, response.coefficients, w, scales, method=method, model=model)
+    first = {}
+    for caught in raised:
+        first.setdefault(caught.category, [caught.message, 0])[1] += 1
+    for category, (message, count) in first.items():
+        more = f" (the same at {count - 1} more of the branch's {len(w)} points)" if count > 1 else ""
+        warnings.warn(f"{message}{more}", category, stacklevel=2)
     bifurcations = {kind: [int(i) for i, k in zip(st.changes, st.kinds) if k == kind] for kind in set(st.kinds)}
     bifurcations["branch point"] = [int(i) for i in st.branch_points]
     bifurcations["seconds"] = st.seconds

@@ -37,7 +37,7 @@ from scipy.optimize import minimize_scalar
 
 from .. import validation
 from ..io import Saveable
-from .mass import GRID_PER_DECADE, peak_response, with_mass
+from .mass import GRID_PER_DECADE, log_mass_grid, peak_response, with_mass
 
 
 @dataclass
@@ -101,8 +101,12 @@ class BackboneDesign(Saveable):
         the level [N] (right). ``axes``: a pair of axes (a new figure if None); returns the pair."""
         import matplotlib.pyplot as plt
 
+        from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+        from ..plotting import place_legend
+
         if axes is None:
-            _, axes = plt.subplots(1, 2, figsize=(11, 4))
+            _, axes = plt.subplots(1, 2, figsize=(11, 4), constrained_layout=True)
         ax, ax2 = axes
         for j, level in enumerate(self.excitation_levels):
             ok = np.isfinite(self.reduction[:, j])
@@ -112,11 +116,15 @@ class BackboneDesign(Saveable):
         ax.set_ylabel("reduction of the resonance tip amplitude [%]")
         ax.set_title(f"{self.kind}: peak by single nonlinear mode synthesis", fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
         ax2.loglog(self.excitation_levels, 1e3 * self.optimal_mass, "o-")
         ax2.set_xlabel("excitation level [N]")
         ax2.set_ylabel("optimal damper mass [g]")
         ax2.grid(True, which="both", alpha=0.3)
+        for axis in (ax.xaxis, ax2.xaxis, ax2.yaxis):      # plain labels at 1, 2, 5 x 10^k, none between
+            axis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+            axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+            axis.set_minor_formatter(NullFormatter())
+        place_legend(ax, fontsize=8)                        # clear of every point (after the layout)
         return axes
 
 
@@ -251,9 +259,8 @@ def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid
             resolved[m] |= set(todo)
         return peaks[m]
 
-    n = max(5, int(np.ceil(grid_per_decade * np.log10(hi / lo))) + 1)
-    loggrid = np.linspace(np.log(lo), np.log(hi), n)
-    grid = np.exp(loggrid)
+    loggrid, grid = log_mass_grid((lo, hi), grid_per_decade)
+    n = len(grid)
     grid_vals = np.array([evaluate(m) for m in grid])              # (n, l)
 
     with warnings.catch_warnings():
@@ -271,7 +278,7 @@ def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid
             continue
         i = int(np.nanargmin(col))
         a, b = loggrid[max(i - 1, 0)], loggrid[min(i + 1, n - 1)]
-        brackets[j] = np.exp([a, b])
+        brackets[j] = grid[max(i - 1, 0)], grid[min(i + 1, n - 1)]
         fail = 10 * undamped[j]
 
         def objective(logm, j=j, fail=fail):

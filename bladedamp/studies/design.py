@@ -31,6 +31,7 @@ from ..damper.kinetics import seat
 from ..disk import TunedDisk
 from ..io import Saveable
 from ..plotting import place_legend, plain_log_ticks, reference_level
+from ..progress import progress_callback
 from .parallel import parallel_map
 from .mass import optimal_mass, peak_response, with_mass
 
@@ -145,7 +146,7 @@ def engine_order_sweep(disk: TunedDisk, engine_orders=range(0, 9), mass_bounds=(
     Parameters
     ----------
     disk : TunedDisk with a damper (its mass is the one thing not used: it is optimised)
-    engine_orders : EOs in 0..n/2 (non-empty)
+    engine_orders : EOs >= 0 (non-empty; above n/2 the backward waves, :func:`bladedamp.disk.nodal_diameter`)
     mass_bounds : (low, high) [kg], 0 < low < high
     rotor_speed_eo0_hz : rotor speed at EO = 0 [Hz] (> 0) if the disk has none; otherwise
         Omega_R = Omega_E / EO (or the disk's fixed rotor speed)
@@ -153,7 +154,8 @@ def engine_order_sweep(disk: TunedDisk, engine_orders=range(0, 9), mass_bounds=(
         the peak sits at an end
     xatol : tolerance of the optimiser in log(mass)
     harmonics : of every peak search (default the paper's (1,))
-    progress : optional callable(done, total)
+    progress : True (a progress bar, tqdm.auto: a widget in Jupyter, a bar in a terminal), False / None (none) or a callable
+        (done, total) called as the engine orders finish
     processes : worker processes over the engine orders (None: every core)
     known : {EO: MassOptimum} optima already found by :func:`optimal_mass` for this disk at those
         EOs with the same bounds, range, ``xatol`` and harmonics: used as given, not recomputed
@@ -169,17 +171,17 @@ def engine_order_sweeps(disks, engine_orders=range(0, 9), mass_bounds=(1e-5, 2e-
     (disk, EO) optimisation one case of a single pool of ``processes`` workers (the costly
     high EOs first, so that no worker is left with a long case at the end). ``known``: one
     {EO: MassOptimum} (or None) per disk. Returns one EngineOrderSweep per disk."""
+    progress = progress_callback(progress, "engine orders")
     disks = list(disks)
     if not disks:
         raise ValueError("disks must be a non-empty sequence of TunedDisk with a damper")
     for disk in disks:
         _check_disk(disk)
-    n_max = min(disk.n_blades for disk in disks) // 2
     eos = np.atleast_1d(np.asarray(list(engine_orders) if not np.isscalar(engine_orders) else [engine_orders]))
     if eos.size == 0:
-        raise ValueError(f"engine_orders must be a non-empty range of integers in [0, {n_max}]")
+        raise ValueError("engine_orders must be a non-empty range of integers >= 0")
     for eo in eos:
-        validation.integer("engine_orders", eo, minimum=0, maximum=n_max)
+        validation.integer("engine_orders", eo, minimum=0)
     bounds = _check_mass_bounds(mass_bounds)
     validation.positive("rotor_speed_eo0_hz", rotor_speed_eo0_hz)
     f_range = _check_f_range(f_range_hz)
@@ -320,10 +322,12 @@ def platform_angle_study(disk: TunedDisk, gamma_right_deg, gamma_left_deg: float
     mass_bounds : (low, high) [kg] of the mass optimisation, 0 < low < high
     optimise : False skips the mass optimisation (optimal_* are NaN)
     harmonics : of every peak search (default the paper's (1,))
-    progress : optional callable(done, total); processes : worker processes (None: every core)
+    progress : True (a progress bar, tqdm.auto: a widget in Jupyter, a bar in a terminal), False / None (none) or a callable
+        (done, total); processes : worker processes (None: every core)
     known : {gamma_R [deg]: (peak at ``fixed_mass`` [m], MassOptimum)} already found for some of
         the angles (same disk, bounds, range, ``xatol``, harmonics): used as given, not recomputed
     """
+    progress = progress_callback(progress, "platform angles")
     _check_disk(disk)
     gl = float(np.degrees(disk.gamma_left)) if gamma_left_deg is None else gamma_left_deg
     fixed_mass = disk.damper.mass if fixed_mass is None else fixed_mass
@@ -445,6 +449,8 @@ class LiftoffMap(Saveable):
     static_approach : (2, P) a_static [m]
     normal_amplitude : (2, P) |w_zeta,1| [m]
     peak_frequency_hz : [Hz]; peak_amplitude : [m]; n_samples : time samples per period of the AFT
+    harmonic_error : the one-harmonic response's harmonic error estimate at its peak [-] (relative
+        change of the tip amplitude with the static term and more harmonics; NaN if not estimated)
     """
 
     xi_star: np.ndarray
@@ -457,6 +463,7 @@ class LiftoffMap(Saveable):
     peak_frequency_hz: float
     peak_amplitude: float
     n_samples: int
+    harmonic_error: float = float("nan")
 
     @property
     def lifts_off(self) -> np.ndarray:
@@ -503,7 +510,8 @@ def wedge_liftoff_map(disk: TunedDisk, f_range_hz=(90.0, 105.0)) -> LiftoffMap:
     min_a = a_t.min(axis=0)
     xi_s, eta_s = geometry.patches[0].normalised_coordinates
     return LiftoffMap(xi_s, eta_s, amplitude / a_static, (a_static - min_a) / a_static, min_a, a_static,
-                      amplitude, float(r.frequency_hz[i]), float(r.tip_amplitude[i, 0]), basis.n_samples)
+                      amplitude, float(r.frequency_hz[i]), float(r.tip_amplitude[i, 0]), basis.n_samples,
+                      float(r.harmonic_error))
 
 
 # ---------------------------------------------------------------------------------------
@@ -583,8 +591,10 @@ def design_map(disk: TunedDisk, masses, gamma_right_deg, contact_height: float |
 
     masses [kg] (> 0, non-empty), gamma_right_deg [deg] in (0, 90) (non-empty), contact_height [m]
     (wedge only; default the disk's), gamma_left_deg [deg] (default the disk's). Grid points
-    whose response fails are NaN (never a number that was not solved).
+    whose response fails are NaN (never a number that was not solved). ``progress``: True (a progress bar, tqdm.auto: a widget in Jupyter, a bar in a terminal), False / None (none) or a callable
+    (done, total).
     """
+    progress = progress_callback(progress, "design map")
     _check_disk(disk)
     masses = np.atleast_1d(np.asarray(masses, dtype=float))
     gr = np.atleast_1d(np.asarray(gamma_right_deg, dtype=float))
@@ -622,8 +632,10 @@ def liftoff_onset(disk: TunedDisk, contact_heights, forces, f_range_hz=(90.0, 10
     excitation F_x [N] (the other excitation components stay the disk's).
 
     Returns {'contact_height_mm': [...], 'force_n': [...], 'max_ratio': [[...]] (heights x forces),
-    'mass_g'}; r > 1 means some point separates during the cycle.
+    'mass_g'}; r > 1 means some point separates during the cycle. ``progress``: True (a progress bar, tqdm.auto: a widget in Jupyter, a bar in a terminal), False / None (none) or a callable
+    (done, total).
     """
+    progress = progress_callback(progress, "lift-off onset")
     _check_disk(disk)
     if disk.damper.kind != "wedge":
         raise ValueError(f"liftoff_onset needs a wedge damper (the disk's is a {disk.damper.kind})")

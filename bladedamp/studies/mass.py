@@ -12,6 +12,7 @@ from .. import palette, validation
 from ..disk import TunedDisk
 from ..io import Saveable
 from ..plotting import place_legend, plain_log_ticks
+from ..progress import progress_callback
 from ..response import refined_peak
 
 
@@ -173,7 +174,9 @@ def robust_peak(disk: TunedDisk, f_range_hz=(90.0, 105.0), harmonics=(1,), direc
         except IncompleteResponse as exc:
             messages.append(f"{options}: {exc}")
             bound = np.fmax(bound, exc.lower_bound)
-            if exc.response is not None and exc.response.stopped_by:
+            # stopped by stop_above (its amplitude passed the bound), not by the budget
+            r = exc.response
+            if r is not None and r.stopped_by and len(r.omega) and r.tip_amplitude[:, direction].max() > stop_above:
                 return PeakEvaluation(False, np.nan, np.nan, float(bound), f"stopped above the bound: {exc}", runs,
                                       stopped_above=True)
             r = exc.response
@@ -268,8 +271,11 @@ def mass_sweep(disk: TunedDisk, masses, f_range_hz=(90.0, 105.0), harmonics=(1,)
                processes: int | None = 1) -> MassSweep:
     """Peak tip amplitude for each damper mass in ``masses`` [kg] (each > 0).
 
-    ``processes``: worker processes over the masses (None: every core)."""
+    ``processes``: worker processes over the masses (None: every core); ``progress``: True (a progress bar, tqdm.auto: a widget in Jupyter, a bar in a terminal), False / None (none) or a callable
+    (done, total)."""
     from .parallel import parallel_map
+
+    progress = progress_callback(progress, "mass sweep")
 
     masses = np.atleast_1d(np.asarray(masses, dtype=float))
     if masses.size == 0:
@@ -333,6 +339,19 @@ GRID_PER_DECADE = 4   # bracketing grid density; the narrowest valley measured (
                       # falls from 0.54 to 0.06 mm between 5 and 7.9 g, i.e. over 0.2 decade
 
 
+def log_mass_grid(bounds, grid_per_decade: float = GRID_PER_DECADE):
+    """The bracketing grid of a mass optimisation over ``bounds`` = (low, high) [kg]:
+    n = max(5, ceil(grid_per_decade * log10(high / low)) + 1) points evenly spaced in log(mass).
+    Returns (log masses (n,), masses (n,) [kg]); the masses' ends are the bounds exactly
+    (exp(log(1e-5)) is 9.999999999999997e-06 in floating point, below a bound of 1e-5 kg)."""
+    lo, hi = bounds
+    n = max(5, int(np.ceil(grid_per_decade * np.log10(hi / lo))) + 1)
+    loggrid = np.linspace(np.log(lo), np.log(hi), n)
+    masses = np.clip(np.exp(loggrid), lo, hi)
+    masses[0], masses[-1] = lo, hi
+    return loggrid, masses
+
+
 def _robust_peak_case(case):
     disk, f_range, harmonics, attempts, downward, give_up_above, stop_above = case
     return robust_peak(disk, f_range, harmonics, attempts=attempts, downward=downward, give_up_above=give_up_above,
@@ -383,12 +402,15 @@ def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0),
     interval around the best grid point. Each mass is evaluated by :func:`robust_peak`
     (retries with a finer continuation and a downward sweep); masses that still fail are listed
     in the result with a lower bound of their peak, and ``success`` says whether they could
-    hide a better optimum. ``processes``: worker processes over the grid (None: every core).
+    hide a better optimum. ``processes``: worker processes over the grid (None: every core);
+    ``progress``: True (a progress bar, tqdm.auto: a widget in Jupyter, a bar in a terminal), False / None (none) or a callable (done, total) over the grid.
     ``complete_grid``: afterwards, also solve the grid masses whose branch was stopped above the
     best peak (branch and bound), so ``grid_peak_amplitude`` is the whole curve around the
     optimum (for a figure; it costs those responses, and does not change the optimum).
     """
     from .parallel import parallel_map, workers
+
+    progress = progress_callback(progress, "mass grid")
 
     lo, hi = validation.interval("mass bounds", bounds, "kg")
     validation.positive("xatol", xatol)
@@ -403,8 +425,15 @@ def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0),
     def best_so_far():
         return min((ev.peak_amplitude for ev in evaluations.values() if ev.success), default=np.inf)
 
+    loggrid, grid_m = log_mass_grid((lo, hi), grid_per_decade)
+    n = len(loggrid)
+
+    def mass_of(logm):          # the grid's own masses at its points (its ends: the bounds exactly)
+        at = np.flatnonzero(loggrid == logm)
+        return float(grid_m[at[0]]) if at.size else float(np.exp(logm))
+
     def fun(logm):
-        m = float(np.exp(logm))
+        m = mass_of(logm)
         return record(m, robust_peak(with_mass(disk, m), f_range_hz, harmonics, give_up_above=best_so_far()))
 
     def evaluate_grid(loggrid):
@@ -412,7 +441,7 @@ def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0),
         # are workers, each branch stopped once it is above the best peak found before it (that
         # mass cannot be the optimum: branch and bound); then the retries of those that failed,
         # except where a partial branch is already above the best grid peak (no optimum there)
-        masses = [float(m) for m in np.exp(loggrid)]
+        masses = [mass_of(x) for x in loggrid]
         wave = workers(processes, len(masses))
         order = masses[::-1]
         for k in range(0, len(order), wave):
@@ -430,10 +459,7 @@ def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0),
             record(m, ev)
         return [evaluations[m].peak_amplitude if evaluations[m].success else np.nan for m in masses]
 
-    n = max(5, int(np.ceil(grid_per_decade * np.log10(hi / lo))) + 1)
-    loggrid = np.linspace(np.log(lo), np.log(hi), n)
     logm, peak, _, (a, b) = bracket_minimum(fun, loggrid, xatol, 10 * undamped, evaluate_grid=evaluate_grid)
-    grid_m = np.exp(loggrid)
     if complete_grid and np.isfinite(logm):
         rest = [float(m) for m in grid_m if evaluations[float(m)].stopped_above]
         cases = [(with_mass(disk, m), f_range_hz, harmonics, ROBUST_ATTEMPTS, True, np.inf, np.inf) for m in rest]
@@ -447,11 +473,11 @@ def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0),
     msgs = tuple(evaluations[m].message for m in failed)
     if not np.isfinite(logm):
         raise RuntimeError(f"no damper mass in {bounds} kg gave a computable response: " + msgs[0])
-    best = float(np.exp(logm))
+    best = mass_of(logm)
     open_ = [m for m, lb in zip(failed, bounds_f) if not lb > peak]
     where = "at a bound of the search" if logm in (loggrid[0], loggrid[-1]) else "interior"
     text = (f"optimum {1e3 * best:.4g} g ({where}), peak {1e3 * peak:.4g} mm, from a {n}-point log grid and a "
-            f"bounded search in {1e3 * np.exp(a):.4g}-{1e3 * np.exp(b):.4g} g")
+            f"bounded search in {1e3 * mass_of(a):.4g}-{1e3 * mass_of(b):.4g} g")
     if stopped:
         text += f"; {len(stopped)} grid mass(es) stopped once above the best peak found before them"
     if failed:
@@ -463,6 +489,6 @@ def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0),
             text += ", each with a partial branch already above the optimum peak: they cannot be the optimum"
     evaluated = np.array(sorted(evaluations))
     return MassOptimum(best, peak, undamped, len(evaluations), tuple(failed), bounds_f, msgs, grid_m, grid_p,
-                       (float(np.exp(a)), float(np.exp(b))), not open_, text, stopped, evaluated,
+                       (mass_of(a), mass_of(b)), not open_, text, stopped, evaluated,
                        np.array([evaluations[m].peak_amplitude if evaluations[m].success else np.nan
                                  for m in evaluated]))

@@ -27,6 +27,7 @@ from .. import palette, validation
 from ..disk import TunedDisk
 from ..io import Saveable, npz_path
 from ..plotting import place_legend, save_figure
+from ..progress import progress_callback
 from ..mistuned import MistunedDisk, MistunedResponse
 
 PAPER_STD = 0.02
@@ -277,11 +278,13 @@ def paper_cases(disk_factory=None, progress=None, f_range_hz=None, max_step: flo
     ``f_range_hz``: None -> :func:`auto_range` of each case.
 
     ``disk_factory(mass) -> TunedDisk`` (default: the reference cylinder disk);
-    ``progress(done, total, message)`` is called after
+    ``progress``: True (a progress bar, tqdm.auto: a widget in Jupyter, a bar in a terminal), False / None (none) or a callable (done, total, message) called after
     every FRF; ``processes``: worker processes over the tuned, then the mistuned responses
     (None: every core).
     Keys: ``random_1g, reordered_1g, alternating_1g, random_5g, reordered_5g``."""
     from .parallel import parallel_map
+
+    progress = progress_callback(progress, "mistuning cases")
 
     if disk_factory is None:
         from ..reference import reference_disk
@@ -623,11 +626,13 @@ def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f
         :func:`local_worker_config`), no set-up needed; an address ("tcp://host:8786") -> that
         Dask cluster (start its workers with MALLOC_TRIM_THRESHOLD_ unset for the same speed);
         "serial" -> in this process, without Dask.
-    progress : callable (done, total) after every disk.  out : path stem for npz/json results.
+    progress : True (a progress bar, tqdm.auto: a widget in Jupyter, a bar in a terminal), False / None (none) or a callable
+        (done, total) after every disk.  out : path stem for npz/json results.
     Kappa of disk i is ``random_kappa(n, std, seed=[seed, i])`` (reproducible, independent of the
     scheduling).
     """
     n_disks = validation.integer("n_disks", n_disks, minimum=1)
+    progress = progress_callback(progress, "Monte Carlo disks")
     n = disk.n_blades
     kappas = np.array([random_kappa(n, std, seed=[int(seed), i]) for i in range(n_disks)])
     settings = dict(harmonics=tuple(harmonics), max_step=validation.positive("max_step", max_step),

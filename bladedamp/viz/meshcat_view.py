@@ -27,16 +27,28 @@ What is drawn (blade frame: x circumferential, y axial, z radial):
 * dampers: rigid-body motion u_D (6 DOF) about their centre of gravity;
 * blade k moves with x_0(tau + k dphi) (cyclic symmetry, Eq. 25); displacements are multiplied
   by ``scale`` (default: the tip amplitude shown as 8 % of the blade length);
-* contact maps of the reference damper's OL and OR patches, enlarged beside the sector: the
-  state of every point (stick / slip / separated) at each frame of the cycle (from the AFT time
-  samples of the contact model at the chosen frequency), and the lift-off ratio
-  r = (mean(a) - min(a)) / mean(a) of the approach a(t) = a_static - u_zeta(t) (r > 1: the point
-  lifts off during the cycle; with one harmonic this is Fig. 9's ratio of ``wedge_liftoff_map``);
-* a legend (a textured plane drawn with matplotlib).
+* the contact painted on the faces: at every point contact's position on the platforms' and the
+  damper's contact faces (:meth:`bladedamp.geometry.SectorLayout.contact_points`) a tile in the
+  colour of its state (stick / slip / separated, :mod:`bladedamp.palette`) or of its normal
+  pressure, one mesh per frame of the cycle (from the AFT time samples of the contact model at
+  the chosen frequency; damper k shows damper 0's samples at tau + k dphi); platform tiles move
+  with their platform, damper tiles with the damper;
+* the damper solid, transparent or exploded (moved radially inwards) so that the faces show; the
+  first camera on damper 0 between its two platforms, or on the whole sector / disk;
+* an HTML overlay on the standalone page (:func:`overlay_html`): the design, the frequency, the
+  legend, play / pause, a phase scrubber and the camera and damper buttons; the page reads
+  ``?phase=DEG&paused&view=...&damper=...`` when it opens (the live server of
+  :meth:`Scene.serve` shows the scene without it);
+* optionally (``contact_maps=True``) flat contact maps of the reference damper's OL and OR
+  patches, enlarged beside the model: the state of every point at each frame and the lift-off
+  ratio r = (mean(a) - min(a)) / mean(a) of the approach a(t) = a_static - u_zeta(t) (r > 1: the
+  point lifts off during the cycle; with one harmonic this is Fig. 9's ratio of
+  ``wedge_liftoff_map``), with a legend (a textured plane drawn with matplotlib).
 """
 from __future__ import annotations
 
 import atexit
+import base64
 import io
 import os
 import shutil
@@ -52,7 +64,7 @@ import meshcat.animation
 import meshcat.geometry as mg
 import umsgpack
 from meshcat.servers.tree import SceneTree, find_node, walk
-from meshcat.servers.zmqserver import VIEWER_ROOT, create_command
+from meshcat.servers.zmqserver import VIEWER_ROOT
 
 from .. import geometry as bgeo
 from .. import palette
@@ -63,6 +75,8 @@ STATE_COLORS = np.array([palette.rgb(c) for c in palette.CONTACT_STATES])   # st
 BLADE_COLOR = 0xb8c2cc
 PLATFORM_COLOR = 0x8796a6
 DAMPER_COLOR = 0xd4a017
+BACKGROUND_TOP = (0.97, 0.97, 0.97)      # rgb in [0, 1]: a neutral light grey
+BACKGROUND_BOTTOM = (0.82, 0.82, 0.82)
 ROOT = "bladedamp"
 _REPETITIONS = 100000   # set_animation(repetitions=0) never plays in meshcat 0.3.2: a large positive count
 
@@ -77,6 +91,7 @@ class _RecordingWindow:
         self.tree = SceneTree()
         self.commands = []
         self.server_proc = None
+        self.overlay = ""           # extra HTML (and scripts) after the viewer's, see Scene.overlay
 
     def send(self, command):
         self.commands.append(command)
@@ -107,24 +122,30 @@ class _RecordingWindow:
         commands, animations = [], []
         for node in walk(self.tree):
             if node.object is not None:
-                commands.append(create_command(node.object))
-            commands += [create_command(p) for p in node.properties]
+                commands.append(node.object)
+            commands += list(node.properties)
             if node.transform is not None:
-                commands.append(create_command(node.transform))
+                commands.append(node.transform)
             if node.animation is not None:
-                animations.append(create_command(node.animation))
+                animations.append(node.animation)
         # animations last: the viewer binds each track to the object at its path when the
         # animation loads, so a track on an object itself (".../<object>", e.g. its morph target
-        # influences) needs that object set first
-        commands += animations
+        # influences) needs that object set first. The commands are fetched from data URLs
+        # (asynchronous) and handled in this order once all have arrived; then the page sets
+        # ``window.bladedampLoaded = true`` (the overlay's controls wait for it).
+        commands = ",\n".join('fetch("data:application/octet-binary;base64,%s").then(res => res.arrayBuffer())'
+                               % base64.b64encode(c).decode("ascii") for c in commands + animations)
+        commands = ("Promise.all([\n" + commands + "\n]).then(buffers => {\n"
+                    "  buffers.forEach(b => viewer.handle_command_bytearray(new Uint8Array(b)));\n"
+                    "  window.bladedampLoaded = true;\n});\n")
         with open(os.path.join(VIEWER_ROOT, "main.min.js")) as f:
             js = f.read()
         return ("<!DOCTYPE html>\n<html>\n<head><meta charset=utf-8><title>bladedamp</title></head>\n<body>\n"
                 "<div id=\"meshcat-pane\"></div>\n<script>\n" + js + "\n</script>\n<script>\n"
                 "var viewer = new MeshCat.Viewer(document.getElementById(\"meshcat-pane\"));\n"
-                + "".join(commands) +
+                + commands +
                 "\n</script>\n<style>body {margin: 0;} #meshcat-pane {width: 100vw; height: 100vh; overflow: hidden;}"
-                "</style>\n</body>\n</html>\n")
+                "</style>\n" + self.overlay + "</body>\n</html>\n")
 
     def close(self):
         pass
@@ -146,6 +167,16 @@ class Scene:
     @property
     def commands(self) -> list:
         return self._window.commands
+
+    @property
+    def overlay(self) -> str:
+        """HTML written into the standalone page after meshcat's viewer (the global ``viewer``
+        exists when its scripts run); empty by default."""
+        return self._window.overlay
+
+    @overlay.setter
+    def overlay(self, html: str):
+        self._window.overlay = str(html)
 
     def paths(self) -> set:
         """Paths of all objects set in the scene (strings like "/meshcat/bladedamp/...")."""
@@ -317,6 +348,11 @@ class CycleData:
         1 slip, 2 separated); None without damper
     liftoff_ratio : (2, P) r = (mean a - min a) / mean a, a(t) = a_static - u_zeta(t)
     tip_amplitude : first-harmonic tip amplitude u_x [m]
+    normal_load : (T, 2, P) normal force of every point [N] (>= 0), None without damper
+    displacement : (T, 2, P, 3) relative displacement damper - platform of every point in its
+        contact frame (xi, eta, zeta) [m], None without damper
+    force : (T, 2, P, 3) contact force of every point on the platform, same axes [N]
+    slip_work : (2, P) energy dissipated by friction at every point over the cycle [J]
     """
 
     index: int
@@ -327,6 +363,16 @@ class CycleData:
     liftoff_ratio: np.ndarray | None
     tip_amplitude: float
     patches: tuple = field(default=(), repr=False)
+    normal_load: np.ndarray | None = field(default=None, repr=False)
+    displacement: np.ndarray | None = field(default=None, repr=False)
+    force: np.ndarray | None = field(default=None, repr=False)
+    slip_work: np.ndarray | None = field(default=None, repr=False)
+
+    def sample(self, frame: int, n_frames: int) -> int:
+        """The AFT time sample shown at animation frame ``frame`` of ``n_frames`` per cycle (the
+        nearest sample to the frame's phase 2 pi frame / n_frames)."""
+        T = self.states.shape[0]
+        return int(round(frame / n_frames * T)) % T
 
 
 def cycle_data(result, index: int | None = None, frequency_hz: float | None = None) -> CycleData:
@@ -335,7 +381,7 @@ def cycle_data(result, index: int | None = None, frequency_hz: float | None = No
     i = _pick(result, index, frequency_hz)
     disk, basis = result.disk, result.basis
     X = result.coefficients[i]
-    states = ratio = None
+    states = ratio = normal = disp = force = work = None
     patches = ()
     if disk is not None and disk.has_damper:
         system = disk.hbm_system(basis.harmonics, basis.n_samples)
@@ -343,6 +389,10 @@ def cycle_data(result, index: int | None = None, frequency_hz: float | None = No
         local = (coupling.matrix @ X.ravel()).reshape(basis.n_coeffs, coupling.element.n_local)   # 12, or more with flexible platforms
         evs = coupling.element.evaluate(local, basis, result.omega[i], jacobian=False)
         states = np.stack([ev.points.state.T for ev in evs], axis=1)               # (T, 2, P)
+        normal = np.stack([ev.points.normal_load.T for ev in evs], axis=1)         # (T, 2, P)
+        disp = np.stack([ev.points.displacement.transpose(1, 0, 2) for ev in evs], axis=1)   # (T, 2, P, 3)
+        force = np.stack([ev.points.force.transpose(1, 0, 2) for ev in evs], axis=1)
+        work = np.array([ev.points.slip_work for ev in evs])                         # (2, P)
         patches = coupling.element.geometry.patches
         if basis.has_static:
             a_static = np.zeros((2, patches[0].n_points))
@@ -354,7 +404,7 @@ def cycle_data(result, index: int | None = None, frequency_hz: float | None = No
         with np.errstate(divide="ignore", invalid="ignore"):
             ratio = np.where(mean > 0, (mean - a.min(axis=0)) / mean, np.inf)
     return CycleData(i, float(result.frequency_hz[i]), X, basis, states, ratio,
-                     float(result.tip_amplitude[i, 0]), patches)
+                     float(result.tip_amplitude[i, 0]), patches, normal, disp, force, work)
 
 
 # --------------------------------------------------------------------------------------
@@ -428,6 +478,15 @@ def _rigid(u, phi, about) -> np.ndarray:
 # --------------------------------------------------------------------------------------
 # scene builders
 # --------------------------------------------------------------------------------------
+def plain_stage(vis) -> None:
+    """No grid, no axes, and a light grey background instead of meshcat's blue gradient (a blue
+    behind the blades would read as the stick colour)."""
+    vis["/Grid"].set_property("visible", False)
+    vis["/Axes"].set_property("visible", False)
+    vis["/Background"].set_property("top_color", list(BACKGROUND_TOP))
+    vis["/Background"].set_property("bottom_color", list(BACKGROUND_BOTTOM))
+
+
 def _mesh_geometry(mesh, color=None):
     return mg.TriangularMeshGeometry(mesh.vertices, mesh.faces, color)
 
@@ -503,6 +562,15 @@ def _tile_mesh(xi_n, eta_n, n_xi, n_eta, width, height, origin, colors):
     return mg.TriangularMeshGeometry(np.array(verts), np.array(faces), np.array(cols))
 
 
+def _camera_values(target, position):
+    """(column-major 4x4 transform of /meshcat/bladedamp, camera position in its rotated frame) of
+    :func:`_set_camera`, as the page's commands take them."""
+    T = np.eye(4)
+    T[:3, 3] = -np.asarray(target, float)
+    x, y, z = map(float, position)
+    return list(map(float, T.T.ravel())), [x, z, -y]
+
+
 def _set_camera(vis, target, position):
     """Look at ``target`` from ``target + position`` (meshcat frame, z up). meshcat's orbit camera
     looks at the world origin, so the drawing (everything under /meshcat/bladedamp) is shifted by
@@ -510,8 +578,26 @@ def _set_camera(vis, target, position):
     T = np.eye(4)
     T[:3, 3] = -np.asarray(target, float)
     vis[ROOT].set_transform(T)
-    x, y, z = position
-    vis["/Cameras/default/rotated/<object>"].set_property("position", [float(x), float(z), float(-y)])
+    vis["/Cameras/default/rotated/<object>"].set_property("position", _camera_values(target, position)[1])
+
+
+def project(point, target, position, size, fov_deg: float = 75.0) -> np.ndarray:
+    """Pixel (x right, y down) of a blade-frame ``point`` [m] in a ``size`` = (width, height) page
+    whose camera :func:`_set_camera` set: meshcat's perspective camera (vertical field of view
+    75 deg) at ``target + position`` looking at ``target``, z up."""
+    point = np.asarray(point, float)
+    eye = np.asarray(target, float) + np.asarray(position, float)
+    forward = (np.asarray(target, float) - eye) / np.linalg.norm(np.asarray(position, float))
+    right = np.cross(forward, [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    d = point - eye
+    depth = d @ forward
+    t = np.tan(np.radians(fov_deg) / 2)
+    w, h = size
+    x_ndc = (d @ right) / (depth * t * w / h)
+    y_ndc = (d @ up) / (depth * t)
+    return np.stack([(x_ndc + 1) / 2 * w, (1 - y_ndc) / 2 * h], axis=-1)
 
 
 def _add_contact_maps(scene, data, origin, n_frames, width=0.05, gap=0.008):
@@ -523,8 +609,7 @@ def _add_contact_maps(scene, data, origin, n_frames, width=0.05, gap=0.008):
     height = width * (max(patch.height, patch.length / n_eta * n_xi) / patch.length) if patch.height > 0 \
         else width / n_eta
     height = max(height, width / n_eta)
-    T = data.states.shape[0]
-    samples = [int(round(f / n_frames * T)) % T for f in range(n_frames)]
+    samples = [data.sample(f, n_frames) for f in range(n_frames)]
     colors = np.zeros((n_frames, 2, patch.n_points, 3))
     rows = {}
     for c, name in enumerate(("OL", "OR")):
@@ -600,10 +685,20 @@ def _map_frames(scene, anim, n_frames, phase):
             pose(frame, f, True)
 
 
+PAINTS = ("state", "pressure")
+DAMPER_VIEWS = ("solid", "transparent", "exploded")
+VIEWS = ("damper", "whole")
+DAMPER_OPACITY = 0.3          # the transparent damper
+PAINT_OFFSET = 5e-5           # [m] painted tiles stand this far off their face (no z-fighting)
+
+
 def ods_scene(result, index: int | None = None, frequency_hz: float | None = None, scale: float | None = None,
               layout: str = "sector", n_frames: int = 36, period_s: float = 2.0, animate: bool = True,
-              phase: float = 0.0, contact_maps: bool = True, blade_geometry=None, camera=None) -> Scene:
-    """Operating deflection shape of ``result`` (a DiskResponse) over one vibration cycle.
+              phase: float = 0.0, contact_maps: bool = False, blade_geometry=None, camera=None,
+              paint: str | None = "state", damper_view: str = "transparent", view: str = "damper",
+              title: str | None = None, painted_dampers=None, overlay: bool = True) -> Scene:
+    """Operating deflection shape of ``result`` (a DiskResponse) over one vibration cycle, with the
+    contact painted on the contact faces.
 
     index / frequency_hz : branch point (default: resonance, the largest tip amplitude)
     scale : displacement magnification (default: tip amplitude drawn as 8 % of the blade length)
@@ -611,22 +706,51 @@ def ods_scene(result, index: int | None = None, frequency_hz: float | None = Non
         "disk" (all n blades wrapped around the axis, see :func:`bladedamp.geometry.disk_placements`)
     n_frames, period_s : frames per cycle and the cycle's duration in the viewer [s]
     animate : False draws one still frame at ``phase`` [rad] (no animation)
-    contact_maps : draw the contact-state and lift-off maps and the legend
+    paint : what is painted at every point contact's position on the damper's and the platforms'
+        contact faces (:meth:`bladedamp.geometry.SectorLayout.contact_points`), per frame:
+        "state" (stick / slip / separated in the colours of :mod:`bladedamp.palette`),
+        "pressure" (the normal load of the point over its cell: MPa for an area contact, N/mm
+        along a line contact, viridis from 0 to the largest over the cycle) or None
+    painted_dampers : indices of the dampers painted (default: every damper of the sector layout,
+        damper 0 of the disk)
+    damper_view : "solid", "transparent" (opacity 0.3: the faces under it show) or "exploded"
+        (the damper and its painted faces moved radially inwards by 2.5 times its height: the
+        platforms' faces show from below, the damper's from above)
+    view : the first camera: "damper" (damper 0 between its two platforms, seen from the front
+        and below) or "whole" (the sector or the whole disk)
+    camera : (target (3,), camera position relative to the target (3,)) in the blade frame [m];
+        replaces the first camera of ``view``
+    contact_maps : also draw the flat contact-state and lift-off maps beside the model, and their
+        legend (see :func:`contact_map_scene`)
     blade_geometry : BeamBladeGeometry for the shapes (default the reference blade, or the solid
-        blade's own parametric geometry; a solid blade is drawn as its deformed FE surface)
-    camera : (target (3,), camera position relative to the target (3,)) in the blade frame [m]
+        blade's own parametric geometry; a solid blade is drawn as its deformed FE surface, and
+        the platforms' painted faces then stay at rest)
+    title : the design's name in the overlay (default: damper type, mass, blades and engine order)
+    overlay : write the HTML overlay into the standalone page (:func:`overlay_html`): title,
+        frequency, legend, play / pause, phase scrubber, camera and damper buttons
+
+    ``scene.info["paint"]`` holds what was painted: for each painted damper, the platform and
+    damper tile paths, the point positions (world, at rest) and the colours per frame.
     """
     disk = result.disk
     if disk is None:
         raise ValueError("result must be a DiskResponse with its disk")
+    if paint not in PAINTS + (None,):
+        raise ValueError(f'paint must be one of {PAINTS} or None (got {paint!r})')
+    if damper_view not in DAMPER_VIEWS:
+        raise ValueError(f"damper_view must be one of {DAMPER_VIEWS} (got {damper_view!r})")
+    if view not in VIEWS:
+        raise ValueError(f"view must be one of {VIEWS} (got {view!r})")
+    if int(n_frames) < 1:
+        raise ValueError(f"n_frames must be an integer >= 1 (got {n_frames!r})")
+    n_frames = int(n_frames)
     data = cycle_data(result, index, frequency_hz)
     blade = disk.blade
     nm = blade.n_modes
     has_damper = disk.has_damper and data.states is not None
     scene = Scene()
     vis = scene.vis
-    vis["/Grid"].set_property("visible", False)
-    vis["/Axes"].set_property("visible", False)
+    plain_stage(vis)
 
     # a solid FE blade (bladedamp.solid.SolidModalBlade) brings its boundary surface and the
     # mode shapes there: drawn deformed (exact superposition) instead of the beam's segments
@@ -700,12 +824,18 @@ def ods_scene(result, index: int | None = None, frequency_hz: float | None = Non
         bp["platform"]["mesh"].set_object(_mesh_geometry(bm.platform), mg.MeshLambertMaterial(color=PLATFORM_COLOR))
         for s, (mesh, _) in enumerate(bm.segments):
             bp[f"segment_{s:02d}"]["mesh"].set_object(_mesh_geometry(mesh), mg.MeshLambertMaterial(color=BLADE_COLOR))
+    explode = np.eye(4)
     if has_damper:
         dmesh = bgeo.damper_mesh(disk.damper, disk.gamma_left, disk.gamma_right)
+        explode = bgeo.homogeneous(translation=(0.0, 0.0, -2.5 * float(np.ptp(dmesh.vertices[:, 2]))))
+        opacity = DAMPER_OPACITY if damper_view == "transparent" else 1.0
         for j in range(n_dampers):
             dp = vis[ROOT]["dampers"][f"damper_{ks[j]:02d}"]
             dp.set_transform(D[j])
-            dp["body"]["mesh"].set_object(_mesh_geometry(dmesh), mg.MeshLambertMaterial(color=DAMPER_COLOR))
+            dp["body"]["mesh"].set_object(_mesh_geometry(dmesh), mg.MeshLambertMaterial(
+                color=DAMPER_COLOR, transparent=opacity < 1, opacity=opacity))
+            if damper_view == "exploded":
+                dp["body"]["mesh"].set_transform(explode)
 
     # motion per frame
     def pose(frame_vis, tau, animated):
@@ -741,6 +871,18 @@ def ods_scene(result, index: int | None = None, frequency_hz: float | None = Non
     else:
         pose(vis, phase, False)
 
+    # the contact painted on the faces
+    legend = None
+    if paint is not None and has_damper:
+        if painted_dampers is None:
+            painted_dampers = list(ks[:n_dampers]) if layout == "sector" else [ks[0]]
+        painted = [int(k) for k in painted_dampers]
+        drawn = [int(k) for k in ks[:n_dampers]]
+        if not set(painted) <= set(drawn):
+            raise ValueError(f"painted_dampers must be among the dampers drawn, {drawn} (got {painted})")
+        legend = _paint_faces(scene, data, lay, paint, painted, drawn, list(ks), B, D, n, dphi, anim,
+                              n_frames, phase, explode if damper_view == "exploded" else None)
+
     # contact maps
     map_origin = np.array([0.04, 0.0, z_p + 0.06])
     r_tip = None
@@ -757,21 +899,289 @@ def ods_scene(result, index: int | None = None, frequency_hz: float | None = Non
         _discrete_visibility(anim)
         vis.set_animation(anim, play=True, repetitions=_REPETITIONS)
 
-    # camera
-    if camera is None:
-        if layout == "disk":
-            # the whole disk and the maps beside it, seen from the front and a little from the side
-            # and above so that the dampers between the platforms show
-            target = np.array([0.06, 0.0, -r_root])
-            camera = (target, np.array([0.02, -0.42, 0.04]))
-        else:
-            target = np.array([0.01, 0.0, 0.5 * g.total_length - 0.01])
-            camera = (target, np.array([0.05, -0.245, 0.04]))
-    _set_camera(vis, *camera)
+    # cameras: the whole sector / disk, and damper 0 between its platforms
+    if layout == "disk":
+        # the whole disk (and the maps beside it), seen from the front and a little from the side
+        # and above so that the dampers between the platforms show
+        whole = ((np.array([0.06, 0.0, -r_root]), np.array([0.02, -0.42, 0.04])) if contact_maps and has_damper
+                 else (np.array([0.0, 0.0, -r_root]), np.array([0.0, -0.36, 0.04])))
+    else:
+        whole = (np.array([0.01, 0.0, 0.5 * g.total_length - 0.01]), np.array([0.05, -0.245, 0.04]))
+    cameras = {"whole": whole}
+    if has_damper:
+        # front and below: the platforms' inclined faces and the damper between them
+        R0 = D[0][:3, :3]
+        cameras["damper"] = (D[0][:3, 3].copy(), R0 @ np.array([0.0, -0.036, -0.018]))
+    first = camera if camera is not None else cameras.get(view, whole)
+    _set_camera(vis, *first)
     scene.info.update(index=data.index, frequency_hz=data.frequency_hz, scale=scale, n_frames=n_frames,
                       layout=layout, blades=list(ks), tip_amplitude=data.tip_amplitude, animate=animate,
-                      liftoff_ratio=data.liftoff_ratio, root_radius=r_root, cycle=data)
+                      liftoff_ratio=data.liftoff_ratio, root_radius=r_root, cycle=data, cameras=cameras,
+                      camera=first, damper_view=damper_view, period_s=float(period_s), phase=float(phase),
+                      explode=explode, dampers=[int(k) for k in ks[:n_dampers]] if has_damper else [])
+    if title is None:
+        title = _design_title(disk)
+    scene.info["title"] = title
+    if overlay:
+        scene.overlay = overlay_html(scene, title, legend)
     return scene
+
+
+def _design_title(disk) -> str:
+    """'cylinder damper 1 g, 16 blades, EO 1' (or 'no damper, ...')."""
+    damper = f"{disk.damper.kind} damper {1e3 * disk.damper.mass:.3g} g" if disk.has_damper else "no damper"
+    return f"{damper}, {disk.n_blades} blades, EO {disk.engine_order}"
+
+
+def _face_tiles(points, frame, half_xi, half_eta, offset, colors):
+    """One quad per point contact in its contact plane: centred ``offset`` [m] along the normal
+    (frame rows xi, eta, zeta) off ``points`` (P, 3), half sizes ``half_xi``, ``half_eta`` [m];
+    vertex colours ``colors`` (P, 3)."""
+    e_xi, e_eta, e_zeta = frame
+    verts, faces, cols = [], [], []
+    for p, c in zip(points, colors):
+        o = p + offset * e_zeta
+        base = len(verts)
+        verts += [o - half_xi * e_xi - half_eta * e_eta, o + half_xi * e_xi - half_eta * e_eta,
+                  o + half_xi * e_xi + half_eta * e_eta, o - half_xi * e_xi + half_eta * e_eta]
+        faces += [[base, base + 1, base + 2], [base, base + 2, base + 3]]
+        cols += [c] * 4
+    return mg.TriangularMeshGeometry(np.array(verts), np.array(faces), np.array(cols))
+
+
+def point_pressure(data) -> tuple[np.ndarray, str]:
+    """Normal pressure of every point contact over the cycle, (T, 2, P), and its unit: the normal
+    load over the point's cell, h_C l_C / P [m^2] in MPa for an area contact, l_C / n_eta [m]
+    in N/mm along a line contact (h_C = 0). ``data``: a :class:`CycleData` with a damper."""
+    patch = data.patches[0]
+    if patch.height > 0:
+        return data.normal_load / (patch.height * patch.length / patch.n_points) / 1e6, "MPa"
+    return data.normal_load / (patch.length / patch.n_eta) / 1e3, "N/mm"
+
+
+def _paint_faces(scene, data, lay, paint, painted, drawn, ks, B, D, n_blades, dphi, anim, n_frames, phase,
+                 explode):
+    """Tiles coloured by ``paint`` at every point contact on the platforms' and the damper's contact
+    faces of the dampers ``painted``; one mesh per frame and face, shown one frame at a time.
+    Returns the legend (dict) for the overlay."""
+    import matplotlib
+
+    vis = scene.vis[ROOT]
+    patches = data.patches
+    pts = lay.contact_points()                                       # (2, P, 3) blade 0 frame
+    frames = lay.frames
+    half = []
+    for p in patches:
+        cell_eta = p.length / p.n_eta
+        half.append((0.45 * (p.height / p.n_xi if p.height > 0 else 0.6 * cell_eta), 0.45 * cell_eta))
+    if paint == "state":
+        values = data.states
+        colour_of = lambda v: STATE_COLORS[v]                        # noqa: E731
+        legend = {"kind": "state", "names": list(STATE_NAMES), "colors": list(palette.CONTACT_STATES)}
+    else:
+        values, unit = point_pressure(data)
+        vmax = float(values.max()) if values.max() > 0 else 1.0
+        cmap = matplotlib.colormaps["viridis"]
+        colour_of = lambda v: cmap(np.clip(v / vmax, 0, 1))[..., :3]   # noqa: E731
+        legend = {"kind": "pressure", "unit": unit, "max": vmax,
+                  "colors": [matplotlib.colors.to_hex(cmap(x)) for x in np.linspace(0, 1, 9)]}
+    T = values.shape[0]
+    n_shown = n_frames if anim is not None else 1
+    info = {"kind": paint, "dampers": {}}
+    blade_index = {int(k): j for j, k in enumerate(ks)}
+    for k in painted:
+        j = drawn.index(k)
+        left, right = int(k), (int(k) + 1) % n_blades                 # OL on blade k, OR on blade k + 1
+        if right not in blade_index:
+            raise ValueError(f"damper {k}: blade {right} is not drawn")
+        own = [pts[0], pts[1] + np.array([lay.pitch, 0.0, 0.0])]     # each face in its blade's own frame
+        damper_pts = pts - lay.damper_cg
+        entry = {"platform_paths": [], "damper_paths": [], "samples": [], "colors": [], "values": [],
+                 "world": [], "damper_world": []}
+        for c, (name, b) in enumerate((("OL", left), ("OR", right))):
+            Bb = B[blade_index[b]]
+            entry["world"].append(own[c] @ Bb[:3, :3].T + Bb[:3, 3])
+            Dj = D[j] @ (explode if explode is not None else np.eye(4))
+            entry["damper_world"].append(damper_pts[c] @ Dj[:3, :3].T + Dj[:3, 3])
+        for f in range(n_shown):
+            tau = 2 * np.pi * f / n_frames if anim is not None else phase
+            s = int(round((tau + k * dphi) / (2 * np.pi) * T)) % T    # damper k: damper 0 at tau + k dphi
+            colors = np.array([colour_of(values[s, c]) for c in range(2)])       # (2, P, 3)
+            entry["samples"].append(s)
+            entry["colors"].append(colors)
+            entry["values"].append(values[s])
+            tag = f"frame_{f:03d}"
+            for c, (name, b) in enumerate((("OL", left), ("OR", right))):
+                hx, he = half[c]
+                pp = vis["blades"][f"blade_{b:02d}"]["platform"]["paint"][f"damper_{k:02d}_{name}"][tag]
+                pp.set_object(_face_tiles(own[c], frames[c], hx, he, PAINT_OFFSET, colors[c]),
+                              mg.MeshBasicMaterial(vertexColors=True))
+                dp = vis["dampers"][f"damper_{k:02d}"]["body"]["paint"][name][tag]
+                dp.set_object(_face_tiles(damper_pts[c], frames[c], hx, he, -PAINT_OFFSET, colors[c]),
+                              mg.MeshBasicMaterial(vertexColors=True))
+                if f == 0:
+                    entry["platform_paths"].append(pp.path.lower().rsplit("/", 1)[0])
+                    entry["damper_paths"].append(dp.path.lower().rsplit("/", 1)[0])
+        if explode is not None:
+            vis["dampers"][f"damper_{k:02d}"]["body"]["paint"].set_transform(explode)
+        entry["colors"] = np.array(entry["colors"])
+        entry["world"] = np.array(entry["world"])
+        entry["damper_world"] = np.array(entry["damper_world"])
+        info["dampers"][k] = entry
+    if anim is not None:
+        for f in range(n_frames + 1):
+            with anim.at_frame(scene.vis, f) as frame:
+                for k, entry in info["dampers"].items():
+                    for path in entry["platform_paths"] + entry["damper_paths"]:
+                        node = frame[path.replace("/meshcat/", "", 1)]
+                        for m in range(n_frames):
+                            node[f"frame_{m:03d}"].set_property("visible", "boolean", bool(m == f % n_frames))
+    scene.info["paint"] = info
+    return legend
+
+
+def overlay_html(scene, title: str, legend: dict | None) -> str:
+    """The page's overlay (top left, text 14 px): the design ``title``, frequency and drawn
+    magnification, the legend of what is painted, and the controls: play / pause and a phase
+    scrubber (animated scenes), the camera (damper 0 / whole) and the damper (solid /
+    transparent / exploded). The page reads ``?phase=DEG&paused&view=damper|whole&damper=...``
+    (or the same after ``#``) when it opens."""
+    import html as _html
+    import json
+
+    info = scene.info
+    T0 = {}
+    for name, (target, position) in info["cameras"].items():
+        root, cam = _camera_values(target, position)
+        T0[name] = {"root": root, "camera": cam}
+    damper_nodes = []
+    for k in info["dampers"]:
+        base = f"/meshcat/{ROOT}/dampers/damper_{k:02d}/body"
+        damper_nodes.append({"mesh": base + "/mesh", "paint": base + "/paint"})
+    explode = info["explode"]
+    config = {"period": info["period_s"] if info["animate"] else 0.0, "animate": bool(info["animate"]),
+              "cameras": T0, "dampers": damper_nodes, "explode": list(map(float, explode.T.ravel())),
+              "identity": list(map(float, np.eye(4).ravel())), "damper_color": list(palette.rgb("#%06x" % DAMPER_COLOR)),
+              "opacity": DAMPER_OPACITY, "damper_view": info["damper_view"],
+              "view": next((k for k, v in info["cameras"].items() if v is info["camera"]), "custom")}
+    rows = []
+    if legend is not None and legend["kind"] == "state":
+        items = "".join(f'<span class="bd-item"><span class="bd-swatch" style="background:{c}"></span>{_html.escape(nm)}</span>'
+                        for nm, c in zip(legend["names"], legend["colors"]))
+        rows.append(f'<div id="bd-legend">contact: {items}</div>')
+    elif legend is not None:
+        grad = ", ".join(legend["colors"])
+        rows.append(f'<div id="bd-legend">normal pressure [{_html.escape(legend["unit"])}]: 0 '
+                    f'<span class="bd-bar" style="background: linear-gradient(to right, {grad})"></span> '
+                    f'{legend["max"]:.3g}</div>')
+    whole_name = "whole disk" if info["layout"] == "disk" else "whole sector"
+    controls = []
+    if info["animate"]:
+        controls.append('<div><button id="bd-play" type="button">pause</button> '
+                        '<input id="bd-phase" type="range" min="0" max="360" step="1" value="0" aria-label="phase"> '
+                        '<span id="bd-phase-value">0&deg;</span></div>')
+    else:
+        controls.append(f'<div>phase {np.degrees(info.get("phase", 0.0)) % 360:.0f}&deg; (still frame)</div>')
+    buttons = []
+    if "damper" in info["cameras"]:
+        buttons.append('<button id="bd-view-damper" type="button">one damper</button>')
+    buttons.append(f'<button id="bd-view-whole" type="button">{whole_name}</button>')
+    if info["dampers"]:
+        buttons.append('damper: ' + " ".join(f'<button id="bd-damper-{v}" type="button">{v}</button>'
+                                             for v in DAMPER_VIEWS))
+    controls.append('<div>' + " ".join(buttons) + '</div>')
+    style = ("#bd-overlay {position: absolute; top: 8px; left: 8px; z-index: 10; max-width: 580px; "
+             "font: 14px/1.5 system-ui, sans-serif; color: #111; background: rgba(255, 255, 255, 0.9); "
+             "padding: 8px 12px; border-radius: 6px; box-shadow: 0 1px 4px rgba(0, 0, 0, 0.3);} "
+             "#bd-overlay div {margin: 2px 0;} #bd-title {font-size: 16px; font-weight: 600;} "
+             "#bd-overlay button {font: 14px system-ui, sans-serif; margin: 2px 2px 2px 0;} "
+             "#bd-overlay button.bd-on {background: #333; color: #fff;} "
+             "#bd-phase {width: 180px; vertical-align: middle;} "
+             ".bd-item {margin-right: 10px; white-space: nowrap;} "
+             ".bd-swatch {display: inline-block; width: 14px; height: 14px; margin: 0 4px -2px 4px; "
+             "border: 1px solid #555;} .bd-bar {display: inline-block; width: 140px; height: 12px; "
+             "vertical-align: middle; border: 1px solid #555;}")
+    text = (f'<div id="bd-title">{_html.escape(title)}</div>'
+            f'<div id="bd-frequency">{info["frequency_hz"]:.2f} Hz, tip amplitude '
+            f'{1e3 * info["tip_amplitude"]:.3g} mm, motion drawn {info["scale"]:.3g} x</div>')
+    return ("<style>" + style + "</style>\n<div id=\"bd-overlay\">" + text + "".join(rows) + "".join(controls)
+            + "</div>\n<script>\nvar bladedampView = " + json.dumps(config) + ";\n" + _OVERLAY_JS + "</script>\n")
+
+
+_OVERLAY_JS = r"""
+(function () {
+  var cfg = bladedampView, anim = viewer.animator;
+  var play = document.getElementById("bd-play"), scrub = document.getElementById("bd-phase");
+  var shown = document.getElementById("bd-phase-value");
+  function send(type, path, key, value) {
+    var c = {type: type, path: path};
+    if (type === "set_transform") { c.matrix = value; } else { c.property = key; c.value = value; }
+    viewer.handle_command(c);
+  }
+  function mark(prefix, which) {
+    document.querySelectorAll("button[id^='" + prefix + "']").forEach(function (b) {
+      b.classList.toggle("bd-on", b.id === prefix + which);
+    });
+  }
+  function setView(name) {
+    var c = cfg.cameras[name];
+    if (!c) { return; }
+    send("set_transform", "/meshcat/bladedamp", null, c.root);
+    send("set_property", "/Cameras/default/rotated/<object>", "position", c.camera);
+    if (viewer.controls) { viewer.controls.target.set(0, 0, 0); viewer.controls.update(); }
+    cfg.view = name; mark("bd-view-", name); viewer.set_dirty();
+  }
+  function setDamper(mode) {
+    var col = cfg.damper_color.concat([mode === "transparent" ? cfg.opacity : 1.0]);
+    cfg.dampers.forEach(function (d) {
+      send("set_property", d.mesh, "color", col);
+      var m = mode === "exploded" ? cfg.explode : cfg.identity;
+      send("set_transform", d.mesh, null, m);
+      send("set_transform", d.paint, null, m);
+    });
+    cfg.damper_view = mode; mark("bd-damper-", mode); viewer.set_dirty();
+  }
+  function phaseDeg() {
+    if (!anim.actions.length || !cfg.period) { return 0; }
+    var t = anim.actions[0].time % cfg.period;
+    return 360 * t / cfg.period;
+  }
+  function showPhase() {
+    if (!scrub) { return; }
+    var d = phaseDeg();
+    scrub.value = Math.round(d) % 360; shown.textContent = Math.round(d) % 360 + "\u00b0";
+  }
+  function seek(deg) { anim.seek(cfg.period * (((deg % 360) + 360) % 360) / 360); showPhase(); }
+  function setPlaying(on) {
+    if (on) { anim.play(); } else { anim.pause(); }
+    if (play) { play.textContent = on ? "pause" : "play"; }
+  }
+  document.querySelectorAll("button[id^='bd-view-']").forEach(function (b) {
+    b.addEventListener("click", function () { setView(b.id.slice(8)); });
+  });
+  document.querySelectorAll("button[id^='bd-damper-']").forEach(function (b) {
+    b.addEventListener("click", function () { setDamper(b.id.slice(10)); });
+  });
+  mark("bd-view-", cfg.view); mark("bd-damper-", cfg.damper_view);
+  var params = new URLSearchParams(location.search + "&" + location.hash.replace(/^#/, ""));
+  window.bladedampControls = {setView: setView, setDamper: setDamper, seek: seek, setPlaying: setPlaying,
+                              phase: phaseDeg};
+  function start() {                     // once the scene's commands are handled
+    if (!window.bladedampLoaded || (cfg.animate && !anim.actions.length)) { setTimeout(start, 20); return; }
+    if (params.get("view")) { setView(params.get("view")); }
+    if (params.get("damper")) { setDamper(params.get("damper")); }
+    if (cfg.animate) {
+      play.addEventListener("click", function () { setPlaying(!anim.playing); });
+      scrub.addEventListener("input", function () { setPlaying(false); seek(parseFloat(scrub.value)); });
+      if (params.has("phase")) { setPlaying(false); seek(parseFloat(params.get("phase")) || 0); }
+      if (params.has("paused")) { setPlaying(false); }
+      setInterval(function () { if (anim.playing) { showPhase(); } }, 100);
+    }
+    document.body.setAttribute("data-bd-ready", "1");
+  }
+  start();
+})();
+"""
 
 
 def _discrete_visibility(anim):
@@ -800,8 +1210,7 @@ def contact_map_scene(result, index: int | None = None, frequency_hz: float | No
     data = cycle_data(result, index, frequency_hz)
     scene = Scene()
     vis = scene.vis
-    vis["/Grid"].set_property("visible", False)
-    vis["/Axes"].set_property("visible", False)
+    plain_stage(vis)
     origin = np.zeros(3)
     samples = _add_contact_maps(scene, data, origin, n_frames)
     anim = meshcat.animation.Animation(default_framerate=n_frames / period_s) if animate else None
@@ -822,7 +1231,8 @@ def show(result, path=None, live: bool = False, open_browser: bool = False, **op
     """Build :func:`ods_scene` for ``result``; write it to ``path`` (standalone HTML) if given; with
     ``live=True`` also start a localhost meshcat server and return ``(scene, view)`` (close the view).
     Returns the Scene otherwise. Default layout: the whole disk ("disk", every blade and damper,
-    the contact maps and their legend beside it) for a damped disk, the sector without damper."""
+    damper 0's contact painted on its faces, the camera on it) for a damped disk, the sector
+    without damper."""
     disk = getattr(result, "disk", None)
     options.setdefault("layout", "disk" if disk is not None and disk.has_damper else "sector")
     scene = ods_scene(result, **options)

@@ -36,7 +36,7 @@ from ..contact.point import SEPARATED, SLIP, STICK, point_contact_forces
 from ..hbm.fourier import HarmonicBasis
 from ..oscillator import FrictionOscillator
 
-__all__ = ["interactive_view", "hysteresis_loop", "hysteresis_figure", "describing_function", "describing_function_figure",
+__all__ = ["interactive_view", "interact_with_image", "hysteresis_loop", "hysteresis_figure", "describing_function", "describing_function_figure",
            "oscillator_comparison", "oscillator_figure", "DiskFRF", "DiskFRFCache", "DEFAULT_CACHE", "disk_frf",
            "undamped_frf", "disk_frf_figure", "mass_sweep_peaks", "mass_study_figure", "engine_order_figure",
            "contact_state_at_peak", "platform_angle_figure", "closed_form_jenkins"]
@@ -62,6 +62,42 @@ def interactive_view(callback):
         plt.show()
 
     return view
+
+
+def interact_with_image(callback, **controls):
+    """``ipywidgets.interact(callback, **controls)`` whose saved output also holds a still image.
+
+    The widget is displayed as one output whose MIME bundle carries the widget view and, beside
+    it, the PNG of the figure ``callback`` drew at the controls' initial values (its first
+    ``image/png`` display). A front end that draws the widget (a trusted notebook with a running
+    or saved widget state) shows the live sliders; one that does not (an untrusted notebook,
+    a static viewer) shows the PNG instead of the widget's ``interactive(children=...)`` text.
+    The callback runs once, as with ``interact``; its outputs go to the widget's output area.
+    Returns None (a returned widget would be displayed a second time)."""
+    import functools
+
+    from IPython.display import display
+    from IPython.utils.capture import capture_output
+    from ipywidgets import interactive
+
+    first = []
+
+    @functools.wraps(callback)
+    def view(*args, **kwargs):
+        if first:
+            return callback(*args, **kwargs)
+        with capture_output() as captured:
+            result = callback(*args, **kwargs)
+        first.append(captured)
+        captured.show()             # inside the widget's output area, as interact would show it
+        return result
+
+    widget = interactive(view, **controls)
+    bundle = widget._repr_mimebundle_()
+    images = [out.data["image/png"] for out in (first[0].outputs if first else []) if "image/png" in out.data]
+    if images:
+        bundle["image/png"] = images[0]
+    display(bundle, raw=True)
 
 
 def _figure(*args, **kwargs):
@@ -374,17 +410,19 @@ class DiskFRFCache:
 
     # -- keys -------------------------------------------------------------------------
     @staticmethod
-    def family(kind, engine_order=1, gamma_right_deg=35.0, excitation=None, harmonics=(1,)):
+    def family(kind, engine_order=1, gamma_right_deg=35.0, excitation=None, harmonics=(1,),
+               friction_coefficient=None):
         """Everything but the mass (the blade's beam modes are built once per family)."""
         exc = None if excitation is None else tuple(float(v) for v in excitation)
-        return (kind, int(engine_order), round(float(gamma_right_deg), 6), exc, tuple(harmonics))
+        mu = None if friction_coefficient is None or kind is None else round(float(friction_coefficient), 6)
+        return (kind, int(engine_order), round(float(gamma_right_deg), 6), exc, tuple(harmonics), mu)
 
     def _disk(self, family, mass):
         """The family's reference disk with ``mass`` [kg]."""
         from ..reference import reference_disk
 
         if family not in self._base_disks:
-            kind, eo, gamma_r, exc, _ = family
+            kind, eo, gamma_r, exc, _, mu = family
             kw = {}
             if exc is not None:
                 kw["excitation"] = np.array(exc)
@@ -393,6 +431,9 @@ class DiskFRFCache:
             disk = reference_disk(kind, 1e-3, engine_order=eo, **kw)
             if gamma_r != 35.0:
                 disk = dataclasses.replace(disk, gamma_right=np.radians(gamma_r))
+            if mu is not None:
+                contact = dataclasses.replace(disk.damper.contact, friction_coefficient=mu)
+                disk = dataclasses.replace(disk, damper=dataclasses.replace(disk.damper, contact=contact))
             self._base_disks[family] = disk
         base = self._base_disks[family]
         if base.damper is None:
@@ -401,16 +442,20 @@ class DiskFRFCache:
 
     # -- public -----------------------------------------------------------------------
     def response(self, kind="cylinder", mass=1e-3, engine_order=1, gamma_right_deg=35.0, excitation=None,
-                 harmonics=(1,)) -> DiskFRF:
+                 harmonics=(1,), friction_coefficient=None) -> DiskFRF:
         """Frequency response of the reference disk with a ``kind`` damper of ``mass`` [kg]
-        (``kind=None``: no damper), at ``engine_order``, right platform angle [deg]."""
+        (``kind=None``: no damper), at ``engine_order``, right platform angle [deg], tip
+        ``excitation`` (6,) [N, N m] (None: the reference's), damper ``friction_coefficient``
+        mu [-] (None: the reference's)."""
         from ..studies.mass import IncompleteResponse, peak_response
 
         if kind not in (None, "cylinder", "wedge"):
             raise ValueError(f"kind must be None, 'cylinder' or 'wedge' (got {kind!r})")
         if kind is not None and not mass > 0:
             raise ValueError(f"mass must be > 0 kg (got {mass!r})")
-        fam = self.family(kind, engine_order, gamma_right_deg, excitation, harmonics)
+        if friction_coefficient is not None and not friction_coefficient >= 0:
+            raise ValueError(f"friction_coefficient must be >= 0 (got {friction_coefficient!r})")
+        fam = self.family(kind, engine_order, gamma_right_deg, excitation, harmonics, friction_coefficient)
         mass = 0.0 if kind is None else float(mass)
         key = fam + (float(f"{mass:.6g}"),)
         if key in self._memo:

@@ -1,0 +1,596 @@
+"""Blades from FE exports (bladedamp.fe_formats, ModalBlade.from_file): Nastran OUTPUT4 and punch
+DMIG, Abaqus matrix output, MATLAB. Real files of the exporting programs are in tests/data/fe
+(README there: sources and licences); the reference blade's own matrices are written in every
+format by the small writers below."""
+import struct
+from pathlib import Path
+
+import numpy as np
+import pytest
+import scipy.io
+import scipy.linalg
+import scipy.sparse
+
+from bladedamp.blade import ModalBlade, beam_modes
+from bladedamp.fe_formats import read_fe_matrices, read_op4
+from bladedamp.reference import reference_blade_geometry
+
+DATA = Path(__file__).parent / "data" / "fe"
+
+
+# ---------------------------------------------------------------------------------------
+# files written by the real programs
+# ---------------------------------------------------------------------------------------
+def test_nastran_binary_and_text_output4_of_the_same_matrices_agree_exactly():
+    """Nastran wrote the same test matrices (identity, lower triangular, random real and complex,
+    null, strings) as binary and as text OUTPUT4, both in the sparse 'bigmat' layout: the two
+    independent code paths of the reader give the same numbers (the text has 16 digits, enough
+    to carry the single- and double-precision values exactly)."""
+    text, binary = read_op4(DATA / "mat_t_s2.op4"), read_op4(DATA / "mat_b_s2.op4")
+    assert sorted(text) == sorted(binary) == ["EYE10", "EYE5CD", "LOW", "NULL", "RND1CD", "RND1CS",
+                                              "RND1RD", "RND1RS", "STRINGS"]
+    for name in text:
+        (a, nra, nca, _), (b, nrb, ncb, _) = text[name], binary[name]
+        assert (nra, nca) == (nrb, ncb)
+        A, B = np.zeros((nra, nca), complex), np.zeros((nrb, ncb), complex)
+        A[a.rows, a.cols] = a.vals
+        B[b.rows, b.cols] = b.vals
+        if name == "RND1RS" or name == "RND1CS":          # single precision: text rounds to 16 digits
+            np.testing.assert_allclose(A, B, rtol=1e-15)
+        else:
+            np.testing.assert_array_equal(A, B)
+    e = text["EYE10"][0]
+    assert sorted(zip(e.rows, e.cols)) == [(k, k) for k in range(10)] and set(e.vals) == {1.0}
+    s = text["STRINGS"][0]                                 # 30 x 20: column j holds j in strings of 3 rows
+    assert text["STRINGS"][1:3] == (30, 20) and set(s.vals) <= set(range(1, 21))
+
+
+def raw_dmig_large_field(path, name):
+    """Independent reading of a large-field DMIG matrix: the '*' lines after 'DMIG* name'."""
+    entries, column = {}, None
+    for line in Path(path).read_text().splitlines():
+        if line.startswith("DMIG*"):
+            column = (int(line[24:40]), int(line[40:56])) if line[8:24].strip() == name else None
+        elif line.startswith("*") and column is not None:
+            row = (int(line[8:24]), int(line[24:40]))
+            entries[(row, column)] = float(line[40:56].replace("D", "E"))
+        elif not line.startswith("*"):
+            column = None
+    labels = sorted({k for pair in entries for k in pair})
+    A = np.zeros((len(labels), len(labels)))
+    for (r, c), v in entries.items():
+        A[labels.index(r), labels.index(c)] = A[labels.index(c), labels.index(r)] = v
+    return A, labels
+
+
+def test_nastran_punch_dmig_matrices_and_their_eigenvalues():
+    """KAAX, MAAX of a Nastran EXTOUT,DMIGPCH punch (one triangle, large field, D exponents):
+    the reader gives the file's values (read here line by line) and the generalized
+    eigenvalues of the spring chain, node 101 clamped, equal scipy's on those values."""
+    fe = read_fe_matrices(DATA / "dmig.pch")
+    assert fe.names == ("MAAX", "KAAX")
+    K, k_labels = raw_dmig_large_field(DATA / "dmig.pch", "KAAX")
+    M, m_labels = raw_dmig_large_field(DATA / "dmig.pch", "MAAX")
+    assert k_labels == m_labels == [tuple(lab) for lab in fe.labels.tolist()]
+    np.testing.assert_array_equal(fe.stiffness.toarray(), K)
+    np.testing.assert_array_equal(fe.mass.toarray(), M)
+    free = fe.row_indices("free", [(n, (1,)) for n in (102, 105, 106, 107, 108, 109, 201, 301, 302, 305,
+                                                     306, 307, 308, 309)])
+    lam_file = scipy.linalg.eigh(K[np.ix_(free, free)], M[np.ix_(free, free)], eigvals_only=True)
+    lam = scipy.linalg.eigh(fe.stiffness.toarray()[np.ix_(free, free)], fe.mass.toarray()[np.ix_(free, free)],
+                            eigvals_only=True)
+    np.testing.assert_array_equal(lam, lam_file)
+    assert lam.min() > 0                                   # clamping node 101 removes the rigid mode
+
+
+def test_nastran_craig_bampton_output4_blade():
+    """External superelement KAA, MAA (Nastran EXTSEOUT, text OUTPUT4, 12 boundary grids x 6 DOF,
+    then 33 fixed-interface modal coordinates). With every boundary grid clamped the modal block
+    is M = I, K = diag(omega_j^2): the fixed-interface frequencies. Freeing grid 1 (rows 1-6) and
+    reading it as OL, OR, tip and excitation gives a blade whose frequencies are scipy's on the
+    same rows and, by Rayleigh's interlacing theorem, lie below the fixed-interface ones."""
+    fe = read_fe_matrices(DATA / "se_test_n11.op4")
+    assert fe.names == ("MAA", "KAA") and fe.labels is None and fe.n == 105
+    M, K = fe.mass.toarray(), fe.stiffness.toarray()
+    np.testing.assert_allclose(M[72:, 72:], np.eye(33), atol=1e-12)
+    k_mm = K[72:, 72:]
+    off = k_mm - np.diag(np.diag(k_mm))
+    assert np.abs(off).max() <= 1e-11 * np.diag(k_mm).max()      # diagonal to Nastran's rounding
+    fixed_interface_hz = np.sqrt(np.diag(k_mm)) / (2 * np.pi)
+    lam_mm = scipy.linalg.eigh(k_mm, M[72:, 72:], eigvals_only=True)
+    # Weyl: the rounding-level off-diagonal part E moves each eigenvalue by at most ||E||_2 (plus M - I)
+    bound = np.linalg.norm(off, 2) + np.abs(M[72:, 72:] - np.eye(33)).sum() * np.diag(k_mm).max()
+    assert np.abs(lam_mm - np.sort(np.diag(k_mm))).max() <= bound
+
+    points = {p: (0.0, 0.0, 0.0) for p in ("OL", "OR", "tip", "excitation")}
+    blade = ModalBlade.from_file(DATA / "se_test_n11.op4", dof_map={p: range(1, 7) for p in points}, points=points,
+                                 n_modes=8, damping_ratios=0.01, fixed_dofs=range(7, 73))
+    free = np.r_[0:6, 72:105]
+    lam = scipy.linalg.eigh(K[np.ix_(free, free)], M[np.ix_(free, free)], eigvals_only=True)
+    np.testing.assert_allclose(blade.natural_frequencies_hz, np.sqrt(lam[:8]) / (2 * np.pi), rtol=1e-9)
+    # Cauchy interlacing, 6 DOF added to the 33 modal ones: f_k <= f_k(clamped) <= f_(k+6)
+    clamped = np.sqrt(lam_mm) / (2 * np.pi)
+    assert np.all(blade.natural_frequencies_hz <= clamped[:8] * (1 + 1e-12))
+    assert np.all(blade.natural_frequencies_hz[6:] >= clamped[:2] * (1 - 1e-12))
+
+
+def test_abaqus_matrix_generate_beam_blade():
+    """Abaqus *MATRIX GENERATE of one B33 beam element (nodes 1, 2 and internal node -1;
+    MATRIX INPUT lines, lower triangle): the file's values land at (node, DOF) and the blade
+    clamped at node 1 has scipy's frequencies on the values read here with numpy."""
+    fe = read_fe_matrices(DATA / "model_STIF1.mtx")
+    assert fe.names == ("model_MASS1.mtx", "model_STIF1.mtx")
+    labels = [tuple(lab) for lab in fe.labels.tolist()]
+    assert labels == [(-1, 1), (-1, 2)] + [(n, d) for n in (1, 2) for d in range(1, 7)]
+    raw = {}
+    for which in ("MASS", "STIF"):
+        A = np.zeros((14, 14))
+        for a, b, c, d, v in np.loadtxt(DATA / f"model_{which}1.mtx", delimiter=","):
+            i, j = labels.index((int(a), int(b))), labels.index((int(c), int(d)))
+            A[i, j] = A[j, i] = v
+        raw[which] = A
+    np.testing.assert_array_equal(fe.mass.toarray(), raw["MASS"])
+    np.testing.assert_array_equal(fe.stiffness.toarray(), raw["STIF"])
+
+    points = {p: (0.0, 0.0, 3.0) for p in ("OL", "OR", "tip", "excitation")}
+    blade = ModalBlade.from_file(DATA / "model_MASS1.mtx", dof_map={p: 2 for p in points}, points=points,
+                                 n_modes=6, damping_ratios=0.0, fixed_dofs=[1])
+    free = [labels.index(lab) for lab in labels if lab[0] != 1]
+    lam = scipy.linalg.eigh(raw["STIF"][np.ix_(free, free)], raw["MASS"][np.ix_(free, free)], eigvals_only=True)
+    np.testing.assert_allclose(blade.natural_frequencies_hz, np.sqrt(lam[:6]) / (2 * np.pi), rtol=1e-9)
+
+
+def test_matlab_v5_file_from_tmdsimpy():
+    """tmdsimpy's 3-DOF test system (MATLAB 5.0 MAT-file): M and K as MATLAB wrote them."""
+    data = scipy.io.loadmat(DATA / "duffing_3DOF.mat")
+    fe = read_fe_matrices(DATA / "duffing_3DOF.mat")
+    assert fe.names == ("M", "K") and fe.labels is None
+    np.testing.assert_array_equal(fe.mass.toarray(), data["M"])
+    np.testing.assert_array_equal(fe.stiffness.toarray(), data["K"])
+
+
+# ---------------------------------------------------------------------------------------
+# the reference blade's matrices written in every format
+# ---------------------------------------------------------------------------------------
+def reference_matrices():
+    g = reference_blade_geometry()
+    modes = beam_modes(g)
+    n = modes.mass.shape[0]
+    assert n == 6 * (modes.n_nodes - 1)                   # node k >= 1 at rows 6k-6 .. 6k-1
+    nodes = {"platform": modes.platform_node, "tip": modes.n_nodes - 1, "excitation": modes.n_nodes - 1}
+    points = {p: g.points()[p] for p in ("OL", "OR", "platform", "tip", "excitation")}
+    return modes.mass, modes.stiffness, nodes, points
+
+
+LINKS = {"OL": "platform", "OR": "platform"}
+
+
+def write_op4_text(path, matrices):
+    with open(path, "w") as fh:
+        for name, A in matrices.items():
+            n = A.shape[0]
+            fh.write(f"{n:8d}{n:8d}{6:8d}{2:8d}{name:<8s}1P,3E26.17\n")
+            for j in range(n):
+                col = A[:, j]
+                nz = np.flatnonzero(col)
+                if nz.size == 0:
+                    continue
+                lo, hi = nz[0], nz[-1] + 1
+                fh.write(f"{j + 1:8d}{lo + 1:8d}{hi - lo:8d}\n")
+                values = col[lo:hi]
+                for k in range(0, values.size, 3):
+                    fh.write("".join(f"{v:26.17E}" for v in values[k:k + 3]) + "\n")
+            fh.write(f"{n + 1:8d}{1:8d}{1:8d}\n{1.0:26.17E}\n")
+
+
+def write_op4_binary(path, matrices, order="<"):
+    def record(payload):
+        return struct.pack(order + "i", len(payload)) + payload + struct.pack(order + "i", len(payload))
+    out = b""
+    for name, A in matrices.items():
+        n = A.shape[0]
+        out += record(struct.pack(order + "4i", n, n, 6, 2) + f"{name:<8s}".encode())
+        for j in range(n):
+            words = b""                                   # sparse strings: IS = IROW + 65536 (L + 1)
+            nz = np.flatnonzero(A[:, j])
+            if nz.size == 0:
+                continue
+            runs = np.split(nz, np.flatnonzero(np.diff(nz) > 1) + 1)
+            for run in runs:
+                words += struct.pack(order + "i", int(run[0]) + 1 + 65536 * (2 * run.size + 1))
+                words += A[run, j].astype(order + "f8").tobytes()
+            out += record(struct.pack(order + "3i", j + 1, 0, len(words) // 4) + words)
+        out += record(struct.pack(order + "3i", n + 1, 1, 2) + np.float64(1.0).astype(order + "f8").tobytes())
+    Path(path).write_bytes(out)
+
+
+def write_dmig(path, matrices):
+    """Free-field DMIG (full 17-digit values), upper triangle (IFO = 6), node k >= 1 with
+    components 1-6 at rows 6k-6 .. 6k-1."""
+    lines = []
+    for name, A in matrices.items():
+        n = A.shape[0]
+        lines.append(f"DMIG,{name},0,6,2,0,,,{n}")
+        for j in range(n):
+            rows = np.flatnonzero(A[: j + 1, j])
+            if rows.size == 0:
+                continue
+            lines.append(f"DMIG,{name},{j // 6 + 1},{j % 6 + 1},")
+            lines += [f"+,{i // 6 + 1},{i % 6 + 1},{float(A[i, j])!r}," for i in rows]
+    Path(path).write_text("\n".join(lines) + "\n")
+
+
+def write_abaqus(path_stif, path_mass, M, K):
+    for path, A in ((path_stif, K), (path_mass, M)):
+        rows, cols = np.nonzero(np.tril(A))
+        Path(path).write_text("".join(f"{i // 6 + 1},{i % 6 + 1}, {j // 6 + 1},{j % 6 + 1}, {float(A[i, j])!r}\n"
+                                      for i, j in zip(rows, cols)))
+
+
+def write_matlab_v73(path, matrices):
+    import h5py
+    with h5py.File(path, "w", userblock_size=512) as f:
+        for name, A in matrices.items():
+            f.create_dataset(name, data=A.T)
+            f[name].attrs["MATLAB_class"] = np.bytes_("double")
+    with open(path, "r+b") as fh:                          # MATLAB's 128-byte text header
+        fh.write(b"MATLAB 7.3 MAT-file, written by the bladedamp tests".ljust(116) + b"\x00" * 8 + b"\x00\x02IM")
+
+
+@pytest.mark.parametrize("fmt", ["op4-text", "op4-binary-le", "op4-binary-be", "dmig", "abaqus", "mat-v5", "mat-v73"])
+def test_reference_blade_matrices_in_every_format_give_the_same_frf(tmp_path, fmt):
+    M, K, nodes, points = reference_matrices()
+    direct = ModalBlade.from_matrices(M, K, {p: range(6 * k - 6, 6 * k) for p, k in nodes.items()}, points=points,
+                                      n_modes=4, damping_ratios=0.002, rigid_links=LINKS)
+    labelled = fmt in ("dmig", "abaqus")
+    dof_map = {p: (k if labelled else range(6 * k - 5, 6 * k + 1)) for p, k in nodes.items()}
+    if fmt == "op4-text":
+        path = tmp_path / "blade.op4"
+        write_op4_text(path, {"KAA": K, "MAA": M})
+    elif fmt.startswith("op4-binary"):
+        path = tmp_path / "blade.op4"
+        write_op4_binary(path, {"KAA": K, "MAA": M}, "<" if fmt.endswith("le") else ">")
+    elif fmt == "dmig":
+        path = tmp_path / "blade.pch"
+        write_dmig(path, {"KAAX": K, "MAAX": M})
+    elif fmt == "abaqus":
+        path = tmp_path / "blade_STIF1.mtx"
+        write_abaqus(path, tmp_path / "blade_MASS1.mtx", M, K)
+    elif fmt == "mat-v5":
+        path = tmp_path / "blade.mat"
+        scipy.io.savemat(path, {"M": M, "K": K})
+    else:
+        pytest.importorskip("h5py")
+        path = tmp_path / "blade.mat"
+        write_matlab_v73(path, {"M": M, "K": K})
+    blade = ModalBlade.from_file(path, dof_map=dof_map, points=points, n_modes=4, damping_ratios=0.002,
+                                 rigid_links=LINKS)
+    f = np.linspace(50.0, 2000.0, 400)
+    force = np.array([1.0, 0.5, 0, 0, 0, 0.01])
+    a, b = blade.linear_frf(f, force), direct.linear_frf(f, force)
+    assert np.abs(a - b).max() <= 1e-10 * np.abs(b).max()
+    for p in ("OL", "OR", "tip"):
+        b_frf = direct.linear_frf(f, force, response_at=p)
+        assert np.abs(blade.linear_frf(f, force, response_at=p) - b_frf).max() <= 1e-10 * np.abs(b_frf).max()
+
+
+# ---------------------------------------------------------------------------------------
+# bad files: one ValueError naming the file, the place and what was expected
+# ---------------------------------------------------------------------------------------
+POINTS = {p: (0.0, 0.0, 0.0) for p in ("OL", "OR", "tip", "excitation")}
+
+
+def blade_args(dof_map):
+    return dict(dof_map=dof_map, points=POINTS, n_modes=2, damping_ratios=0.01)
+
+
+def test_truncated_text_output4(tmp_path):
+    lines = (DATA / "se_test_n11.op4").read_text().splitlines()
+    path = tmp_path / "cut.op4"
+    path.write_text("\n".join(lines[:500]) + "\n")
+    with pytest.raises(ValueError, match=r"cut\.op4: line 501: the file ends inside matrix KAA \(header at line 1\); expected \d+ more numbers"):
+        read_fe_matrices(path)
+
+
+def test_truncated_binary_output4(tmp_path):
+    data = (DATA / "mat_b_s2.op4").read_bytes()
+    path = tmp_path / "cut.op4"
+    path.write_bytes(data[:1000])
+    with pytest.raises(ValueError, match=r"cut\.op4: record \d+ \(byte \d+\): .*expected a complete Fortran"):
+        read_op4(path)
+
+
+def test_wrong_file_type(tmp_path):
+    path = tmp_path / "blade.op4"
+    path.write_text("mode,frequency_hz\n1,95\n")
+    with pytest.raises(ValueError, match=r"blade\.op4: line 1: expected a matrix header"):
+        read_fe_matrices(path)
+    path = tmp_path / "blade.pch"
+    path.write_text("GRID    1               0.      0.      0.\n")
+    with pytest.raises(ValueError, match=r"blade\.pch: no DMIG card found; expected"):
+        read_fe_matrices(path)
+    path = tmp_path / "blade_STIF1.mtx"
+    path.write_text("1, 1, 1.0\n1, 2\n")
+    with pytest.raises(ValueError, match=r"blade_STIF1\.mtx: line 2: 2 comma-separated fields; expected 3"):
+        read_fe_matrices(path, mass="blade_STIF1.mtx")
+    path = tmp_path / "blade.mat"
+    path.write_bytes(b"not a mat file at all" * 10)
+    with pytest.raises(ValueError, match=r"blade\.mat: not a readable MATLAB \.mat file"):
+        read_fe_matrices(path)
+
+
+def test_dof_map_naming_a_node_or_row_not_in_the_file():
+    with pytest.raises(ValueError, match=r"dmig\.pch: dof_map\['tip'\] names node 999 component 1, which is not "
+                                         r"in the file .*expected a node"):
+        ModalBlade.from_file(DATA / "dmig.pch", **blade_args({"OL": (101, (1,)), "OR": (101, (1,)), "tip": 999,
+                                                              "excitation": (101, (1,))}))
+    with pytest.raises(ValueError, match=r"dmig\.pch: dof_map\['OL'\] names node 101 component 2, which is not in "
+                                         r"the file \(node 101 has components \[1\]\)"):
+        ModalBlade.from_file(DATA / "dmig.pch", **blade_args({p: 101 for p in POINTS}))
+    with pytest.raises(ValueError, match=r"se_test_n11\.op4: dof_map\['tip'\] must be a sequence of row numbers "
+                                         r"in \[1, 105\]"):
+        ModalBlade.from_file(DATA / "se_test_n11.op4", **blade_args(dict({p: range(1, 7) for p in POINTS},
+                                                                         tip=range(101, 107))))
+    with pytest.raises(FileNotFoundError, match=r"absent_MASS1\.mtx: no such Abaqus matrix file \(the mass matrix beside"):
+        read_fe_matrices(DATA / "model_STIF1.mtx", mass="absent_MASS1.mtx")
+
+
+def test_unsymmetric_matrix_names_the_line(tmp_path):
+    text = (DATA / "model_STIF1.mtx").read_text()
+    path = tmp_path / "model_STIF1.mtx"
+    path.write_text(text + "-1,1, -1,2, -2.6e6\n")            # the transpose of line 2 (-2.5e6), disagreeing
+    (tmp_path / "model_MASS1.mtx").write_text((DATA / "model_MASS1.mtx").read_text())
+    with pytest.raises(ValueError, match=r"model_STIF1\.mtx: matrix model_STIF1\.mtx: line \d+: entry \(\d+, \d+\) = "
+                                         r".* but its transpose at line \d+ is .*expected a symmetric matrix"):
+        read_fe_matrices(path)
+
+
+def test_indefinite_matrices_name_the_row_or_the_matrices(tmp_path):
+    M, K, nodes, points = reference_matrices()
+    bad_m = M.copy()
+    bad_m[8, 8] = -1.0
+    path = tmp_path / "blade.pch"
+    write_dmig(path, {"KAAX": K, "MAAX": bad_m})
+    dof_map = dict(nodes)
+    with pytest.raises(ValueError, match=r"blade\.pch: mass matrix MAAX: row 9 \(node 2, component 3\) has M = -1; "
+                                         r"expected a positive diagonal"):
+        ModalBlade.from_file(path, dof_map=dof_map, points=points, n_modes=4, damping_ratios=0.0, rigid_links=LINKS)
+    bad_k = K - 2.0 * np.abs(K).max() * np.eye(K.shape[0])
+    write_dmig(path, {"KAAX": bad_k, "MAAX": M})
+    with pytest.raises(ValueError, match=r"blade\.pch: matrices MAAX \(mass\), KAAX \(stiffness\): stiffness must "
+                                         r"be positive semi-definite"):
+        ModalBlade.from_file(path, dof_map=dof_map, points=points, n_modes=4, damping_ratios=0.0, rigid_links=LINKS)
+
+
+def test_fe_options_need_an_fe_file_and_an_fe_file_needs_them(tmp_path):
+    with pytest.raises(ValueError, match=r"dmig\.pch: an FE matrix file needs \['points', 'n_modes', 'damping_ratios'\]"):
+        ModalBlade.from_file(DATA / "dmig.pch", dof_map={"OL": 101})
+    path = tmp_path / "blade.csv"
+    path.write_text("x\n")
+    with pytest.raises(ValueError, match=r"blade\.csv: \['dof_map'\] apply to FE matrix files only"):
+        ModalBlade.from_file(path, dof_map={"OL": 1})
+
+
+# ---------------------------------------------------------------------------------------
+# Ansys (the ansys extra)
+# ---------------------------------------------------------------------------------------
+def test_ansys_full_file_blade():
+    """The .full file of a hexahedral beam shipped with ansys-mapdl-reader (MIT; written by
+    Ansys): constrained DOF left out, rows labelled (node, 1-3), and the blade's frequencies are
+    the ones ansys-mapdl-reader publishes for this file (its examples.load_km, 8 decimals)."""
+    pytest.importorskip("ansys.mapdl.reader")
+    from ansys.mapdl.reader import examples
+    published_hz = [1283.20036921, 1283.20036921, 5781.97486169, 6919.39887714, 6919.39887714, 10172.61497694]
+    fe = read_fe_matrices(examples.fullfile)
+    assert fe.n == 900 and set(fe.labels[:, 1]) == {1, 2, 3}       # 321 nodes x 3, 21 nodes clamped
+    node = int(fe.labels[-1, 0])
+    with pytest.warns(UserWarning, match=r"dof_map\['O[LR]'\] has translations only"):   # OL and OR
+        blade = ModalBlade.from_file(examples.fullfile, dof_map={p: (node, (1, 2, 3)) for p in POINTS}, points=POINTS,
+                                     n_modes=6, damping_ratios=0.001)
+    np.testing.assert_allclose(blade.natural_frequencies_hz, published_hz, rtol=1e-9)
+    with pytest.raises(ValueError, match=r"file\.full: dof_map\['OL'\] names node 1 component 1, which is not in "
+                                         r"the file"):                 # node 1 is clamped
+        ModalBlade.from_file(examples.fullfile, **blade_args({p: (1, (1, 2, 3)) for p in POINTS}))
+
+
+def test_ansys_bad_file(tmp_path):
+    pytest.importorskip("ansys.mapdl.reader")
+    path = tmp_path / "blade.full"
+    path.write_bytes((DATA / "mat_b_s2.op4").read_bytes())
+    with pytest.raises(ValueError, match=r"blade\.full: not a readable Ansys \.full file .*expected the \.full file"):
+        read_fe_matrices(path)
+
+
+def test_matrix_names_and_complex_or_rectangular_matrices(tmp_path):
+    with pytest.raises(ValueError, match=r"se_test_n11\.op4: no matrix named 'MHH' \(mass\); the file holds \['KAA'"):
+        read_fe_matrices(DATA / "se_test_n11.op4", mass="MHH")
+    with pytest.raises(ValueError, match=r"mat_t_s2\.op4: matrix RND1CD is complex; expected a real mass or "
+                                         r"stiffness matrix"):
+        read_fe_matrices(DATA / "mat_t_s2.op4", mass="RND1CD", stiffness="RND1RD")
+    with pytest.raises(ValueError, match=r"mat_t_s2\.op4: matrix STRINGS is 30 x 20; expected a square matrix"):
+        read_fe_matrices(DATA / "mat_t_s2.op4", mass="EYE10", stiffness="STRINGS")
+    with pytest.raises(ValueError, match=r"dmig\.pch: more than one mass matrix among the default names .*name it "
+                                         r"with mass="):
+        path = tmp_path / "dmig.pch"
+        path.write_text((DATA / "dmig.pch").read_text().replace("BAAX", "MAA "))
+        read_fe_matrices(path)
+
+
+def test_unsymmetric_full_storage_output4_names_the_line(tmp_path):
+    M, K, _, _ = reference_matrices()
+    bad = K.copy()
+    bad[3, 0] += 1e-3 * np.abs(K).max()
+    path = tmp_path / "blade.op4"
+    write_op4_text(path, {"KAA": bad, "MAA": M})
+    with pytest.raises(ValueError, match=r"blade\.op4: matrix KAA: line 2: entry \(4, 1\) = .* has no transposed "
+                                         r"entry \(1, 4\); expected a symmetric matrix"):   # K[0, 3] = 0
+        read_fe_matrices(path)
+    bad = K.copy()
+    bad[6, 0] *= 1.001                                         # both entries given, disagreeing
+    write_op4_text(path, {"KAA": bad, "MAA": M})
+    with pytest.raises(ValueError, match=r"blade\.op4: matrix KAA: line \d+: entry \((7, 1|1, 7)\) = .* but its "
+                                         r"transpose at line \d+ is .*expected a symmetric matrix"):
+        read_fe_matrices(path)
+
+
+def test_abaqus_d_exponents_and_a_bad_line(tmp_path):
+    """The numpy fast path falls back to the line-by-line reading, which reads Fortran D
+    exponents and names a bad line."""
+    for which in ("STIF", "MASS"):
+        text = (DATA / f"model_{which}1.mtx").read_text().replace("e+", "D+").replace("e-", "D-")
+        (tmp_path / f"model_{which}1.mtx").write_text(text)
+    fe, ref = read_fe_matrices(tmp_path / "model_STIF1.mtx"), read_fe_matrices(DATA / "model_STIF1.mtx")
+    np.testing.assert_array_equal(fe.stiffness.toarray(), ref.stiffness.toarray())
+    lines = (DATA / "model_MASS1.mtx").read_text().splitlines()
+    lines[6] = "1,1, -1,x, 1.0"
+    (tmp_path / "model_MASS1.mtx").write_text("\n".join(lines) + "\n")
+    with pytest.raises(ValueError, match=r"model_MASS1\.mtx: line 7: expected node, dof, node, dof, value"):
+        read_fe_matrices(tmp_path / "model_STIF1.mtx")
+
+
+def test_dmig_cards_in_a_punch_file_with_result_sections(tmp_path):
+    """A punch file also holding result output (a $ header, then data lines) reads the DMIG
+    cards only."""
+    results = ("$TITLE   = \n$DISPLACEMENTS\n$REAL OUTPUT\n"
+               "         1       G      0.000000E+00      0.000000E+00      0.000000E+00       7\n"
+               "-CONT-                  0.000000E+00      0.000000E+00      0.000000E+00       8\n")
+    path = tmp_path / "mixed.pch"
+    path.write_text(results + (DATA / "dmig.pch").read_text() + results)
+    fe, ref = read_fe_matrices(path), read_fe_matrices(DATA / "dmig.pch")
+    np.testing.assert_array_equal(fe.stiffness.toarray(), ref.stiffness.toarray())
+    np.testing.assert_array_equal(fe.labels, ref.labels)
+
+
+def test_matlab_v73_sparse_matrices(tmp_path):
+    """MATLAB v7.3 stores a sparse matrix as a group (data, ir, jc; attribute MATLAB_sparse =
+    number of rows), compressed by columns."""
+    h5py = pytest.importorskip("h5py")
+    M, K, nodes, points = reference_matrices()
+    path = tmp_path / "blade.mat"
+    with h5py.File(path, "w", userblock_size=512) as f:
+        for name, A in (("MAA", M), ("KAA", K)):
+            C = scipy.sparse.csc_matrix(A)
+            g = f.create_group(name)
+            g.attrs["MATLAB_class"] = np.bytes_("double")
+            g.attrs["MATLAB_sparse"] = np.uint64(A.shape[0])
+            g["data"], g["ir"], g["jc"] = C.data, C.indices.astype(np.uint64), C.indptr.astype(np.uint64)
+    fe = read_fe_matrices(path)
+    assert fe.names == ("MAA", "KAA")
+    np.testing.assert_array_equal(fe.stiffness.toarray(), K)
+    np.testing.assert_array_equal(fe.mass.toarray(), M)
+
+
+def test_a_matrix_name_written_twice_is_read_as_name_2(tmp_path):
+    M, K, _, _ = reference_matrices()
+    write_op4_text(tmp_path / "a.op4", {"KAA": K, "MAA": M})
+    write_op4_text(tmp_path / "b.op4", {"KAA": 2.0 * K})
+    path = tmp_path / "both.op4"
+    path.write_text((tmp_path / "a.op4").read_text() + (tmp_path / "b.op4").read_text())
+    assert sorted(read_op4(path)) == ["KAA", "KAA#2", "MAA"]
+    np.testing.assert_array_equal(read_fe_matrices(path).stiffness.toarray(), K)
+    np.testing.assert_array_equal(read_fe_matrices(path, stiffness="KAA#2").stiffness.toarray(), 2.0 * K)
+
+
+# ---------------------------------------------------------------------------------------
+# the design file: [blade] modal_file with [blade.fe]
+# ---------------------------------------------------------------------------------------
+FE_DESIGN = """[blade]
+modal_file = "{file}"
+n_modes = 4
+damping_ratio = 0.002
+
+[blade.fe]
+fixed_rows = {fixed}
+
+[blade.fe.platform]
+rows = [1, 2, 3, 4, 5, 6]
+position_mm = [0.0, 0.0, 50.0]
+
+[blade.fe.OL]
+link = "platform"
+position_mm = [-12.0, 0.0, 50.0]
+
+[blade.fe.OR]
+link = "platform"
+position_mm = [12.0, 0.0, 50.0]
+
+[blade.fe.tip]
+rows = [1, 2, 3, 4, 5, 6]
+position_mm = [0.0, 0.0, 80.0]
+
+[blade.fe.excitation]
+rows = [1, 2, 3, 4, 5, 6]
+position_mm = [0.0, 0.0, 80.0]
+"""
+
+
+def write_fe_design(tmp_path, text=None):
+    (tmp_path / "se.op4").write_bytes((DATA / "se_test_n11.op4").read_bytes())
+    path = tmp_path / "design.toml"
+    path.write_text(text if text is not None else FE_DESIGN.format(file="se.op4", fixed=list(range(7, 73))))
+    return path
+
+
+def test_design_file_fe_blade_is_from_file_with_the_same_arguments(tmp_path):
+    from bladedamp.design import load_design
+    design = load_design(write_fe_design(tmp_path))
+    points = {"platform": (0, 0, 0.05), "OL": (-0.012, 0, 0.05), "OR": (0.012, 0, 0.05), "tip": (0, 0, 0.08),
+              "excitation": (0, 0, 0.08)}
+    blade = ModalBlade.from_file(DATA / "se_test_n11.op4", dof_map={p: range(1, 7) for p in ("platform", "tip",
+                                                                                          "excitation")},
+                                 points=points, n_modes=4, damping_ratios=0.002, fixed_dofs=range(7, 73),
+                                 rigid_links={"OL": "platform", "OR": "platform"})
+    got = design.disk.blade
+    np.testing.assert_array_equal(got.natural_frequencies_hz, blade.natural_frequencies_hz)
+    np.testing.assert_array_equal(got.damping_ratios, blade.damping_ratios)
+    for p in points:
+        np.testing.assert_array_equal(got.mode_shapes[p], blade.mode_shapes[p])
+        np.testing.assert_allclose(got.points[p], blade.points[p], rtol=1e-15)
+
+
+@pytest.mark.parametrize("edit, expected", [
+    (lambda t: t.replace('[blade.fe.tip]\nrows = [1, 2, 3, 4, 5, 6]\n', '[blade.fe.tip]\n'),
+     r"\[blade\.fe\.tip\] needs exactly one of node, rows or link \(got none\)"),
+    (lambda t: t.replace('link = "platform"\nposition_mm = [-12.0', 'link = "platform"\nrows = [1]\nposition_mm = [-12.0'),
+     r"\[blade\.fe\.OL\] needs exactly one of node, rows or link \(got rows, link\)"),
+    (lambda t: t.replace('rows = [1, 2, 3, 4, 5, 6]\nposition_mm = [0.0, 0.0, 80.0]\n\n[blade.fe.excitation]',
+                         'rows = [101, 102, 103, 104, 105, 106]\nposition_mm = [0.0, 0.0, 80.0]\n\n[blade.fe.excitation]'),
+     r"modal_file = \"se\.op4\": .*se\.op4: dof_map\['tip'\] must be a sequence of row numbers in \[1, 105\]"),
+    (lambda t: t.replace('modal_file = "se.op4"', 'modal_file = "blade.npz"'),
+     r"\[blade\.fe\] fixed_rows applies to an FE matrix file as \[blade\] modal_file"),
+])
+def test_design_file_fe_blade_errors_are_one_line_naming_the_key(tmp_path, edit, expected):
+    from bladedamp.design import DesignError, load_design
+    text = edit(FE_DESIGN.format(file="se.op4", fixed=list(range(7, 73))))
+    with pytest.raises(DesignError, match=expected) as info:
+        load_design(write_fe_design(tmp_path, text))
+    assert "\n" not in str(info.value)
+
+
+def test_cli_fe_blade_error_is_one_line_with_exit_code_2(tmp_path):
+    import os
+    import subprocess
+    import sys
+    text = FE_DESIGN.format(file="se.op4", fixed=list(range(7, 73))).replace(
+        '[blade.fe.tip]\nrows = [1, 2, 3, 4, 5, 6]', '[blade.fe.tip]\nnode = 5')
+    path = write_fe_design(tmp_path, text)
+    env = dict(os.environ, PYTHONPATH=str(Path(__file__).parents[1]))
+    run = subprocess.run([sys.executable, "-m", "bladedamp.cli", "frf", str(path), "--out", str(tmp_path / "out")],
+                         capture_output=True, text=True, env=env, timeout=120)
+    assert run.returncode == 2
+    lines = run.stderr.strip().splitlines()
+    assert len(lines) == 1 and "se.op4" in lines[0] and "row numbers" in lines[0], run.stderr
+
+
+@pytest.mark.parametrize("suffix", ["op4", "pch", "mtx", "mat"])
+def test_missing_empty_or_folder_fe_files_are_one_file_read_error(tmp_path, suffix):
+    from bladedamp.io import FileReadError, MissingFileError
+    with pytest.raises(MissingFileError, match=rf"none_STIF1\.{suffix}: no such finite-element matrix file"):
+        read_fe_matrices(tmp_path / f"none_STIF1.{suffix}")
+    (tmp_path / f"empty_STIF1.{suffix}").write_bytes(b"")
+    (tmp_path / f"empty_MASS1.{suffix}").write_bytes(b"")
+    with pytest.raises(FileReadError, match=rf"empty_STIF1\.{suffix}: .*(empty|no matrix|no DMIG|not a readable)"):
+        read_fe_matrices(tmp_path / f"empty_STIF1.{suffix}")
+    (tmp_path / f"dir.{suffix}").mkdir()
+    with pytest.raises(FileReadError, match=rf"dir\.{suffix}: is a folder, not a finite-element matrix file"):
+        read_fe_matrices(tmp_path / f"dir.{suffix}")

@@ -1,0 +1,260 @@
+"""The typed status of every frequency response (bladedamp.response.Status), derived from the
+fields a result has, and the flag of a largest amplitude at an end of the range
+(``peak_at_range_end``) with the linear systems' estimate of where the resonance lies."""
+import dataclasses
+import inspect
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import bladedamp as bd
+from bladedamp.mistuned import MistunedResponse
+from bladedamp.response import (STATUS_EXPLANATIONS, Status, range_end_of_largest, response_status,
+                                with_checks)
+
+DATA = Path(__file__).parent / "data"
+
+
+def oscillator_response(**options):
+    """The default friction oscillator over 12-20 Hz, one harmonic (its resonance, near 16-17 Hz,
+    lies inside): 0.1 s once compiled."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return bd.FrictionOscillator().frequency_response(12.0, 20.0, harmonics=(1,), **options)
+
+
+@pytest.fixture(scope="module")
+def complete():
+    return oscillator_response()
+
+
+# ----- one status for each case, from real solves ------------------------------------------
+def test_a_complete_branch_with_its_error_within_the_tolerance_is_verified(complete):
+    r = complete
+    assert r.reached_range_end and not r.failed_checks and np.isfinite(r.harmonic_error)
+    assert r.harmonic_error <= r.harmonic_tolerance
+    assert r.status is Status.COMPLETE_VERIFIED and r.success and not r.peak_at_range_end
+    assert r.status_message.startswith("complete, verified: harmonic error estimate")
+    assert "range end" not in r.status_message
+
+
+def test_a_complete_branch_with_its_error_above_the_tolerance_is_said_so():
+    # the same branch held to a tolerance below its estimate (about 3e-4: the one-harmonic
+    # oscillator's error against richer sets)
+    r = oscillator_response(harmonic_tolerance=1e-6)
+    assert r.harmonic_error > 1e-6 and r.harmonics_converged is False
+    assert r.status is Status.COMPLETE_ABOVE_TOLERANCE and r.success        # success keeps its meaning
+    assert r.status_message.startswith("complete, above tolerance: harmonic error estimate")
+    assert "above the tolerance 0.0001 %" in r.status_message
+
+
+def test_a_complete_branch_without_an_estimate_is_unverified():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = bd.reference_disk().frequency_response(92.0, 99.0, harmonics=(1,), max_step=0.05,
+                                                   estimate_harmonic_error=False)
+    assert r.success and r.harmonics_converged is None and np.isnan(r.harmonic_error)
+    assert r.status is Status.COMPLETE_UNVERIFIED and not r.peak_at_range_end
+    assert "harmonic error not estimated" in r.status_message and "harmonics='auto'" in r.status_message
+
+
+def test_an_estimate_the_enriched_solve_could_not_verify_is_unverified(complete):
+    # what annotate records when the enriched set's Newton fails at the peak: NaN, not converged
+    r = dataclasses.replace(complete, harmonic_error=float("nan"), harmonics_converged=False)
+    assert r.status is Status.COMPLETE_UNVERIFIED and r.success
+    assert "harmonic error not verified" in r.status_message
+
+
+def test_a_complete_branch_that_failed_a_physical_check_is_not_complete(complete):
+    r = with_checks(complete, {"dissipation": "negative friction dissipation at 3 points"})
+    assert r.reached_range_end and not r.success
+    assert r.status is Status.CHECK_FAILED and not r.status.complete
+    assert "dissipation: negative friction dissipation at 3 points" in r.status_message
+
+
+def test_a_branch_stopped_by_the_callers_condition_is_stopped_with_its_reason():
+    def stop_when(x, omega):
+        return "stopped above 14 Hz" if omega > 2 * np.pi * 14.0 else ""
+    r = oscillator_response(stop_when=stop_when)
+    assert r.stopped_by == "stopped above 14 Hz" and not r.success
+    assert r.status is Status.STOPPED
+    assert r.status_message.startswith("stopped: stopped above 14 Hz;")
+
+
+def test_a_branch_that_runs_out_of_points_is_stopped():
+    r = oscillator_response(max_points=5)
+    assert not r.reached_range_end and not r.stopped_by
+    assert r.status is Status.STOPPED and not r.success
+
+
+def test_a_budget_stop_is_out_of_budget():
+    count = []
+
+    def budget(x, omega):                 # as a budget would: a stop whose reason starts with "budget"
+        count.append(omega)
+        return "budget: 20 points used" if len(count) >= 20 else ""
+    r = oscillator_response(stop_when=budget)
+    assert r.stopped_by.startswith("budget") and not r.success and len(r.omega) == 20
+    assert r.status is Status.OUT_OF_BUDGET
+    assert r.status_message.startswith("out of budget: budget: 20 points used;")
+
+
+def test_an_empty_branch_is_stopped(complete):
+    empty = dataclasses.replace(complete, omega=complete.omega[:0], coefficients=complete.coefficients[:0],
+                                success=False, reached_end=False)
+    assert empty.status is Status.STOPPED and not empty.peak_at_range_end
+
+
+# ----- the derivation ---------------------------------------------------------------------
+@pytest.mark.parametrize("fields, expected", [
+    (dict(success=True, harmonic_error=0.005, harmonic_tolerance=0.01), Status.COMPLETE_VERIFIED),
+    (dict(success=True, harmonic_error=0.01, harmonic_tolerance=0.01), Status.COMPLETE_VERIFIED),
+    (dict(success=True, harmonic_error=0.02, harmonic_tolerance=0.01), Status.COMPLETE_ABOVE_TOLERANCE),
+    (dict(success=True, harmonic_error=float("nan"), harmonic_tolerance=0.01), Status.COMPLETE_UNVERIFIED),
+    (dict(success=True, harmonic_error=0.005, harmonic_tolerance=float("nan")), Status.COMPLETE_UNVERIFIED),
+    (dict(success=False, reached_end=True, failed_checks={"step": "x"}), Status.CHECK_FAILED),
+    (dict(success=False, reached_end=None), Status.STOPPED),
+    (dict(success=False, reached_end=False, failed_checks={"dissipation": "x"}), Status.STOPPED),
+    (dict(success=False, stopped_by="peak above 0.1 mm"), Status.STOPPED),
+    (dict(success=False, stopped_by="budget: 120 CPU s"), Status.OUT_OF_BUDGET),
+])
+def test_the_status_follows_from_the_fields(complete, fields, expected):
+    r = dataclasses.replace(complete, **fields)
+    assert response_status(r) is expected and r.status is expected
+    assert r.status.complete == r.success                     # success is exactly the complete statuses
+    assert r.status_message.startswith(expected.value + ": ") and expected.explanation in r.status_message
+
+
+def test_every_status_explains_itself_in_one_sentence():
+    assert set(STATUS_EXPLANATIONS) == set(Status)
+    texts = [s.explanation for s in Status]
+    assert len(set(texts)) == len(texts)
+    assert all(t and "." not in t.replace("e.g.", "") and "\n" not in t for t in texts)
+    assert all(any(w in t for w in ("run", "raise", "shorten", "check", "trusted", "holds")) for t in texts)
+    assert bd.Status is Status
+
+
+@pytest.mark.parametrize("cls", [bd.FrequencyResponse, bd.DiskResponse, MistunedResponse], ids=lambda c: c.__name__)
+def test_every_response_has_the_status_and_the_range_end_flag(cls):
+    for name in ("status", "status_message", "peak_at_range_end"):
+        assert isinstance(inspect.getattr_static(cls, name), property), (cls, name)
+    assert "linear_natural_frequencies_hz" in {f.name for f in dataclasses.fields(cls)}
+
+
+# ----- saved results ------------------------------------------------------------------------
+def test_results_saved_before_the_status_load_with_one():
+    """Files written by bladedamp before the status and the range-end flag existed (main 427345c):
+    an oscillator over 12-20 Hz (harmonics (1,)) and the 1 kg cylinder disk over 90-105 Hz."""
+    old = bd.load(DATA / "oscillator_response_v1.npz")
+    assert old.linear_natural_frequencies_hz == ()
+    assert old.status is Status.COMPLETE_VERIFIED and not old.peak_at_range_end
+    disk = bd.load(DATA / "disk_response_v1.npz")
+    assert disk.status is Status.COMPLETE_VERIFIED and disk.peak_at_range_end
+    # the estimate of where needs the model, which the file does not hold: the side is still said
+    assert "largest amplitude is at the end of the computed range (105 Hz)" in disk.status_message
+    assert "may lie above the range" in disk.status_message and "stuck" not in disk.status_message
+
+
+def test_save_and_load_keep_the_status_and_the_estimate(tmp_path):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = bd.FrictionOscillator().frequency_response(12.0, 14.0, harmonics=(1,))
+    loaded = bd.load(r.save(tmp_path / "r"))
+    assert loaded.linear_natural_frequencies_hz == r.linear_natural_frequencies_hz and len(r.linear_natural_frequencies_hz) == 2
+    assert loaded.status is r.status and loaded.status_message == r.status_message and loaded.peak_at_range_end
+
+
+# ----- the largest amplitude at an end of the range -------------------------------------------
+def test_range_end_of_largest_on_known_curves():
+    f = np.linspace(90.0, 105.0, 31)
+    assert range_end_of_largest(f, np.exp(-(f - 97.0) ** 2)) is None            # a peak inside
+    assert range_end_of_largest(f, f) == 105.0                                   # rising to the end
+    assert range_end_of_largest(f, 200.0 - f) == 90.0                            # falling from the start
+    assert range_end_of_largest(f[::-1], f[::-1]) == 105.0                       # a downward sweep
+    flat = np.where(f > 100.0, 1.0, 0.5)
+    flat[-2] = 1.0 + 1e-10                                                       # a flat top: unresolved
+    assert range_end_of_largest(f, flat) == 105.0
+    flat[-2] = 1.0 + 1e-6
+    assert range_end_of_largest(f, flat) is None
+    # a fold: the branch goes back before the end, its largest at the end's frequency
+    folded = np.array([90.0, 95.0, 100.0, 105.0, 104.0, 105.0])
+    assert range_end_of_largest(folded, [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]) == 105.0
+    # several curves (blades): any curve whose largest lies at an end
+    two = np.stack([np.exp(-(f - 97.0) ** 2), 0.1 * f], axis=1)
+    assert range_end_of_largest(f, two) == 105.0
+    assert range_end_of_largest(f[:0], f[:0]) is None
+
+
+def test_a_oscillator_peak_beyond_the_range_is_flagged_and_bracketed():
+    """The oscillator's resonance lies between its linear frequencies without the contact and with
+    it stuck, sqrt(k / m) and sqrt((k + k_T) / m); over 12-14 Hz the curve still rises at 14 Hz."""
+    osc = bd.FrictionOscillator()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        short = osc.frequency_response(12.0, 14.0, harmonics=(1,))
+        wide = osc.frequency_response(12.0, 26.0, harmonics=(1,))
+    free, stuck = short.linear_natural_frequencies_hz
+    assert free == pytest.approx(np.sqrt(1e4 / 1.0) / (2 * np.pi), rel=1e-14)
+    assert stuck == pytest.approx(np.sqrt(2e4 / 1.0) / (2 * np.pi), rel=1e-14)
+    assert short.peak_at_range_end and short.status is Status.COMPLETE_VERIFIED
+    assert not wide.peak_at_range_end and wide.linear_natural_frequencies_hz == ()
+    assert 14.0 < wide.peak_frequency_hz and free < wide.peak_frequency_hz < stuck
+    for text in (short.message, short.status_message):
+        assert "end of the computed range (14 Hz), not a resonance: the resonance may lie above the range" in text
+        assert f"({free:.6g} Hz) and with them stuck ({stuck:.6g} Hz)" in text
+
+
+@pytest.fixture(scope="module")
+def heavy_cylinder():
+    """The reference disk with a 1 kg cylinder (implausible on purpose: it sticks, and its
+    resonance moves from 95 Hz to 109.65 Hz, out of the usual range)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return bd.reference_disk("cylinder", 1.0)
+
+
+def test_a_disk_peak_beyond_the_range_is_flagged_and_bracketed(heavy_cylinder):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        short = heavy_cylinder.frequency_response(90.0, 105.0)
+        beyond = heavy_cylinder.frequency_response(105.0, 115.0)
+    assert short.success and short.peak_at_range_end and short.peak_frequency_hz == pytest.approx(105.0, abs=1e-9)
+    # the true resonance, solved on the branch by the peak condition: 1.603 mm at 109.65 Hz
+    amplitude, f_res = heavy_cylinder.solve_peak(beyond)
+    assert not beyond.peak_at_range_end
+    assert 1e3 * amplitude == pytest.approx(1.603, abs=5e-4) and f_res == pytest.approx(109.65, abs=5e-3)
+    free, stuck = short.linear_natural_frequencies_hz
+    assert free == pytest.approx(95.0, rel=1e-9)             # the blade's 1F (Table 1) without dampers
+    assert free <= f_res <= stuck                             # friction softens: at most the stuck frequency
+    assert stuck - f_res < 0.01                               # a 1 kg damper nearly sticks
+    for text in (short.message, short.status_message):
+        assert "end of the computed range (105 Hz), not a resonance: the resonance may lie above the range" in text
+        assert f"({free:.6g} Hz) and with them stuck ({stuck:.6g} Hz)" in text
+
+
+def test_the_reference_disk_over_its_range_is_not_flagged():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = bd.reference_disk().frequency_response(92.0, 99.0, harmonics=(1,), max_step=0.05)
+    assert r.success and not r.peak_at_range_end and r.linear_natural_frequencies_hz == ()
+    assert "range end" not in r.status_message and "range end" not in r.message
+
+
+def test_a_mistuned_response_has_a_status_a_stop_reason_and_one_range_end_flag():
+    """Four blades, 1 g cylinders, 2 % mistuning: over 92-99 Hz every blade's peak lies inside
+    (tests/test_api.py); stopped by the caller at 95 Hz the curves still rise at the stop."""
+    td = dataclasses.replace(bd.reference_disk("cylinder", 1e-3), n_blades=4)
+    disk = bd.MistunedDisk.from_tuned(td, [1.01, 0.99, 1.02, 1.0])
+
+    def stop_when(x, omega):
+        return "budget: stopped at 95 Hz" if omega > 2 * np.pi * 95.0 else ""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        full = disk.frequency_response(92.0, 99.0, harmonics=(1,), max_step=0.1)
+        part = disk.frequency_response(92.0, 99.0, harmonics=(1,), max_step=0.1, stop_when=stop_when)
+    assert full.status is Status.COMPLETE_VERIFIED and full.peak_at_range_end is False
+    assert part.stopped_by == "budget: stopped at 95 Hz" and part.status is Status.OUT_OF_BUDGET
+    assert part.peak_at_range_end is True and part.linear_natural_frequencies_hz == ()
+    assert "end of the computed range (95" in part.status_message
