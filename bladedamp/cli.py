@@ -553,6 +553,8 @@ def precompile_command(args) -> int:
 
 def frf_command(args) -> int:
     """``bladedamp frf``: the frequency response of the design at each of its engine orders."""
+    import dataclasses
+
     from .report import frf_outputs
 
     t0 = time.perf_counter()
@@ -582,7 +584,13 @@ def frf_command(args) -> int:
         progress(f"mistuned full assembly at EO = {design.disk.engine_order}")
         responses[f"mistuned_EO{design.disk.engine_order}"] = design.mistuned_disk().frequency_response(
             a.f_start_hz, a.f_end_hz, **checks, **a.options())
-    summary = frf_outputs(out, design, responses, measured=measured)
+    undamped = {}
+    if design.disk.has_damper:      # the damper-free reference of the figure: linear, one harmonic is exact
+        progress("damper-free reference responses")
+        for eo in design.engine_orders:
+            undamped[f"EO{eo}"] = dataclasses.replace(design.disk_at(eo), damper=None).frequency_response(
+                a.f_start_hz, a.f_end_hz, harmonics=(1,), max_step=a.max_step, estimate_harmonic_error=False)
+    summary = frf_outputs(out, design, responses, undamped, measured=measured)
     for k, v in summary["responses"].items():      # each response's status first
         print(f"{k}: {v['status_message']}", file=sys.stderr)
     peaks = ", ".join(f"{k} {'largest amplitude at the range end' if v['peak_at_range_end'] else 'peak'} "
@@ -618,7 +626,8 @@ def optimize_command(args) -> int:
     progress.compiling()
     options = dict(f_range_hz=a.f_range_hz, harmonics=a.study_harmonics)
     progress(f"optimal mass in {1e3 * a.mass_bounds[0]:g}-{1e3 * a.mass_bounds[1]:g} g")
-    optimum = optimal_mass(disk, a.mass_bounds, processes=args.processes, progress=progress.bar("mass grid"), **options)
+    optimum = optimal_mass(disk, a.mass_bounds, processes=args.processes, progress=progress.bar("mass grid"),
+                           complete_grid=True, **options)      # the whole curve for optimize.png
     angles = heights = None
     if args.gamma_right_deg:
         angles = platform_angle_study(disk, args.gamma_right_deg, mass_bounds=a.mass_bounds, processes=args.processes,
@@ -1001,6 +1010,13 @@ def _validate_flags(args) -> None:
             validation.integer("--seed", args.seed, minimum=0)
     except ValueError as exc:
         raise UsageError(str(exc)) from None
+    if hasattr(args, "format"):
+        from .plotting import check_figure_output
+
+        try:
+            args.format, args.dpi = check_figure_output(args.format, args.dpi)
+        except ValueError as exc:
+            raise UsageError(f"--{exc}") from None
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -1024,6 +1040,12 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--overwrite", action="store_true",
                        help="write into an --out folder that holds files already, replacing the files of the same\n"
                             "names (the others stay)")
+
+    def figure_args(p):
+        p.add_argument("--format", default="png", metavar="FORMATS",
+                       help="file formats of the figures, comma-separated from png, svg, pdf (default: png)")
+        p.add_argument("--dpi", type=int, default=120,
+                       help="resolution of the PNG figures in dots per inch, in [10, 2400] (default: 120)")
 
     def processes_arg(p):
         p.add_argument("--processes", type=int, default=None,
@@ -1058,6 +1080,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--measured-record", metavar="K", type=int,
                    help="which dataset 58 record of a --measured UFF file holding several (from 0)")
     out_arg(p, "results/<design file name>/frf")
+    figure_args(p)
 
     p = command("optimize", optimize_command, "optimal damper mass of a design",
                 "The damper mass of the lowest resonance amplitude in [analysis] mass_range_g (global on a log\n"
@@ -1071,6 +1094,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="also optimise the mass at each of these wedge contact heights [mm], in (0, 100]")
     processes_arg(p)
     out_arg(p, "results/<design file name>/optimize")
+    figure_args(p)
 
     def engine_orders_arg(p):
         p.add_argument("--engine-orders", type=int, nargs="+", metavar="EO",
@@ -1084,6 +1108,7 @@ def build_parser() -> argparse.ArgumentParser:
     engine_orders_arg(p)
     processes_arg(p)
     out_arg(p, "results/<design file name>/eo-sweep")
+    figure_args(p)
 
     def speed_args(p):
         p.add_argument("--speed-range-rpm", type=float, nargs=2, metavar=("LOW", "HIGH"), default=None,
@@ -1100,6 +1125,7 @@ def build_parser() -> argparse.ArgumentParser:
     design_arg(p)
     speed_args(p)
     out_arg(p, "results/<design file name>/zzenf")
+    figure_args(p)
 
     p = command("campbell", campbell_command, "Campbell diagram with the damped resonance at each engine order",
                 "Natural frequencies over rotor speed (without dampers; stuck at each engine order's nodal\n"
@@ -1111,6 +1137,7 @@ def build_parser() -> argparse.ArgumentParser:
     engine_orders_arg(p)
     speed_args(p)
     out_arg(p, "results/<design file name>/campbell")
+    figure_args(p)
 
     p = command("montecarlo", monte_carlo_command, "Monte Carlo of randomly mistuned disks (Dask)",
                 "Peak amplification (largest blade over the tuned peak) of N disks with Gaussian frequency\n"
@@ -1138,6 +1165,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--tol", type=float, default=None,
                    help="continuation tolerance per disk, in (0, 1) (default 1e-6; 1e-10 for full FRF accuracy)")
     out_arg(p, "results/<design file name>/montecarlo, or results/montecarlo without a design")
+    figure_args(p)
 
     p = command("show", show_command, "3D view of a design's resonance (standalone HTML)",
                 "The operating deflection shape at the resonance with the contact states of every point, as an\n"
@@ -1161,6 +1189,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--from", dest="saved", type=Path, action="append", metavar="DIR",
                    help="a folder of bladedamp frf results to compare (repeatable)")
     out_arg(p, "results/compare")
+    figure_args(p)
 
     p = command("app", app_command, "the damper-design dashboard in the browser (Voila)",
                 "Serves a teaching dashboard on this machine (127.0.0.1 only): damper type, mass, engine order,\n"
@@ -1176,6 +1205,7 @@ def build_parser() -> argparse.ArgumentParser:
                 "the paper's numbers, with a verdict per row. Writes summary.json, report.md and the figures.\n"
                 "About 2 min on two cores.")
     out_arg(p, "results")
+    figure_args(p)
     processes_arg(p)
 
     from .compilation import COLD_COMPILE_SECONDS
@@ -1198,7 +1228,13 @@ def main(argv=None) -> int:
     with Notes() as notes:
         try:
             _validate_flags(args)
-            code = args.run(args)
+            if not hasattr(args, "format"):
+                code = args.run(args)
+            else:
+                from .plotting import figure_output
+
+                with figure_output(args.format, args.dpi):
+                    code = args.run(args)
         except (FileReadError, UsageError) as exc:     # a design file or another file, an option
             print(f"bladedamp {args.command}: error: {exc}", file=sys.stderr)
             code = 2

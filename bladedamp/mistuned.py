@@ -1370,9 +1370,12 @@ class MistunedResponse(FrequencyResponse):
         peaks = self.peak_amplitude
         if highlight is None:
             highlight = sorted({int(np.argmax(peaks)), int(np.argmin(peaks))})
+        from . import palette
+
         for k in range(self.n_sector):
             if k in highlight:
                 ax.plot(self.frequency_hz, 1e3 * self.tip_amplitude[:, k, direction], lw=1.6,
+                        color=palette.series(list(highlight).index(k)),
                         label=f"blade {k + 1} (peak {1e3 * peaks[k]:.3f} mm)")
             else:
                 ax.plot(self.frequency_hz, 1e3 * self.tip_amplitude[:, k, direction], color="0.6", lw=0.8)

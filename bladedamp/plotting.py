@@ -4,10 +4,70 @@
 would cover a point (a resonance peak, a marker), it makes room above the data by raising the
 upper y limit until the legend is clear. :func:`legend_covers` counts the data points under a
 legend (the tests use it on every figure of the report).
+
+:func:`save_figure` writes every figure the product saves, in the formats and resolution set by
+:func:`figure_output` (the command line's ``--format`` and ``--dpi``; PNG at 120 dpi otherwise).
 """
 from __future__ import annotations
 
+import contextlib
+from pathlib import Path
+
 import numpy as np
+
+#: the file formats a figure can be written in (matplotlib's Agg, SVG and PDF backends)
+FIGURE_FORMATS = ("png", "svg", "pdf")
+DEFAULT_DPI = 120
+_output = {"formats": ("png",), "dpi": DEFAULT_DPI}
+
+
+def check_figure_output(formats, dpi) -> tuple[tuple[str, ...], int]:
+    """(formats, dpi) checked: ``formats`` a non-empty sequence of :data:`FIGURE_FORMATS` (or a
+    comma-separated string of them), ``dpi`` an integer in [10, 2400]; ValueError naming the
+    parameter otherwise."""
+    if isinstance(formats, str):
+        formats = [f.strip().lower() for f in formats.split(",") if f.strip()]
+    formats = tuple(dict.fromkeys(formats))
+    bad = [repr(f) for f in formats if f not in FIGURE_FORMATS]
+    if not formats or bad:
+        raise ValueError(f"format {', '.join(bad) or 'empty'}: must be one or more of {', '.join(FIGURE_FORMATS)}, "
+                         "comma-separated")
+    if isinstance(dpi, bool) or not isinstance(dpi, (int, np.integer)) or not 10 <= dpi <= 2400:
+        raise ValueError(f"dpi {dpi!r}: must be an integer in [10, 2400]")
+    return formats, int(dpi)
+
+
+@contextlib.contextmanager
+def figure_output(formats=("png",), dpi: int = DEFAULT_DPI):
+    """Within the block, :func:`save_figure` writes each figure in every format of ``formats``
+    (see :func:`check_figure_output`) at ``dpi`` dots per inch (the pixel size of PNG; SVG and
+    PDF are vector formats)."""
+    formats, dpi = check_figure_output(formats, dpi)
+    before = dict(_output)
+    _output.update(formats=formats, dpi=dpi)
+    try:
+        yield
+    finally:
+        _output.update(before)
+
+
+def save_figure(fig, path) -> list[str]:
+    """Lay out ``fig`` (tight layout unless it has its own layout engine), write it at ``path``
+    with the suffix of each format of :func:`figure_output` (``path``'s own suffix replaced)
+    and close it; returns the names of the files written."""
+    import matplotlib.pyplot as plt
+
+    engine = fig.get_layout_engine()
+    if engine is None or type(engine).__name__ in ("PlaceHolderLayoutEngine", "TightLayoutEngine"):
+        fig.tight_layout()
+    path = Path(path)
+    names = []
+    for fmt in _output["formats"]:
+        target = path.with_suffix(f".{fmt}")
+        fig.savefig(target, dpi=_output["dpi"], format=fmt)
+        names.append(target.name)
+    plt.close(fig)
+    return names
 
 
 def _data_points(ax):
@@ -92,3 +152,41 @@ def place_legend(ax, loc: str = "best", max_tries: int = 8, **kwargs):
             ax.set_ylim(lo, hi + 0.15 * (hi - lo))
         legend = ax.legend(loc=loc, **kwargs)
     return legend
+
+
+def plain_log_ticks(axis) -> None:
+    """Ticks of a logarithmic ``axis`` (``ax.xaxis`` or ``ax.yaxis``) at 1, 2, 5 per decade
+    (labelled at the powers of ten only when the axis spans more than three decades), written as
+    plain numbers ('0.5', '2', '10', not '5 x 10^-1'), no minor labels."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    def label(value, _):
+        low, high = sorted(axis.get_view_interval())
+        mantissa = value / 10.0 ** np.floor(np.log10(value) + 1e-9)
+        if low > 0 and high / low > 1e3 and not np.isclose(mantissa, 1.0):
+            return ""
+        return f"{value:g}"
+    axis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+    axis.set_major_formatter(FuncFormatter(label))
+    axis.set_minor_formatter(NullFormatter())
+
+
+def reference_level(ax, value: float, label: str, unit: str = "mm", min_share: float = 1 / 3) -> None:
+    """A damper-free reference level ``value`` (in the axes' y units) on ``ax``: a dashed
+    horizontal line in the palette's UNDAMPED colour when each curve already drawn (a line of two
+    or more points; markers alone do not count) keeps at least ``min_share`` of the y range with it; else (it would flatten them) no line, and a legend
+    entry that gives the value and says it lies above the axes. Call after the series, before
+    the legend."""
+    from . import palette
+
+    series = [np.asarray(line.get_ydata(), dtype=float) for line in ax.get_lines()       # curves, not markers
+              if line.get_transform() is ax.transData and line.get_gid() != "reference"
+              and line.get_linestyle() not in ("None", "", " ")]
+    series = [v[np.isfinite(v)] for v in series if np.sum(np.isfinite(v)) >= 2]
+    text = f"{label} {value:.3g} {unit}"
+    if series:
+        low, high = min(min(v.min() for v in series), value), max(max(v.max() for v in series), value)
+    if series and min(np.ptp(v) for v in series) < min_share * (high - low):
+        ax.plot([], [], ls="--", lw=1, color=palette.UNDAMPED, label=f"{text} (above the axes)")
+        return
+    ax.axhline(value, ls="--", lw=1, color=palette.UNDAMPED, label=text, gid="reference")

@@ -13,7 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .plotting import place_legend
+from . import palette
+from .plotting import place_legend, plain_log_ticks, reference_level, save_figure
 from .studies.design import tip_dof_amplitude
 
 # the paper's numbers that the reproduce report compares with
@@ -25,15 +26,6 @@ PAPER = {
 }
 # tip DOF that shows each mode: flatwise u_x, torsion phi_z, edgewise u_y
 MODE_TIP_DOF = {"1F": 0, "2F": 0, "1T": 5, "1E": 1}
-
-
-def save_figure(fig, path: Path, dpi: int = 120):
-    """Lay out, write and close a figure."""
-    import matplotlib.pyplot as plt
-
-    fig.tight_layout()
-    fig.savefig(path, dpi=dpi)
-    plt.close(fig)
 
 
 # ---------------------------------------------------------------------------------------
@@ -514,13 +506,15 @@ def plot_four_modes(windows, path: Path):
     f0 = {t[0]: t[1] for t in PAPER["table1"]}
     fig, axes = plt.subplots(2, 2, figsize=(10, 7))
     for ax, (name, dof, r_free, r_damp) in zip(axes.ravel(), windows):
-        ax.semilogy(r_free.frequency_hz, 1e3 * tip_dof_amplitude(r_free, dof), label="no damper")
-        ax.semilogy(r_damp.frequency_hz, 1e3 * tip_dof_amplitude(r_damp, dof), label="cylinder 1 g")
+        ax.semilogy(r_free.frequency_hz, 1e3 * tip_dof_amplitude(r_free, dof), ls="--", color=palette.UNDAMPED,
+                    label="no damper")
+        ax.semilogy(r_damp.frequency_hz, 1e3 * tip_dof_amplitude(r_damp, dof), color=palette.DAMPER["cylinder"],
+                    label="cylinder 1 g")
         ax.set_title(f"{name} (f0 = {f0[name]} Hz)")
         ax.set_xlabel("frequency [Hz]")
         ax.set_ylabel(f"tip {'u_' + 'xyz'[dof] + ' [mm]' if dof < 3 else 'phi_z [mrad]'}")
         ax.grid(True, which="both", alpha=0.3)
-    fig.suptitle("Fig. 4: tuned disk, EO = 1, F_x = 0.1 N, F_y = -0.1 N, M_z = 0.001 N m")
+    fig.suptitle("Fig. 4: reference disk, tuned, EO = 1, F_x = 0.1 N, F_y = -0.1 N, M_z = 0.001 N m")
     for ax in axes.ravel():
         place_legend(ax, fontsize=8)
     save_figure(fig, path)
@@ -532,12 +526,13 @@ def plot_mass_variation(free, responses, path: Path):
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(7, 4.5))
-    ax.plot(free.frequency_hz, 1e3 * free.tip_amplitude[:, 0], "k--", label="m = 0 g (no damper)")
-    for m, r in responses:
-        ax.plot(r.frequency_hz, 1e3 * r.tip_amplitude[:, 0], label=f"m = {1e3 * m:g} g")
+    ax.plot(free.frequency_hz, 1e3 * free.tip_amplitude[:, 0], ls="--", color=palette.UNDAMPED,
+            label="m = 0 g (no damper)")
+    for k, (m, r) in enumerate(responses):
+        ax.plot(r.frequency_hz, 1e3 * r.tip_amplitude[:, 0], color=palette.series(k), label=f"m = {1e3 * m:g} g")
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel("tip amplitude u_x [mm]")
-    ax.set_title("Fig. 5: variation of the cylinder's mass (EO = 1, F_x = 0.1 N)")
+    ax.set_title("Fig. 5: reference disk, variation of the cylinder's mass (EO = 1, F_x = 0.1 N)")
     ax.grid(True, alpha=0.3)
     place_legend(ax)
     save_figure(fig, path)
@@ -549,11 +544,11 @@ def plot_mass_optimisation(sweeps: dict, optima: dict, path: Path):
 
     fig, ax = plt.subplots(figsize=(7, 4.5))
     for kind, sw in sweeps.items():
-        sw.plot(ax=ax)
+        sw.plot(ax=ax, color=palette.DAMPER.get(kind))
     for k, kind in enumerate(sweeps):
         ax.plot(1e3 * optima[kind].mass, 1e3 * optima[kind].peak_amplitude, "k*", ms=12,
                 label="optimum" if k == 0 else "_optimum")
-    ax.set_title("Fig. 6: resonance amplitude over damper mass, EO = 1")
+    ax.set_title("Fig. 6: reference disk, resonance amplitude over damper mass, EO = 1")
     place_legend(ax)
     save_figure(fig, path)
 
@@ -565,22 +560,24 @@ def plot_engine_orders(sweeps: dict, path: Path):
     fig, axes = plt.subplots(1, 2, figsize=(11, 4))
     missing = []
     for kind, sw in sweeps.items():
-        axes[0].plot(sw.engine_orders, 100 * sw.reduction, marker="o", label=kind)
-        axes[1].plot(sw.engine_orders, 1e3 * sw.optimal_mass, marker="s", label=kind)
+        axes[0].plot(sw.engine_orders, 100 * sw.reduction, marker="o", color=palette.DAMPER.get(kind), label=kind)
+        axes[1].plot(sw.engine_orders, 1e3 * sw.optimal_mass, marker="s", color=palette.DAMPER.get(kind), label=kind)
         gone = [int(eo) for eo, m in zip(sw.engine_orders, sw.optimal_mass) if not np.isfinite(m)]
         if gone:
             missing.append(f"{kind}: no mass damps at EO {', '.join(map(str, gone))}")
     if missing:     # say why a point is absent rather than leave a gap
         axes[1].text(0.98, 0.03, "; ".join(missing), transform=axes[1].transAxes, ha="right", va="bottom", fontsize=8)
-    axes[0].set(xlabel="engine order", ylabel="amplitude reduction at optimal mass [%]", title="Fig. 7")
-    axes[1].set(xlabel="engine order", ylabel="optimal damper mass [g]", yscale="log", title="Fig. 8")
+    axes[0].set(xlabel="engine order EO [-]", ylabel="amplitude reduction at optimal mass [%]", title="Fig. 7")
+    axes[1].set(xlabel="engine order EO [-]", ylabel="optimal damper mass [g]", yscale="log", title="Fig. 8")
+    plain_log_ticks(axes[1].yaxis)
+    fig.suptitle("reference disk: damper mass re-optimised at every engine order")
     for ax in axes:
         ax.grid(True, alpha=0.3)
         place_legend(ax)
     save_figure(fig, path)
 
 
-def plot_platform_angles(study, path: Path, title: str = "Fig. 10: cylinder, gamma_L = 35 deg, EO = 1"):
+def plot_platform_angles(study, path: Path, title: str = "Fig. 10: reference disk, cylinder, gamma_L = 35 deg, EO = 1"):
     """Fig. 10: a PlatformAngleStudy."""
     import matplotlib.pyplot as plt
 
@@ -594,10 +591,11 @@ def plot_contact_states(states: dict, path: Path):
     """Fig. 11: {gamma_R [deg]: ContactState} side by side."""
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, len(states), figsize=(5 * len(states), 5))
+    fig, axes = plt.subplots(1, len(states), figsize=(5 * len(states), 5.4), layout="constrained")
     for ax, (g, state) in zip(np.atleast_1d(axes), states.items()):
         state.plot(ax=ax)
         ax.set_title(f"Fig. 11: gamma_R = {g:g} deg")
+    fig.suptitle("reference disk, cylinder 1 g: contact state at the resonance (Eq. 27)")
     save_figure(fig, path)
 
 
@@ -607,7 +605,7 @@ def plot_liftoff(lift, path: Path):
 
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
     lift.plot(ax=ax)
-    ax.set_title("Fig. 9: wedge 1 g, F_x = 0.1 N, contact OL")
+    ax.set_title("Fig. 9: reference disk, wedge 1 g, F_x = 0.1 N, contact OL")
     save_figure(fig, path)
 
 
@@ -624,11 +622,13 @@ def plot_stability_backbones(frfs: dict, converged: dict, modes: dict, path: Pat
     from .response import plot_branch
 
     kinds = list(frfs)
+    legends = []
     fig, axes = plt.subplots(1, len(kinds) + 1, figsize=(5.2 * (len(kinds) + 1), 4.4))
     for ax, kind in zip(axes, kinds):
         top = 0.0
         any_unstable = False
-        for r, label, color in ((frfs[kind], "FRF, one harmonic", "C0"), (converged.get(kind), "FRF, converged", "C1")):
+        for r, label, color in ((frfs[kind], "FRF, one harmonic", palette.series(0)),
+                                (converged.get(kind), "FRF, converged", palette.series(1))):
             if r is None or not len(r.omega):
                 continue
             tip = 1e3 * r.tip_amplitude[:, 0]
@@ -636,7 +636,7 @@ def plot_stability_backbones(frfs: dict, converged: dict, modes: dict, path: Pat
                         label=f"{label} ({_harmonics(r.basis.harmonics)})")
             if r.stable is not None and not np.all(r.stable):
                 bad = ~np.asarray(r.stable, bool)        # circled: a fold at a corner is too narrow to see dashed
-                ax.plot(r.frequency_hz[bad], tip[bad], "o", mfc="none", mec="r", ms=7, label="_unstable points")
+                ax.plot(r.frequency_hz[bad], tip[bad], "o", mfc="none", mec=palette.SLIP, ms=7, label="_unstable points")
                 any_unstable = True
             top = max(top, float(tip.max()))
         mode = modes.get(kind)
@@ -650,9 +650,9 @@ def plot_stability_backbones(frfs: dict, converged: dict, modes: dict, path: Pat
                         label="peak by nonlinear-mode synthesis")
         handles, labels = ax.get_legend_handles_labels()
         if any_unstable:
-            handles.append(Line2D([], [], color="0.3", ls="--", marker="o", mfc="none", mec="r"))
+            handles.append(Line2D([], [], color="0.3", ls="--", marker="o", mfc="none", mec=palette.SLIP))
             labels.append("unstable (dashed, circled)")
-        place_legend(ax, handles=handles, labels=labels, fontsize=8, loc="upper left")
+        legends.append((ax, dict(handles=handles, labels=labels, fontsize=8, loc="upper left")))
         ax.set_xlabel("excitation frequency [Hz]")
         ax.set_ylabel("tip amplitude u_x [mm]")
         ax.set_title(f"{kind}" + (f" {1e3 * _mass_of(frfs[kind]):.3g} g" if _mass_of(frfs[kind]) else "")
@@ -661,7 +661,7 @@ def plot_stability_backbones(frfs: dict, converged: dict, modes: dict, path: Pat
     ax = axes[-1]
     for kind, mode in modes.items():
         tip = 1e3 * np.asarray(mode.output_amplitude)[:, 0]
-        line, = ax.semilogx(tip, 100 * np.asarray(mode.damping_ratio), label=kind)
+        line, = ax.semilogx(tip, 100 * np.asarray(mode.damping_ratio), color=palette.DAMPER.get(kind), label=kind)
         peak = mode.forced_peak()
         if peak["found"]:
             ax.axvline(1e3 * peak["output_amplitude"][0], color=line.get_color(), ls=":", lw=1.2,
@@ -670,7 +670,9 @@ def plot_stability_backbones(frfs: dict, converged: dict, modes: dict, path: Pat
     ax.set_ylabel("modal damping ratio [%]")
     ax.set_title("1F nonlinear modes: damping over amplitude")
     ax.grid(True, which="both", alpha=0.3)
-    place_legend(ax, fontsize=8)
+    fig.suptitle("reference disk: stability of the forced responses and the 1F nonlinear modes")
+    for ax, options in legends + [(axes[-1], dict(fontsize=8))]:     # last: the layout is settled
+        place_legend(ax, **options)
     save_figure(fig, path)
 
 
@@ -687,7 +689,8 @@ def plot_design_maps(maps: list, path: Path):
     fig, axes = plt.subplots(1, len(maps), figsize=(5.2 * len(maps), 4.2))
     for ax, m in zip(np.atleast_1d(axes), maps):
         m.plot(ax=ax)
-    save_figure(fig, path, 110)
+    fig.suptitle("reference disk: design maps, resonance tip amplitude over damper mass and platform angle")
+    save_figure(fig, path)
 
 
 # ---------------------------------------------------------------------------------------
@@ -779,21 +782,85 @@ def write_summary(out: Path, command: str, design, lines: list, files: list, ana
     return path
 
 
-def frf_outputs(out: Path, design, responses: dict, measured=None) -> dict:
-    """frf.png, frf_<label>.npz, results.json and summary.md of ``bladedamp frf``; ``measured``:
-    a :class:`~bladedamp.measurement.MeasuredResponse` drawn on frf.png (in mm; an FRF times the
-    design's excitation force).
-    ``responses``: {label: DiskResponse or MistunedResponse}. Each response's entry and summary.md
-    lead with its status (:attr:`~bladedamp.response.FrequencyResponse.status_message`); a largest
-    amplitude at an end of the range is named so, not a peak. Returns the JSON summary."""
+def design_name(design) -> str:
+    """The name of a design in titles: its file's stem, or 'reference design'."""
+    return design.path.stem if design.path else "reference design"
+
+
+def design_title(design, what: str) -> str:
+    """A figure title that names the design: '<what>: <name>' over its damper and blades."""
+    disk = design.disk
+    damper = "no damper" if not disk.has_damper else f"{disk.damper.kind} damper {1e3 * disk.damper.mass:.3g} g"
+    return f"{what}: {design_name(design)}\n{damper}, {disk.n_blades} blades"
+
+
+def _tip_x(response) -> np.ndarray:
+    """Tip amplitude u_x [m] of a tuned response, or its largest blade's of a mistuned one."""
+    tip = response.tip_amplitude
+    return tip[:, 0] if tip.ndim == 2 else tip[:, :, 0].max(axis=1)
+
+
+def plot_frf(ax, design, responses: dict, undamped: dict | None = None) -> None:
+    """The frequency responses ``responses`` ({label: response}) of ``design`` on ``ax``, each
+    with its peak marked and annotated (amplitude [mm] and frequency [Hz]), and the damper-free
+    responses ``undamped`` ({label: response}) dashed. Amplitude axis logarithmic when a damped
+    peak is below a quarter of the undamped one (both then stay readable)."""
+    undamped = undamped or {}
+    kind = design.disk.damper.kind if design.disk.has_damper else None
+    single = len(responses) == 1
+    peaks, top = [], 0.0
+    for k, (label, r) in enumerate(responses.items()):
+        tip = 1e3 * _tip_x(r)
+        colour = palette.DAMPER.get(kind, palette.series(0)) if single else palette.series(k)
+        shown = label.replace("EO", "EO = ").replace("_", ", ") + ("" if r.tip_amplitude.ndim == 2 else
+                                                                    " (largest blade)")
+        ax.plot(r.frequency_hz, tip, color=colour, lw=1.6, label=shown)
+        if label in undamped and len(undamped[label].omega):
+            free = 1e3 * _tip_x(undamped[label])
+            ax.plot(undamped[label].frequency_hz, free, ls="--", lw=1.2,
+                    color=palette.UNDAMPED if single else colour, label=f"{shown.split(' (')[0]}, no damper")
+            top = max(top, float(free.max()))
+        if len(tip):
+            i = int(np.argmax(tip))
+            which = "" if single else f"{shown.split(' (')[0]}: "
+            what = "largest amplitude (at the range end)" if getattr(r, "peak_at_range_end", False) else "peak"
+            peaks.append((float(r.frequency_hz[i]), float(tip[i]), colour, f"{which}{what}"))
+            ax.plot(r.frequency_hz[i], tip[i], "o", ms=7, mfc="none", mec=colour, mew=1.6, label="_peak")
+    if not peaks:
+        return
+    log = top > 0 and max(p for _, p, _, _ in peaks) < 0.25 * top
+    if log:
+        ax.set_yscale("log")
+    # room above the highest curve for the annotations, stacked, each beside its peak
+    low, high = ax.get_ylim()
+    highest = max([top] + [p for _, p, _, _ in peaks])
+    ax.set_ylim(low, highest * 3.0 ** (1 + 0.3 * len(peaks)) if log else
+                highest + (0.12 + 0.08 * len(peaks)) * (highest - low))
+    x0, x1 = ax.get_xlim()
+    for k, (f, p, colour, which) in enumerate(peaks):
+        right = f < x0 + 0.5 * (x1 - x0)
+        ax.annotate(f"{which} {p:.3g} mm at {f:.2f} Hz", (f, p), xytext=(15 if right else -15, 8 + 14 * k),
+                    textcoords="offset points", fontsize=8, color=colour, va="bottom", ha="left" if right else "right",
+                    bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="none", alpha=0.85),
+                    arrowprops=dict(arrowstyle="-", color=colour, lw=0.8))
+    ax.set_xlabel("excitation frequency [Hz]")
+    ax.set_ylabel("tip amplitude u_x [mm]")
+    ax.grid(True, which="both", alpha=0.3)
+
+
+def frf_outputs(out: Path, design, responses: dict, undamped: dict | None = None, measured=None) -> dict:
+    """frf.png (and the other formats of :func:`bladedamp.plotting.figure_output`),
+    frf_<label>.npz, results.json and summary.md of ``bladedamp frf``. ``responses``: {label:
+    DiskResponse or MistunedResponse}; ``undamped``: {label: the damper-free DiskResponse},
+    drawn dashed; ``measured``: a :class:`~bladedamp.measurement.MeasuredResponse` drawn on
+    frf.png (in mm; an FRF times the design's excitation force). Each response's entry and
+    summary.md lead with its status (:attr:`~bladedamp.response.FrequencyResponse.status_message`);
+    a largest amplitude at an end of the range is named so, not a peak. Returns the JSON summary."""
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7.5, 4.5))
-    leads, rows, files, summary = [], [], ["frf.png"], {"design": design.path, "responses": {}}
+    leads, rows, files, summary = [], [], [], {"design": design.path, "responses": {}}
     for label, r in responses.items():
-        tip = r.tip_amplitude[:, 0] if r.tip_amplitude.ndim == 2 else r.tip_amplitude[:, :, 0].max(axis=1)
-        shown = label.replace("EO", "EO = ").replace("_", ", ")
-        ax.plot(r.frequency_hz, 1e3 * tip, label=shown + ("" if r.tip_amplitude.ndim == 2 else " (largest blade)"))
+        tip = _tip_x(r)
         saved = save_result(r, out / f"frf_{label}")
         if saved:
             files.append(saved)
@@ -809,27 +876,58 @@ def frf_outputs(out: Path, design, responses: dict, measured=None) -> dict:
             "success": bool(r.success), "message": r.message, "harmonics": list(r.basis.harmonics),
             "harmonic_error_pct": 100 * err, "peak_amplitude_mm": 1e3 * peak, "peak_frequency_hz": f_peak,
             "peak_time_check": timed, "frequency_hz": r.frequency_hz, "tip_amplitude_x_mm": 1e3 * tip}
+        if undamped and label in undamped and len(undamped[label].omega):
+            summary["responses"][label]["undamped_peak_amplitude_mm"] = 1e3 * float(_tip_x(undamped[label]).max())
         leads.append(f"- **{label}**: {r.status_message}")
         rows.append(f"| {label} | {r.status.value} | {tuple(r.basis.harmonics)} | "
                     f"{'not estimated' if not np.isfinite(err) else f'{100 * err:.2g} %'} | {_mm(peak)}"
                     f"{' (largest amplitude at the range end)' if at_end else ''} | "
                     f"{'-' if not np.isfinite(f_peak) else f'{f_peak:.3f} Hz'} | {timed or '-'} |")
-    ax.set_xlabel("excitation frequency [Hz]")
-    ax.set_ylabel("tip amplitude u_x [mm]")
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8)
+    fig, ax = plt.subplots(figsize=(7.5, 4.8))
+    plot_frf(ax, design, responses, undamped)
     if measured is not None:
         from .measurement import draw_measurement
 
         draw_measurement(ax, measured, model=design.disk)
-    ax.set_title(f"frequency response: {design.path.name if design.path else 'design'}")
-    save_figure(fig, out / "frf.png")
+    ax.set_title(design_title(design, "frequency response"))
+    place_legend(ax, fontsize=8)
+    files[:0] = save_figure(fig, out / "frf.png")
     write_json(out / "results.json", summary)
     files.append("results.json")
     lines = [*leads, "", "| response | status | harmonics | harmonic error | peak u_x | at | "
              "time integration at the peak |", "|---|---|---|---|---|---|---|", *rows]
     write_summary(out, "frf", design, lines, files)
     return summary
+
+
+def plot_mass_optimum(ax, optimum, kind: str) -> None:
+    """A MassOptimum on ``ax``: the peak tip amplitude [mm] of every mass evaluated (the log
+    grid and the bounded search's points) over the mass [g] on a log axis, the optimum starred
+    on that curve, the masses not solved at the lower bound of their peak, and the damper-free
+    peak (:func:`bladedamp.plotting.reference_level`)."""
+    colour = palette.DAMPER.get(kind, palette.series(0))
+    if optimum.evaluated_mass is not None:
+        m, p = np.asarray(optimum.evaluated_mass, float), np.asarray(optimum.evaluated_peak_amplitude, float)
+    else:                                     # a result saved before the search's points were kept
+        m, p = np.asarray(optimum.grid_mass, float), np.asarray(optimum.grid_peak_amplitude, float)
+    ok = np.isfinite(p)
+    grid = np.isin(m, np.asarray(optimum.grid_mass, float))
+    ax.semilogx(1e3 * m[ok], 1e3 * p[ok], color=colour, lw=1.4, label=f"{kind}: every mass evaluated")
+    ax.plot(1e3 * m[ok & grid], 1e3 * p[ok & grid], "o", color=colour, ms=5, label="log grid")
+    if np.any(ok & ~grid):
+        ax.plot(1e3 * m[ok & ~grid], 1e3 * p[ok & ~grid], ".", color="0.2", ms=6, label="bounded search")
+    bound = np.asarray(optimum.failed_lower_bounds, float)
+    if bound.size and np.any(np.isfinite(bound)):
+        sel = np.isfinite(bound)
+        ax.plot(1e3 * np.asarray(optimum.failed_masses, float)[sel], 1e3 * bound[sel], "^", mfc="none", mec=colour,
+                ms=7, label="not solved: peak at least")
+    ax.plot(1e3 * optimum.mass, 1e3 * optimum.peak_amplitude, "*", color="k", ms=15, zorder=5,
+            label=f"optimum {1e3 * optimum.mass:.3g} g, {1e3 * optimum.peak_amplitude:.3g} mm")
+    reference_level(ax, 1e3 * optimum.undamped_peak_amplitude, "no damper")
+    ax.set(xlabel="damper mass [g]", ylabel="resonance tip amplitude u_x [mm]")
+    plain_log_ticks(ax.xaxis)
+    ax.grid(True, which="both", alpha=0.3)
+    place_legend(ax, fontsize=8)
 
 
 def optimize_outputs(out: Path, design, optimum, angles=None, heights=None) -> dict:
@@ -853,16 +951,10 @@ def optimize_outputs(out: Path, design, optimum, angles=None, heights=None) -> d
              f"{'certified global over the mass range' if optimum.success else 'not certified global'}.", "",
              f"How: {optimum.message}.", ""]
     panels = 1 + (angles is not None) + (heights is not None)
-    fig, axes = plt.subplots(1, panels, figsize=(6 * panels, 4.2))
+    fig, axes = plt.subplots(1, panels, figsize=(6 * panels, 4.6))
     axes = np.atleast_1d(axes)
-    ok = np.isfinite(np.asarray(optimum.grid_peak_amplitude, dtype=float))
-    axes[0].semilogx(1e3 * np.asarray(optimum.grid_mass)[ok], 1e3 * np.asarray(optimum.grid_peak_amplitude)[ok],
-                     marker="o", label="mass grid")
-    axes[0].plot(1e3 * optimum.mass, 1e3 * optimum.peak_amplitude, "r*", ms=14, label="optimum")
-    axes[0].axhline(1e3 * optimum.undamped_peak_amplitude, color="gray", ls="--", lw=1, label="no damper")
-    axes[0].set(xlabel="damper mass [g]", ylabel="resonance tip amplitude u_x [mm]", title="damper mass")
-    axes[0].grid(True, which="both", alpha=0.3)
-    axes[0].legend(fontsize=8)
+    plot_mass_optimum(axes[0], optimum, design.disk.damper.kind)
+    axes[0].set_title("damper mass")
     k = 1
     if angles is not None:
         angles.plot(ax=axes[k])
@@ -880,7 +972,7 @@ def optimize_outputs(out: Path, design, optimum, angles=None, heights=None) -> d
     if heights is not None:
         h = np.array([x for x, _ in heights])
         p = np.array([o.peak_amplitude for _, o in heights])
-        axes[k].plot(1e3 * h, 1e3 * p, marker="o")
+        axes[k].plot(1e3 * h, 1e3 * p, marker="o", color=palette.DAMPER.get(design.disk.damper.kind))
         axes[k].set(xlabel="wedge contact height h_C [mm]", ylabel="resonance tip amplitude u_x [mm]",
                     title="contact height, mass re-optimised")
         axes[k].grid(True, alpha=0.3)
@@ -890,7 +982,8 @@ def optimize_outputs(out: Path, design, optimum, angles=None, heights=None) -> d
                   "| h_C [mm] | optimal mass [g] | peak u_x [mm] |", "|---|---|---|"]
         lines += [f"| {1e3 * x:g} | {1e3 * o.mass:.4g} | {1e3 * o.peak_amplitude:.4f} |" for x, o in heights]
         lines.append("")
-    save_figure(fig, out / "optimize.png")
+    fig.suptitle(design_title(design, "optimal damper mass"))
+    files[:1] = save_figure(fig, out / "optimize.png")
     write_json(out / "results.json", summary)
     files.append("results.json")
     write_summary(out, "optimize", design, lines, files, analysis_line(design, studies=True))
@@ -906,8 +999,8 @@ def eo_sweep_outputs(out: Path, design, sweep) -> dict:
     files += [saved] if saved else []
     fig, ax = plt.subplots(figsize=(7, 4.5))
     sweep.plot(ax=ax)
-    ax.set_title(f"{sweep.kind}: mass re-optimised at every engine order")
-    save_figure(fig, out / "eo_sweep.png")
+    ax.set_title(design_title(design, "damper mass re-optimised at every engine order"))
+    files[:1] = save_figure(fig, out / "eo_sweep.png")
     summary = {"design": design.path, "engine_orders": sweep.engine_orders, "optimal_mass_g": 1e3 * sweep.optimal_mass,
                "optimal_peak_amplitude_mm": 1e3 * sweep.optimal_peak_amplitude,
                "undamped_peak_amplitude_mm": 1e3 * sweep.undamped_peak_amplitude,
@@ -938,7 +1031,8 @@ def montecarlo_outputs(out: Path, design, result, saved: list) -> dict:
         result.plot(ax=ax)
     else:
         ax.text(0.5, 0.5, "no disk solved", ha="center", transform=ax.transAxes)
-    save_figure(fig, out / "montecarlo.png")
+    ax.set_title(design_title(design, "mistuned disks"))
+    figures = save_figure(fig, out / "montecarlo.png")
     n, failed = summary["n_disks"], summary["n_failed"]
     lines = [f"{n - failed} of {n} mistuned disks solved (std {summary.get('std', float('nan')):g}, "
              f"seed {summary.get('seed', '-')}); tuned peak {_mm(result.tuned_peak_amplitude)}.", ""]
@@ -956,7 +1050,7 @@ def montecarlo_outputs(out: Path, design, result, saved: list) -> dict:
     error = meta.get("harmonic_error_first_disk")
     analysis += (" Harmonic error estimate of the first disk (the one estimated, against an enriched "
                  f"harmonic set): {'not estimated' if error is None else fmt_percent(error)} of its peak.")
-    write_summary(out, "montecarlo", design, lines, ["montecarlo.png", *saved], analysis)
+    write_summary(out, "montecarlo", design, lines, [*figures, *saved], analysis)
     return summary
 
 

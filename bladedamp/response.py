@@ -545,9 +545,11 @@ class FrequencyResponse(Saveable):
         """Excitation frequency of :attr:`peak_amplitude` [Hz] (the resonance)."""
         return self.peak()[0]
 
-    def plot(self, ax=None, *, dof=0, harmonic: int = 1, scale: float = 1.0, unit: str = "", measured=None,
+    def plot(self, ax=None, *, dof=0, harmonic: int = 1, scale: float = 1.0, unit: str = "m", measured=None,
              **kwargs):
-        """Plot |X_h| of ``dof`` over frequency [Hz] into ``ax`` (a new figure if None); returns
+        """Plot ``scale`` |X_h| of ``dof`` over frequency [Hz] into ``ax`` (a new figure if None);
+        ``unit``: the unit of the plotted values, shown in brackets on the axis (default m, the
+        SI unit of a displacement DOF at ``scale`` 1; e.g. ``scale=1e3, unit="mm"``). Returns
         the axes. Every response class's ``plot`` takes ``ax`` first, options by keyword.
         ``measured``: a measured displacement (or velocity, acceleration) response or its file,
         drawn times ``scale`` beside it (:func:`bladedamp.measurement.draw_measurement`; an FRF
@@ -560,7 +562,7 @@ class FrequencyResponse(Saveable):
         plot_branch(ax, self.frequency_hz, scale * self.harmonic_amplitude(dof, harmonic), self.stable,
                     label=label, **kwargs)
         ax.set_xlabel("excitation frequency [Hz]")
-        ax.set_ylabel(f"|{self.dof_names[self._dof(dof)]}| harmonic {harmonic} {unit}".strip())
+        ax.set_ylabel(f"|{self.dof_names[self._dof(dof)]}| harmonic {harmonic} [{unit}]")
         ax.grid(True, alpha=0.3)
         if not self.success:
             ax.set_title(f"incomplete: {self.message}", fontsize=8)

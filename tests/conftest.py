@@ -191,3 +191,49 @@ def reference_regions():
     return {"clamp": solid.PlaneRegion((0.0, 0.0, 0.0), (0.0, 0.0, -1.0)),
             "OL": solid.PlaneRegion(pts["OL"], contact_normal("OL", sg.gamma_left)),
             "OR": solid.PlaneRegion(pts["OR"], contact_normal("OR", sg.gamma_right))}
+
+
+# ---------------------------------------------------------------------------------------
+# figures
+# ---------------------------------------------------------------------------------------
+class SavedFigures(dict):
+    """{file stem: (figure problems of tests/figure_checks.py without the title rule, titles,
+    the Figure)} of every figure saved while the fixture is active (checked once per figure, at
+    its first file)."""
+
+    def check(self, design: str | None, *stems) -> None:
+        """AssertionError listing every figure (``stems``, default all) that breaks a rule, the
+        title rule with ``design`` (None: no title rule)."""
+        from figure_checks import title_problems
+
+        assert self, "no figure was saved"
+        bad = []
+        for stem in stems or self:
+            assert stem in self, f"{stem}: not saved (saved: {sorted(self)})"
+            problems, _, fig = self[stem]
+            problems = problems + (title_problems(fig, design) if design is not None else [])
+            bad += [f"{stem}: {p}" for p in problems]
+        assert not bad, "figures break the slide rules:\n  " + "\n  ".join(bad)
+
+
+@pytest.fixture
+def saved_figures(monkeypatch):
+    """Every figure saved with ``Figure.savefig`` to a file during the test, checked by
+    tests/figure_checks.py as it is saved (a :class:`SavedFigures`)."""
+    import os
+    from pathlib import Path
+
+    import matplotlib.figure
+    from figure_checks import figure_problems, titles
+
+    saved = SavedFigures()
+    original = matplotlib.figure.Figure.savefig
+
+    def checked(self, fname, *args, **kwargs):
+        if isinstance(fname, (str, os.PathLike)):
+            stem = Path(fname).stem
+            if stem not in saved:
+                saved[stem] = (figure_problems(self, None), titles(self), self)
+        return original(self, fname, *args, **kwargs)
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", checked)
+    return saved

@@ -207,28 +207,31 @@ def test_frf_checks_a_stopped_branch_by_time_integration_unless_told_not_to(smal
     """``bladedamp frf`` asks the tuned responses for ``check_stop`` (the time integration beyond a
     branch that stops early, tested in test_disk.py) and ``check_peak`` (at the peak of a branch
     whose harmonic error the enriched set could not verify, tested in test_random_designs.py);
-    ``--no-stop-check`` and ``--no-peak-check`` turn them off, each alone."""
+    ``--no-stop-check`` and ``--no-peak-check`` turn them off, each alone. The damper-free
+    reference of frf.png (linear) is solved without either."""
     from bladedamp.disk import TunedDisk
 
-    asked, original = [], TunedDisk.frequency_response
+    asked, free, original = [], [], TunedDisk.frequency_response
 
     def spy(self, *args, **options):
-        asked.append((options.get("check_stop"), options.get("check_peak")))
+        (asked if self.has_damper else free).append((options.get("check_stop"), options.get("check_peak")))
         return original(self, *args, **options)
     monkeypatch.setattr(TunedDisk, "frequency_response", spy)
     assert main(["frf", str(small_design), "--out", str(tmp_path / "a")]) == 0
     assert main(["frf", str(small_design), "--no-stop-check", "--out", str(tmp_path / "b")]) == 0
     assert main(["frf", str(small_design), "--no-peak-check", "--out", str(tmp_path / "c")]) == 0
     assert asked == [(True, True), (False, True), (True, False)]
+    assert len(free) == 3 and not any(check for pair in free for check in pair)
 
 
-def test_frf_mistuned_with_unit_kappa_is_the_tuned_response(small_design, tmp_path):
+def test_frf_mistuned_with_unit_kappa_is_the_tuned_response(small_design, tmp_path, saved_figures):
     path = tmp_path / "design.toml"
     path.write_text(small_design.read_text().replace("# kappa = [1.02, 0.98]", "kappa = [1.0, 1.0, 1.0, 1.0]")
                     .replace("std = 0.02\n", "").replace("seed = 2\n", ""))
     out = tmp_path / "frf"
     assert main(["frf", str(path), "--mistuned", "--out", str(out)]) == 0
     _, results = _outputs(out, "frf.png", "summary.md", "results.json", "frf_mistuned_EO1.npz")
+    saved_figures.check("design")          # two annotated peaks at the same point, stacked
     tuned, mistuned = results["responses"]["EO1"], results["responses"]["mistuned_EO1"]
     assert tuned["success"] and mistuned["success"]
     # the full assembly of identical blades is the cyclic model: same peak (continuation points differ)
@@ -236,13 +239,14 @@ def test_frf_mistuned_with_unit_kappa_is_the_tuned_response(small_design, tmp_pa
     assert mistuned["peak_frequency_hz"] == pytest.approx(tuned["peak_frequency_hz"], abs=0.05)
 
 
-def test_montecarlo_on_a_small_design(small_design, tmp_path):
+def test_montecarlo_on_a_small_design(small_design, tmp_path, saved_figures):
     from bladedamp.studies.mistuning import MonteCarloResult
 
     path = small_design
     out = tmp_path / "mc"
     assert main(["montecarlo", str(path), "--disks", "1", "--scheduler", "serial", "--out", str(out)]) == 0
     summary, _ = _outputs(out, "montecarlo.png", "summary.md", "montecarlo.npz")
+    saved_figures.check("design")
     result = MonteCarloResult.load(out / "montecarlo.npz")
     assert result.kappa.shape == (1, 4) and result.meta["seed"] == 2 and result.meta["std"] == 0.02
     # the damper still works on the mistuned 4-blade disk: every blade's peak stays well below the
@@ -357,6 +361,79 @@ def test_progress_bar_in_place_on_a_terminal_and_one_line_otherwise():
             tick(done, 10)
     assert log.getvalue().count("\n") == 1 and "mass sweep done (10)" in log.getvalue()
     assert "\r" in tty.getvalue() and "10/10" in tty.getvalue() and "mass sweep done (10)" in tty.getvalue()
+
+
+# ---------------------------------------------------------------------------------------
+# the commands' figures (tests/figure_checks.py through the saved_figures fixture)
+# ---------------------------------------------------------------------------------------
+def _png_size(path):
+    import matplotlib.image
+
+    height, width = matplotlib.image.imread(path).shape[:2]
+    return width, height
+
+
+def test_frf_figure_shows_the_undamped_response_dashed_and_the_annotated_peak(fast_design, tmp_path, saved_figures):
+    out = tmp_path / "frf"
+    assert main(["frf", str(fast_design), "--no-stop-check", "--no-peak-check", "--format", "png,svg,pdf",
+                 "--dpi", "60", "--out", str(out)]) == 0
+    summary, results = _outputs(out, "frf.png", "frf.svg", "frf.pdf", "summary.md", "results.json")
+    assert "`frf.png`, `frf.svg`, `frf.pdf`" in summary
+    assert (out / "frf.pdf").read_bytes().startswith(b"%PDF") and b"<svg" in (out / "frf.svg").read_bytes()
+    saved_figures.check("design")
+    _, titles, fig = saved_figures["frf"]
+    assert "cylinder damper 1 g, 16 blades" in titles[0] and "frf" not in titles[0]
+    w, h = fig.get_size_inches()
+    assert _png_size(out / "frf.png") == (round(60 * w), round(60 * h))          # --dpi respected
+    ax = fig.axes[0]
+    dashed = [line for line in ax.get_lines() if line.get_linestyle() == "--"]
+    assert len(dashed) == 1 and "no damper" in dashed[0].get_label()
+    # the damper-free peak is the reference calibration's 1.7 mm (bladedamp.reference)
+    assert dashed[0].get_ydata().max() == pytest.approx(1.7, rel=0.01)
+    r = results["responses"]["EO1"]
+    assert r["undamped_peak_amplitude_mm"] == pytest.approx(dashed[0].get_ydata().max())
+    notes = [t.get_text() for t in ax.texts]
+    assert notes == [f"peak {r['peak_amplitude_mm']:.3g} mm at {r['peak_frequency_hz']:.2f} Hz"]
+    marked = [line for line in ax.get_lines() if line.get_marker() == "o"]
+    assert len(marked) == 1 and marked[0].get_ydata()[0] == pytest.approx(r["peak_amplitude_mm"])
+
+
+def test_optimize_figure_draws_the_optimum_inside_the_curve_of_every_mass(fast_design, tmp_path, saved_figures):
+    out = tmp_path / "opt"
+    assert main(["optimize", str(fast_design), "--processes", "1", "--format", "svg", "--out", str(out)]) == 0
+    summary, results = _outputs(out, "optimize.svg", "summary.md", "results.json")
+    assert not (out / "optimize.png").exists() and "`optimize.svg`" in summary
+    saved_figures.check("design")
+    fig = saved_figures["optimize"][2]
+    ax = fig.axes[0]
+    assert ax.get_xscale() == "log"
+    m = results["mass"]
+    grid_m, grid_p = np.array(m["grid_mass_g"]), np.array(m["grid_peak_amplitude_mm"])
+    assert np.all(np.isfinite(grid_p))                 # the masses stopped by branch and bound were completed
+    curve = next(line for line in ax.get_lines() if "every mass evaluated" in line.get_label())
+    x, y = curve.get_xdata(), curve.get_ydata()
+    assert np.all(np.isin(np.round(grid_m, 9), np.round(x, 9)))                  # every grid mass on the curve
+    star = next(line for line in ax.get_lines() if line.get_marker() == "*")
+    xs, ys = star.get_xdata()[0], star.get_ydata()[0]
+    assert xs == pytest.approx(m["optimal_mass_g"]) and x.min() < xs < x.max()    # inside the curve
+    assert ys == pytest.approx(y.min())                # the lowest point of the curve it lies on
+    assert y[0] > 1.2 * ys and y[-1] > 1.1 * ys         # the rise on both sides of the optimum
+
+
+@pytest.mark.parametrize("args, needles", [(["--format", "png,jpg"], ["--format", "'jpg'", "png, svg, pdf"]),
+                                           (["--dpi", "0"], ["--dpi 0", "[10, 2400]"])])
+def test_bad_figure_options_exit_2_with_one_line(fast_design, tmp_path, capsys, args, needles):
+    assert main(["frf", str(fast_design), *args, "--out", str(tmp_path / "x")]) == 2
+    _one_error_line(capsys, *needles)
+    assert not (tmp_path / "x").exists()
+
+
+def test_every_command_that_draws_takes_format_and_dpi():
+    parser = build_parser()
+    for command in ("frf", "optimize", "eo-sweep", "montecarlo", "reproduce"):
+        args = parser.parse_args([command, "d.toml", "--format", "svg,pdf", "--dpi", "300"] if command != "reproduce"
+                                 else [command, "--format", "svg,pdf", "--dpi", "300"])
+        assert (args.format, args.dpi) == ("svg,pdf", 300), command
 
 
 def test_frf_leads_with_the_status_and_names_a_range_end_maximum(tmp_path, capsys):

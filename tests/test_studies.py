@@ -210,6 +210,29 @@ def test_branch_and_bound_of_the_mass_grid_keeps_the_optimum(monkeypatch):
     assert "stopped once above the best peak" in pruned.message
 
 
+def test_complete_grid_solves_the_stopped_masses_as_the_unpruned_search_does(monkeypatch):
+    """``optimal_mass(complete_grid=True)`` (for optimize.png's whole curve) fills the grid masses
+    that branch and bound stopped with their full peaks: the same numbers as a search without
+    branch and bound, and the same optimum; ``evaluated_mass`` holds the grid and the search's
+    points with their peaks."""
+    import bladedamp.studies.mass as mass
+
+    disk = reference_disk("cylinder", 1e-3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        complete = optimal_mass(disk, bounds=(0.3e-3, 3e-3), grid_per_decade=3, xatol=0.1, complete_grid=True)
+        plain_case = mass._robust_peak_case
+        monkeypatch.setattr(mass, "_robust_peak_case", lambda case: plain_case(case[:-1] + (np.inf,)))
+        plain = optimal_mass(disk, bounds=(0.3e-3, 3e-3), grid_per_decade=3, xatol=0.1)
+    assert (complete.mass, complete.peak_amplitude) == (plain.mass, plain.peak_amplitude)
+    assert np.all(np.isfinite(complete.grid_peak_amplitude))
+    np.testing.assert_allclose(complete.grid_peak_amplitude, plain.grid_peak_amplitude, rtol=1e-9)
+    assert np.all(np.diff(complete.evaluated_mass) > 0) and np.all(np.isin(complete.grid_mass, complete.evaluated_mass))
+    assert len(complete.evaluated_mass) > len(complete.grid_mass)             # the bounded search's points too
+    k = int(np.argmin(np.abs(complete.evaluated_mass - complete.mass)))
+    assert complete.evaluated_peak_amplitude[k] == complete.peak_amplitude
+
+
 # ---------------------------------------------------------------------------------------
 # asymmetric platforms (Fig. 10)
 # ---------------------------------------------------------------------------------------

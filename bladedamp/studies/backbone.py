@@ -103,6 +103,8 @@ class BackboneDesign(Saveable):
 
         from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
+        from ..plotting import place_legend
+
         if axes is None:
             _, axes = plt.subplots(1, 2, figsize=(11, 4), constrained_layout=True)
         ax, ax2 = axes
@@ -114,7 +116,6 @@ class BackboneDesign(Saveable):
         ax.set_ylabel("reduction of the resonance tip amplitude [%]")
         ax.set_title(f"{self.kind}: peak by single nonlinear mode synthesis", fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
         ax2.loglog(self.excitation_levels, 1e3 * self.optimal_mass, "o-")
         ax2.set_xlabel("excitation level [N]")
         ax2.set_ylabel("optimal damper mass [g]")
@@ -123,6 +124,7 @@ class BackboneDesign(Saveable):
             axis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
             axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
             axis.set_minor_formatter(NullFormatter())
+        place_legend(ax, fontsize=8)                        # clear of every point (after the layout)
         return axes
 
 

@@ -26,12 +26,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import validation
+from .. import palette, validation
 from ..damper.kinetics import seat
 from ..disk import TunedDisk
 from ..io import Saveable
+from ..plotting import place_legend, plain_log_ticks, reference_level
 from ..progress import progress_callback
-from ..plotting import place_legend
 from .parallel import parallel_map
 from .mass import optimal_mass, peak_response, with_mass
 
@@ -88,21 +88,36 @@ class EngineOrderSweep(Saveable):
     messages: dict = field(default_factory=dict)
 
     def plot(self, ax=None, **kwargs):
-        """Resonance amplitude [mm] (and optimal mass [g], right axis) over engine order."""
+        """Resonance amplitude [mm] (and optimal mass [g], right axis, log) over engine order;
+        the damper-free peaks dashed."""
         import matplotlib.pyplot as plt
 
         if ax is None:
             _, ax = plt.subplots(figsize=(6, 4))
-        kwargs.setdefault("label", f"{self.kind}, optimal mass")
+        colour = palette.DAMPER.get(self.kind, palette.series(0))
+        kwargs.setdefault("label", f"{self.kind}: peak at the optimal mass")
+        kwargs.setdefault("color", colour)
         ax.plot(self.engine_orders, 1e3 * self.optimal_peak_amplitude, marker="o", **kwargs)
-        ax.plot(self.engine_orders, 1e3 * self.undamped_peak_amplitude, color="gray", ls="--", lw=1, label="no damper")
-        ax.set_xlabel("engine order EO")
+        undamped = 1e3 * np.asarray(self.undamped_peak_amplitude, dtype=float)
+        if np.ptp(undamped) <= 0.01 * np.max(undamped):        # the same at every EO: one level
+            reference_level(ax, float(np.mean(undamped)), "no damper")
+        else:
+            ax.plot(self.engine_orders, undamped, color=palette.UNDAMPED, ls="--", lw=1, label="no damper",
+                    gid="reference")
+        ax.set_xlabel("engine order EO [-]")
         ax.set_ylabel("resonance tip amplitude u_x [mm]")
+        ax.xaxis.set_major_locator(plt.MaxNLocator(integer=True))
         ax.grid(True, alpha=0.3)
-        ax.legend(loc="upper left")
         ax2 = ax.twinx()
-        ax2.plot(self.engine_orders, 1e3 * self.optimal_mass, marker="s", ls=":", color="C3")
-        ax2.set_ylabel("optimal damper mass [g]", color="C3")
+        ok = np.isfinite(self.optimal_mass)
+        ax2.semilogy(self.engine_orders[ok], 1e3 * self.optimal_mass[ok], marker="s", ls=":", color="0.35",
+                     label="optimal mass (right axis)")
+        ax2.set_ylabel("optimal damper mass [g]", color="0.35")
+        plain_log_ticks(ax2.yaxis)
+        handles = [h for a in (ax, ax2) for h in a.get_legend_handles_labels()[0]]
+        # below the axes: the twin axes' points would lie under a legend inside them
+        ax2.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=len(handles), fontsize=8,
+                   frameon=False)
         return ax
 
 
@@ -264,14 +279,16 @@ class PlatformAngleStudy(Saveable):
 
         if ax is None:
             _, ax = plt.subplots(figsize=(6, 4))
-        ax.plot(self.gamma_right_deg, 1e3 * self.optimal_peak_amplitude, marker="o", label="optimal mass", **kwargs)
-        ax.plot(self.gamma_right_deg, 1e3 * self.peak_amplitude_at_fixed_mass, marker="s",
+        colour = palette.DAMPER.get(self.kind, palette.series(0))
+        ax.plot(self.gamma_right_deg, 1e3 * self.optimal_peak_amplitude, marker="o", color=colour,
+                label="optimal mass", **kwargs)
+        ax.plot(self.gamma_right_deg, 1e3 * self.peak_amplitude_at_fixed_mass, marker="s", ls=":", color=colour,
                 label=f"m = {1e3 * self.fixed_mass:g} g", **kwargs)
-        ax.axhline(1e3 * self.undamped_peak_amplitude, color="gray", ls="--", lw=1, label="no damper")
+        reference_level(ax, 1e3 * self.undamped_peak_amplitude, "no damper")
         ax.set_xlabel(f"platform angle gamma_R [deg] (gamma_L = {self.gamma_left_deg:g} deg)")
         ax.set_ylabel("resonance tip amplitude u_x [mm]")
         ax.grid(True, alpha=0.3)
-        ax.legend()
+        place_legend(ax, fontsize=8)
         return ax
 
 
@@ -372,10 +389,10 @@ class ContactState(Saveable):
         for c, name in enumerate(("OL", "OR")):
             for z, label, style in ((self.w_star[c], f"w*_xi,{name}", "-"), (self.F_star[c], f"F*_xi,{name}", ":")):
                 ax.annotate("", xy=(z.real, z.imag), xytext=(0, 0),
-                            arrowprops=dict(arrowstyle="->", color=f"C{c}", ls=style))
+                            arrowprops=dict(arrowstyle="->", color=palette.series(c), ls=style))
                 # F* hollow and w* on top: where the two nearly coincide (OL at gamma_R = 85 deg) both show
-                marker = dict(marker="o", color=f"C{c}", zorder=4) if style == "-" else \
-                    dict(marker="s", mfc="none", mec=f"C{c}", ms=9, mew=1.5, zorder=3)
+                marker = dict(marker="o", color=palette.series(c), zorder=4) if style == "-" else \
+                    dict(marker="s", mfc="none", mec=palette.series(c), ms=9, mew=1.5, zorder=3)
                 ax.plot([z.real], [z.imag], ls="none", label=label, **marker, **kwargs)
         lim = 1.1 * max(1.0, np.abs(self.w_star).max(), np.abs(self.F_star).max())
         ax.set_xlim(-lim, lim)
@@ -383,8 +400,8 @@ class ContactState(Saveable):
         ax.set_aspect("equal")
         ax.axhline(0, color="k", lw=0.5)
         ax.axvline(0, color="k", lw=0.5)
-        ax.set_xlabel("real part")
-        ax.set_ylabel("imaginary part")
+        ax.set_xlabel("real part of w*, F* [-]")
+        ax.set_ylabel("imaginary part of w*, F* [-]")
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
         return ax
@@ -462,11 +479,11 @@ class LiftoffMap(Saveable):
         kwargs.setdefault("cmap", "viridis")
         sc = ax.scatter(self.xi_star, self.eta_star, c=self.ratio[contact], s=80, **kwargs)
         lift = self.lifts_off[contact]
-        ax.scatter(self.xi_star[lift], self.eta_star[lift], s=160, facecolors="none", edgecolors="r",
+        ax.scatter(self.xi_star[lift], self.eta_star[lift], s=160, facecolors="none", edgecolors=palette.SLIP,
                    label="r > 1 (lift-off)")
-        ax.figure.colorbar(sc, ax=ax, label="r = |w_zeta| / w_zeta,static")
-        ax.set_xlabel("xi* = xi / h_C")
-        ax.set_ylabel("eta* = eta / l_C")
+        ax.figure.colorbar(sc, ax=ax, label="r = |w_zeta| / w_zeta,static [-]")
+        ax.set_xlabel("xi* = xi / h_C [-]")
+        ax.set_ylabel("eta* = eta / l_C [-]")
         ax.set_title(f"{('OL', 'OR')[contact]} at {self.peak_frequency_hz:.2f} Hz")
         if lift.any():
             place_legend(ax, loc="upper center", fontsize=8)     # above the points, none hidden

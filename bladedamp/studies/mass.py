@@ -8,11 +8,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from .. import validation
+from .. import palette, validation
 from ..disk import TunedDisk
 from ..io import Saveable
+from ..plotting import place_legend, plain_log_ticks
 from ..progress import progress_callback
-from ..plotting import place_legend
 from ..response import refined_peak
 
 
@@ -247,10 +247,13 @@ class MassSweep(Saveable):
         if ax is None:
             _, ax = plt.subplots(figsize=(6, 4))
         kwargs.setdefault("label", self.kind)
+        if kwargs.get("color") is None:
+            kwargs["color"] = palette.DAMPER.get(self.kind)
         ax.semilogx(1e3 * self.mass, 1e3 * self.peak_amplitude, marker="o", **kwargs)
         shown = any(line.get_label() == "no damper" for line in ax.get_lines())
-        ax.axhline(1e3 * self.undamped_peak_amplitude, color="gray", ls="--", lw=1,
+        ax.axhline(1e3 * self.undamped_peak_amplitude, color=palette.UNDAMPED, ls="--", lw=1,
                    label="_no damper" if shown else "no damper")      # one legend entry per axes
+        plain_log_ticks(ax.xaxis)
         ax.set_xlabel("damper mass [g]")
         ax.set_ylabel("resonance tip amplitude u_x [mm]")
         ax.grid(True, which="both", alpha=0.3)
@@ -307,6 +310,8 @@ class MassOptimum(Saveable):
     success : True when the optimum is certified global on the grid: every failed mass has a
         lower bound above the optimum peak (so it cannot hide a better mass)
     message : what was found, and which failed masses leave the claim open
+    evaluated_mass : (e,) [kg] every mass evaluated (the grid and the bounded search's points),
+        increasing; evaluated_peak_amplitude : (e,) [m] their peaks (NaN where failed or stopped)
     """
 
     mass: float
@@ -322,6 +327,8 @@ class MassOptimum(Saveable):
     success: bool = True
     message: str = ""
     stopped_masses: tuple = ()
+    evaluated_mass: np.ndarray = None
+    evaluated_peak_amplitude: np.ndarray = None
 
     @property
     def reduction(self) -> float:
@@ -387,7 +394,7 @@ def bracket_minimum(fun, grid, xatol: float, fail_value: float, processes: int |
 
 def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0), harmonics=(1,),
                  xatol: float = 0.02, grid_per_decade: float = GRID_PER_DECADE, processes: int | None = 1,
-                 progress=None) -> MassOptimum:
+                 progress=None, complete_grid: bool = False) -> MassOptimum:
     """Mass minimising the peak tip amplitude, global over ``bounds`` [kg] (0 < low < high).
 
     A log grid of ``grid_per_decade`` points per decade (at least 5) brackets the best mass;
@@ -397,6 +404,9 @@ def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0),
     in the result with a lower bound of their peak, and ``success`` says whether they could
     hide a better optimum. ``processes``: worker processes over the grid (None: every core);
     ``progress``: True (a progress bar, tqdm.auto: a widget in Jupyter, a bar in a terminal), False / None (none) or a callable (done, total) over the grid.
+    ``complete_grid``: afterwards, also solve the grid masses whose branch was stopped above the
+    best peak (branch and bound), so ``grid_peak_amplitude`` is the whole curve around the
+    optimum (for a figure; it costs those responses, and does not change the optimum).
     """
     from .parallel import parallel_map, workers
 
@@ -450,6 +460,12 @@ def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0),
         return [evaluations[m].peak_amplitude if evaluations[m].success else np.nan for m in masses]
 
     logm, peak, _, (a, b) = bracket_minimum(fun, loggrid, xatol, 10 * undamped, evaluate_grid=evaluate_grid)
+    if complete_grid and np.isfinite(logm):
+        rest = [float(m) for m in grid_m if evaluations[float(m)].stopped_above]
+        cases = [(with_mass(disk, m), f_range_hz, harmonics, ROBUST_ATTEMPTS, True, np.inf, np.inf) for m in rest]
+        for m, ev in zip(rest, parallel_map(_robust_peak_case, cases, processes)):
+            ev.attempts += evaluations[m].attempts
+            record(m, ev)
     grid_p = np.array([evaluations[float(m)].peak_amplitude for m in grid_m])
     failed = sorted(m for m, ev in evaluations.items() if not ev.success and not ev.stopped_above)
     stopped = tuple(sorted(m for m, ev in evaluations.items() if ev.stopped_above))
@@ -471,5 +487,8 @@ def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0),
                      "(no partial branch above the optimum): global optimum not certified")
         else:
             text += ", each with a partial branch already above the optimum peak: they cannot be the optimum"
+    evaluated = np.array(sorted(evaluations))
     return MassOptimum(best, peak, undamped, len(evaluations), tuple(failed), bounds_f, msgs, grid_m, grid_p,
-                       (mass_of(a), mass_of(b)), not open_, text, stopped)
+                       (mass_of(a), mass_of(b)), not open_, text, stopped, evaluated,
+                       np.array([evaluations[m].peak_amplitude if evaluations[m].success else np.nan
+                                 for m in evaluated]))

@@ -23,11 +23,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import validation
+from .. import palette, validation
 from ..disk import TunedDisk
 from ..io import Saveable, npz_path
+from ..plotting import place_legend, save_figure
 from ..progress import progress_callback
-from ..plotting import place_legend
 from ..mistuned import MistunedDisk, MistunedResponse
 
 PAPER_STD = 0.02
@@ -427,12 +427,12 @@ def plot_cases(cases: dict[str, MistuningCase], path=None):
     for ax, (key, c) in zip(axes.ravel(), cases.items()):
         c.response.plot(ax=ax, tuned=c.tuned_response, title=re.sub(r"_(\d+)g$", r", \1 g", key))
     axes.ravel()[-1].axis("off")
+    fig.suptitle("Figs. 13-17: reference disk, mistuned blades (random, reordered, alternating)")
     fig.tight_layout()
     for ax, _ in zip(axes.ravel(), cases):
         place_legend(ax, fontsize=8)       # clear of every curve (the largest peak included)
     if path is not None:
-        fig.savefig(path, dpi=110)
-        plt.close(fig)
+        save_figure(fig, path)
     return fig
 
 
@@ -574,13 +574,13 @@ class MonteCarloResult(Saveable):
         if ax is None:
             _, ax = plt.subplots(figsize=(6, 4))
         a = self.amplification[self.valid]
-        ax.hist(a, bins=bins, color="C0", alpha=0.8)
+        ax.hist(a, bins=bins, color=palette.series(0), alpha=0.8)
         lo, hi = self.confidence_interval()
         ax.axvline(a.mean(), color="k", label=f"mean {a.mean():.3f} (95 % CI {lo:.3f}-{hi:.3f})")
-        ax.axvline(1.0, color="k", ls="--", lw=1, label="tuned")
-        ax.set_xlabel("peak amplification (max blade / tuned)")
-        ax.set_ylabel("disks")
-        ax.legend(fontsize=8)
+        ax.axvline(1.0, color=palette.UNDAMPED, ls="--", lw=1, label="tuned")
+        ax.set_xlabel("peak amplification, largest blade / tuned [-]")
+        ax.set_ylabel("number of disks [-]")
+        place_legend(ax, fontsize=8)
         return ax
 
 
