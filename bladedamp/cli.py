@@ -644,6 +644,15 @@ def optimize_command(args) -> int:
                           f"reduction {fmt_percent(optimum.reduction)}")
 
 
+def engine_orders(args, design) -> tuple:
+    """The engine orders of ``--engine-orders`` (default: the design's), each checked >= 0."""
+    eos = tuple(args.engine_orders or design.engine_orders)
+    for eo in eos:
+        if eo < 0:
+            raise UsageError(f"--engine-orders {eo}: must be an integer >= 0")
+    return eos
+
+
 def eo_sweep_command(args) -> int:
     """``bladedamp eo-sweep``: the optimal damper mass at each engine order."""
     from .report import eo_sweep_outputs
@@ -652,10 +661,7 @@ def eo_sweep_command(args) -> int:
     t0 = time.perf_counter()
     design = _load(args)
     disk, a = _damped(design, "eo-sweep"), design.analysis
-    eos = args.engine_orders or design.engine_orders
-    for eo in eos:
-        if eo < 0:
-            raise UsageError(f"--engine-orders {eo}: must be an integer >= 0")
+    eos = engine_orders(args, design)
     out = output_dir(output_folder(args), args.overwrite)
     progress = Progress()
     progress.compiling()
@@ -727,10 +733,7 @@ def campbell_command(args) -> int:
     if design.rotor_speed_hz is not None:
         raise UsageError(f"{design.path}: [disk] rotor_speed_rpm fixes the rotor speed; campbell follows each engine "
                          "order over rotor speed (set rotor_speed_rpm = \"auto\"; --speed-range-rpm sets the diagram's range)")
-    eos = tuple(sorted(set(args.engine_orders))) if args.engine_orders else design.engine_orders
-    for eo in eos:
-        if eo < 0:
-            raise UsageError(f"--engine-orders {eo}: must be an integer >= 0")
+    eos = tuple(sorted(set(engine_orders(args, design))))
     speeds = _rotor_speed_range_hz(design, args, eos)
     f_max = _top_frequency_hz(design, args)
     out = output_dir(output_folder(args), args.overwrite)
