@@ -118,3 +118,19 @@ def test_bad_input_is_one_line_and_exit_2(small_design, tmp_path, capsys, argv, 
     assert main([argv[0], str(design), *argv[1:], "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and needle in err[0], err
+
+
+def test_zzenf_and_campbell_figures_pass_the_slide_checks_and_summaries_list_the_files_written(
+        small_design, tmp_path, saved_figures):
+    """The figures of both commands obey tests/figure_checks.py with a title naming the design
+    file; with --format svg no PNG is written and summary.md names the SVG instead."""
+    zz, cb = tmp_path / "zz", tmp_path / "cb"
+    assert main(["zzenf", str(small_design), "--speed-range-rpm", "1500", "7000", "--format", "svg",
+                 "--out", str(zz)]) == 0
+    assert main(["campbell", str(small_design), "--engine-orders", "1", "3", "4", "--format", "svg",
+                 "--out", str(cb)]) == 0
+    saved_figures.check(small_design.stem, "zzenf", "campbell")
+    for out, name in ((zz, "zzenf"), (cb, "campbell")):
+        assert (out / f"{name}.svg").is_file() and not (out / f"{name}.png").exists()
+        summary = (out / "summary.md").read_text()
+        assert f"`{name}.svg`" in summary and f"{name}.png" not in summary
