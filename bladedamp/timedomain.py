@@ -118,7 +118,10 @@ class TimeResponse(Saveable):
         spec = np.fft.rfft(self.samples, axis=1) / self.samples.shape[1]
         return (1 if harmonic == 0 else 2) * np.abs(spec[:, harmonic])
 
-    def plot(self, ax=None, *, scale: float = 1.0, **kwargs):
+    def plot(self, ax=None, *, scale: float = 1.0, unit: str = "m", **kwargs):
+        """Plot ``scale`` times the first-harmonic amplitude over frequency [Hz] as markers into
+        ``ax`` (a new figure if None); ``unit``: the unit of the plotted values, shown in brackets
+        on the axis (default m at ``scale`` 1; e.g. ``scale=1e3, unit="mm"``). Returns the axes."""
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -128,7 +131,7 @@ class TimeResponse(Saveable):
         kwargs.setdefault("linestyle", "none")
         ax.plot(self.frequency_hz, scale * self.amplitude, **kwargs)
         ax.set_xlabel("excitation frequency [Hz]")
-        ax.set_ylabel("first-harmonic amplitude")
+        ax.set_ylabel(f"first-harmonic amplitude [{unit}]")
         ax.grid(True, alpha=0.3)
         ax.legend()
         return ax

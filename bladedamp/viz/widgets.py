@@ -171,35 +171,50 @@ def hysteresis_loop(amplitude, k_t, slip_force, normal_variation=0.0, phase_deg=
                 slip_work=float(pts.slip_work[0]), energy_closed_form=float(e_closed), share=share)
 
 
+def contact_point_title(k_t_kn_per_m, slip_force_n, normal_variation=0.0) -> str:
+    """The suptitle of the contact point's figures: what the point is, with its parameters."""
+    varies = f", normal load varying by +-{100 * normal_variation:g} %" if normal_variation else ""
+    return f"friction contact point: k_T = {k_t_kn_per_m:g} kN/m, mu N_0 = {slip_force_n:g} N{varies}"
+
+
 def hysteresis_figure(amplitude_mm=0.1, k_t_kn_per_m=10.0, slip_force_n=0.3, normal_variation=0.0, phase_deg=0.0):
     """Slider callback (notebook 01): the hysteresis loop f(u) coloured by stick / slip / lift-off,
-    beside the time signals. Returns the figure; ``fig.loop`` holds the :func:`hysteresis_loop` data."""
+    beside the time signals (the slip limits +-mu N(t) drawn as references). Returns the figure;
+    ``fig.loop`` holds the :func:`hysteresis_loop` data."""
+    from matplotlib.ticker import MaxNLocator
+
+    from ..plotting import place_legend
+
     A, k_t = 1e-3 * amplitude_mm, 1e3 * k_t_kn_per_m
     d = hysteresis_loop(A, k_t, slip_force_n, normal_variation, phase_deg)
-    fig, (ax, ax2) = _figure(1, 2, figsize=(10, 3.8))
+    fig, (ax, ax2) = _figure(1, 2, figsize=(10, 4.2))
     u_mm = 1e3 * d["u"]
     for s in (STICK, SLIP, SEPARATED):
         sel = d["state"] == s
         if sel.any():
             ax.scatter(u_mm[sel], d["force"][sel], s=6, color=STATE_COLOURS[s], label=STATE_NAMES[s])
-    ax.plot(np.append(u_mm, u_mm[0]), np.append(d["force"], d["force"][0]), color="k", lw=0.6)
-    ax.axhline(slip_force_n, color="gray", ls=":", lw=1)
-    ax.axhline(-slip_force_n, color="gray", ls=":", lw=1)
+    ax.plot(np.append(u_mm, u_mm[0]), np.append(d["force"], d["force"][0]), color=palette.UNDAMPED, lw=0.6)
+    ax.axhline(slip_force_n, color=palette.SEPARATED, ls=":", lw=1)
+    ax.axhline(-slip_force_n, color=palette.SEPARATED, ls=":", lw=1)
+    ax.xaxis.set_major_locator(MaxNLocator(5))
     ax.set_xlabel("tangential displacement u [mm]")
     ax.set_ylabel("tangential contact force f_T [N]")
     ax.set_title(f"loop area = dissipated energy: {1e3 * d['energy']:.3g} mJ per cycle"
                  + ("" if normal_variation else f"\n(closed form {1e3 * d['energy_closed_form']:.3g} mJ)"), fontsize=9)
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8, loc="upper left")
-    ax2.plot(np.degrees(d["tau"]), d["force"], label="f_T [N]")
-    ax2.plot(np.degrees(d["tau"]), FRICTION_COEFFICIENT * d["normal"], label="mu N(t) [N]", ls="--")
-    ax2.plot(np.degrees(d["tau"]), -FRICTION_COEFFICIENT * d["normal"], color="C1", ls="--")
+    ax2.plot(np.degrees(d["tau"]), d["force"], color=palette.series(0), label="f_T")
+    for sign in (1, -1):
+        ax2.plot(np.degrees(d["tau"]), sign * FRICTION_COEFFICIENT * d["normal"], color=palette.series(1), ls="--",
+                 gid="reference", label="+-mu N(t)" if sign == 1 else None)
     ax2.set_xlabel("phase Omega t [deg]")
     ax2.set_ylabel("force [N]")
     ax2.set_xlim(0, 360)
+    ax2.set_xticks([0, 90, 180, 270, 360])
     ax2.grid(True, alpha=0.3)
-    ax2.legend(fontsize=8, loc="lower right")
-    fig.tight_layout()
+    fig.suptitle(contact_point_title(k_t_kn_per_m, slip_force_n, normal_variation)
+                 + f", amplitude {amplitude_mm:g} mm", fontsize=10)
+    place_legend(ax, loc="upper left", fontsize=8)
+    place_legend(ax2, loc="upper right", fontsize=8)
     fig.loop = d
     return fig
 
@@ -238,32 +253,39 @@ def describing_function_figure(k_t_kn_per_m=10.0, slip_force_n=0.3, normal_varia
                                n_points=60):
     """Slider callback (notebook 01): equivalent stiffness and damping over the amplitude
     (normalised by the slip amplitude mu N / k_T), AFT points on the closed form, and the energy
-    per cycle. ``fig.data`` holds the :func:`describing_function` result."""
+    per cycle (on the log axis from 1e-5 of its largest value: a contact that sticks dissipates
+    nothing). ``fig.data`` holds the :func:`describing_function` result."""
+    from ..plotting import place_legend
+
     k_t = 1e3 * k_t_kn_per_m
     a_slip = slip_force_n / k_t
     A = a_slip * np.logspace(-1, 2, n_points)
     d = describing_function(k_t, slip_force_n, A, normal_variation)
     x = A / a_slip
     fig, (ax, ax2) = _figure(1, 2, figsize=(10, 3.8))
-    ax.semilogx(x, d["k_eq_closed"] / k_t, "C0-", label="k_eq / k_T, closed form")
-    ax.semilogx(x, d["d_eq_closed"] / k_t, "C3-", label="d_eq / k_T, closed form")
-    ax.semilogx(x, d["k_eq"] / k_t, "C0o", ms=3, label="k_eq / k_T, AFT (Eq. 10)")
-    ax.semilogx(x, d["d_eq"] / k_t, "C3o", ms=3, label="d_eq / k_T, AFT (Eq. 10)")
-    ax.set_xlabel("amplitude A / (mu N / k_T)")
-    ax.set_ylabel("complex contact stiffness / k_T")
+    k_colour, d_colour = palette.series(0), palette.series(1)
+    ax.semilogx(x, d["k_eq_closed"] / k_t, "-", color=k_colour, label="k_eq / k_T, closed form")
+    ax.semilogx(x, d["d_eq_closed"] / k_t, "-", color=d_colour, label="d_eq / k_T, closed form")
+    ax.semilogx(x, d["k_eq"] / k_t, "o", color=k_colour, ms=3, label="k_eq / k_T, AFT (Eq. 10)")
+    ax.semilogx(x, d["d_eq"] / k_t, "o", color=d_colour, ms=3, label="d_eq / k_T, AFT (Eq. 10)")
+    ax.set_xlabel("amplitude A / (mu N / k_T) [-]")
+    ax.set_ylabel("complex contact stiffness / k_T [-]")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    ax2.loglog(1e3 * A, 1e3 * np.maximum(d["energy_closed"], 1e-30), "k-", label="closed form 4 mu N (A - mu N / k_T)")
-    ax2.loglog(1e3 * A, 1e3 * np.maximum(d["energy"], 1e-30), "C2o", ms=3, label="AFT: pi A^2 Im k_hat")
-    ax2.set_ylim(1e3 * max(d["energy_closed"].max(), 1e-30) * 1e-5, None)
+    floor = 1e3 * max(d["energy_closed"].max(), 1e-30) * 1e-5
+    shown = {key: np.where(1e3 * d[key] >= floor, 1e3 * d[key], np.nan) for key in ("energy_closed", "energy")}
+    ax2.loglog(1e3 * A, shown["energy_closed"], "-", color=palette.UNDAMPED, label="closed form 4 mu N (A - mu N / k_T)")
+    ax2.loglog(1e3 * A, shown["energy"], "o", color=palette.series(2), ms=3, label="AFT: pi A^2 Im k_hat")
+    ax2.set_xlim(1e3 * A[0], 1e3 * A[-1])                  # the sticking amplitudes too (no energy)
+    ax2.set_ylim(floor, None)
     ax2.set_xlabel("amplitude A [mm]")
     ax2.set_ylabel("energy dissipated per cycle [mJ]")
     ax2.grid(True, which="both", alpha=0.3)
-    ax2.legend(fontsize=8)
     if amplitude_mm is not None:
-        ax.axvline(1e-3 * amplitude_mm / a_slip, color="k", ls=":")
-        ax2.axvline(amplitude_mm, color="k", ls=":")
-    fig.tight_layout()
+        ax.axvline(1e-3 * amplitude_mm / a_slip, color=palette.UNDAMPED, ls=":")
+        ax2.axvline(amplitude_mm, color=palette.UNDAMPED, ls=":")
+    fig.suptitle(contact_point_title(k_t_kn_per_m, slip_force_n, normal_variation), fontsize=10)
+    place_legend(ax, fontsize=8)
+    place_legend(ax2, loc="lower right", fontsize=8)
     fig.data = d
     return fig
 
