@@ -29,13 +29,14 @@ def close_figures():
 # ---------------------------------------------------------------------------------------
 # notebook 01: the friction contact point and the friction oscillator
 # ---------------------------------------------------------------------------------------
-@pytest.mark.parametrize("normal_variation", [0.0, 0.5])
-def test_hysteresis_figure(normal_variation):
-    check_figure(widgets.hysteresis_figure(normal_variation=normal_variation), "friction contact point")
+@pytest.mark.parametrize("amplitude_mm, normal_variation", [(0.1, 0.0), (0.1, 0.5), (0.3, 1.5)])   # 1.5: lift-off
+def test_hysteresis_figure(amplitude_mm, normal_variation):
+    check_figure(widgets.hysteresis_figure(amplitude_mm, normal_variation=normal_variation), "friction contact point")
 
 
-def test_describing_function_figure():
-    check_figure(widgets.describing_function_figure(amplitude_mm=0.1), "friction contact point")
+@pytest.mark.parametrize("amplitude_mm", [None, 0.005, 0.1, 2.5])     # the slider's marker line anywhere
+def test_describing_function_figure(amplitude_mm):
+    check_figure(widgets.describing_function_figure(amplitude_mm=amplitude_mm), "friction contact point")
 
 
 def test_oscillator_figure():

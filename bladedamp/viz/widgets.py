@@ -192,7 +192,7 @@ def hysteresis_figure(amplitude_mm=0.1, k_t_kn_per_m=10.0, slip_force_n=0.3, nor
     for s in (STICK, SLIP, SEPARATED):
         sel = d["state"] == s
         if sel.any():
-            ax.scatter(u_mm[sel], d["force"][sel], s=6, color=STATE_COLOURS[s], label=STATE_NAMES[s])
+            ax.plot(u_mm[sel], d["force"][sel], "o", ms=2.5, color=STATE_COLOURS[s], label=STATE_NAMES[s])
     ax.plot(np.append(u_mm, u_mm[0]), np.append(d["force"], d["force"][0]), color=palette.UNDAMPED, lw=0.6)
     ax.axhline(slip_force_n, color=palette.SEPARATED, ls=":", lw=1)
     ax.axhline(-slip_force_n, color=palette.SEPARATED, ls=":", lw=1)
@@ -255,14 +255,12 @@ def describing_function_figure(k_t_kn_per_m=10.0, slip_force_n=0.3, normal_varia
     (normalised by the slip amplitude mu N / k_T), AFT points on the closed form, and the energy
     per cycle (on the log axis from 1e-5 of its largest value: a contact that sticks dissipates
     nothing). ``fig.data`` holds the :func:`describing_function` result."""
-    from ..plotting import place_legend
-
     k_t = 1e3 * k_t_kn_per_m
     a_slip = slip_force_n / k_t
     A = a_slip * np.logspace(-1, 2, n_points)
     d = describing_function(k_t, slip_force_n, A, normal_variation)
     x = A / a_slip
-    fig, (ax, ax2) = _figure(1, 2, figsize=(10, 3.8))
+    fig, (ax, ax2) = _figure(1, 2, figsize=(10, 4.6))
     k_colour, d_colour = palette.series(0), palette.series(1)
     ax.semilogx(x, d["k_eq_closed"] / k_t, "-", color=k_colour, label="k_eq / k_T, closed form")
     ax.semilogx(x, d["d_eq_closed"] / k_t, "-", color=d_colour, label="d_eq / k_T, closed form")
@@ -284,8 +282,9 @@ def describing_function_figure(k_t_kn_per_m=10.0, slip_force_n=0.3, normal_varia
         ax.axvline(1e-3 * amplitude_mm / a_slip, color=palette.UNDAMPED, ls=":")
         ax2.axvline(amplitude_mm, color=palette.UNDAMPED, ls=":")
     fig.suptitle(contact_point_title(k_t_kn_per_m, slip_force_n, normal_variation), fontsize=10)
-    place_legend(ax, fontsize=8)
-    place_legend(ax2, loc="lower right", fontsize=8)
+    for a in (ax, ax2):      # below the axes: the amplitude's marker line moves with the slider
+        a.legend(fontsize=8, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.2))
+    fig.tight_layout()
     fig.data = d
     return fig
 
