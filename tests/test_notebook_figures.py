@@ -138,3 +138,24 @@ def test_liftoff_figure(monkeypatch):
     m = LiftoffMap(xi, eta, r, r, np.zeros((2, P)), np.ones((2, P)), r, 95.5, 3e-4, 64)
     monkeypatch.setattr(notebook3d, "liftoff_case", lambda *args, **kwargs: m)
     check_figure(notebook3d.liftoff_figure(2.0, 0.1), "wedge")
+
+
+# ---------------------------------------------------------------------------------------
+# notebooks 02, 03: the reference disk's frequency responses (one harmonic, 92-100 Hz)
+# ---------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def disk_cache():
+    return widgets.DiskFRFCache()
+
+
+def test_disk_frf_figure(disk_cache):
+    check_figure(widgets.disk_frf_figure(1.0, cache=disk_cache), "reference disk")
+
+
+def test_mass_study_figure(disk_cache):
+    sweeps = {"cylinder": widgets.mass_sweep_peaks("cylinder", [0.3, 1.0, 3.0], cache=disk_cache)}
+    check_figure(widgets.mass_study_figure(1.0, sweeps=sweeps, cache=disk_cache), "reference disk")
+
+
+def test_platform_angle_figure(disk_cache):
+    check_figure(widgets.platform_angle_figure(35.0, cache=disk_cache), "reference disk")

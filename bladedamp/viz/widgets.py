@@ -35,6 +35,7 @@ from ..contact.patch import ContactPatch
 from ..contact.point import SEPARATED, SLIP, STICK, point_contact_forces
 from ..hbm.fourier import HarmonicBasis
 from ..oscillator import FrictionOscillator
+from ..plotting import place_legend, plain_log_ticks
 
 __all__ = ["interactive_view", "interact_with_image", "hysteresis_loop", "hysteresis_figure", "describing_function", "describing_function_figure",
            "oscillator_comparison", "oscillator_figure", "DiskFRF", "DiskFRFCache", "DEFAULT_CACHE", "disk_frf",
@@ -183,7 +184,6 @@ def hysteresis_figure(amplitude_mm=0.1, k_t_kn_per_m=10.0, slip_force_n=0.3, nor
     ``fig.loop`` holds the :func:`hysteresis_loop` data."""
     from matplotlib.ticker import MaxNLocator
 
-    from ..plotting import place_legend
 
     A, k_t = 1e-3 * amplitude_mm, 1e3 * k_t_kn_per_m
     d = hysteresis_loop(A, k_t, slip_force_n, normal_variation, phase_deg)
@@ -548,18 +548,18 @@ def disk_frf_figure(mass_g=1.0, kind="cylinder", engine_order=1, gamma_right_deg
     damped = disk_frf(kind, mass_g, engine_order, gamma_right_deg, cache=cache)
     free = undamped_frf(engine_order, cache=cache)
     fig, ax = _figure(figsize=(7, 4))
-    ax.plot(free.frequency_hz, 1e3 * free.tip_amplitude[:, 0], "k--", lw=1, label="no damper")
-    ax.plot(damped.frequency_hz, 1e3 * damped.tip_amplitude[:, 0], "C0-", label=f"{kind} {mass_g:.3g} g")
-    ax.plot([damped.peak_frequency_hz], [1e3 * damped.peak_amplitude], "C3o")
+    colour = palette.DAMPER.get(kind, palette.series(0))
+    ax.plot(free.frequency_hz, 1e3 * free.tip_amplitude[:, 0], "--", color=palette.UNDAMPED, lw=1, label="no damper")
+    ax.plot(damped.frequency_hz, 1e3 * damped.tip_amplitude[:, 0], "-", color=colour, label=f"{kind} {mass_g:.3g} g")
+    ax.plot([damped.peak_frequency_hz], [1e3 * damped.peak_amplitude], "o", mfc="none", mec=colour, mew=1.4)
     ax.set_xlabel("excitation frequency [Hz]")
     ax.set_ylabel("tip amplitude u_x [mm]")
     ax.set_xlim(damped.frequency_hz[0], damped.frequency_hz[-1])
-    ax.set_title(f"EO = {engine_order}, gamma_R = {gamma_right_deg:g} deg: peak {1e3 * damped.peak_amplitude:.3f} mm at "
-                 f"{damped.peak_frequency_hz:.2f} Hz, reduction {100 * damped.reduction(free):.1f} % "
-                 f"({damped.method}, {damped.seconds:.2f} s)", fontsize=9)
+    ax.set_title(f"reference disk, EO = {engine_order}, gamma_R = {gamma_right_deg:g} deg\n"
+                 f"peak {1e3 * damped.peak_amplitude:.3f} mm at {damped.peak_frequency_hz:.2f} Hz, reduction "
+                 f"{100 * damped.reduction(free):.1f} % ({damped.method}, {damped.seconds:.2f} s)", fontsize=9)
     ax.grid(True, alpha=0.3)
-    ax.legend()
-    fig.tight_layout()
+    place_legend(ax)
     fig.data = (damped, free)
     return fig
 
@@ -585,24 +585,28 @@ def mass_study_figure(mass_g=1.0, kind="cylinder", sweeps=None, engine_order=1, 
     ``sweeps`` {kind: :func:`mass_sweep_peaks` result} with the current mass marked."""
     damped = disk_frf(kind, mass_g, engine_order, cache=cache)
     free = undamped_frf(engine_order, cache=cache)
-    fig, (ax, ax2) = _figure(1, 2, figsize=(11, 4))
-    ax.plot(free.frequency_hz, 1e3 * free.tip_amplitude[:, 0], "k--", lw=1, label="no damper")
-    ax.plot(damped.frequency_hz, 1e3 * damped.tip_amplitude[:, 0], label=f"{kind} {mass_g:.3g} g")
+    fig, (ax, ax2) = _figure(1, 2, figsize=(11, 4.3))
+    ax.plot(free.frequency_hz, 1e3 * free.tip_amplitude[:, 0], "--", color=palette.UNDAMPED, lw=1, label="no damper")
+    ax.plot(damped.frequency_hz, 1e3 * damped.tip_amplitude[:, 0], color=palette.DAMPER.get(kind, palette.series(0)),
+            label=f"{kind} {mass_g:.3g} g")
     ax.set_xlim(damped.frequency_hz[0], damped.frequency_hz[-1])
     ax.set_xlabel("excitation frequency [Hz]")
     ax.set_ylabel("tip amplitude u_x [mm]")
     ax.set_title(f"peak {1e3 * damped.peak_amplitude:.3f} mm, reduction {100 * damped.reduction(free):.1f} %", fontsize=9)
     ax.grid(True, alpha=0.3)
-    ax.legend()
-    for k, sw in (sweeps or {}).items():
-        ax2.semilogx(sw["mass_g"], 1e3 * sw["peak_amplitude"], "o-", label=k)
-    ax2.axhline(1e3 * free.peak_amplitude, color="gray", ls="--", lw=1, label="no damper")
-    ax2.plot([mass_g], [1e3 * damped.peak_amplitude], "k*", ms=14, label="this mass")
+    for j, (k, sw) in enumerate((sweeps or {}).items()):
+        ax2.semilogx(sw["mass_g"], 1e3 * sw["peak_amplitude"], "o-", color=palette.DAMPER.get(k, palette.series(j)),
+                     label=k)
+    ax2.axhline(1e3 * free.peak_amplitude, color=palette.UNDAMPED, ls="--", lw=1, label="no damper")
+    ax2.plot([mass_g], [1e3 * damped.peak_amplitude], "*", color=palette.UNDAMPED, ms=14, label="this mass")
+    ax2.set_xscale("log")
+    plain_log_ticks(ax2.xaxis)
     ax2.set_xlabel("damper mass [g]")
     ax2.set_ylabel("resonance tip amplitude u_x [mm]")
     ax2.grid(True, which="both", alpha=0.3)
-    ax2.legend(fontsize=8)
-    fig.tight_layout()
+    fig.suptitle(f"reference disk, {kind} damper, EO = {engine_order}", fontsize=10)
+    place_legend(ax)
+    place_legend(ax2, fontsize=8)
     fig.data = (damped, free)
     return fig
 
@@ -629,18 +633,19 @@ def platform_angle_figure(gamma_right_deg=35.0, kind="cylinder", mass_g=1.0, cac
     free = undamped_frf(1, cache=cache)
     state = contact_state_at_peak(damped, cache)
     fig, (ax, ax2) = _figure(1, 2, figsize=(11, 4.5), gridspec_kw={"width_ratios": [1.4, 1]})
-    ax.plot(free.frequency_hz, 1e3 * free.tip_amplitude[:, 0], "k--", lw=1, label="no damper")
-    ax.plot(damped.frequency_hz, 1e3 * damped.tip_amplitude[:, 0], label=f"{kind} {mass_g:.3g} g, gamma_R = {gamma_right_deg:g} deg")
+    ax.plot(free.frequency_hz, 1e3 * free.tip_amplitude[:, 0], "--", color=palette.UNDAMPED, lw=1, label="no damper")
+    ax.plot(damped.frequency_hz, 1e3 * damped.tip_amplitude[:, 0], color=palette.DAMPER.get(kind, palette.series(0)),
+            label=f"{kind} {mass_g:.3g} g, gamma_R = {gamma_right_deg:g} deg")
     ax.set_xlim(damped.frequency_hz[0], damped.frequency_hz[-1])
     ax.set_xlabel("excitation frequency [Hz]")
     ax.set_ylabel("tip amplitude u_x [mm]")
     ax.set_title(f"peak {1e3 * damped.peak_amplitude:.3f} mm, reduction {100 * damped.reduction(free):.1f} %; "
                  f"N_OL = {state.normal_load[0]:.3g} N, N_OR = {state.normal_load[1]:.3g} N", fontsize=9)
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8)
     state.plot(ax=ax2)
     ax2.set_title("Eq. 27 at resonance: |w*| < 1 sticks", fontsize=9)
-    fig.tight_layout()
+    fig.suptitle(f"reference disk, {kind} damper, gamma_L = 35 deg, EO = 1", fontsize=10)
+    place_legend(ax, fontsize=8)
     fig.data = (damped, free, state)
     return fig
 
