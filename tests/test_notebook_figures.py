@@ -159,3 +159,22 @@ def test_mass_study_figure(disk_cache):
 
 def test_platform_angle_figure(disk_cache):
     check_figure(widgets.platform_angle_figure(35.0, cache=disk_cache), "reference disk")
+
+
+# ---------------------------------------------------------------------------------------
+# notebook 05: the mistuning explorer (a 4-blade reference disk, one harmonic)
+# ---------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def explorer():
+    from bladedamp.reference import reference_disk
+
+    disk = dataclasses.replace(reference_disk("cylinder", 1e-3), n_blades=4)
+    tuned = disk.frequency_response(92.0, 100.0, harmonics=(1,), max_step=0.2)
+    return widgets.MistuningExplorer(disk, tuned, tuned.peak_amplitude, max_step=0.2)
+
+
+@pytest.mark.parametrize("pattern", ["random", "alternating"])
+def test_mistuning_explorer_figure(explorer, pattern):
+    fig = explorer.figure(pattern, 0, 2.0)
+    assert fig.amplification is not None
+    check_figure(fig, "reference disk")

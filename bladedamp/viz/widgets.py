@@ -658,12 +658,15 @@ class MistuningExplorer:
 
     ``disk`` : the tuned reference (its damper at every position); ``tuned_response`` : its
     DiskResponse (drawn for comparison) and ``tuned_peak_amplitude`` [m] (amplification factors);
-    ``max_step`` : continuation step of each FRF. The alternating pattern is solved as its exact
-    two-blade cyclic sector (see :func:`bladedamp.studies.mistuning.mistuned_response`).
+    ``max_step`` : continuation step of each FRF; ``name`` : the disk's name in the figure's
+    title. The alternating pattern is solved as its exact two-blade cyclic sector (see
+    :func:`bladedamp.studies.mistuning.mistuned_response`).
     """
 
-    def __init__(self, disk, tuned_response, tuned_peak_amplitude: float, max_step: float = 0.05):
+    def __init__(self, disk, tuned_response, tuned_peak_amplitude: float, max_step: float = 0.05,
+                 name: str = "reference disk"):
         self.disk = disk
+        self.name = name
         self.tuned_response = tuned_response
         self.tuned_peak_amplitude = float(tuned_peak_amplitude)
         self.max_step = max_step
@@ -705,22 +708,24 @@ class MistuningExplorer:
         elapsed = time.perf_counter() - t0
         amp = np.resize(r.amplification(), n)            # a two-blade sector repeated around the disk
         fig, axes = _figure(1, 3, figsize=(15, 3.8), gridspec_kw={"width_ratios": [0.8, 1.5, 1]})
-        axes[0].bar(blade_no, k - 1, color="C0")
-        axes[0].set_xlabel("blade")
-        axes[0].set_ylabel("kappa - 1")
+        axes[0].bar(blade_no, k - 1, color=palette.series(0))
+        axes[0].set_xlabel("blade [-]")
+        axes[0].set_ylabel("kappa - 1 [-]")
         axes[0].set_title(f"{pattern}" + ("" if pattern == "alternating" else f", seed {seed}")
                           + f", {std_percent:.1f} %", fontsize=9)
         r.plot(ax=axes[1], tuned=self.tuned_response)
         model = "two-blade sector" if r.n_sector == 2 else f"{n} blades"
         axes[1].set_title(f"{model}: {len(r.omega)} points, " + ("cached" if elapsed < 0.05 else f"{elapsed:.1f} s"),
                           fontsize=9)
-        colours = ["C3" if b == amp.argmax() else "C2" if b == amp.argmin() else "0.6" for b in range(n)]
+        marked = sorted({int(amp.argmax()), int(amp.argmin())})    # the colours of the blades drawn in the FRF
+        colours = [palette.series(marked.index(b)) if b in marked else palette.SEPARATED for b in range(n)]
         axes[2].bar(blade_no, amp, color=colours)
-        axes[2].axhline(1.0, color="k", ls="--", lw=1)
-        axes[2].set_xlabel("blade")
-        axes[2].set_ylabel("amplification")
+        axes[2].axhline(1.0, color=palette.UNDAMPED, ls="--", lw=1)
+        axes[2].set_xlabel("blade [-]")
+        axes[2].set_ylabel("amplification [-]")
         axes[2].set_title(f"largest {amp.max():.3f} (blade {amp.argmax() + 1}), smallest {amp.min():.3f} "
                           f"(blade {amp.argmin() + 1})", fontsize=9)
+        fig.suptitle(f"{self.name}, {n} blades, mistuned", fontsize=10)
         fig.tight_layout()
         fig.amplification, fig.kappa = amp, k
         return fig
