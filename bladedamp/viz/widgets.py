@@ -341,13 +341,14 @@ def oscillator_figure(normal_load=3.0, forcing=2.0, damping=2.0, **kwargs):
     limits. ``fig.data`` holds the :func:`oscillator_comparison` result."""
     d = oscillator_comparison(normal_load, forcing, damping, **kwargs)
     fig, ax = _figure(figsize=(7, 4))
-    ax.semilogy(d["frequency_dense_hz"], 1e3 * d["free_dense"], color="gray", ls="--", lw=1,
+    ax.semilogy(d["frequency_dense_hz"], 1e3 * d["free_dense"], color=palette.SEPARATED, ls="--", lw=1,
                 label="linear, no contact (k)")
-    ax.semilogy(d["frequency_dense_hz"], 1e3 * d["stuck_dense"], color="gray", ls=":", lw=1,
+    ax.semilogy(d["frequency_dense_hz"], 1e3 * d["stuck_dense"], color=palette.SEPARATED, ls=":", lw=1,
                 label="linear, stuck (k + k_T)")
-    ax.semilogy(d["frequency_hz"], 1e3 * d["hbm"], "C0-", label=f"HBM, harmonics {tuple(d['frf'].basis.harmonics)}")
+    ax.semilogy(d["frequency_hz"], 1e3 * d["hbm"], "-", color=palette.series(0), label=f"HBM, harmonics {tuple(d['frf'].basis.harmonics)}")
     if d["time_frequency_hz"].size:
-        ax.semilogy(d["time_frequency_hz"], 1e3 * d["time_amplitude"], "C3o", label="time integration")
+        ax.semilogy(d["time_frequency_hz"], 1e3 * d["time_amplitude"], "o", color=palette.series(1),
+                    label="time integration")
     ax.set_xlabel("excitation frequency [Hz]")
     ax.set_ylabel("first-harmonic amplitude |x_1| [mm]")
     ax.set_title(f"friction oscillator: mu N = {d['osc'].slip_force:.3g} N, F = {forcing:.3g} N", fontsize=9)
