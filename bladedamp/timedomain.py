@@ -124,7 +124,8 @@ class TimeResponse(Saveable):
         on the axis (default m at ``scale`` 1; e.g. ``scale=1e3, unit="mm"``). Returns the axes."""
         import matplotlib.pyplot as plt
 
-        if ax is None:
+        own = ax is None
+        if own:
             _, ax = plt.subplots(figsize=(6, 4))
         kwargs.setdefault("label", "time integration")
         kwargs.setdefault("marker", "o")
@@ -134,6 +135,8 @@ class TimeResponse(Saveable):
         ax.set_ylabel(f"first-harmonic amplitude [{unit}]")
         ax.grid(True, alpha=0.3)
         ax.legend()
+        if own:
+            ax.figure.tight_layout()
         return ax
 
 
@@ -643,7 +646,8 @@ class DiskTimeResponse(Saveable):
         periodic are drawn as open markers."""
         import matplotlib.pyplot as plt
 
-        if ax is None:
+        own = ax is None
+        if own:
             _, ax = plt.subplots(figsize=(6, 4))
         blades = range(self.n_blades) if blades is None else blades
         kwargs.setdefault("marker", "o")
@@ -661,6 +665,8 @@ class DiskTimeResponse(Saveable):
         ax.set_ylabel(f"tip amplitude u_{'xyz'[direction]} [mm]")
         ax.grid(True, alpha=0.3)
         ax.legend()
+        if own:
+            ax.figure.tight_layout()
         return ax
 
 

@@ -64,6 +64,7 @@ def test_time_response_plot():
     ax.figure.tight_layout()
     check_figure(ax.figure, "friction oscillator")
     assert ax.get_ylabel() == "first-harmonic amplitude [mm]"
+    check_figure(r.plot().figure, None)              # its own figure, laid out, in m by default
 
 
 def disk_time_response(f, tip):
@@ -87,6 +88,7 @@ def test_disk_time_response_plot():
     ax.set_title("reference disk")
     ax.figure.tight_layout()
     check_figure(ax.figure, "reference disk")
+    check_figure(disk_time_response(f, tip).plot().figure, None)     # its own figure, laid out
 
 
 def jenkins_mode(n=40, mass=1.0, k=1e4, k_t=1e4, slip_force=0.9, success=True):
