@@ -120,6 +120,24 @@ def test_bad_input_is_one_line_and_exit_2(small_design, tmp_path, capsys, argv, 
     assert len(err) == 1 and needle in err[0], err
 
 
+@pytest.mark.parametrize("speeds_hz", [[100.0, 100.0], [20.0, 100.0]])
+def test_interference_diagram_figure_at_one_speed_and_with_engine_orders_above_it(speeds_hz):
+    """EO 0 (f = 0), engine orders whose range leaves the diagram's top (EO 7 from 140 Hz at
+    20 rev/s, EO 9) and a single speed: the figure still passes tests/figure_checks.py."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from figure_checks import check_figure
+
+    z = interference_diagram(four_blades(), speeds_hz, 130.0, engine_orders=(0, 1, 3, 4, 7, 9))
+    fig, ax = plt.subplots(figsize=(9.5, 5))
+    z.plot(ax=ax)
+    fig.tight_layout()
+    check_figure(fig, None)
+    plt.close(fig)
+
+
 def test_zzenf_and_campbell_figures_pass_the_slide_checks_and_summaries_list_the_files_written(
         small_design, tmp_path, saved_figures):
     """The figures of both commands obey tests/figure_checks.py with a title naming the design

@@ -160,7 +160,7 @@ class InterferenceDiagram:
             k, _ = nodal_diameter(e, self.n_blades)
             lo, hi = self.excitation_hz(e)
             zig.append((k, hi))
-            if e in self.engine_orders:
+            if e in self.engine_orders and lo <= self.f_max_hz:       # (an engine order above the diagram: not drawn)
                 i = self.engine_orders.index(e)
                 c = palette.series(i)
                 same = [f for f in self.engine_orders if nodal_diameter(f, self.n_blades)[0] == k]
