@@ -138,6 +138,29 @@ def test_interference_diagram_figure_at_one_speed_and_with_engine_orders_above_i
     plt.close(fig)
 
 
+def test_campbell_diagram_figure_with_engine_order_zero_and_one_above_it():
+    """EO 0 (the static load, f = 0) and EO 9 (from 180 Hz, above the 130 Hz top: in the legend
+    only) on a diagram without crossings (stuck frequencies of a linear stiffening): the figure
+    passes tests/figure_checks.py."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from figure_checks import check_figure
+
+    from bladedamp.studies.interference import CampbellDiagram
+
+    speeds = np.linspace(20.0, 100.0, 7)
+    stuck = {eo: np.column_stack([f0 + 0.01 * speeds]) for eo, f0 in ((0, 95.0), (3, 103.0), (4, 95.0), (9, 103.0))}
+    diagram = CampbellDiagram(4, speeds, (0, 3, 4, 9), np.array([95.0, 300.0]), stuck, [], 130.0)
+    fig, ax = plt.subplots(figsize=(9.5, 5))
+    diagram.plot(ax=ax)
+    fig.tight_layout()
+    check_figure(fig, None)
+    assert "EO 9 (k = 1, forward): above the diagram" in [t.get_text() for t in ax.get_legend().get_texts()]
+    plt.close(fig)
+
+
 def test_zzenf_and_campbell_figures_pass_the_slide_checks_and_summaries_list_the_files_written(
         small_design, tmp_path, saved_figures):
     """The figures of both commands obey tests/figure_checks.py with a title naming the design

@@ -276,7 +276,8 @@ class CampbellDiagram:
         """Draw the diagram: frequency [Hz] over rotor speed [rpm]; free natural frequencies
         dashed black, the stuck ones of each nodal diameter of the engine orders thin (one line
         style per nodal diameter; levels of the model, drawn as references, ``gid`` "reference"),
-        the engine-order lines f = EO Omega_R up to ``f_max_hz``, and each damped resonance as a
+        the engine-order lines f = EO Omega_R up to ``f_max_hz`` (one that starts above it only in
+        the legend; EO 0, the static load at f = 0, as a reference), and each damped resonance as a
         marker with its peak amplitude [mm] (hollow where no resonance was found:
         :attr:`CampbellCrossing.found`)."""
         import matplotlib.pyplot as plt
@@ -301,8 +302,9 @@ class CampbellDiagram:
                             label=f"dampers stuck, nodal diameter {k}" if j == 0 else None)
         for i, eo in enumerate(self.engine_orders):
             k, direction = nodal_diameter(eo, self.n_blades)
-            ax.plot(*_below(rpm, eo * self.rotor_speeds_hz, self.f_max_hz), color=palette.series(i), lw=1.6,
-                    label=f"EO {eo} (k = {k}, {direction})")
+            x, f = _below(rpm, eo * self.rotor_speeds_hz, self.f_max_hz)
+            ax.plot(x, f, color=palette.series(i), lw=1.6, gid="reference" if eo == 0 else None,     # EO 0: f = 0
+                    label=f"EO {eo} (k = {k}, {direction})" + ("" if len(f) else ": above the diagram"))
         for i, c in enumerate(self.crossings):
             colour = palette.series(self.engine_orders.index(c.engine_order))
             if not np.isfinite(c.peak_amplitude):
