@@ -201,7 +201,7 @@ def compare_outputs(out: Path, entries: list, undamped: dict, shared: bool) -> d
     from .plotting import place_legend
 
     place_legend(ax, fontsize=8)
-    save_figure(fig, out / "compare.png")
+    figures = save_figure(fig, out / "compare.png")
 
     columns = ["design", "response", "damper", "damper_mass_g", "peak_amplitude_mm", "peak_frequency_hz",
                "peak_at_range_end",
@@ -238,6 +238,6 @@ def compare_outputs(out: Path, entries: list, undamped: dict, shared: bool) -> d
         lines.append("The designs differ beyond their dampers: no common damper-free response is drawn; each "
                      "reduction is against the design's own.")
     lines += [f"- {e.note}; no damper-free reference for {e.name}." for e in entries if e.note]
-    lines += ["", "Files: `compare.png`, `compare.csv`, `compare.json`.", ""]
+    lines += ["", "Files: " + ", ".join(f"`{f}`" for f in [*figures, "compare.csv", "compare.json"]) + ".", ""]
     (out / "summary.md").write_text("\n".join(lines))
     return summary

@@ -1075,8 +1075,8 @@ def zzenf_outputs(out: Path, design, diagram) -> dict:
     diagram.plot(ax=ax)
     rpm = 60 * diagram.rotor_speeds_hz
     speeds = f"{rpm[0]:.0f} rpm" if rpm[0] == rpm[-1] else f"{rpm[0]:.0f}-{rpm[-1]:.0f} rpm"
-    ax.set_title(f"Interference diagram, {diagram.n_blades} blades, rotor speed {speeds}", fontsize=10)
-    save_figure(fig, out / "zzenf.png")
+    ax.set_title(design_title(design, f"interference diagram, {speeds}"), fontsize=10)
+    figures = save_figure(fig, out / "zzenf.png")
     crossings = diagram.crossings()
     summary = {"design": design.path, "n_blades": diagram.n_blades, "nodal_diameters": diagram.nodal_diameters,
                "rotor_speeds_rpm": rpm, "f_max_hz": diagram.f_max_hz,
@@ -1111,7 +1111,7 @@ def zzenf_outputs(out: Path, design, diagram) -> dict:
                          f"{fmt_number(60 * c['stuck_speed_hz'], '.0f')} |")
     else:
         lines.append("none in the speed range.")
-    write_summary(out, "zzenf", design, lines, ["zzenf.png", "results.json"],
+    write_summary(out, "zzenf", design, lines, [*figures, "results.json"],
                   f"Speed range {speeds}, diagram up to {diagram.f_max_hz:g} Hz.")
     return plain(summary)
 
@@ -1125,9 +1125,8 @@ def campbell_outputs(out: Path, design, diagram) -> dict:
     diagram.plot(ax=ax)
     harmonics = sorted({c.harmonics for c in diagram.crossings})
     estimate = " (one-harmonic estimate)" if harmonics == [(1,)] else ""
-    ax.set_title(f"Campbell diagram, {diagram.n_blades} blades: damped peak u_x at each crossing{estimate}",
-                 fontsize=10)
-    save_figure(fig, out / "campbell.png")
+    ax.set_title(design_title(design, f"Campbell diagram, damped peak u_x at each crossing{estimate}"), fontsize=10)
+    figures = save_figure(fig, out / "campbell.png")
     rows = []
     for c in diagram.crossings:
         rows.append({"engine_order": c.engine_order, "nodal_diameter": c.nodal_diameter, "direction": c.direction,
@@ -1158,7 +1157,7 @@ def campbell_outputs(out: Path, design, diagram) -> dict:
     if any(eo == 0 for eo in diagram.engine_orders):
         lines.append("EO 0: a static load (f = 0) has no crossing.")
     rpm = 60 * diagram.rotor_speeds_hz
-    write_summary(out, "campbell", design, lines, ["campbell.png", "results.json"],
+    write_summary(out, "campbell", design, lines, [*figures, "results.json"],
                   f"Analysis: {design.analysis.f_start_hz:g}-{design.analysis.f_end_hz:g} Hz per engine order, "
                   f"max_step {design.analysis.max_step:g}; diagram {rpm[0]:.0f}-{rpm[-1]:.0f} rpm, up to "
                   f"{diagram.f_max_hz:g} Hz.")

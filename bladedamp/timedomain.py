@@ -118,19 +118,25 @@ class TimeResponse(Saveable):
         spec = np.fft.rfft(self.samples, axis=1) / self.samples.shape[1]
         return (1 if harmonic == 0 else 2) * np.abs(spec[:, harmonic])
 
-    def plot(self, ax=None, *, scale: float = 1.0, **kwargs):
+    def plot(self, ax=None, *, scale: float = 1.0, unit: str = "m", **kwargs):
+        """Plot ``scale`` times the first-harmonic amplitude over frequency [Hz] as markers into
+        ``ax`` (a new figure if None); ``unit``: the unit of the plotted values, shown in brackets
+        on the axis (default m at ``scale`` 1; e.g. ``scale=1e3, unit="mm"``). Returns the axes."""
         import matplotlib.pyplot as plt
 
-        if ax is None:
+        own = ax is None
+        if own:
             _, ax = plt.subplots(figsize=(6, 4))
         kwargs.setdefault("label", "time integration")
         kwargs.setdefault("marker", "o")
         kwargs.setdefault("linestyle", "none")
         ax.plot(self.frequency_hz, scale * self.amplitude, **kwargs)
         ax.set_xlabel("excitation frequency [Hz]")
-        ax.set_ylabel("first-harmonic amplitude")
+        ax.set_ylabel(f"first-harmonic amplitude [{unit}]")
         ax.grid(True, alpha=0.3)
         ax.legend()
+        if own:
+            ax.figure.tight_layout()
         return ax
 
 
@@ -640,7 +646,8 @@ class DiskTimeResponse(Saveable):
         periodic are drawn as open markers."""
         import matplotlib.pyplot as plt
 
-        if ax is None:
+        own = ax is None
+        if own:
             _, ax = plt.subplots(figsize=(6, 4))
         blades = range(self.n_blades) if blades is None else blades
         kwargs.setdefault("marker", "o")
@@ -658,6 +665,8 @@ class DiskTimeResponse(Saveable):
         ax.set_ylabel(f"tip amplitude u_{'xyz'[direction]} [mm]")
         ax.grid(True, alpha=0.3)
         ax.legend()
+        if own:
+            ax.figure.tight_layout()
         return ax
 
 

@@ -198,3 +198,17 @@ def test_compare_keeps_earlier_results_and_writes_results_compare_by_default(sav
     assert main(["compare", str(designs["light"]), str(designs["heavy"]), "--out", str(out)]) == 2
     _one_error_line(capsys, f"--out {out}", "not empty", "--overwrite")
     assert (out / "summary.md").read_text() == "the results of an earlier run"
+
+
+def test_compare_figure_passes_the_slide_checks_and_the_summary_lists_the_files_written(saved, tmp_path, saved_figures):
+    """compare.png obeys tests/figure_checks.py (its title names the designs compared); with
+    --format pdf,svg summary.md names the PDF and SVG written, no PNG."""
+    root, designs, folders = saved
+    out = tmp_path / "cmp"
+    assert main(["compare", str(designs["light"]), str(designs["heavy"]), "--format", "pdf,svg",
+                 "--out", str(out)]) == 0
+    saved_figures.check("light", "compare")
+    saved_figures.check("heavy", "compare")
+    assert (out / "compare.pdf").is_file() and (out / "compare.svg").is_file() and not (out / "compare.png").exists()
+    summary = (out / "summary.md").read_text()
+    assert "`compare.pdf`" in summary and "`compare.svg`" in summary and "compare.png" not in summary

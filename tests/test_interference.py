@@ -118,3 +118,60 @@ def test_bad_input_is_one_line_and_exit_2(small_design, tmp_path, capsys, argv, 
     assert main([argv[0], str(design), *argv[1:], "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and needle in err[0], err
+
+
+@pytest.mark.parametrize("speeds_hz", [[100.0, 100.0], [20.0, 100.0]])
+def test_interference_diagram_figure_at_one_speed_and_with_engine_orders_above_it(speeds_hz):
+    """EO 0 (f = 0), engine orders whose range leaves the diagram's top (EO 7 from 140 Hz at
+    20 rev/s, EO 9) and a single speed: the figure still passes tests/figure_checks.py."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from figure_checks import check_figure
+
+    z = interference_diagram(four_blades(), speeds_hz, 130.0, engine_orders=(0, 1, 3, 4, 7, 9))
+    fig, ax = plt.subplots(figsize=(9.5, 5))
+    z.plot(ax=ax)
+    fig.tight_layout()
+    check_figure(fig, None)
+    plt.close(fig)
+
+
+def test_campbell_diagram_figure_with_engine_order_zero_and_one_above_it():
+    """EO 0 (the static load, f = 0) and EO 9 (from 180 Hz, above the 130 Hz top: in the legend
+    only) on a diagram without crossings (stuck frequencies of a linear stiffening): the figure
+    passes tests/figure_checks.py."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from figure_checks import check_figure
+
+    from bladedamp.studies.interference import CampbellDiagram
+
+    speeds = np.linspace(20.0, 100.0, 7)
+    stuck = {eo: np.column_stack([f0 + 0.01 * speeds]) for eo, f0 in ((0, 95.0), (3, 103.0), (4, 95.0), (9, 103.0))}
+    diagram = CampbellDiagram(4, speeds, (0, 3, 4, 9), np.array([95.0, 300.0]), stuck, [], 130.0)
+    fig, ax = plt.subplots(figsize=(9.5, 5))
+    diagram.plot(ax=ax)
+    fig.tight_layout()
+    check_figure(fig, None)
+    assert "EO 9 (k = 1, forward): above the diagram" in [t.get_text() for t in ax.get_legend().get_texts()]
+    plt.close(fig)
+
+
+def test_zzenf_and_campbell_figures_pass_the_slide_checks_and_summaries_list_the_files_written(
+        small_design, tmp_path, saved_figures):
+    """The figures of both commands obey tests/figure_checks.py with a title naming the design
+    file; with --format svg no PNG is written and summary.md names the SVG instead."""
+    zz, cb = tmp_path / "zz", tmp_path / "cb"
+    assert main(["zzenf", str(small_design), "--speed-range-rpm", "1500", "7000", "--format", "svg",
+                 "--out", str(zz)]) == 0
+    assert main(["campbell", str(small_design), "--engine-orders", "1", "3", "4", "--format", "svg",
+                 "--out", str(cb)]) == 0
+    saved_figures.check(small_design.stem, "zzenf", "campbell")
+    for out, name in ((zz, "zzenf"), (cb, "campbell")):
+        assert (out / f"{name}.svg").is_file() and not (out / f"{name}.png").exists()
+        summary = (out / "summary.md").read_text()
+        assert f"`{name}.svg`" in summary and f"{name}.png" not in summary

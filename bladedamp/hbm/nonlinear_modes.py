@@ -411,7 +411,7 @@ class NonlinearModeResponse(Saveable):
         ax_z.semilogx(self.modal_amplitude, 100 * np.asarray(self.damping_ratio), label=label, **kwargs)
         ax_f.set_ylabel("natural frequency [Hz]")
         ax_z.set_ylabel("damping ratio [%]")
-        ax_z.set_xlabel("modal amplitude a")
+        ax_z.set_xlabel("modal amplitude a [sqrt(kg) m]")
         for a_ in (ax_f, ax_z):
             a_.grid(True, which="both", alpha=0.3)
         ax_f.legend()

@@ -53,6 +53,17 @@ def _speed_range(rotor_speeds_hz) -> np.ndarray:
     return speeds
 
 
+def _below(x, y, top: float):
+    """The polyline (x, y) with ascending ``y`` cut where it reaches ``top``: the points up to
+    ``top`` and the point on the segment that crosses it (arrays, possibly empty)."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    n = int(np.searchsorted(y, top, side="right"))
+    if n == 0 or n == len(y):
+        return x[:n], y[:n]
+    t = (top - y[n - 1]) / (y[n] - y[n - 1])
+    return np.append(x[:n], x[n - 1] + t * (x[n] - x[n - 1])), np.append(y[:n], top)
+
+
 def _engine_orders(engine_orders) -> tuple[int, ...]:
     eos = tuple(validation.integer("engine_orders", e, minimum=0) for e in np.atleast_1d(engine_orders))
     if not eos:
@@ -118,7 +129,10 @@ class InterferenceDiagram:
         """Draw the diagram: frequency [Hz] over nodal diameter; free natural frequencies dashed
         black, stuck ones solid (top speed) and dotted (lowest speed) with the band between,
         every engine order's excitation range as a bar at its nodal diameter (the design's in
-        colour, labelled), and the zig-zag of EO Omega_R at the top speed."""
+        colour, labelled with the whole range, drawn up to ``f_max_hz``), and the zig-zag of
+        EO Omega_R at the top speed up to ``f_max_hz``. The natural frequencies and the bars are
+        levels and ranges set by the model and the speed range (drawn as references, ``gid``
+        "reference": they may be flat or short)."""
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -133,10 +147,10 @@ class InterferenceDiagram:
                 if np.nanmin(np.minimum(top, low)) > self.f_max_hz:
                     continue
                 first = j == 0
-                ax.plot(nd, top, color=palette.STICK, lw=1.8, marker="o", ms=3,
+                ax.plot(nd, top, color=palette.STICK, lw=1.8, marker="o", ms=3, gid="reference",
                         label=f"dampers stuck, {speeds_rpm[-1]:.0f} rpm" if first else None)
                 if len(speeds_rpm) > 1 and speeds_rpm[0] != speeds_rpm[-1]:
-                    ax.plot(nd, low, color=palette.STICK, lw=1, ls=":",
+                    ax.plot(nd, low, color=palette.STICK, lw=1, ls=":", gid="reference",
                             label=f"dampers stuck, {speeds_rpm[0]:.0f} rpm" if first else None)
                     ax.fill_between(nd, low, top, color=palette.STICK, alpha=0.12, lw=0)
         # every engine order up to the top of the diagram: its range at its nodal diameter
@@ -146,24 +160,25 @@ class InterferenceDiagram:
             k, _ = nodal_diameter(e, self.n_blades)
             lo, hi = self.excitation_hz(e)
             zig.append((k, hi))
-            if e in self.engine_orders:
+            if e in self.engine_orders and lo <= self.f_max_hz:       # (an engine order above the diagram: not drawn)
                 i = self.engine_orders.index(e)
                 c = palette.series(i)
                 same = [f for f in self.engine_orders if nodal_diameter(f, self.n_blades)[0] == k]
                 x = k + 0.14 * (same.index(e) - (len(same) - 1) / 2)      # side by side on one nodal diameter
-                ax.plot([x, x], [lo, hi], color=c, lw=6, alpha=0.8, solid_capstyle="butt",
+                ax.plot([x, x], [lo, min(hi, self.f_max_hz)], color=c, lw=6, alpha=0.8, solid_capstyle="butt",
+                        gid="reference",
                         label=f"EO {e}: {lo:.4g}-{hi:.4g} Hz" if lo != hi else f"EO {e}: {hi:.4g} Hz")
-                if lo == hi:
+                if lo == hi and hi <= self.f_max_hz:
                     ax.plot(x, hi, "s", color=c, ms=8)
             if hi <= self.f_max_hz:
                 ax.annotate(f"{e}", (k, hi), textcoords="offset points", xytext=(4, 2), fontsize=7,
                             color="0.3")
-        zk, zf = np.array(zig).T
+        zk, zf = _below(*np.array(zig).T, self.f_max_hz)
         ax.plot(zk, zf, color="0.55", lw=0.9, ls="-.", label=f"EO x {60 * self.rotor_speeds_hz[-1]:.0f} rpm (zig-zag)")
         ax.set_xlim(-0.3, nd[-1] + 0.5)
         ax.set_ylim(0, self.f_max_hz)
         ax.set_xticks(nd)
-        ax.set_xlabel("nodal diameter k (EO mod n; n - (EO mod n) backward)")
+        ax.set_xlabel("nodal diameter k [-] (EO mod n; n - (EO mod n) backward)")
         ax.set_ylabel("frequency [Hz]")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
@@ -260,9 +275,11 @@ class CampbellDiagram:
     def plot(self, ax=None):
         """Draw the diagram: frequency [Hz] over rotor speed [rpm]; free natural frequencies
         dashed black, the stuck ones of each nodal diameter of the engine orders thin (one line
-        style per nodal diameter),
-        the engine-order lines f = EO Omega_R, and each damped resonance as a marker with its
-        peak amplitude [mm] (hollow where no resonance was found: :attr:`CampbellCrossing.found`)."""
+        style per nodal diameter; levels of the model, drawn as references, ``gid`` "reference"),
+        the engine-order lines f = EO Omega_R up to ``f_max_hz`` (one that starts above it only in
+        the legend; EO 0, the static load at f = 0, as a reference), and each damped resonance as a
+        marker with its peak amplitude [mm] (hollow where no resonance was found:
+        :attr:`CampbellCrossing.found`)."""
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -281,11 +298,13 @@ class CampbellDiagram:
             for j in range(stuck.shape[1]):
                 if np.nanmin(stuck[:, j]) <= self.f_max_hz:
                     ax.plot(rpm, stuck[:, j], color=palette.STICK, lw=1.1, ls=styles[len(drawn) % len(styles)],
+                            gid="reference",
                             label=f"dampers stuck, nodal diameter {k}" if j == 0 else None)
         for i, eo in enumerate(self.engine_orders):
             k, direction = nodal_diameter(eo, self.n_blades)
-            ax.plot(rpm, eo * self.rotor_speeds_hz, color=palette.series(i), lw=1.6,
-                    label=f"EO {eo} (k = {k}, {direction})")
+            x, f = _below(rpm, eo * self.rotor_speeds_hz, self.f_max_hz)
+            ax.plot(x, f, color=palette.series(i), lw=1.6, gid="reference" if eo == 0 else None,     # EO 0: f = 0
+                    label=f"EO {eo} (k = {k}, {direction})" + ("" if len(f) else ": above the diagram"))
         for i, c in enumerate(self.crossings):
             colour = palette.series(self.engine_orders.index(c.engine_order))
             if not np.isfinite(c.peak_amplitude):

@@ -29,6 +29,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from .. import palette
 from ..palette import CONTACT_STATE_NAMES as STATE_NAMES
 from ..palette import CONTACT_STATES as STATE_COLORS
 
@@ -148,13 +149,13 @@ def liftoff_figure(contact_height_mm: float = 2.0, force_n: float = 0.1, mass_g:
         sc = ax.scatter(m.eta_star, m.xi_star, c=m.ratio[c], s=140, cmap="viridis", vmin=0, vmax=vmax,
                         marker="s")
         lift = m.lifts_off[c]
-        ax.scatter(m.eta_star[lift], m.xi_star[lift], s=260, facecolors="none", edgecolors="r", lw=1.5)
-        ax.set_xlabel("eta* = eta / l_C (along the damper)")
+        ax.scatter(m.eta_star[lift], m.xi_star[lift], s=260, facecolors="none", edgecolors=palette.SLIP, lw=1.5)
+        ax.set_xlabel("eta* = eta / l_C [-] (along the damper)")
         ax.set_title(f"{('OL', 'OR')[c]}: max r = {m.ratio[c].max():.2f}")
         ax.set_xlim(-0.65, 0.65)
         ax.set_ylim(-0.65, 0.65)
-    axes[0].set_ylabel("xi* = xi / h_C (across the height)")
-    fig.colorbar(sc, ax=axes, label="lift-off ratio r (red ring: r > 1)")
+    axes[0].set_ylabel("xi* = xi / h_C [-] (across the height)")
+    fig.colorbar(sc, ax=axes, label="lift-off ratio r [-] (ring: r > 1)")
     fig.suptitle(f"wedge {mass_g:g} g, h_C = {contact_height_mm:g} mm, F_x = {force_n:g} N: "
                  f"resonance {m.peak_frequency_hz:.2f} Hz, tip {1e3 * m.peak_amplitude:.3f} mm\n"
                  + one_harmonic_label(m.harmonic_error), fontsize=10)
@@ -196,7 +197,8 @@ def misfit_wedge_disk(misfit_deg: float = 2.0, force_n: float = 0.05, mass_g: fl
 def cycle_figure(data, title: str = ""):
     """Contact state of every point over the cycle (OL, OR: rows = points numbered along the
     rows of the patch grid, columns = time samples) and the lift-off ratio per point.
-    ``data``: a :class:`~bladedamp.viz.meshcat_view.CycleData`."""
+    ``data``: a :class:`~bladedamp.viz.meshcat_view.CycleData`; ``title``: the suptitle, which
+    should name the design (``data`` does not know it; default: the frequency and tip amplitude)."""
     import matplotlib.pyplot as plt
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
@@ -213,20 +215,22 @@ def cycle_figure(data, title: str = ""):
         ax.set_xlabel("phase in the cycle [deg]")
         ax.set_title(("OL", "OR")[c])
         ax.set_xticks([0, 90, 180, 270, 360])
-    axes[0].set_ylabel("point")
+    axes[0].set_ylabel("point [-]")
+    axes[1].tick_params(labelleft=False)                  # the same points as OL's
     axes[1].legend(handles=[Patch(color=STATE_COLORS[k], label=STATE_NAMES[k]) for k in range(3)],
                    fontsize=8, loc="upper right", framealpha=0.9)
     for c in range(2):
         finite = np.isfinite(ratio[c])
-        axes[2].plot(np.arange(1, P + 1)[finite], ratio[c][finite], "o-", label=("OL", "OR")[c])
+        axes[2].plot(np.arange(1, P + 1)[finite], ratio[c][finite], "o-", color=palette.series(c),
+                     label=("OL", "OR")[c])
         opened = ~finite
         if opened.any():   # a_static <= 0: r is infinite, marked at the top of the axis
             top = max(2.0, 1.1 * np.nanmax(np.where(np.isfinite(ratio), ratio, np.nan)))
-            axes[2].plot(np.arange(1, P + 1)[opened], np.full(opened.sum(), top), "x", color=f"C{c}", ms=10,
+            axes[2].plot(np.arange(1, P + 1)[opened], np.full(opened.sum(), top), "x", color=palette.series(c), ms=10,
                          label=f"{('OL', 'OR')[c]}: open at rest (r = inf)")
-    axes[2].axhline(1.0, color="r", lw=0.8, ls="--")
-    axes[2].set_xlabel("point")
-    axes[2].set_ylabel("lift-off ratio r")
+    axes[2].axhline(1.0, color=palette.SEPARATED, lw=0.8, ls="--")
+    axes[2].set_xlabel("point [-]")
+    axes[2].set_ylabel("lift-off ratio r [-]")
     axes[2].legend(fontsize=8)
     axes[2].grid(True, alpha=0.3)
     fig.suptitle(title or f"{data.frequency_hz:.2f} Hz, tip {1e3 * data.tip_amplitude:.3f} mm", fontsize=10)

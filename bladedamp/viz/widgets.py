@@ -35,6 +35,7 @@ from ..contact.patch import ContactPatch
 from ..contact.point import SEPARATED, SLIP, STICK, point_contact_forces
 from ..hbm.fourier import HarmonicBasis
 from ..oscillator import FrictionOscillator
+from ..plotting import place_legend, plain_log_ticks
 
 __all__ = ["interactive_view", "interact_with_image", "hysteresis_loop", "hysteresis_figure", "describing_function", "describing_function_figure",
            "oscillator_comparison", "oscillator_figure", "DiskFRF", "DiskFRFCache", "DEFAULT_CACHE", "disk_frf",
@@ -171,35 +172,49 @@ def hysteresis_loop(amplitude, k_t, slip_force, normal_variation=0.0, phase_deg=
                 slip_work=float(pts.slip_work[0]), energy_closed_form=float(e_closed), share=share)
 
 
+def contact_point_title(k_t_kn_per_m, slip_force_n, normal_variation=0.0) -> str:
+    """The suptitle of the contact point's figures: what the point is, with its parameters."""
+    varies = f", normal load varying by +-{100 * normal_variation:g} %" if normal_variation else ""
+    return f"friction contact point: k_T = {k_t_kn_per_m:g} kN/m, mu N_0 = {slip_force_n:g} N{varies}"
+
+
 def hysteresis_figure(amplitude_mm=0.1, k_t_kn_per_m=10.0, slip_force_n=0.3, normal_variation=0.0, phase_deg=0.0):
     """Slider callback (notebook 01): the hysteresis loop f(u) coloured by stick / slip / lift-off,
-    beside the time signals. Returns the figure; ``fig.loop`` holds the :func:`hysteresis_loop` data."""
+    beside the time signals (the slip limits +-mu N(t) drawn as references). Returns the figure;
+    ``fig.loop`` holds the :func:`hysteresis_loop` data."""
+    from matplotlib.ticker import MaxNLocator
+
+
     A, k_t = 1e-3 * amplitude_mm, 1e3 * k_t_kn_per_m
     d = hysteresis_loop(A, k_t, slip_force_n, normal_variation, phase_deg)
-    fig, (ax, ax2) = _figure(1, 2, figsize=(10, 3.8))
+    fig, (ax, ax2) = _figure(1, 2, figsize=(10, 4.2))
     u_mm = 1e3 * d["u"]
     for s in (STICK, SLIP, SEPARATED):
         sel = d["state"] == s
         if sel.any():
-            ax.scatter(u_mm[sel], d["force"][sel], s=6, color=STATE_COLOURS[s], label=STATE_NAMES[s])
-    ax.plot(np.append(u_mm, u_mm[0]), np.append(d["force"], d["force"][0]), color="k", lw=0.6)
-    ax.axhline(slip_force_n, color="gray", ls=":", lw=1)
-    ax.axhline(-slip_force_n, color="gray", ls=":", lw=1)
+            ax.plot(u_mm[sel], d["force"][sel], "o", ms=2.5, color=STATE_COLOURS[s], label=STATE_NAMES[s])
+    ax.plot(np.append(u_mm, u_mm[0]), np.append(d["force"], d["force"][0]), color=palette.UNDAMPED, lw=0.6)
+    ax.axhline(slip_force_n, color=palette.SEPARATED, ls=":", lw=1)
+    ax.axhline(-slip_force_n, color=palette.SEPARATED, ls=":", lw=1)
+    ax.xaxis.set_major_locator(MaxNLocator(5))
     ax.set_xlabel("tangential displacement u [mm]")
     ax.set_ylabel("tangential contact force f_T [N]")
     ax.set_title(f"loop area = dissipated energy: {1e3 * d['energy']:.3g} mJ per cycle"
                  + ("" if normal_variation else f"\n(closed form {1e3 * d['energy_closed_form']:.3g} mJ)"), fontsize=9)
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8, loc="upper left")
-    ax2.plot(np.degrees(d["tau"]), d["force"], label="f_T [N]")
-    ax2.plot(np.degrees(d["tau"]), FRICTION_COEFFICIENT * d["normal"], label="mu N(t) [N]", ls="--")
-    ax2.plot(np.degrees(d["tau"]), -FRICTION_COEFFICIENT * d["normal"], color="C1", ls="--")
+    ax2.plot(np.degrees(d["tau"]), d["force"], color=palette.series(0), label="f_T")
+    for sign in (1, -1):
+        ax2.plot(np.degrees(d["tau"]), sign * FRICTION_COEFFICIENT * d["normal"], color=palette.series(1), ls="--",
+                 gid="reference", label="+-mu N(t)" if sign == 1 else None)
     ax2.set_xlabel("phase Omega t [deg]")
     ax2.set_ylabel("force [N]")
     ax2.set_xlim(0, 360)
+    ax2.set_xticks([0, 90, 180, 270, 360])
     ax2.grid(True, alpha=0.3)
-    ax2.legend(fontsize=8, loc="lower right")
-    fig.tight_layout()
+    fig.suptitle(contact_point_title(k_t_kn_per_m, slip_force_n, normal_variation)
+                 + f", amplitude {amplitude_mm:g} mm", fontsize=10)
+    place_legend(ax, loc="upper left", fontsize=8)
+    place_legend(ax2, loc="upper right", fontsize=8)
     fig.loop = d
     return fig
 
@@ -238,31 +253,37 @@ def describing_function_figure(k_t_kn_per_m=10.0, slip_force_n=0.3, normal_varia
                                n_points=60):
     """Slider callback (notebook 01): equivalent stiffness and damping over the amplitude
     (normalised by the slip amplitude mu N / k_T), AFT points on the closed form, and the energy
-    per cycle. ``fig.data`` holds the :func:`describing_function` result."""
+    per cycle (on the log axis from 1e-5 of its largest value: a contact that sticks dissipates
+    nothing). ``fig.data`` holds the :func:`describing_function` result."""
     k_t = 1e3 * k_t_kn_per_m
     a_slip = slip_force_n / k_t
     A = a_slip * np.logspace(-1, 2, n_points)
     d = describing_function(k_t, slip_force_n, A, normal_variation)
     x = A / a_slip
-    fig, (ax, ax2) = _figure(1, 2, figsize=(10, 3.8))
-    ax.semilogx(x, d["k_eq_closed"] / k_t, "C0-", label="k_eq / k_T, closed form")
-    ax.semilogx(x, d["d_eq_closed"] / k_t, "C3-", label="d_eq / k_T, closed form")
-    ax.semilogx(x, d["k_eq"] / k_t, "C0o", ms=3, label="k_eq / k_T, AFT (Eq. 10)")
-    ax.semilogx(x, d["d_eq"] / k_t, "C3o", ms=3, label="d_eq / k_T, AFT (Eq. 10)")
-    ax.set_xlabel("amplitude A / (mu N / k_T)")
-    ax.set_ylabel("complex contact stiffness / k_T")
+    fig, (ax, ax2) = _figure(1, 2, figsize=(10, 4.6))
+    k_colour, d_colour = palette.series(0), palette.series(1)
+    ax.semilogx(x, d["k_eq_closed"] / k_t, "-", color=k_colour, label="k_eq / k_T, closed form")
+    ax.semilogx(x, d["d_eq_closed"] / k_t, "-", color=d_colour, label="d_eq / k_T, closed form")
+    ax.semilogx(x, d["k_eq"] / k_t, "o", color=k_colour, ms=3, label="k_eq / k_T, AFT (Eq. 10)")
+    ax.semilogx(x, d["d_eq"] / k_t, "o", color=d_colour, ms=3, label="d_eq / k_T, AFT (Eq. 10)")
+    ax.set_xlabel("amplitude A / (mu N / k_T) [-]")
+    ax.set_ylabel("complex contact stiffness / k_T [-]")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    ax2.loglog(1e3 * A, 1e3 * np.maximum(d["energy_closed"], 1e-30), "k-", label="closed form 4 mu N (A - mu N / k_T)")
-    ax2.loglog(1e3 * A, 1e3 * np.maximum(d["energy"], 1e-30), "C2o", ms=3, label="AFT: pi A^2 Im k_hat")
-    ax2.set_ylim(1e3 * max(d["energy_closed"].max(), 1e-30) * 1e-5, None)
+    floor = 1e3 * max(d["energy_closed"].max(), 1e-30) * 1e-5
+    shown = {key: np.where(1e3 * d[key] >= floor, 1e3 * d[key], np.nan) for key in ("energy_closed", "energy")}
+    ax2.loglog(1e3 * A, shown["energy_closed"], "-", color=palette.UNDAMPED, label="closed form 4 mu N (A - mu N / k_T)")
+    ax2.loglog(1e3 * A, shown["energy"], "o", color=palette.series(2), ms=3, label="AFT: pi A^2 Im k_hat")
+    ax2.set_xlim(1e3 * A[0], 1e3 * A[-1])                  # the sticking amplitudes too (no energy)
+    ax2.set_ylim(floor, None)
     ax2.set_xlabel("amplitude A [mm]")
     ax2.set_ylabel("energy dissipated per cycle [mJ]")
     ax2.grid(True, which="both", alpha=0.3)
-    ax2.legend(fontsize=8)
     if amplitude_mm is not None:
-        ax.axvline(1e-3 * amplitude_mm / a_slip, color="k", ls=":")
-        ax2.axvline(amplitude_mm, color="k", ls=":")
+        ax.axvline(1e-3 * amplitude_mm / a_slip, color=palette.UNDAMPED, ls=":")
+        ax2.axvline(amplitude_mm, color=palette.UNDAMPED, ls=":")
+    fig.suptitle(contact_point_title(k_t_kn_per_m, slip_force_n, normal_variation), fontsize=10)
+    for a in (ax, ax2):      # below the axes: the amplitude's marker line moves with the slider
+        a.legend(fontsize=8, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.2))
     fig.tight_layout()
     fig.data = d
     return fig
@@ -320,13 +341,14 @@ def oscillator_figure(normal_load=3.0, forcing=2.0, damping=2.0, **kwargs):
     limits. ``fig.data`` holds the :func:`oscillator_comparison` result."""
     d = oscillator_comparison(normal_load, forcing, damping, **kwargs)
     fig, ax = _figure(figsize=(7, 4))
-    ax.semilogy(d["frequency_dense_hz"], 1e3 * d["free_dense"], color="gray", ls="--", lw=1,
+    ax.semilogy(d["frequency_dense_hz"], 1e3 * d["free_dense"], color=palette.SEPARATED, ls="--", lw=1,
                 label="linear, no contact (k)")
-    ax.semilogy(d["frequency_dense_hz"], 1e3 * d["stuck_dense"], color="gray", ls=":", lw=1,
+    ax.semilogy(d["frequency_dense_hz"], 1e3 * d["stuck_dense"], color=palette.SEPARATED, ls=":", lw=1,
                 label="linear, stuck (k + k_T)")
-    ax.semilogy(d["frequency_hz"], 1e3 * d["hbm"], "C0-", label=f"HBM, harmonics {tuple(d['frf'].basis.harmonics)}")
+    ax.semilogy(d["frequency_hz"], 1e3 * d["hbm"], "-", color=palette.series(0), label=f"HBM, harmonics {tuple(d['frf'].basis.harmonics)}")
     if d["time_frequency_hz"].size:
-        ax.semilogy(d["time_frequency_hz"], 1e3 * d["time_amplitude"], "C3o", label="time integration")
+        ax.semilogy(d["time_frequency_hz"], 1e3 * d["time_amplitude"], "o", color=palette.series(1),
+                    label="time integration")
     ax.set_xlabel("excitation frequency [Hz]")
     ax.set_ylabel("first-harmonic amplitude |x_1| [mm]")
     ax.set_title(f"friction oscillator: mu N = {d['osc'].slip_force:.3g} N, F = {forcing:.3g} N", fontsize=9)
@@ -527,18 +549,18 @@ def disk_frf_figure(mass_g=1.0, kind="cylinder", engine_order=1, gamma_right_deg
     damped = disk_frf(kind, mass_g, engine_order, gamma_right_deg, cache=cache)
     free = undamped_frf(engine_order, cache=cache)
     fig, ax = _figure(figsize=(7, 4))
-    ax.plot(free.frequency_hz, 1e3 * free.tip_amplitude[:, 0], "k--", lw=1, label="no damper")
-    ax.plot(damped.frequency_hz, 1e3 * damped.tip_amplitude[:, 0], "C0-", label=f"{kind} {mass_g:.3g} g")
-    ax.plot([damped.peak_frequency_hz], [1e3 * damped.peak_amplitude], "C3o")
+    colour = palette.DAMPER.get(kind, palette.series(0))
+    ax.plot(free.frequency_hz, 1e3 * free.tip_amplitude[:, 0], "--", color=palette.UNDAMPED, lw=1, label="no damper")
+    ax.plot(damped.frequency_hz, 1e3 * damped.tip_amplitude[:, 0], "-", color=colour, label=f"{kind} {mass_g:.3g} g")
+    ax.plot([damped.peak_frequency_hz], [1e3 * damped.peak_amplitude], "o", mfc="none", mec=colour, mew=1.4)
     ax.set_xlabel("excitation frequency [Hz]")
     ax.set_ylabel("tip amplitude u_x [mm]")
     ax.set_xlim(damped.frequency_hz[0], damped.frequency_hz[-1])
-    ax.set_title(f"EO = {engine_order}, gamma_R = {gamma_right_deg:g} deg: peak {1e3 * damped.peak_amplitude:.3f} mm at "
-                 f"{damped.peak_frequency_hz:.2f} Hz, reduction {100 * damped.reduction(free):.1f} % "
-                 f"({damped.method}, {damped.seconds:.2f} s)", fontsize=9)
+    ax.set_title(f"reference disk, EO = {engine_order}, gamma_R = {gamma_right_deg:g} deg\n"
+                 f"peak {1e3 * damped.peak_amplitude:.3f} mm at {damped.peak_frequency_hz:.2f} Hz, reduction "
+                 f"{100 * damped.reduction(free):.1f} % ({damped.method}, {damped.seconds:.2f} s)", fontsize=9)
     ax.grid(True, alpha=0.3)
-    ax.legend()
-    fig.tight_layout()
+    place_legend(ax)
     fig.data = (damped, free)
     return fig
 
@@ -564,24 +586,28 @@ def mass_study_figure(mass_g=1.0, kind="cylinder", sweeps=None, engine_order=1, 
     ``sweeps`` {kind: :func:`mass_sweep_peaks` result} with the current mass marked."""
     damped = disk_frf(kind, mass_g, engine_order, cache=cache)
     free = undamped_frf(engine_order, cache=cache)
-    fig, (ax, ax2) = _figure(1, 2, figsize=(11, 4))
-    ax.plot(free.frequency_hz, 1e3 * free.tip_amplitude[:, 0], "k--", lw=1, label="no damper")
-    ax.plot(damped.frequency_hz, 1e3 * damped.tip_amplitude[:, 0], label=f"{kind} {mass_g:.3g} g")
+    fig, (ax, ax2) = _figure(1, 2, figsize=(11, 4.3))
+    ax.plot(free.frequency_hz, 1e3 * free.tip_amplitude[:, 0], "--", color=palette.UNDAMPED, lw=1, label="no damper")
+    ax.plot(damped.frequency_hz, 1e3 * damped.tip_amplitude[:, 0], color=palette.DAMPER.get(kind, palette.series(0)),
+            label=f"{kind} {mass_g:.3g} g")
     ax.set_xlim(damped.frequency_hz[0], damped.frequency_hz[-1])
     ax.set_xlabel("excitation frequency [Hz]")
     ax.set_ylabel("tip amplitude u_x [mm]")
     ax.set_title(f"peak {1e3 * damped.peak_amplitude:.3f} mm, reduction {100 * damped.reduction(free):.1f} %", fontsize=9)
     ax.grid(True, alpha=0.3)
-    ax.legend()
-    for k, sw in (sweeps or {}).items():
-        ax2.semilogx(sw["mass_g"], 1e3 * sw["peak_amplitude"], "o-", label=k)
-    ax2.axhline(1e3 * free.peak_amplitude, color="gray", ls="--", lw=1, label="no damper")
-    ax2.plot([mass_g], [1e3 * damped.peak_amplitude], "k*", ms=14, label="this mass")
+    for j, (k, sw) in enumerate((sweeps or {}).items()):
+        ax2.semilogx(sw["mass_g"], 1e3 * sw["peak_amplitude"], "o-", color=palette.DAMPER.get(k, palette.series(j)),
+                     label=k)
+    ax2.axhline(1e3 * free.peak_amplitude, color=palette.UNDAMPED, ls="--", lw=1, label="no damper")
+    ax2.plot([mass_g], [1e3 * damped.peak_amplitude], "*", color=palette.UNDAMPED, ms=14, label="this mass")
+    ax2.set_xscale("log")
+    plain_log_ticks(ax2.xaxis)
     ax2.set_xlabel("damper mass [g]")
     ax2.set_ylabel("resonance tip amplitude u_x [mm]")
     ax2.grid(True, which="both", alpha=0.3)
-    ax2.legend(fontsize=8)
-    fig.tight_layout()
+    fig.suptitle(f"reference disk, {kind} damper, EO = {engine_order}", fontsize=10)
+    place_legend(ax)
+    place_legend(ax2, fontsize=8)
     fig.data = (damped, free)
     return fig
 
@@ -608,18 +634,19 @@ def platform_angle_figure(gamma_right_deg=35.0, kind="cylinder", mass_g=1.0, cac
     free = undamped_frf(1, cache=cache)
     state = contact_state_at_peak(damped, cache)
     fig, (ax, ax2) = _figure(1, 2, figsize=(11, 4.5), gridspec_kw={"width_ratios": [1.4, 1]})
-    ax.plot(free.frequency_hz, 1e3 * free.tip_amplitude[:, 0], "k--", lw=1, label="no damper")
-    ax.plot(damped.frequency_hz, 1e3 * damped.tip_amplitude[:, 0], label=f"{kind} {mass_g:.3g} g, gamma_R = {gamma_right_deg:g} deg")
+    ax.plot(free.frequency_hz, 1e3 * free.tip_amplitude[:, 0], "--", color=palette.UNDAMPED, lw=1, label="no damper")
+    ax.plot(damped.frequency_hz, 1e3 * damped.tip_amplitude[:, 0], color=palette.DAMPER.get(kind, palette.series(0)),
+            label=f"{kind} {mass_g:.3g} g, gamma_R = {gamma_right_deg:g} deg")
     ax.set_xlim(damped.frequency_hz[0], damped.frequency_hz[-1])
     ax.set_xlabel("excitation frequency [Hz]")
     ax.set_ylabel("tip amplitude u_x [mm]")
     ax.set_title(f"peak {1e3 * damped.peak_amplitude:.3f} mm, reduction {100 * damped.reduction(free):.1f} %; "
                  f"N_OL = {state.normal_load[0]:.3g} N, N_OR = {state.normal_load[1]:.3g} N", fontsize=9)
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8)
     state.plot(ax=ax2)
     ax2.set_title("Eq. 27 at resonance: |w*| < 1 sticks", fontsize=9)
-    fig.tight_layout()
+    fig.suptitle(f"reference disk, {kind} damper, gamma_L = 35 deg, EO = 1", fontsize=10)
+    place_legend(ax, fontsize=8)
     fig.data = (damped, free, state)
     return fig
 
@@ -632,12 +659,15 @@ class MistuningExplorer:
 
     ``disk`` : the tuned reference (its damper at every position); ``tuned_response`` : its
     DiskResponse (drawn for comparison) and ``tuned_peak_amplitude`` [m] (amplification factors);
-    ``max_step`` : continuation step of each FRF. The alternating pattern is solved as its exact
-    two-blade cyclic sector (see :func:`bladedamp.studies.mistuning.mistuned_response`).
+    ``max_step`` : continuation step of each FRF; ``name`` : the disk's name in the figure's
+    title. The alternating pattern is solved as its exact two-blade cyclic sector (see
+    :func:`bladedamp.studies.mistuning.mistuned_response`).
     """
 
-    def __init__(self, disk, tuned_response, tuned_peak_amplitude: float, max_step: float = 0.05):
+    def __init__(self, disk, tuned_response, tuned_peak_amplitude: float, max_step: float = 0.05,
+                 name: str = "reference disk"):
         self.disk = disk
+        self.name = name
         self.tuned_response = tuned_response
         self.tuned_peak_amplitude = float(tuned_peak_amplitude)
         self.max_step = max_step
@@ -679,22 +709,24 @@ class MistuningExplorer:
         elapsed = time.perf_counter() - t0
         amp = np.resize(r.amplification(), n)            # a two-blade sector repeated around the disk
         fig, axes = _figure(1, 3, figsize=(15, 3.8), gridspec_kw={"width_ratios": [0.8, 1.5, 1]})
-        axes[0].bar(blade_no, k - 1, color="C0")
-        axes[0].set_xlabel("blade")
-        axes[0].set_ylabel("kappa - 1")
+        axes[0].bar(blade_no, k - 1, color=palette.series(0))
+        axes[0].set_xlabel("blade [-]")
+        axes[0].set_ylabel("kappa - 1 [-]")
         axes[0].set_title(f"{pattern}" + ("" if pattern == "alternating" else f", seed {seed}")
                           + f", {std_percent:.1f} %", fontsize=9)
         r.plot(ax=axes[1], tuned=self.tuned_response)
         model = "two-blade sector" if r.n_sector == 2 else f"{n} blades"
         axes[1].set_title(f"{model}: {len(r.omega)} points, " + ("cached" if elapsed < 0.05 else f"{elapsed:.1f} s"),
                           fontsize=9)
-        colours = ["C3" if b == amp.argmax() else "C2" if b == amp.argmin() else "0.6" for b in range(n)]
+        marked = sorted({int(amp.argmax()), int(amp.argmin())})    # the colours of the blades drawn in the FRF
+        colours = [palette.series(marked.index(b)) if b in marked else palette.SEPARATED for b in range(n)]
         axes[2].bar(blade_no, amp, color=colours)
-        axes[2].axhline(1.0, color="k", ls="--", lw=1)
-        axes[2].set_xlabel("blade")
-        axes[2].set_ylabel("amplification")
+        axes[2].axhline(1.0, color=palette.UNDAMPED, ls="--", lw=1)
+        axes[2].set_xlabel("blade [-]")
+        axes[2].set_ylabel("amplification [-]")
         axes[2].set_title(f"largest {amp.max():.3f} (blade {amp.argmax() + 1}), smallest {amp.min():.3f} "
                           f"(blade {amp.argmin() + 1})", fontsize=9)
+        fig.suptitle(f"{self.name}, {n} blades, mistuned", fontsize=10)
         fig.tight_layout()
         fig.amplification, fig.kappa = amp, k
         return fig

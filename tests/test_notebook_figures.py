@@ -1,0 +1,182 @@
+"""The figures of the notebooks' helpers (bladedamp.viz.widgets, bladedamp.viz.notebook3d) and
+the ``.plot()`` of the time-integration results and of the nonlinear modes, checked by
+tests/figure_checks.py (units, no overlapping or cut text, every series visible, a title naming
+the design), on small results built from closed forms where the figure needs no solve."""
+import dataclasses
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+from figure_checks import check_figure  # noqa: E402
+
+from bladedamp.hbm.fourier import HarmonicBasis  # noqa: E402
+from bladedamp.hbm.nonlinear_modes import NonlinearModeResponse  # noqa: E402
+from bladedamp.studies.design import LiftoffMap  # noqa: E402
+from bladedamp.timedomain import DiskTimeResponse, TimeResponse  # noqa: E402
+from bladedamp.viz import notebook3d, widgets  # noqa: E402
+
+
+@pytest.fixture(autouse=True)
+def close_figures():
+    yield
+    plt.close("all")
+
+
+# ---------------------------------------------------------------------------------------
+# notebook 01: the friction contact point and the friction oscillator
+# ---------------------------------------------------------------------------------------
+@pytest.mark.parametrize("amplitude_mm, normal_variation", [(0.1, 0.0), (0.1, 0.5), (0.3, 1.5)])   # 1.5: lift-off
+def test_hysteresis_figure(amplitude_mm, normal_variation):
+    check_figure(widgets.hysteresis_figure(amplitude_mm, normal_variation=normal_variation), "friction contact point")
+
+
+@pytest.mark.parametrize("amplitude_mm", [None, 0.005, 0.1, 2.5])     # the slider's marker line anywhere
+def test_describing_function_figure(amplitude_mm):
+    check_figure(widgets.describing_function_figure(amplitude_mm=amplitude_mm), "friction contact point")
+
+
+def test_oscillator_figure():
+    check_figure(widgets.oscillator_figure(time_frequencies_hz=(14.0, 20.5)), "friction oscillator")
+
+
+# ---------------------------------------------------------------------------------------
+# the time-integration results and the nonlinear modes
+# ---------------------------------------------------------------------------------------
+def oscillator_amplitude(f_hz, f_n=15.9, zeta=0.02, static=2e-4):
+    """Amplitude [m] of a linear oscillator of natural frequency f_n, damping ratio zeta and
+    static deflection ``static`` at excitation f_hz [Hz] (closed form)."""
+    r = np.asarray(f_hz) / f_n
+    return static / np.sqrt((1 - r ** 2) ** 2 + (2 * zeta * r) ** 2)
+
+
+def test_time_response_plot():
+    f = np.array([12.0, 14.0, 15.0, 15.9, 17.0, 19.0])
+    a = oscillator_amplitude(f)
+    n = f.size
+    r = TimeResponse(2 * np.pi * f, a, a, np.zeros((n, 8)), np.full(n, 40), np.ones(n, bool))
+    _, ax = plt.subplots(figsize=(6, 4))
+    r.plot(ax=ax, scale=1e3, unit="mm")
+    ax.set_title("friction oscillator")
+    ax.figure.tight_layout()
+    check_figure(ax.figure, "friction oscillator")
+    assert ax.get_ylabel() == "first-harmonic amplitude [mm]"
+    check_figure(r.plot().figure, None)              # its own figure, laid out, in m by default
+
+
+def disk_time_response(f, tip):
+    """A DiskTimeResponse with tip amplitudes ``tip`` (n, s) [m] in x at ``f`` [Hz], the last
+    point not periodic; the fields the plot does not read left empty."""
+    n, s = tip.shape
+    amplitude = np.zeros((n, s, 3))
+    amplitude[:, :, 0] = tip
+    empty = {fld.name: None for fld in dataclasses.fields(DiskTimeResponse)
+             if fld.default is dataclasses.MISSING and fld.default_factory is dataclasses.MISSING}
+    periodic = np.ones(n, bool)
+    periodic[-1] = False
+    return DiskTimeResponse(**{**empty, "omega": 2 * np.pi * f, "tip_amplitude": amplitude, "periodic": periodic})
+
+
+def test_disk_time_response_plot():
+    f = np.linspace(92.0, 100.0, 7)
+    tip = np.column_stack([oscillator_amplitude(f, 95.5, 0.01, 1e-5), oscillator_amplitude(f, 96.0, 0.01, 1e-5)])
+    _, ax = plt.subplots(figsize=(6, 4))
+    disk_time_response(f, tip).plot(ax=ax)
+    ax.set_title("reference disk")
+    ax.figure.tight_layout()
+    check_figure(ax.figure, "reference disk")
+    check_figure(disk_time_response(f, tip).plot().figure, None)     # its own figure, laid out
+
+
+def jenkins_mode(n=40, mass=1.0, k=1e4, k_t=1e4, slip_force=0.9, success=True):
+    """The nonlinear mode of a mass on a spring k beside a Jenkins contact (k_t, slip force) by
+    the closed-form describing function: omega^2 = (k + k_eq) / m, zeta = d_eq / (2 (k + k_eq))."""
+    a = (slip_force / k_t) * np.logspace(-1, 2, n)
+    k_eq, d_eq, _ = widgets.closed_form_jenkins(k_t, slip_force, a)
+    basis = HarmonicBasis((1,), 16)
+    return NonlinearModeResponse(a * np.sqrt(mass), np.sqrt((k + k_eq) / mass) / (2 * np.pi), d_eq / (2 * (k + k_eq)),
+                                 np.zeros((n, basis.n_coeffs, 1)), basis, ("x",), success=success,
+                                 message="" if success else "Newton did not converge at a = 0.01")
+
+
+@pytest.mark.parametrize("success", [True, False])
+def test_nonlinear_mode_plot(success):
+    axes = jenkins_mode(success=success).plot()
+    fig = axes[0].figure
+    fig.suptitle("friction oscillator")
+    fig.tight_layout()
+    check_figure(fig, "friction oscillator")
+
+
+# ---------------------------------------------------------------------------------------
+# notebook 04: the contact over one cycle and the wedge's lift-off map
+# ---------------------------------------------------------------------------------------
+def cycle_data(T=48, P=6):
+    """A CycleData whose points stick, then slip, the last two lifting off over part of the cycle."""
+    from bladedamp.viz.meshcat_view import CycleData
+
+    phase = np.linspace(0, 2 * np.pi, T, endpoint=False)
+    states = np.zeros((T, 2, P), dtype=int)
+    for p in range(P):
+        states[np.sin(phase - 0.3 * p) > 0.6, :, p] = 1
+        if p >= P - 2:
+            states[np.sin(phase) < -0.8, :, p] = 2
+    ratio = np.vstack([np.linspace(0.2, 1.4, P), np.linspace(0.1, 1.2, P)])
+    return CycleData(3, 96.2, np.zeros((3, 1)), HarmonicBasis((1,), T), states, ratio, 2.1e-4)
+
+
+def test_cycle_figure():
+    check_figure(notebook3d.cycle_figure(cycle_data(), "1 g cylinder at resonance"), "cylinder")
+
+
+def test_liftoff_figure(monkeypatch):
+    xi, eta = np.meshgrid([-0.4, -0.2, 0.0, 0.2, 0.4], [-0.4, -0.2, 0.0, 0.2, 0.4])
+    xi, eta = xi.ravel(), eta.ravel()
+    r = np.vstack([0.3 + 2.5 * np.abs(xi), 0.2 + 2.0 * np.abs(eta)])
+    P = xi.size
+    m = LiftoffMap(xi, eta, r, r, np.zeros((2, P)), np.ones((2, P)), r, 95.5, 3e-4, 64)
+    monkeypatch.setattr(notebook3d, "liftoff_case", lambda *args, **kwargs: m)
+    check_figure(notebook3d.liftoff_figure(2.0, 0.1), "wedge")
+
+
+# ---------------------------------------------------------------------------------------
+# notebooks 02, 03: the reference disk's frequency responses (one harmonic, 92-100 Hz)
+# ---------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def disk_cache():
+    return widgets.DiskFRFCache()
+
+
+def test_disk_frf_figure(disk_cache):
+    check_figure(widgets.disk_frf_figure(1.0, cache=disk_cache), "reference disk")
+
+
+def test_mass_study_figure(disk_cache):
+    sweeps = {"cylinder": widgets.mass_sweep_peaks("cylinder", [0.3, 1.0, 3.0], cache=disk_cache)}
+    check_figure(widgets.mass_study_figure(1.0, sweeps=sweeps, cache=disk_cache), "reference disk")
+
+
+def test_platform_angle_figure(disk_cache):
+    check_figure(widgets.platform_angle_figure(35.0, cache=disk_cache), "reference disk")
+
+
+# ---------------------------------------------------------------------------------------
+# notebook 05: the mistuning explorer (a 4-blade reference disk, one harmonic)
+# ---------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def explorer():
+    from bladedamp.reference import reference_disk
+
+    disk = dataclasses.replace(reference_disk("cylinder", 1e-3), n_blades=4)
+    tuned = disk.frequency_response(92.0, 100.0, harmonics=(1,), max_step=0.2)
+    return widgets.MistuningExplorer(disk, tuned, tuned.peak_amplitude, max_step=0.2)
+
+
+@pytest.mark.parametrize("pattern", ["random", "alternating"])
+def test_mistuning_explorer_figure(explorer, pattern):
+    fig = explorer.figure(pattern, 0, 2.0)
+    assert fig.amplification is not None
+    check_figure(fig, "reference disk")
