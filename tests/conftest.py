@@ -72,6 +72,16 @@ def duffing_jenkins_residual(A, omega, osc):
 # ---------------------------------------------------------------------------------------
 # numerical helpers
 # ---------------------------------------------------------------------------------------
+def one_error_line(capsys, *needles) -> str:
+    """The one line a command printed on stderr (no traceback), holding every one of ``needles``."""
+    err = capsys.readouterr().err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in err, err
+    for needle in needles:
+        assert needle in lines[0], (needle, lines[0])
+    return lines[0]
+
+
 def scale_columns(J, s):
     """J diag(s) for dense or sparse J (sparse: a CSC copy). With :func:`border`, the reference
     of bladedamp.hbm.continuation._bordered (the bordered continuation matrix in one pass)."""

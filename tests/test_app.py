@@ -21,38 +21,31 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import one_error_line
 
 from bladedamp.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def _one_error_line(capsys, *needles):
-    err = capsys.readouterr().err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and "Traceback" not in err, err
-    for needle in needles:
-        assert needle in lines[0], (needle, lines[0])
-
-
 def test_app_without_voila_says_how_to_install(capsys, monkeypatch):
     real = importlib.util.find_spec
     monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "voila" else real(name, *a))
     assert main(["app", "--no-browser"]) == 2
-    _one_error_line(capsys, "voila", "pip install 'bladedamp[app]'")
+    one_error_line(capsys, "voila", "pip install 'bladedamp[app]'")
 
 
 def test_app_bad_or_busy_port_one_line_exit_2(capsys):
     if importlib.util.find_spec("voila") is None:
         pytest.skip("voila is not installed (pip install 'bladedamp[app]')")
     assert main(["app", "--no-browser", "--port", "80"]) == 2
-    _one_error_line(capsys, "--port 80", "[1024, 65535]")
+    one_error_line(capsys, "--port 80", "[1024, 65535]")
     with socket.socket() as busy:
         busy.bind(("127.0.0.1", 0))
         busy.listen()
         port = busy.getsockname()[1]
         assert main(["app", "--no-browser", "--port", str(port)]) == 2
-    _one_error_line(capsys, f"--port {port}", "in use")
+    one_error_line(capsys, f"--port {port}", "in use")
 
 
 def test_the_dashboard_notebook_is_package_data():

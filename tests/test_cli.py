@@ -10,6 +10,7 @@ import time
 
 import numpy as np
 import pytest
+from conftest import one_error_line
 
 import bladedamp
 from bladedamp.cli import build_parser, main
@@ -120,15 +121,6 @@ def fast_design(tmp_path_factory):
     return _edited(path, FAST)
 
 
-def _one_error_line(capsys, *needles):
-    err = capsys.readouterr().err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and "Traceback" not in err, err
-    for needle in needles:
-        assert needle in lines[0], (needle, lines[0])
-    return lines[0]
-
-
 def _outputs(out, *names):
     for name in names:
         assert (out / name).stat().st_size > 0, name
@@ -145,7 +137,7 @@ def test_init_writes_the_reference_design_and_keeps_an_existing_file(tmp_path, c
     assert path.read_text() == template()
     capsys.readouterr()
     assert main(["init", str(path)]) == 2
-    _one_error_line(capsys, str(path), "exists")
+    one_error_line(capsys, str(path), "exists")
     assert main(["init", str(path), "--force"]) == 0
 
 
@@ -267,7 +259,7 @@ def test_show_writes_html_or_says_how_to_install(fast_design, tmp_path, capsys, 
     real = importlib.util.find_spec
     monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "meshcat" else real(name, *a))
     assert main(["show", str(fast_design), "--out", str(tmp_path / "no_meshcat")]) == 2
-    _one_error_line(capsys, "meshcat", "pip install 'bladedamp[viz]'")
+    one_error_line(capsys, "meshcat", "pip install 'bladedamp[viz]'")
     assert not (tmp_path / "no_meshcat").exists()          # nothing computed, nothing written
 
 
@@ -283,7 +275,7 @@ def test_a_bad_field_exits_2_with_one_line_naming_file_key_value_and_range(tmp_p
     path = tmp_path / "bad.toml"
     path.write_text(text)
     assert main([command, str(path), "--out", str(tmp_path / "out")]) == 2
-    _one_error_line(capsys, str(path), *needles)
+    one_error_line(capsys, str(path), *needles)
     assert not (tmp_path / "out").exists()
 
 
@@ -306,7 +298,7 @@ def test_user_errors_exit_2_with_one_line_before_computing(tmp_path, capsys, fas
     t0 = time.perf_counter()
     assert main(args) == 2
     assert time.perf_counter() - t0 < 10          # nothing was computed
-    _one_error_line(capsys, *needles)
+    one_error_line(capsys, *needles)
     assert not (tmp_path / "out").exists()       # and no output folder made for a bad option
 
 
@@ -424,7 +416,7 @@ def test_optimize_figure_draws_the_optimum_inside_the_curve_of_every_mass(fast_d
                                            (["--dpi", "0"], ["--dpi 0", "[10, 2400]"])])
 def test_bad_figure_options_exit_2_with_one_line(fast_design, tmp_path, capsys, args, needles):
     assert main(["frf", str(fast_design), *args, "--out", str(tmp_path / "x")]) == 2
-    _one_error_line(capsys, *needles)
+    one_error_line(capsys, *needles)
     assert not (tmp_path / "x").exists()
 
 

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import one_error_line
 
 import bladedamp
 from bladedamp.cli import main
@@ -41,14 +42,6 @@ def saved(tmp_path_factory):
         folders[name] = root / f"frf_{name}"
         assert main(["frf", str(path), "--no-stop-check", "--no-peak-check", "--out", str(folders[name])]) == 0
     return root, designs, folders
-
-
-def _one_error_line(capsys, *needles):
-    err = capsys.readouterr().err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and "Traceback" not in err, err
-    for needle in needles:
-        assert needle in lines[0], (needle, lines[0])
 
 
 def _curves(out):
@@ -133,7 +126,7 @@ def test_show_from_saved_results_uses_the_saved_response(saved, tmp_path, capsys
     assert np.array_equal(shown.tip_amplitude, 0.5 * r.tip_amplitude)
     capsys.readouterr()
     assert main(["show", str(designs["heavy"]), "--from", str(folders["light"]), "--out", str(tmp_path / "x")]) == 2
-    _one_error_line(capsys, "--from", "light.toml", "not of", "heavy.toml")
+    one_error_line(capsys, "--from", "light.toml", "not of", "heavy.toml")
 
 
 @pytest.mark.parametrize("case, needles", [
@@ -158,7 +151,7 @@ def test_compare_bad_inputs_one_line_exit_2(saved, tmp_path, capsys, case, needl
     out = tmp_path / "out"
     capsys.readouterr()
     assert main(["compare", *args, "--out", str(out)]) == 2
-    _one_error_line(capsys, *needles)
+    one_error_line(capsys, *needles)
     assert not out.exists()                    # checked before anything is computed or written
 
 
@@ -196,7 +189,7 @@ def test_compare_keeps_earlier_results_and_writes_results_compare_by_default(sav
     (out / "summary.md").write_text("the results of an earlier run")
     capsys.readouterr()
     assert main(["compare", str(designs["light"]), str(designs["heavy"]), "--out", str(out)]) == 2
-    _one_error_line(capsys, f"--out {out}", "not empty", "--overwrite")
+    one_error_line(capsys, f"--out {out}", "not empty", "--overwrite")
     assert (out / "summary.md").read_text() == "the results of an earlier run"
 
 
