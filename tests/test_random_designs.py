@@ -61,7 +61,10 @@ SHARE_REQUIRED = 0.93
 # answered rightly: reached the end with every check passing, or stopped where the product's own
 # time integration (check_stop) finds no periodic motion and the result says so. Measured 316 of
 # 320 = 0.9875 on 2026-12-06 (the 4 others: periodic motions with brief impacts that (0, 1, 2, 3)
-# cannot follow, disks 63, 67, 154, 105); the floor leaves one design for rounding
+# cannot follow, disks 63, 67, 154, 105). Since the settle verdict judges the convergence of the
+# period-to-period map, disk 120's stop check finds a periodic motion beyond its stop (1.92 mm,
+# the damper separated all the period) that it called "not settled" before: 315 of 320 = 0.984375
+# (2026-12-07), exactly this floor, with no design to spare
 ANSWERED_REQUIRED = 0.984
 # Harmonics of the oscillators cross-checked by time integration, and of the random inclined
 # oscillators (normal load varying with the motion, lifting off): the frequency_response default,
