@@ -238,6 +238,18 @@ def converged_response(model, solve, harmonics="auto", tolerance: float = HARMON
                                                message=f"{kept.message}; harmonics {tuple(H)} {what}")
                 if response.stopped_by:
                     return response           # stopped as the caller asked: no estimate, no richer set
+                if best is not None and best[0].success and not response.reached_range_end:
+                    # a richer set whose every branch (both ends, retry, finer samples) failed short
+                    # of the end where a poorer set's reached it: the richer sets after it are not
+                    # tried (on the random EO >= 6 wedges they failed the same way, at the same
+                    # stall, for most of the analysis' time: benchmarks/README.md); the poorer
+                    # set's complete branch is the answer, its estimate saying how far it is
+                    kept = annotate(best[0], best[1], tolerance)
+                    where = (f"its branch got no further than {response.frequency_hz[response.furthest_index()]:.6g} Hz"
+                             if len(response.omega) else "its branch kept no point")
+                    return dataclasses.replace(kept, message=(
+                        f"{kept.message}; harmonics {tuple(H)} did not converge to the end of the range ({where}), "
+                        f"so no richer set was tried"))
                 check = harmonic_error(model, response, n_points=n_points) if len(response.omega) else None
             if check is None:
                 continue
