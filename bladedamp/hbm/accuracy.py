@@ -39,7 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..response import BUDGET_PREFIX
-from .continuation import newton
+from .continuation import newton, stall_guard
 from .fourier import HarmonicBasis
 from .linsolve import one_blas_thread
 from .start import damped_newton
@@ -223,7 +223,13 @@ def converged_response(model, solve, harmonics="auto", tolerance: float = HARMON
         for H in auto_sets(max_harmonic):
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", AccuracyWarning)
-                response = solve(tuple(H))
+                if best is not None and best[0].success:
+                    # a poorer set's branch reached the end: a stalled branch of this set ends early
+                    # (it could change the answer only by reaching the end)
+                    with stall_guard():
+                        response = solve(tuple(H))
+                else:
+                    response = solve(tuple(H))
                 ran_out = response.stopped_by.startswith(BUDGET_PREFIX)
                 if response.stopped_by and best is not None and (not len(response.omega)
                                                                  or (ran_out and best[0].success)):
