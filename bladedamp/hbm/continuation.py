@@ -140,9 +140,9 @@ def stall_guard():
     point of its last STALL_POINTS got further into the range than STALL_PROGRESS x its width
     beyond the furthest point before them. The branch is then unsuccessful, its message says it
     stalled (a failure like the retrace guard's, not a ``stopped_by``: the branch from the end and
-    the retry follow as for any failed branch). Used by the automatic harmonic choice
-    (:func:`bladedamp.hbm.accuracy.converged_response`) for a richer set's branches once a poorer
-    set's reached the end, where a branch that stalls costs time and cannot change the answer
+    the retry follow as for any failed branch). Used by the disks' automatic harmonic choice
+    (:func:`bladedamp.hbm.accuracy.converged_response` with ``guard_stalls``) for a richer set's
+    branches once a poorer set's reached the end, where a branch that stalls costs time and cannot change the answer
     unless it reaches the end: outside this context no branch is ended by it."""
     token = _STALL_GUARD.set(True)
     try:
