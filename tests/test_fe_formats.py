@@ -114,6 +114,97 @@ def test_nastran_craig_bampton_output4_blade():
     assert np.all(blade.natural_frequencies_hz[6:] >= clamped[:2] * (1 - 1e-12))
 
 
+def nastran_eigenvalue_table(path, title="(AFTER AUGMENTATION OF RESIDUAL VECTORS)"):
+    """The rows (mode, eigenvalue, cycles) of the REAL EIGENVALUES table under ``title`` of a
+    Nastran listing (.f06/.out), as printed: the numbers and their strings."""
+    rows, inside = [], False
+    for line in Path(path).read_text().splitlines():
+        if "R E A L   E I G E N V A L U E S" in line:
+            inside = False
+        if title in line:
+            inside, rows = True, []
+            continue
+        fields = line.split()
+        if inside and len(fields) == 7 and fields[0].isdigit() and "E" in fields[2]:
+            rows.append((int(fields[0]), fields[2], fields[4]))
+        elif inside and rows and line.startswith("1"):     # the next page ends the table
+            inside = False
+    return rows
+
+
+def half_unit(printed: str) -> float:
+    """Half a unit of the last printed digit of a number printed as d.ddddddE+xx."""
+    mantissa, exponent = printed.upper().split("E")
+    return 0.5 * 10.0 ** (int(exponent) - len(mantissa.split(".")[1]))
+
+
+def test_nastran_extseout_output4_gives_the_frequencies_nastran_printed():
+    """NX Nastran 9 EXTSEOUT(MATOP4=...) of a Craig-Bampton component (binary OUTPUT4, KXX and
+    MXX: 4 boundary grids x 6 DOF, rows 1-24, then 22 modal coordinates) beside the listing of
+    the same run. With the boundary clamped, the blade read from the file has the fixed-interface
+    eigenvalues that run printed (16 modes and 6 residual vectors, the table after augmentation).
+
+    Bounds: the eigenvalues lambda agree with the printed EIGENVALUE column to half a unit of its
+    7th digit. Nastran keeps eigenvalues in single precision (every modal stiffness in the file is
+    a float32 number) and prints CYCLES computed in single precision from them: the blade's
+    frequencies sqrt(lambda)/2 pi (double precision) agree with the CYCLES column to half a unit
+    of its last digit plus three float32 roundings (2 pi, the square root, the division: 3 x 2^-24
+    relative), and the same sums in float32 print exactly Nastran's digits."""
+    table = nastran_eigenvalue_table(DATA / "outboard.out")
+    assert [r[0] for r in table] == list(range(1, 23))
+    fe = read_fe_matrices(DATA / "outboard.op4")
+    assert fe.names == ("MXX", "KXX") and fe.n == 46 and fe.labels is None
+    K, M = fe.stiffness.toarray(), fe.mass.toarray()
+    lam = scipy.linalg.eigh(K[24:, 24:], M[24:, 24:], eigvals_only=True)
+    printed_lam = np.array([float(r[1]) for r in table])
+    assert np.all(np.abs(lam - printed_lam) <= [half_unit(r[1]) for r in table])
+    q = np.diag(K)[24:]
+    assert np.array_equal(q.astype(np.float32).astype(float), q)         # the file holds float32 eigenvalues
+
+    points = {p: (0.0, 0.0, 0.0) for p in ("OL", "OR", "tip", "excitation")}
+    blade = ModalBlade.from_file(DATA / "outboard.op4", dof_map={p: range(25, 31) for p in points}, points=points,
+                                 n_modes=22, damping_ratios=0.01, fixed_dofs=range(1, 25))
+    cycles = np.array([float(r[2]) for r in table])
+    bound = np.array([half_unit(r[2]) for r in table]) + 3 * 2.0**-24 * cycles
+    assert np.all(np.abs(blade.natural_frequencies_hz - cycles) <= bound)
+    single = np.sqrt(q.astype(np.float32)) / np.float32(2 * np.pi)
+    assert [f"{float(f):.6E}" for f in single] == [r[2] for r in table]
+
+
+def test_nastran_64bit_binary_output4_equals_its_text_twin():
+    """MSC Nastran 2007 run with 8-byte integers (mode=i8) wrote the same four matrices (one of
+    10 000 001 columns) as text (header NCOL, NROW in 16 characters: format ...|I16) and as
+    binary in the 64-bit layout (48-byte headers, 8-byte integers and reals), dense, sparse and
+    sparse 'bigmat': the binary files give the text file's numbers exactly (16 digits carry a
+    double exactly)."""
+    text = read_op4(DATA / "nas_large_dim_bigmat_ascii.op4")
+    assert sorted(text) == ["MATD", "MATD21", "MATD22A", "MATDT"]
+    assert text["MATD"][1:3] == (19, 10000001) and text["MATDT"][1:3] == (10000001, 19)
+    for layout in ("bigmat", "nonbigmat", "dense"):
+        binary = read_op4(DATA / f"nas_large_dim_{layout}_binary.op4")
+        assert (DATA / f"nas_large_dim_{layout}_binary.op4").read_bytes()[:4] == struct.pack("<i", 48)
+        assert sorted(binary) == sorted(text)
+        for name, (a, nra, nca, _) in text.items():
+            b, nrb, ncb, _ = binary[name]
+            assert (nra, nca) == (nrb, ncb)
+            ka = sorted(zip(a.cols, a.rows, a.vals))
+            kb = sorted(zip(b.cols, b.rows, b.vals))
+            assert ka == kb and len(ka) > 0
+
+
+def test_nastran_64bit_big_endian_binary_output4():
+    """MSC Nastran (mode=i8) read the text file rd.op4 and wrote its matrices big-endian in the
+    64-bit binary layout (rdbin.op4, a dense 5 x 6, an empty 10 x 19 and a 1 x 1): the same numbers."""
+    text, binary = read_op4(DATA / "rd.op4"), read_op4(DATA / "rdbin.op4")
+    assert (DATA / "rdbin.op4").read_bytes()[:4] == struct.pack(">i", 48)
+    assert sorted(text) == sorted(binary) == ["R1", "R2", "R3"]
+    for name in text:
+        (a, nra, nca, _), (b, nrb, ncb, _) = text[name], binary[name]
+        assert (nra, nca) == (nrb, ncb)
+        assert sorted(zip(a.cols, a.rows, a.vals)) == sorted(zip(b.cols, b.rows, b.vals))
+    assert text["R1"][1:3] == (5, 6) and len(text["R1"][0].vals) == 20 and len(text["R2"][0].vals) == 0
+
+
 def test_abaqus_matrix_generate_beam_blade():
     """Abaqus *MATRIX GENERATE of one B33 beam element (nodes 1, 2 and internal node -1;
     MATRIX INPUT lines, lower triangle): the file's values land at (node, DOF) and the blade
@@ -183,13 +274,20 @@ def write_op4_text(path, matrices):
             fh.write(f"{n + 1:8d}{1:8d}{1:8d}\n{1.0:26.17E}\n")
 
 
-def write_op4_binary(path, matrices, order="<"):
+def write_op4_binary(path, matrices, order="<", word=4):
+    """Binary OUTPUT4, sparse strings, per the format's description: 4-byte words (a double is
+    two) or, as Nastran's 64-bit integer build writes, 8-byte words (48-byte header with the name
+    as two words of 4 characters; integers and doubles one 8-byte word each)."""
+    i = "i" if word == 4 else "q"
+    per_double = 8 // word
+
     def record(payload):
         return struct.pack(order + "i", len(payload)) + payload + struct.pack(order + "i", len(payload))
     out = b""
     for name, A in matrices.items():
         n = A.shape[0]
-        out += record(struct.pack(order + "4i", n, n, 6, 2) + f"{name:<8s}".encode())
+        label = f"{name:<8s}".encode() if word == 4 else f"{name[:4]:<8s}{name[4:8]:<8s}".encode()
+        out += record(struct.pack(order + "4" + i, n, n, 6, 2) + label)
         for j in range(n):
             words = b""                                   # sparse strings: IS = IROW + 65536 (L + 1)
             nz = np.flatnonzero(A[:, j])
@@ -197,10 +295,10 @@ def write_op4_binary(path, matrices, order="<"):
                 continue
             runs = np.split(nz, np.flatnonzero(np.diff(nz) > 1) + 1)
             for run in runs:
-                words += struct.pack(order + "i", int(run[0]) + 1 + 65536 * (2 * run.size + 1))
+                words += struct.pack(order + i, int(run[0]) + 1 + 65536 * (per_double * run.size + 1))
                 words += A[run, j].astype(order + "f8").tobytes()
-            out += record(struct.pack(order + "3i", j + 1, 0, len(words) // 4) + words)
-        out += record(struct.pack(order + "3i", n + 1, 1, 2) + np.float64(1.0).astype(order + "f8").tobytes())
+            out += record(struct.pack(order + "3" + i, j + 1, 0, len(words) // word) + words)
+        out += record(struct.pack(order + "3" + i, n + 1, 1, per_double) + np.float64(1.0).astype(order + "f8").tobytes())
     Path(path).write_bytes(out)
 
 
@@ -237,7 +335,8 @@ def write_matlab_v73(path, matrices):
         fh.write(b"MATLAB 7.3 MAT-file, written by the bladedamp tests".ljust(116) + b"\x00" * 8 + b"\x00\x02IM")
 
 
-@pytest.mark.parametrize("fmt", ["op4-text", "op4-binary-le", "op4-binary-be", "dmig", "abaqus", "mat-v5", "mat-v73"])
+@pytest.mark.parametrize("fmt", ["op4-text", "op4-binary-le", "op4-binary-be", "op4-binary-64-le", "op4-binary-64-be",
+                                 "dmig", "abaqus", "mat-v5", "mat-v73"])
 def test_reference_blade_matrices_in_every_format_give_the_same_frf(tmp_path, fmt):
     M, K, nodes, points = reference_matrices()
     direct = ModalBlade.from_matrices(M, K, {p: range(6 * k - 6, 6 * k) for p, k in nodes.items()}, points=points,
@@ -249,7 +348,7 @@ def test_reference_blade_matrices_in_every_format_give_the_same_frf(tmp_path, fm
         write_op4_text(path, {"KAA": K, "MAA": M})
     elif fmt.startswith("op4-binary"):
         path = tmp_path / "blade.op4"
-        write_op4_binary(path, {"KAA": K, "MAA": M}, "<" if fmt.endswith("le") else ">")
+        write_op4_binary(path, {"KAA": K, "MAA": M}, "<" if fmt.endswith("le") else ">", 8 if "-64-" in fmt else 4)
     elif fmt == "dmig":
         path = tmp_path / "blade.pch"
         write_dmig(path, {"KAAX": K, "MAAX": M})
@@ -297,6 +396,51 @@ def test_truncated_binary_output4(tmp_path):
     path = tmp_path / "cut.op4"
     path.write_bytes(data[:1000])
     with pytest.raises(ValueError, match=r"cut\.op4: record \d+ \(byte \d+\): .*expected a complete Fortran"):
+        read_op4(path)
+
+
+def test_bad_64bit_binary_output4(tmp_path):
+    """The 64-bit binary layout's bad files: truncated, a 32-bit header after a 64-bit one, a
+    string running past its column, a column whose word count disagrees with NW; and a text
+    header with |I16 whose wide fields are not numbers. One ValueError each naming the file, the
+    record (or line) and what was expected."""
+    data = (DATA / "nas_large_dim_bigmat_binary.op4").read_bytes()
+    path = tmp_path / "cut.op4"
+    path.write_bytes(data[:3000])
+    with pytest.raises(ValueError, match=r"cut\.op4: record \d+ \(byte \d+\): length marker \d+ does not match; "
+                                         r"expected a complete Fortran unformatted record"):
+        read_op4(path)
+    M, K, _, _ = reference_matrices()
+    write_op4_binary(tmp_path / "a.op4", {"KAA": K}, word=8)
+    write_op4_binary(tmp_path / "b.op4", {"MAA": M}, word=4)
+    path = tmp_path / "mixed.op4"
+    path.write_bytes((tmp_path / "a.op4").read_bytes() + (tmp_path / "b.op4").read_bytes())
+    with pytest.raises(ValueError, match=r"mixed\.op4: record \d+: 24 bytes; expected a 48-byte matrix header "
+                                         r"\(NCOL, NROW, FORM, TYPE, NAME in 8-byte words"):
+        read_op4(path)
+    good = bytearray((tmp_path / "a.op4").read_bytes())
+    # the first column record: marker (4 bytes), ICOL, IROW, NW (8 bytes each), IS of its first string
+    at = 4 + 48 + 4 + 4 + 24
+    irow_l = struct.unpack("<q", good[at:at + 8])[0]
+    bad = bytearray(good)
+    bad[at:at + 8] = struct.pack("<q", irow_l + 65536 * 100)          # a string 100 words longer
+    path.write_bytes(bytes(bad))
+    with pytest.raises(ValueError, match=r"mixed\.op4: record 2: a string of \d+ words at word 0; expected a "
+                                         r"multiple of 1 inside the column's \d+ words"):
+        read_op4(path)
+    bad = bytearray(good)
+    bad[at - 8:at] = struct.pack("<q", struct.unpack("<q", good[at - 8:at])[0] + 1)   # NW one word too many
+    path.write_bytes(bytes(bad))
+    with pytest.raises(ValueError, match=r"mixed\.op4: record 2: \d+ data words; expected NW = \d+ \(column 1 of "
+                                         r"matrix KAA, 8-byte words\)"):
+        read_op4(path)
+    lines = (DATA / "nas_large_dim_bigmat_ascii.op4").read_text().splitlines()
+    k = next(i for i, line in enumerate(lines) if line.endswith("|I16"))
+    lines[k] = "   nineteen     " + lines[k][16:]
+    path = tmp_path / "wide.op4"
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(ValueError, match=rf"wide\.op4: line {k + 1}: expected a matrix header NCOL, NROW \(16 "
+                                         r"characters each: the format ends in \|I16\)"):
         read_op4(path)
 
 
