@@ -726,6 +726,21 @@ def test_cli_fe_blade_error_is_one_line_with_exit_code_2(tmp_path):
     assert len(lines) == 1 and "se.op4" in lines[0] and "row numbers" in lines[0], run.stderr
 
 
+def test_cli_bad_64bit_output4_blade_is_one_line_with_exit_code_2(tmp_path, capsys):
+    """A design file whose modal_file is a truncated 64-bit binary OUTPUT4: bladedamp frf stops with
+    one line naming the file, the record and what was expected, exit code 2."""
+    from conftest import one_error_line
+
+    from bladedamp.cli import main
+    M, K, _, _ = reference_matrices()
+    write_op4_binary(tmp_path / "whole.op4", {"KAA": K, "MAA": M}, word=8)
+    (tmp_path / "se.op4").write_bytes((tmp_path / "whole.op4").read_bytes()[:5100])
+    path = tmp_path / "design.toml"
+    path.write_text(FE_DESIGN.format(file="se.op4", fixed=[7]))
+    assert main(["frf", str(path), "--out", str(tmp_path / "out")]) == 2
+    one_error_line(capsys, "se.op4", "record", "expected a complete Fortran unformatted record")
+
+
 @pytest.mark.parametrize("suffix", ["op4", "pch", "mtx", "mat"])
 def test_missing_empty_or_folder_fe_files_are_one_file_read_error(tmp_path, suffix):
     from bladedamp.io import FileReadError, MissingFileError
