@@ -753,3 +753,40 @@ def test_missing_empty_or_folder_fe_files_are_one_file_read_error(tmp_path, suff
     (tmp_path / f"dir.{suffix}").mkdir()
     with pytest.raises(FileReadError, match=rf"dir\.{suffix}: is a folder, not a finite-element matrix file"):
         read_fe_matrices(tmp_path / f"dir.{suffix}")
+
+
+def test_readme_fe_examples_run_from_the_files_in_the_repository(tmp_path, monkeypatch):
+    """The README's section on FE exports: its Python examples run (from the repository's root,
+    the Ansys one with the ansys extra) and its design file builds the blade it describes."""
+    import re
+    import warnings
+
+    from bladedamp.design import load_design
+    root = Path(__file__).parents[1]
+    text = (root / "README.md").read_text()
+    section = text[text.index("### Blades from Nastran, Abaqus, MATLAB and Ansys exports"):
+                   text.index("### A solid FE blade from the geometry")]
+    blocks = re.findall(r"```python\n(.*?)```", section, re.S)
+    assert len(blocks) == 4
+    monkeypatch.chdir(root)
+    namespace = {}
+    for code in blocks:
+        if "ansys" in code and not _has_ansys():
+            continue
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            exec(compile(code, "README.md", "exec"), namespace)
+        assert namespace["blade"].n_modes >= 1
+    (toml,) = re.findall(r"```toml\n(.*?)```", section, re.S)
+    path = tmp_path / "design.toml"
+    path.write_text(toml.replace('modal_file = "tests/', f'modal_file = "{root.as_posix()}/tests/'))
+    blade = load_design(path).disk.blade
+    assert blade.n_modes == 4 and set(blade.points) >= {"OL", "OR", "tip", "excitation", "platform"}
+
+
+def _has_ansys():
+    try:
+        import ansys.mapdl.reader  # noqa: F401
+    except ImportError:
+        return False
+    return True
