@@ -139,7 +139,7 @@ def half_unit(printed: str) -> float:
 
 
 def test_nastran_extseout_output4_gives_the_frequencies_nastran_printed():
-    """NX Nastran 9 EXTSEOUT(MATOP4=...) of a Craig-Bampton component (binary OUTPUT4, KXX and
+    """NX Nastran 9.1 EXTSEOUT(MATOP4=...) of a Craig-Bampton component (binary OUTPUT4, KXX and
     MXX: 4 boundary grids x 6 DOF, rows 1-24, then 22 modal coordinates) beside the listing of
     the same run. With the boundary clamped, the blade read from the file has the fixed-interface
     eigenvalues that run printed (16 modes and 6 residual vectors, the table after augmentation).
