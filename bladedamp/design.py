@@ -250,10 +250,10 @@ def _fe_fields(g) -> list[Field]:
     row = Number(1, 1e9, integer=True)
     rows = [
         Field("blade.fe", "mass", None, Text(MATRIX_NAME), "-",
-              "the mass matrix's name in the file (Abaqus: the mass file); default MAAX, MAA, M or MASS, whichever "
+              "the mass matrix's name in the file (Abaqus: the mass file); default MAAX, MAA, MXX, M or MASS, whichever "
               "the file holds (Abaqus: the _MASS file beside the _STIF one)", example="MAA"),
         Field("blade.fe", "stiffness", None, Text(MATRIX_NAME), "-",
-              "the stiffness matrix's name in the file (Abaqus: the stiffness file); default KAAX, KAA, K or "
+              "the stiffness matrix's name in the file (Abaqus: the stiffness file); default KAAX, KAA, KXX, K or "
               "STIFFNESS", example="KAA"),
         Field("blade.fe", "fixed_nodes", None, List(index), "-",
               "files that label rows by node (DMIG, Abaqus, Ansys): nodes clamped, all their DOF (e.g. the root "
