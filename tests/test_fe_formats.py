@@ -116,16 +116,19 @@ def test_nastran_craig_bampton_output4_blade():
 
 def nastran_eigenvalue_table(path, title="(AFTER AUGMENTATION OF RESIDUAL VECTORS)"):
     """The rows (mode, eigenvalue, cycles) of the REAL EIGENVALUES table under ``title`` of a
-    Nastran listing (.f06/.out), as printed: the numbers and their strings."""
+    Nastran listing (.f06/.out), as printed: the numbers and their strings. A table continued on
+    the next pages (the title repeated) is one table; a row of mode 1 starts a new one."""
     rows, inside = [], False
-    for line in Path(path).read_text().splitlines():
+    for line in Path(path).read_text(errors="replace").splitlines():
         if "R E A L   E I G E N V A L U E S" in line:
             inside = False
         if title in line:
-            inside, rows = True, []
+            inside = True
             continue
         fields = line.split()
-        if inside and len(fields) == 7 and fields[0].isdigit() and "E" in fields[2]:
+        if inside and len(fields) == 7 and fields[0].isdigit() and fields[1].isdigit():
+            if fields[0] == "1":
+                rows = []
             rows.append((int(fields[0]), fields[2], fields[4]))
         elif inside and rows and line.startswith("1"):     # the next page ends the table
             inside = False
@@ -169,6 +172,39 @@ def test_nastran_extseout_output4_gives_the_frequencies_nastran_printed():
     assert np.all(np.abs(blade.natural_frequencies_hz - cycles) <= bound)
     single = np.sqrt(q.astype(np.float32)) / np.float32(2 * np.pi)
     assert [f"{float(f):.6E}" for f in single] == [r[2] for r in table]
+
+
+def test_nastran_punch_dmig_gives_the_frequencies_nastran_printed():
+    """MSC Nastran 2013 SOL 103 of a free-free beam (4 CBAR, a CONM2, coupled mass; GRDSET
+    leaves T3 and R1 of grids 1-5, SUPORT on grid 3): PARAM,EXTOUT,MATRIXPCH punched KAAX and
+    MAAX (test_case.pch, 10 x 10, 10 significant digits) and the run of the same deck printed
+    the REAL EIGENVALUES table (test_case.f06, Givens, 7 digits). The eigenvalues of the file's
+    (K, M), with no further boundary condition, are the printed ones.
+
+    Bounds: each eigenvalue agrees with its print to half a unit of the 7th digit (the two
+    rigid-body modes of the SUPORT Nastran prints as exactly 0.0) plus what the punch's rounding
+    to 10 digits (|dK_ij| <= 5e-10 |K_ij|, the same for M) can move it, to first order
+    5e-10 (|phi|'|K||phi| + lambda |phi|'|M||phi|) for the mass-normalised mode phi (up to
+    5.7e-8 relative for mode 3, twice its half unit; 4e-9 for mode 7), plus eigh's n eps lambda_max.
+    The CYCLES column: the same relative bound plus half a unit of its last digit and three
+    float32 roundings, as in the EXTSEOUT test."""
+    table = nastran_eigenvalue_table(DATA / "test_case.f06", title="R E A L   E I G E N V A L U E S")
+    assert [r[0] for r in table] == list(range(1, 11))
+    fe = read_fe_matrices(DATA / "test_case.pch")
+    assert fe.names == ("MAAX", "KAAX") and fe.n == 10
+    assert fe.labels.tolist() == [[g, c] for g in range(1, 6) for c in (3, 4)]
+    K, M = fe.stiffness.toarray(), fe.mass.toarray()
+    lam, phi = scipy.linalg.eigh(K, M)
+    assert [r[1] for r in table[:2]] == ["0.0", "0.0"]
+    printed = np.array([float(r[1]) for r in table])
+    rounding = 5e-10 * (np.einsum("ik,ij,jk->k", abs(phi), abs(K), abs(phi))
+                        + lam * np.einsum("ik,ij,jk->k", abs(phi), abs(M), abs(phi)))
+    half = np.array([half_unit(r[1]) if "E" in r[1] else 0.0 for r in table])
+    assert np.all(np.abs(lam - printed) <= half + rounding + 10 * np.finfo(float).eps * lam[-1])
+    cycles = np.array([float(r[2]) for r in table[2:]])
+    bound = (np.array([half_unit(r[2]) for r in table[2:]])
+             + (3 * 2.0**-24 + rounding[2:] / lam[2:]) * cycles)
+    assert np.all(np.abs(np.sqrt(lam[2:]) / (2 * np.pi) - cycles) <= bound)
 
 
 def test_nastran_64bit_binary_output4_equals_its_text_twin():
