@@ -37,7 +37,9 @@ lines are comments. Stiffness and mass are separate files (``job_STIF1.mtx``,
 
 MATLAB (``.mat``): v4 to v7 through :func:`scipy.io.loadmat`, v7.3 (HDF5) through h5py
 (the ``matlab`` extra);
-dense or sparse real variables; rows numbered 1, 2, ... as MATLAB indexes them.
+dense or sparse real variables, or fields of scalar structs named as MATLAB writes them
+(``nas.kaa.k0`` is field ``k0`` of field ``kaa`` of struct ``nas``); rows numbered 1, 2, ... as
+MATLAB indexes them.
 
 Ansys (``.full``, the assembled matrices of a modal or substructure run): through
 ansys-mapdl-reader (the ``ansys`` extra; it brings pyvista and vtk). The stiffness and mass of
@@ -728,7 +730,8 @@ def _abaqus_entries(path: Path, ints: np.ndarray, values: np.ndarray, numbers: n
 # MATLAB
 # --------------------------------------------------------------------------------------
 def read_matlab(path) -> dict:
-    """Real 2-D variables of a .mat file (v4-v7 or v7.3): name -> dense array or CSR matrix."""
+    """Variables of a .mat file (v4-v7 or v7.3): name -> dense array or CSR matrix; the fields of
+    a scalar struct (at any depth) as ``struct.field``, the struct itself not listed."""
     path = Path(path)
     import scipy.io
     try:
@@ -739,7 +742,19 @@ def read_matlab(path) -> dict:
         if _is_hdf5(path):                   # an HDF5 .mat without MATLAB's text header
             return _read_matlab_hdf5(path)
         raise ValueError(f"{path}: not a readable MATLAB .mat file ({err}); expected a MAT-file v4-v7.3") from None
-    return {k: v for k, v in data.items() if not k.startswith("__")}
+    out = {}
+
+    def add(name, value):
+        if isinstance(value, np.ndarray) and value.dtype.names and value.size == 1:    # a scalar struct
+            for field in value.dtype.names:
+                add(f"{name}.{field}", value.flat[0][field])
+        else:
+            out[name] = value
+
+    for k, v in data.items():
+        if not k.startswith("__"):
+            add(k, v)
+    return out
 
 
 def _is_hdf5(path: Path) -> bool:
@@ -757,10 +772,14 @@ def _read_matlab_hdf5(path: Path) -> dict:
         raise ValueError(f"{path}: a MATLAB v7.3 (HDF5) file needs h5py: pip install bladedamp[matlab]") from None
     out = {}
     with h5py.File(path, "r") as f:
-        for name, item in f.items():
-            if name.startswith("#"):
+        items = list(f.items())
+        while items:
+            name, item = items.pop(0)
+            if name.split(".")[-1].startswith("#"):
                 continue
-            if isinstance(item, h5py.Group) and "MATLAB_sparse" in item.attrs:
+            if isinstance(item, h5py.Group) and "MATLAB_sparse" not in item.attrs:    # a struct
+                items[:0] = [(f"{name}.{k}", v) for k, v in item.items()]
+            elif isinstance(item, h5py.Group) and "MATLAB_sparse" in item.attrs:
                 n_rows = int(item.attrs["MATLAB_sparse"])
                 jc = item["jc"][()]
                 data = item["data"][()] if "data" in item else np.zeros(0)

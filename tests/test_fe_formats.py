@@ -12,7 +12,7 @@ import scipy.linalg
 import scipy.sparse
 
 from bladedamp.blade import ModalBlade, beam_modes
-from bladedamp.fe_formats import read_fe_matrices, read_op4
+from bladedamp.fe_formats import read_fe_matrices, read_matlab, read_op4
 from bladedamp.reference import reference_blade_geometry
 
 DATA = Path(__file__).parent / "data" / "fe"
@@ -205,6 +205,58 @@ def test_nastran_punch_dmig_gives_the_frequencies_nastran_printed():
     bound = (np.array([half_unit(r[2]) for r in table[2:]])
              + (3 * 2.0**-24 + rounding[2:] / lam[2:]) * cycles)
     assert np.all(np.abs(np.sqrt(lam[2:]) / (2 * np.pi) - cycles) <= bound)
+
+
+def test_matlab_file_of_nastran_system_matrices_gives_the_frequencies_nastran_printed():
+    """pyyeti's nas2cam.mat: MAT-file v5 written by Yeti (db('save'), pyyeti's
+    mk_nas2cam_mat.y) from what NX Nastran 9's NAS2CAM DMAP wrote in the SEMFREQ run
+    assemble.dat (inboard and outboard external superelements on residual SE 0); struct nas with
+    kaa.k0, maa.k0 the residual's a-set (54 DOF). assemble.out is that run's listing: its REAL
+    EIGENVALUES table of SE 0 holds all 54 modes, the first six rigid-body modes (AUTOSUP).
+
+    Bounds: NX keeps eigenvalues in single precision (the file's own nas.lambda.k0 holds float32
+    numbers), so an elastic eigenvalue of the file's (K, M) agrees with the printed one to half
+    a unit of its 7th digit plus one float32 rounding (2^-24 relative) plus eigh's n eps
+    lambda_max; the CYCLES column to half a unit plus 3.5 float32 roundings relative (the
+    rounding of lambda halved by the square root, and 2 pi, the square root, the division). The
+    rigid-body eigenvalues, printed and computed, are rounding noise below n eps lambda_max."""
+    table = nastran_eigenvalue_table(DATA / "assemble.out", title="(BEFORE AUGMENTATION OF RESIDUAL VECTORS)")
+    assert [r[0] for r in table] == list(range(1, 55))
+    fe = read_fe_matrices(DATA / "nas2cam.mat", mass="nas.maa.k0", stiffness="nas.kaa.k0")
+    assert fe.names == ("nas.maa.k0", "nas.kaa.k0") and fe.n == 54 and fe.labels is None
+    K, M = fe.stiffness.toarray(), fe.mass.toarray()
+    lam = scipy.linalg.eigh(K, M, eigvals_only=True)
+    noise = 54 * np.finfo(float).eps * lam[-1]
+    printed = np.array([float(r[1]) for r in table])
+    assert np.all(np.abs(lam[:6]) <= noise) and np.all(np.abs(printed[:6]) <= noise)
+    half = np.array([half_unit(r[1]) for r in table[6:]])
+    assert np.all(np.abs(lam[6:] - printed[6:]) <= half + 2.0**-24 * lam[6:] + noise)
+    cycles = np.array([float(r[2]) for r in table[6:]])
+    bound = np.array([half_unit(r[2]) for r in table[6:]]) + 3.5 * 2.0**-24 * cycles
+    assert np.all(np.abs(np.sqrt(lam[6:]) / (2 * np.pi) - cycles) <= bound)
+    own = read_matlab(DATA / "nas2cam.mat")["nas.lambda.k0"].ravel()
+    assert np.array_equal(own.astype(np.float32).astype(float), own)     # single precision
+
+
+def test_matlab_struct_fields_are_named_as_matlab_writes_them(tmp_path):
+    """A scalar struct's fields (at any depth) are variables "struct.field", in v5 files
+    (scipy.io.savemat writes a dict as a struct) and in v7.3 (a struct is an HDF5 group)."""
+    M, K, _, _ = reference_matrices()
+    path = tmp_path / "v5.mat"
+    scipy.io.savemat(path, {"FEM": {"K": K, "M": M, "info": {"n": 3.0}}})
+    assert sorted(read_matlab(path)) == ["FEM.K", "FEM.M", "FEM.info.n"]
+    fe = read_fe_matrices(path, mass="FEM.M", stiffness="FEM.K")
+    np.testing.assert_array_equal(fe.stiffness.toarray(), K)
+    with pytest.raises(ValueError, match=r"no matrix named 'FEM\.X' \(mass\); the file holds \['FEM\.K'"):
+        read_fe_matrices(path, mass="FEM.X", stiffness="FEM.K")
+    h5py = pytest.importorskip("h5py")
+    path = tmp_path / "v73.mat"
+    with h5py.File(path, "w", userblock_size=512) as f:
+        g = f.create_group("FEM")
+        g.attrs["MATLAB_class"] = np.bytes_("struct")
+        g["K"], g["M"] = K.T, M.T                       # MATLAB stores column-major
+    fe = read_fe_matrices(path, mass="FEM.M", stiffness="FEM.K")
+    np.testing.assert_array_equal(fe.mass.toarray(), M)
 
 
 def test_nastran_64bit_binary_output4_equals_its_text_twin():
