@@ -176,9 +176,10 @@ def test_nastran_extseout_output4_gives_the_frequencies_nastran_printed():
 
 def test_nastran_punch_dmig_gives_the_frequencies_nastran_printed():
     """MSC Nastran 2013 SOL 103 of a free-free beam (4 CBAR, a CONM2, coupled mass; GRDSET
-    leaves T3 and R1 of grids 1-5, SUPORT on grid 3): PARAM,EXTOUT,MATRIXPCH punched KAAX and
-    MAAX (test_case.pch, 10 x 10, 10 significant digits) and the run of the same deck printed
-    the REAL EIGENVALUES table (test_case.f06, Givens, 7 digits). The eigenvalues of the file's
+    leaves T3 and R1 of grids 1-5, SUPORT on grid 3): the deck's PARAM,EXTOUT (matrixpch in
+    test_case.bdf) punched KAAX and MAAX (test_case.pch, 10 x 10, 10 significant digits) and a
+    run of the same deck without it printed the REAL EIGENVALUES table (test_case.f06, Givens,
+    7 digits; ExportNastranKM's README: comment out PARAM,EXTOUT for the modes run). The eigenvalues of the file's
     (K, M), with no further boundary condition, are the printed ones.
 
     Bounds: each eigenvalue agrees with its print to half a unit of the 7th digit (the two
