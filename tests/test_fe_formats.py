@@ -239,6 +239,30 @@ def test_matlab_file_of_nastran_system_matrices_gives_the_frequencies_nastran_pr
     assert np.array_equal(own.astype(np.float32).astype(float), own)     # single precision
 
 
+def test_matlab_file_craig_bampton_blade_gives_the_frequencies_nastran_printed():
+    """The same nas2cam.mat holds the outboard superelement's KAA, MAA (nas.kaa.k101,
+    nas.maa.k101): the Craig-Bampton component of outboard.op4, rows ordered as nas.uset.k101
+    says, the 22 modal coordinates (SPOINTs 1995001-1995022) first, then grids 3, 11, 19, 27 x 6.
+    A blade read from the MAT-file with those grids clamped has the fixed-interface frequencies
+    the outboard run printed (outboard.out), with the bounds of the EXTSEOUT OUTPUT4 test: the
+    eigenvalues to half a unit of the 7th digit, the CYCLES column plus three float32 roundings."""
+    table = nastran_eigenvalue_table(DATA / "outboard.out")
+    uset = read_matlab(DATA / "nas2cam.mat")["nas.uset.k101"]
+    assert list(uset[:22, 0]) == list(range(1995001, 1995023)) and not uset[:22, 1].any()
+    assert uset[22:, :2].tolist() == [[g, c] for g in (3, 11, 19, 27) for c in range(1, 7)]
+    fe = read_fe_matrices(DATA / "nas2cam.mat", mass="nas.maa.k101", stiffness="nas.kaa.k101")
+    K, M = fe.stiffness.toarray(), fe.mass.toarray()
+    lam = scipy.linalg.eigh(K[:22, :22], M[:22, :22], eigvals_only=True)
+    assert np.all(np.abs(lam - [float(r[1]) for r in table]) <= [half_unit(r[1]) for r in table])
+    points = {p: (0.0, 0.0, 0.0) for p in ("OL", "OR", "tip", "excitation")}
+    blade = ModalBlade.from_file(DATA / "nas2cam.mat", mass="nas.maa.k101", stiffness="nas.kaa.k101",
+                                 dof_map={p: range(1, 7) for p in points}, points=points, n_modes=22,
+                                 damping_ratios=0.01, fixed_dofs=range(23, 47))
+    cycles = np.array([float(r[2]) for r in table])
+    bound = np.array([half_unit(r[2]) for r in table]) + 3 * 2.0**-24 * cycles
+    assert np.all(np.abs(blade.natural_frequencies_hz - cycles) <= bound)
+
+
 def test_matlab_struct_fields_are_named_as_matlab_writes_them(tmp_path):
     """A scalar struct's fields (at any depth) are variables "struct.field", in v5 files
     (scipy.io.savemat writes a dict as a struct) and in v7.3 (a struct is an HDF5 group)."""
