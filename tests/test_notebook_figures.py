@@ -207,7 +207,7 @@ NOTEBOOK_DESIGNS = ("friction contact point", "friction oscillator", "reference 
 
 #: run first in the notebook's kernel (not saved): checks, with tests/figure_checks.py, every
 #: figure as it is shown (``plt.show`` and the inline backend's end-of-cell display, slider
-#: callbacks included) and keeps the problems with the cell's execution count
+#: callbacks included) and keeps the problems with the first line of the cell that showed it
 FIGURE_WATCH = '''
 import sys as _sys
 _sys.path.insert(0, {tests!r})
@@ -215,11 +215,11 @@ import matplotlib.pyplot as _plt
 from IPython import get_ipython as _get_ipython
 from figure_checks import figure_problems as _figure_problems, titles as _titles
 
-_figure_watch = {{"problems": [], "checked": set(), "count": 0, "cell": 0}}
+_figure_watch = {{"problems": [], "checked": set(), "count": 0, "cell": ""}}
 
 
-def _note_cell(*args, **kwargs):
-    _figure_watch["cell"] = _get_ipython().execution_count
+def _note_cell(info):
+    _figure_watch["cell"] = info.raw_cell.strip().splitlines()[0][:60] if info.raw_cell.strip() else ""
 
 
 def _check_open_figures(*args, **kwargs):
@@ -232,7 +232,7 @@ def _check_open_figures(*args, **kwargs):
         _found = _figure_problems(_fig, None)
         if not any(d in t.lower() for t in _titles(_fig) for d in {designs!r}):
             _found.append(f"no title names the design (titles: {{_titles(_fig)}})")
-        _figure_watch["problems"] += [f"cell [{{_figure_watch['cell']}}]: {{p}}" for p in _found]
+        _figure_watch["problems"] += [f"cell {{_figure_watch['cell']!r}}: {{p}}" for p in _found]
 
 
 _show = _plt.show
@@ -264,14 +264,7 @@ def notebook_figure_problems(path, timeout=600) -> tuple[int, list[str]]:
     execute_notebook(nb, pathlib.Path(path).parent, timeout=timeout)
     text = "".join(out["text"] for out in nb.cells[-1].outputs if out.get("name") == "stdout")
     report = json.loads(text)
-    cells = {cell.get("execution_count"): (i - 1, cell.source.splitlines()[0][:60]) for i, cell in enumerate(nb.cells)
-             if cell.cell_type == "code"}
-
-    def where(problem):          # "cell [N]: ..." -> "cell i (its first line): ..."
-        count, rest = problem[len("cell ["):].split("]", 1)
-        i, first = cells.get(int(count), ("?", ""))
-        return f"cell {i} ({first!r}){rest}"
-    return report["count"], [where(p) for p in report["problems"]]
+    return report["count"], report["problems"]
 
 
 NOTEBOOK_PATHS = sorted((__import__("pathlib").Path(__file__).resolve().parents[1] / "notebooks").glob("*.ipynb"))

@@ -31,7 +31,6 @@ from functools import lru_cache
 import numpy as np
 
 from .. import palette
-from ..plotting import place_legend
 from ..palette import CONTACT_STATE_NAMES as STATE_NAMES
 from ..palette import CONTACT_STATES as STATE_COLORS
 
@@ -235,7 +234,7 @@ def cycle_figure(data, title: str = ""):
     axes[2].set_xlabel("point [-]")
     axes[2].set_ylabel("lift-off ratio r [-]")
     axes[2].grid(True, alpha=0.3)
-    place_legend(axes[2], fontsize=8)
+    axes[2].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0))   # beside the points, hiding none
     fig.suptitle(title or f"{data.frequency_hz:.2f} Hz, tip {1e3 * data.tip_amplitude:.3f} mm", fontsize=10)
     return fig
 
