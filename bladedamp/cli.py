@@ -83,6 +83,7 @@ class Notes:
         self._catcher = warnings.catch_warnings(record=True)
         self._records = []
         self._printed = 0
+        self._said = []
 
     def __enter__(self):
         self._records = self._catcher.__enter__()
@@ -99,7 +100,7 @@ class Notes:
     def lines(self) -> list[str]:
         """The distinct messages in the order they were first raised, each on one line."""
         distinct = dict.fromkeys(" ".join(str(w.message).split()) for w in self._records)
-        return [line for line in distinct if line]
+        return [line for line in distinct if line and not any(line in text for text in self._said)]
 
     def write(self, out: Path) -> None:
         """Add the messages to ``out``/summary.md (a Notes section) and ``out``/results.json (key
@@ -119,6 +120,11 @@ class Notes:
             data = json.loads(results.read_text())
             data["notes"] = lines
             write_json(results, data)
+
+    def said(self, text: str) -> None:
+        """Record ``text`` as already told to the user (a result's status line): a message it
+        contains is not repeated (:meth:`lines`, :meth:`write`, :meth:`show`)."""
+        self._said.append(" ".join(text.split()))
 
     def show(self, stream=None) -> None:
         """Print the messages not printed yet, one plain line each ("note: ...")."""
@@ -593,6 +599,8 @@ def frf_command(args) -> int:
     summary = frf_outputs(out, design, responses, undamped, measured=measured)
     for k, v in summary["responses"].items():      # each response's status first
         print(f"{k}: {v['status_message']}", file=sys.stderr)
+        if Notes.current is not None:
+            Notes.current.said(v["status_message"])
     peaks = ", ".join(f"{k} {'largest amplitude at the range end' if v['peak_at_range_end'] else 'peak'} "
                       f"{v['peak_amplitude_mm']:.4f} mm at {v['peak_frequency_hz']:.3f} Hz"
                       if v["peak_amplitude_mm"] is not None and math.isfinite(v["peak_amplitude_mm"])
@@ -745,6 +753,8 @@ def campbell_command(args) -> int:
     summary = campbell_outputs(out, design, diagram)
     for c in summary["crossings"]:
         print(f"EO {c['engine_order']}: {c['status_message']}", file=sys.stderr)
+        if Notes.current is not None:
+            Notes.current.said(c["status_message"])
     return _done(out, t0, ", ".join(
         f"EO {c['engine_order']} peak {c['peak_amplitude_mm']:.4f} mm at {c['peak_frequency_hz']:.3f} Hz, "
         f"{c['rotor_speed_rpm']:.0f} rpm" + ("" if c["found"] else " (no resonance found in the range)")

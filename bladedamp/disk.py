@@ -45,8 +45,9 @@ from .hbm.peaks import PeakSolver, first_harmonic_output
 from .hbm.start import robust_start
 from .hbm.fourier import HarmonicBasis
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, nearest_to_range, physical_checks, plot_branch,
-                       sampled_response, with_checks, with_range_end_estimate)
+from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, harmonic_sentence, nearest_to_range, percent,
+                       physical_checks, plot_branch, sampled_response, with_amplitude_check, with_checks,
+                       with_range_end_estimate)
 
 DAMPER_DOFS = ("uD_x", "uD_y", "uD_z", "phiD_x", "phiD_y", "phiD_z")
 # the automatic AFT sampling of a disk's branch (TunedDisk and MistunedDisk) may grow the samples
@@ -794,7 +795,8 @@ class TunedDisk:
         can_check = extra_couplings is None and not self.blade.flexible_platform
         response = peak_checked_response(self, model, solve, harmonics, harmonic_tolerance, max_harmonic,
                                          estimate_harmonic_error, check_peak, can_check)
-        return with_range_end_estimate(self, with_stop_check(self, response, f_start_hz, check_stop))
+        response = with_stop_check(self, response, f_start_hz, check_stop)
+        return with_range_end_estimate(self, with_amplitude_check(response, blade_span(self.blade)))
 
     def linear_natural_frequencies_hz(self, f_low_hz: float, f_high_hz: float) -> tuple[float, float]:
         """(without dampers, dampers stuck): the natural frequency [Hz] of each linear sector
@@ -1059,6 +1061,12 @@ def rest_response(model, omega_start: float, omega_end: float, max_step: float, 
                                harmonics_converged=True)
 
 
+def blade_span(blade) -> float:
+    """The span of ``blade`` [m]: its tip point's distance from the blade frame's origin, the root
+    (the scale of :func:`bladedamp.response.amplitude_check`)."""
+    return float(np.linalg.norm(blade.points["tip"]))
+
+
 def with_stop_check(model, response, f_start_hz: float, check_stop: bool):
     """``response`` of ``model.frequency_response`` (a :class:`TunedDisk` or
     :class:`~bladedamp.mistuned.MistunedDisk`) with its stop note (:func:`with_stop_note`): with
@@ -1146,7 +1154,9 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
     if status not in ("periodic", "drifting"):
         found = (f"{where} finds no periodic motion ({check.message[0]}; the damper's contact points separated "
                  f"{separated:.0f} % of the period): the branch's peak is not a motion the disk settles on")
-        warnings.warn(found, AccuracyWarning, stacklevel=4)   # with_peak_check, peak_checked_response, the model, the caller
+        warnings.warn(f"at the peak, {f:.2f} Hz, the time integration finds no periodic motion: the curve's peak is "
+                      "not a motion the disk keeps; the time integration is the answer there",
+                      AccuracyWarning, stacklevel=4)   # with_peak_check, peak_checked_response, the model, the caller
         return dataclasses.replace(with_checks(response, {"peak_time_check": found}), peak_check=check)
     direct = float(np.abs(model.time_output_amplitudes(check)[0] - at_peak).max() / peak)
     if on_orbit:
@@ -1155,18 +1165,20 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
             note = (f"{where} leaves the branch for a coexisting periodic motion {left}; the branch's peak is not the "
                     "motion a disk started on it keeps (an unstable or coexisting solution): this is no harmonic error "
                     "estimate, peak_check(result, start='static') gives the motion reached from rest")
-            warnings.warn(note, AccuracyWarning, stacklevel=3)
+            warnings.warn(f"at the peak, {f:.2f} Hz, the time integration leaves the curve for another periodic motion "
+                          f"{percent(direct)} away: peak_check(result, start='static') gives the motion from rest",
+                          AccuracyWarning, stacklevel=3)
             return dataclasses.replace(response, peak_check=check, message=response.message + "; " + note)
     error = max(direct, enriched) if np.isfinite(enriched) else direct
     met = error <= tolerance
     motion = ("settles on a periodic motion" if status == "periodic" else
-              f"settles on a vibration whose first harmonics are steady while a damper keeps rolling or walking "
-              f"({check.message[0]}; its mean tip amplitudes compared)")
-    note = (f"{where} {motion}, {100 * direct:.2g} % from the branch's first-harmonic tip amplitudes (the damper's "
-            f"contact points separated {separated:.0f} % of the period): harmonic error estimate {100 * error:.2g} %, "
+              f"settles on a drifting vibration, a damper rolling or walking ({check.message[0]}; its mean compared)")
+    note = (f"{where} {motion}, {100 * direct:.2g} % from the branch's tip amplitudes (contact points separated "
+            f"{separated:.0f} % of the period): harmonic error estimate {100 * error:.2g} %, "
             + ("within" if met else "above") + f" the tolerance {100 * tolerance:.2g} %")
-    if not met:
-        warnings.warn(note, AccuracyWarning, stacklevel=4)
+    if not met:      # the sentence the result's status gives (bladedamp.response.status_message)
+        warnings.warn(harmonic_sentence(response.basis.harmonics, error, tolerance, status == "drifting"),
+                      AccuracyWarning, stacklevel=4)
     return dataclasses.replace(response, harmonic_error=error, harmonic_tolerance=tolerance, harmonics_converged=met,
                                peak_check=check, message=response.message + "; " + note)
 

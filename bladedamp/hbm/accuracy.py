@@ -38,7 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..response import BUDGET_PREFIX
+from ..response import BUDGET_PREFIX, harmonic_sentence
 from .continuation import newton
 from .fourier import HarmonicBasis
 from .linsolve import one_blas_thread
@@ -190,8 +190,9 @@ def annotate(response, check: HarmonicCheck, tolerance: float):
     elif not met:
         note = (f"harmonic error estimate {100 * check.error:.2g} % exceeds the tolerance "
                 f"{100 * tolerance:.2g} % (harmonics {check.harmonics} against {check.enriched})")
-    if note:
-        warnings.warn(note, AccuracyWarning, stacklevel=5)   # annotate, converged_response, its BLAS wrapper, the model, the caller
+    if note:      # warned as the sentence the result's status gives (bladedamp.response.status_message)
+        warnings.warn(harmonic_sentence(check.harmonics, check.error, tolerance, estimated=True), AccuracyWarning,
+                      stacklevel=5)   # annotate, converged_response, its BLAS wrapper, the model, the caller
     message = response.message + ("; " + note if note else "")
     return dataclasses.replace(response, harmonic_error=check.error, harmonic_tolerance=tolerance,
                                harmonics_converged=met, message=message)
@@ -234,7 +235,8 @@ def converged_response(model, solve, harmonics="auto", tolerance: float = HARMON
                     kept = annotate(best[0], best[1], tolerance)
                     what = (f"not computed: {response.stopped_by}" if not len(response.omega) else
                             f"stopped before the end of the range: {response.stopped_by}")
-                    return dataclasses.replace(kept, success=False, stopped_by=response.stopped_by,
+                    return dataclasses.replace(kept, success=False, reached_end=kept.reached_range_end,
+                                               stopped_by=response.stopped_by,
                                                message=f"{kept.message}; harmonics {tuple(H)} {what}")
                 if response.stopped_by:
                     return response           # stopped as the caller asked: no estimate, no richer set
