@@ -303,13 +303,12 @@ def range_end_note(response) -> str:
     if end is None:
         return ""
     side = "above" if end == f.max() and f.max() > f.min() else "below"
-    where = f"the resonance may lie {side} the range"
+    where = f"one may lie {side}"
     bounds = tuple(response.linear_natural_frequencies_hz or ())
     if len(bounds) == 2 and all(np.isfinite(bounds)):
         free, stuck = bounds
-        where = (f"the resonance may lie {side} it, between {free:.6g} Hz (no friction contacts) and "
-                 f"{stuck:.6g} Hz (contacts stuck)")
-    return f"the largest amplitude is at the range end ({end:.6g} Hz), not a resonance: {where}; widen the range"
+        where += f", between {free:.4g} Hz (no contacts) and {stuck:.4g} Hz (stuck)"
+    return f"the largest amplitude is at the range end ({end:.6g} Hz), no resonance: {where}; widen the range"
 
 
 def percent(x: float) -> str:
