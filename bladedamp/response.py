@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import dataclasses
 import enum
+import re
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -93,6 +94,9 @@ def physical_checks(omega, omega_range, dissipation, excitation_work, max_step=N
             relative[suspect] = (fine / scale[suspect]).min(axis=1, initial=0.0)
         bad = relative < -SAMPLING_FLOOR
         how = f", confirmed with {REFINE_SAMPLES_FACTOR * n_samples} AFT samples per period"
+        if bad.any():         # the AFT's energy error of the result itself, at the solve's own samples
+            how = (f" with {REFINE_SAMPLES_FACTOR * n_samples} AFT samples per period; AFT energy error "
+                   f"{100 * own[bad].min():.3g} % with the solve's {n_samples}")
         if judge_solution_samples and not bad.any() and (own < -SAMPLING_FLOOR).any():
             bad, relative = own < -SAMPLING_FLOOR, own
             how = (f" with {n_samples} AFT samples per period: the AFT's energy error, since with "
@@ -152,8 +156,11 @@ def sampled_response(solve, n_samples, first: int, most: int, most_for_dissipati
     n_used = response.basis.n_samples
     failed_with = [str(t) for t in tried if t != n_used]
     note = ""
+    most = not response.success and n_used * SAMPLES_GROWTH > (
+        most if most_for_dissipation is None or not only_sampling_failed(response) else most_for_dissipation)
     if failed_with:
-        note += f"; AFT samples per period raised to {n_used} (the branch failed with {', '.join(failed_with)})"
+        note += (f"; AFT samples per period raised to {n_used}{' (the most)' if most else ''} (the branch failed "
+                 f"with {', '.join(failed_with)})")
     if empty is not None:
         note += f"; with {empty} AFT samples per period the branch kept no point" + (f": {stopped_by}" if stopped_by else "")
     if stopped_by:
@@ -402,8 +409,9 @@ def check_sentence(failed: dict) -> str:
     found = str(failed[first])
     if first == "peak_time_check":
         found = "the time integration at the peak finds no periodic motion"
-    elif first == "dissipation":
-        found = found.split(" (")[0] + " (the AFT's sampling error)"
+    elif first == "dissipation":      # the AFT's energy error at the solve's samples where stated, else the least
+        error = re.search(r"AFT energy error (\S+ %)", found) or re.search(r"down to (\S+ %)", found)
+        found = found.split(" (")[0] + (f", AFT energy error {error.group(1)}" if error else "")
     more = f" (and {len(names) - 1} more: failed_checks)" if len(names) > 1 else ""
     return f"{found}{more}: {CHECK_ADVICE.get(first, 'see failed_checks')}"
 
@@ -447,16 +455,18 @@ def status_message(response) -> str:
     elif status is Status.OUT_OF_BUDGET:
         budget = response.stopped_by.removeprefix(BUDGET_PREFIX).lstrip(": ")
         if response.reached_range_end and len(response.omega):
-            detail = (f"{budget} on a richer harmonic set; the complete curve of harmonics {H} is kept, "
-                      + (f"its error {percent(error)} (tolerance {percent(tolerance)})" if np.isfinite(error)
+            detail = (f"{budget} on a richer set; the complete curve of harmonics {H} is kept, "
+                      + (f"error {percent(error)} (tolerance {percent(tolerance)})" if np.isfinite(error)
                          else "its error unknown"))
         else:
-            detail = f"{budget}: the curve covers part of the range; raise cpu_budget_s or point_budget"
+            detail = (f"{budget}: the curve covers part of the range, its largest amplitude need not be the "
+                      "resonance; raise cpu_budget_s or point_budget")
     elif response.stopped_by:
         detail = f"stopped by your condition: {response.stopped_by}"
     else:
         detail = stop_sentence(response)
-    note = range_end_note(response) if status is not Status.STOPPED or response.stopped_by else ""
+    # where the branch covers part of the range, its last point is no range end: the sentence says so
+    note = range_end_note(response) if response.reached_range_end else ""
     if "amplitude" in response.failed_checks:
         implausible = check_sentence({"amplitude": response.failed_checks["amplitude"]})
         detail += "" if implausible in detail else "; " + implausible

@@ -11,8 +11,11 @@ import pytest
 
 import bladedamp as bd
 from bladedamp.mistuned import MistunedResponse
-from bladedamp.response import (PLAUSIBLE_TIP_DEFLECTION, STATUS_EXPLANATIONS, Status, range_end_of_largest,
-                                response_status, with_checks)
+from bladedamp.blade import reference_blade
+from bladedamp.hbm.fourier import HarmonicBasis
+from bladedamp.response import (PLAUSIBLE_TIP_DEFLECTION, REFINE_SAMPLES_FACTOR, STATUS_EXPLANATIONS, Status,
+                                physical_checks, range_end_of_largest, response_status, sampled_response,
+                                with_checks)
 
 DATA = Path(__file__).parent / "data"
 # issue 33: a result's status in one plain sentence (aimed at 140 characters; the numbers of the
@@ -119,6 +122,21 @@ def test_a_budget_stop_is_out_of_budget():
     assert r.status is Status.OUT_OF_BUDGET
     first = sentences(r.status_message)[0]
     assert first.startswith("out of budget: 20 points used") and "covers part of the range" in first
+
+
+def test_a_budget_that_runs_out_on_a_richer_set_keeps_the_complete_curve_and_says_so():
+    """'auto' with a tolerance (1e-6) that (0, 1) misses (its estimate about 3e-4): (0, 1) reaches
+    the end in about 425 points, then the budget of 470 runs out on (0, 1, 2, 3). The complete
+    (0, 1) curve is kept, and its status says that, not that it covers part of the range."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = bd.FrictionOscillator().frequency_response(12.0, 20.0, harmonic_tolerance=1e-6, point_budget=470)
+    assert r.status is Status.OUT_OF_BUDGET and not r.success and r.stopped_by.startswith("budget")
+    assert r.basis.harmonics == (0, 1) and r.reached_range_end
+    assert r.frequency_hz.min() == pytest.approx(12.0) and r.frequency_hz.max() == pytest.approx(20.0)
+    first, = sentences(r.status_message)
+    assert "complete curve of harmonics (0, 1) is kept" in first and "part of the range" not in first
+    assert f"error {100 * r.harmonic_error:.2g} %" in first and "tolerance 0.0001 %" in first
 
 
 def test_an_empty_branch_is_stopped(complete):
@@ -279,4 +297,80 @@ def test_a_mistuned_response_has_a_status_a_stop_reason_and_one_range_end_flag()
     assert full.status is Status.COMPLETE_VERIFIED and full.peak_at_range_end is False
     assert part.stopped_by == "budget: stopped at 95 Hz" and part.status is Status.OUT_OF_BUDGET
     assert part.peak_at_range_end is True and part.linear_natural_frequencies_hz == ()
-    assert "range end (95" in sentences(part.status_message)[1]
+    first, = sentences(part.status_message)                 # its last point is no range end
+    assert "stopped at 95 Hz" in first and "covers part of the range" in first and "need not be the resonance" in first
+
+
+# ----- an amplitude the model cannot have (issue 32) -----------------------------------------
+def test_the_plausible_deflection_is_where_the_linear_cantilever_is_one_percent_off():
+    """PLAUSIBLE_TIP_DEFLECTION's reason, independently: the elastica of an end-loaded cantilever
+    (EI theta'' = -P cos theta, theta(0) = 0, theta'(L) = 0; Bisshopp & Drucker 1945) against the
+    linear theory's tip deflection P L^3 / (3 EI): 1 % apart at a deflection of 10 % of L."""
+    from scipy.integrate import solve_ivp
+    from scipy.optimize import brentq
+
+    def tip(alpha):                                    # alpha = P L^2 / EI, L = 1
+        def rhs(_, y):
+            return [y[1], -alpha * np.cos(y[0]), np.sin(y[0])]
+
+        def end(k0):
+            return solve_ivp(rhs, (0, 1), [0, k0, 0], rtol=1e-11, atol=1e-13).y[:, -1]
+        k0 = brentq(lambda k: end(k)[1], 0, 1.01 * alpha)
+        return end(k0)[2]
+    alpha = brentq(lambda a: tip(a) - PLAUSIBLE_TIP_DEFLECTION, 0.1, 1.0)
+    linear = alpha / 3
+    assert linear / PLAUSIBLE_TIP_DEFLECTION - 1 == pytest.approx(0.01, abs=0.001)
+
+
+@pytest.fixture(scope="module")
+def undamped_light_cylinder():
+    """issue 32: a 0.05 g cylinder on blades without viscous damping, one harmonic: its friction
+    cannot hold the resonance, and the branch reaches the end with a 1.69 m tip amplitude."""
+    blade = dataclasses.replace(reference_blade(), damping_ratios=np.zeros(4))
+    disk = dataclasses.replace(bd.reference_disk("cylinder", 5e-5), blade=blade)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return disk.frequency_response(90.0, 105.0, harmonics=(1,))
+
+
+def test_an_amplitude_beyond_small_deformations_is_no_success(undamped_light_cylinder):
+    r = undamped_light_cylinder
+    span = 0.2                                                   # the reference blade: root to tip [m]
+    assert r.reached_range_end and r.peak_amplitude > 1.0        # 1.69 m
+    assert r.status is Status.CHECK_FAILED and not r.success and set(r.failed_checks) == {"amplitude"}
+    first, = sentences(r.status_message)
+    assert f"{1e3 * r.peak_amplitude:.4g} mm" in first and f"{100 * r.peak_amplitude / span:.0f} %" in first
+    assert "small-deformation" in first and "add damping" in first
+
+
+def test_the_amplitude_check_passes_the_reference_designs(complete):
+    """The reference disk's 1 g cylinder (0.49 mm) and its damper-free blade (1.7 mm, 0.85 % of the
+    span) lie far inside the bound; the largest random design (excitation x10, no damper) 8.5 %."""
+    from bladedamp.response import amplitude_check
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        free = bd.reference_disk(None).frequency_response(92.0, 99.0, harmonics=(1,), max_step=0.05)
+    assert free.success and free.peak_amplitude == pytest.approx(1.7e-3, rel=0.01)
+    assert amplitude_check(free, 0.2) == {} and amplitude_check(complete, 0.2) == {}
+    assert amplitude_check(free, free.peak_amplitude / (PLAUSIBLE_TIP_DEFLECTION * 1.001))   # just beyond: fails
+
+
+# ----- the AFT's energy error where the dissipation check fails at the most samples ---------
+def test_a_failed_dissipation_check_states_the_aft_energy_error(complete):
+    w = np.linspace(10.0, 20.0, 11)
+    d = np.zeros((11, 1))
+    d[5] = -0.01                                            # -1 % at the solve's samples
+    failed = physical_checks(w, (10.0, 20.0), d, np.ones(11), None, 4096,
+                             refine=lambda i: np.full((len(i), 1), -1e-4))   # -0.01 % with 16 x the samples
+    assert f"AFT energy error -1 % with the solve's 4096" in failed["dissipation"]
+    assert f"-0.01 % of the excitation work there with {REFINE_SAMPLES_FACTOR * 4096}" in failed["dissipation"]
+    r = with_checks(complete, failed)
+    first, = sentences(r.status_message)
+    assert r.status is Status.CHECK_FAILED and "AFT energy error -1 %" in first and "n_samples" in first
+
+    def solve(n):                 # a branch whose dissipation fails at every sample count
+        return with_checks(dataclasses.replace(complete, basis=HarmonicBasis((1,), n)), failed)
+    r = sampled_response(solve, None, 256, 4096)
+    assert r.basis.n_samples == 4096 and "raised to 4096 (the most)" in r.message
+    assert "AFT energy error -1 %" in r.status_message
