@@ -99,7 +99,10 @@ class Notes:
 
     def lines(self) -> list[str]:
         """The distinct messages in the order they were first raised, each on one line."""
-        distinct = dict.fromkeys(" ".join(str(w.message).split()) for w in self._records)
+        from .hbm.continuation import ConvergenceWarning
+
+        records = [w for w in self._records if not (self._said and issubclass(w.category, ConvergenceWarning))]
+        distinct = dict.fromkeys(" ".join(str(w.message).split()) for w in records)
         return [line for line in distinct if line and not any(line in text for text in self._said)]
 
     def write(self, out: Path) -> None:
@@ -123,7 +126,9 @@ class Notes:
 
     def said(self, text: str) -> None:
         """Record ``text`` as already told to the user (a result's status line): a message it
-        contains is not repeated (:meth:`lines`, :meth:`write`, :meth:`show`)."""
+        contains is not repeated (:meth:`lines`, :meth:`write`, :meth:`show`), nor is a
+        continuation's ConvergenceWarning (where and why a branch stopped: the status line says
+        where, and what to do, for the branch the result kept)."""
         self._said.append(" ".join(text.split()))
 
     def show(self, stream=None) -> None:
@@ -917,6 +922,10 @@ def compare_command(args) -> int:
             else:
                 undamped[e.name, label] = undamped_responses(e.design, [label])[label]
     summary = compare_outputs(out, entries, undamped, shared)
+    for row in summary["designs"]:                 # each response's status first, as frf
+        print(f"{row['design']} {row['response']}: {row['status_message']}", file=sys.stderr)
+        if Notes.current is not None:
+            Notes.current.said(row["status_message"])
     what = "; ".join(f"{row['design']} {row['response']} peak {row['peak_amplitude_mm']:.4f} mm at "
                      f"{row['peak_frequency_hz']:.3f} Hz" for row in summary["designs"])
     return _done(out, t0, what)

@@ -423,7 +423,7 @@ def stop_sentence(response) -> str:
     if not len(response.omega):
         where = "no point computed: the start failed"
     else:
-        where = f"the branch stopped at {response.frequency_hz[response.furthest_index()]:.2f} Hz"
+        where = f"the branch ends at {response.frequency_hz[response.furthest_index()]:.2f} Hz"
     if check is not None and len(getattr(check, "periodic", ())):
         if not check.periodic[0]:
             return (f"{where}; the time integration beyond finds no periodic motion (the damper hops or rolls): "

@@ -108,7 +108,7 @@ def test_a_branch_that_runs_out_of_points_is_stopped():
     assert not r.reached_range_end and not r.stopped_by
     assert r.status is Status.STOPPED and not r.success
     first, = sentences(r.status_message)
-    assert f"stopped at {r.frequency_hz[r.furthest_index()]:.2f} Hz" in first
+    assert f"ends at {r.frequency_hz[r.furthest_index()]:.2f} Hz" in first
 
 
 def test_a_budget_stop_is_out_of_budget():

@@ -190,7 +190,8 @@ def annotate(response, check: HarmonicCheck, tolerance: float):
     elif not met:
         note = (f"harmonic error estimate {100 * check.error:.2g} % exceeds the tolerance "
                 f"{100 * tolerance:.2g} % (harmonics {check.harmonics} against {check.enriched})")
-    if note:      # warned as the sentence the result's status gives (bladedamp.response.status_message)
+    if note and response.success:   # the sentence the status gives (bladedamp.response.status_message); a
+        # branch that stopped or failed a check is said so by its status, whose advice is not the harmonics
         warnings.warn(harmonic_sentence(check.harmonics, check.error, tolerance, estimated=True), AccuracyWarning,
                       stacklevel=5)   # annotate, converged_response, its BLAS wrapper, the model, the caller
     message = response.message + ("; " + note if note else "")
