@@ -23,6 +23,7 @@ force is a static load on the damper and the seating is part of the harmonic bal
 from __future__ import annotations
 
 import dataclasses
+import textwrap
 import warnings
 
 from dataclasses import dataclass, field
@@ -1449,7 +1450,7 @@ class DiskResponse(FrequencyResponse):
         ax.grid(True, alpha=0.3)
         ax.legend()
         if not self.success:
-            ax.set_title(f"incomplete: {self.message}", fontsize=8)
+            ax.set_title(textwrap.fill(self.status_message, 100), fontsize=8)   # what it means, not the log
         if measured is not None:
             from .measurement import draw_measurement
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 import dataclasses
 import enum
 import re
+import textwrap
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -431,6 +432,8 @@ def stop_sentence(response) -> str:
         return f"{where}; a periodic motion exists beyond, which a richer set (harmonics='auto') may follow"
     if response.failed_checks:
         return f"{where}; {check_sentence(response.failed_checks)}"
+    if "stopped after max_points" in response.message:
+        return f"{where}, all its max_points = {len(response.omega)} points used: raise max_points"
     more = "check_stop=True tells whether a periodic motion exists beyond" if hasattr(response, "stop_check") \
         else "shorten max_step or run with harmonics='auto'"
     return f"{where}; {more}"
@@ -691,7 +694,7 @@ class FrequencyResponse(Saveable):
         ax.set_ylabel(f"|{self.dof_names[self._dof(dof)]}| harmonic {harmonic} [{unit}]")
         ax.grid(True, alpha=0.3)
         if not self.success:
-            ax.set_title(f"incomplete: {self.message}", fontsize=8)
+            ax.set_title(textwrap.fill(self.status_message, 100), fontsize=8)   # what it means, not the log
         ax.legend()
         if measured is not None:
             from .measurement import draw_measurement
