@@ -695,7 +695,9 @@ class TunedDisk:
         result above the tolerance says so).
         ``max_step`` is the largest arc-length step in scaled units (the frequency range is 1;
         smaller: more points). The result is ``success`` only if the branch reached the end and
-        passed :func:`bladedamp.response.physical_checks`; a range where no bounded response
+        passed :func:`bladedamp.response.physical_checks` and
+        :func:`bladedamp.response.amplitude_check` (a tip amplitude beyond small deformations,
+        10 % of the blade's span, fails it: status CHECK_FAILED); a range where no bounded response
         exists (:meth:`check_bounded`) is refused with a ValueError before any solve. Without
         dynamic excitation (``excitation`` zero, no ``extra_couplings``) the response is rest,
         exactly (:func:`rest_response`).

@@ -182,7 +182,9 @@ def harmonic_error(model, response, harmonics=None, n_points: int = 5, tol: floa
 def annotate(response, check: HarmonicCheck, tolerance: float):
     """``response`` with its harmonic error estimate; the message says when it is above the
     tolerance or could not be checked (``success`` is left as the solver and the sanity checks
-    set it: an explicit harmonic set is the user's choice, the estimate tells its cost)."""
+    set it: an explicit harmonic set is the user's choice, the estimate tells its cost), and, for
+    a complete branch, an AccuracyWarning says it in the sentence its status gives
+    (:func:`bladedamp.response.harmonic_sentence`)."""
     met = bool(np.isfinite(check.error) and check.error <= tolerance)
     note = ""
     if not np.isfinite(check.error):
