@@ -798,8 +798,7 @@ class TunedDisk:
         can_check = extra_couplings is None and not self.blade.flexible_platform
         response = peak_checked_response(self, model, solve, harmonics, harmonic_tolerance, max_harmonic,
                                          estimate_harmonic_error, check_peak, can_check)
-        response = with_stop_check(self, response, f_start_hz, check_stop)
-        return with_range_end_estimate(self, with_amplitude_check(response, blade_span(self.blade)))
+        return with_range_end_estimate(self, with_stop_check(self, response, f_start_hz, check_stop))
 
     def linear_natural_frequencies_hz(self, f_low_hz: float, f_high_hz: float) -> tuple[float, float]:
         """(without dampers, dampers stuck): the natural frequency [Hz] of each linear sector
@@ -1064,10 +1063,13 @@ def rest_response(model, omega_start: float, omega_end: float, max_step: float, 
                                harmonics_converged=True)
 
 
-def blade_span(blade) -> float:
-    """The span of ``blade`` [m]: its tip point's distance from the blade frame's origin, the root
-    (the scale of :func:`bladedamp.response.amplitude_check`)."""
-    return float(np.linalg.norm(blade.points["tip"]))
+def blade_span(model) -> float:
+    """The span of the blades of ``model`` (a :class:`TunedDisk` or
+    :class:`~bladedamp.mistuned.MistunedDisk`) [m]: the tip point's distance from the blade
+    frame's origin, the root, the shortest blade's (the scale of
+    :func:`bladedamp.response.amplitude_check`)."""
+    blades = getattr(model, "blades", None) or [model.blade]
+    return min(float(np.linalg.norm(b.points["tip"])) for b in blades)
 
 
 def with_stop_check(model, response, f_start_hz: float, check_stop: bool):
@@ -1085,13 +1087,15 @@ def peak_checked_response(model, system_model, solve, harmonics, tolerance: floa
     """The response of ``model.frequency_response`` (a :class:`TunedDisk` or
     :class:`~bladedamp.mistuned.MistunedDisk`) before its stop check: the branches of ``solve``
     with their harmonic error estimate (:func:`~bladedamp.hbm.accuracy.converged_response` on
-    ``system_model``), then :func:`with_peak_check`. One accuracy warning per call: where the
+    ``system_model``) and :func:`~bladedamp.response.amplitude_check`, then :func:`with_peak_check`
+    (not run on an implausible amplitude). One accuracy warning per call: where the
     peak check runs, its verdict (which includes the estimate) replaces the estimate's
     AccuracyWarning; every other warning raised on the way is raised again at the caller of
     ``frequency_response``."""
     with warnings.catch_warnings(record=True) as raised:
         response = converged_response(system_model, solve, harmonics, tolerance, max_harmonic, estimate=estimate)
-    response = with_peak_check(model, response, check_peak, tolerance, can_check)
+    response = with_peak_check(model, with_amplitude_check(response, blade_span(model)), check_peak, tolerance,
+                               can_check)
     for w in raised:
         if response.peak_check is None or not issubclass(w.category, AccuracyWarning):
             warnings.warn(w.message, w.category, stacklevel=3)     # this function, frequency_response, its caller
@@ -1135,7 +1139,8 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
     models the disk: ``can_check``, rigid platforms and no extra couplings); a branch that
     stopped early is left to the stop check, and is returned unchanged, as is one stopped by
     ``stop_above``."""
-    if not len(response.omega) or response.stopped_by or not response.reached_range_end:
+    if not len(response.omega) or response.stopped_by or not response.reached_range_end \
+            or "amplitude" in response.failed_checks:         # beyond the model: nothing to check in time
         return response
     enriched = response.harmonic_error
     if not check_peak:

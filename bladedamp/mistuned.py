@@ -62,7 +62,7 @@ from .damper.kinetics import seat
 from .disk import (AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION, DAMPER_DOFS, STOP_CHECK_OFFSET_HZ,
                    DamperContacts, TunedDisk, contact_point_maps, contact_rows, damper_weighted_scales,
                    fused_point_map_forces, interblade_phase, peak_checked_response, point_map_forces, rest_response,
-                   rotor_speed_in_hz, time_at_peak, time_check_beyond, with_stop_check, blade_span)
+                   rotor_speed_in_hz, time_at_peak, time_check_beyond, with_stop_check)
 from .hbm.accuracy import HARMONIC_TOLERANCE
 from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_POINT_BUDGET, Branch, Budget, continuation
 from .hbm.start import robust_start
@@ -72,7 +72,7 @@ from .hbm.peaks import PEAK_MAX_ITERATIONS, PeakSolver, first_harmonic_output
 from .hbm.fourier import HarmonicBasis
 from .hbm.system import Coupling, HarmonicBalanceSystem
 from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, physical_checks, refined_peak, sampled_response,
-                       with_amplitude_check, with_checks)
+                       with_checks)
 
 
 def sparse_real_form(basis: HarmonicBasis, per_harmonic) -> sp.csr_matrix:
@@ -1112,8 +1112,7 @@ class MistunedDisk:
         can_check = not any(b.flexible_platform for b in self.blades)
         response = peak_checked_response(self, self, solve, harmonics, harmonic_tolerance, max_harmonic,
                                          estimate_harmonic_error, check_peak, can_check)
-        response = with_stop_check(self, response, f_start_hz, check_stop)
-        return with_amplitude_check(response, min(blade_span(b) for b in self.blades))
+        return with_stop_check(self, response, f_start_hz, check_stop)
 
     def peak_check(self, response: "MistunedResponse", **options):
         """:meth:`time_response` at the frequency of ``response``'s peak (the largest first-harmonic
