@@ -599,8 +599,11 @@ def frf_command(args) -> int:
     if design.disk.has_damper:      # the damper-free reference of the figure: linear, one harmonic is exact
         progress("damper-free reference responses")
         for eo in design.engine_orders:
-            undamped[f"EO{eo}"] = dataclasses.replace(design.disk_at(eo), damper=None).frequency_response(
-                a.f_start_hz, a.f_end_hz, harmonics=(1,), max_step=a.max_step, estimate_harmonic_error=False)
+            free = dataclasses.replace(design.disk_at(eo), damper=None)
+            if not bounded_without_damper(free, a.f_start_hz, a.f_end_hz):
+                continue
+            undamped[f"EO{eo}"] = free.frequency_response(a.f_start_hz, a.f_end_hz, harmonics=(1,), max_step=a.max_step,
+                                                          estimate_harmonic_error=False)
     summary = frf_outputs(out, design, responses, undamped, measured=measured)
     for k, v in summary["responses"].items():      # each response's status first
         print(f"{k}: {v['status_message']}", file=sys.stderr)
@@ -612,6 +615,19 @@ def frf_command(args) -> int:
                       else f"{k} no peak: no point computed (summary.md says why)"
                       for k, v in summary["responses"].items())
     return _done(out, t0, peaks)
+
+
+def bounded_without_damper(free, f_start_hz: float, f_end_hz: float) -> bool:
+    """Whether the damper-free disk ``free`` has a bounded response over the range
+    (:meth:`bladedamp.disk.TunedDisk.check_bounded`); where it has not (a blade mode without
+    viscous damping inside the range), a note says the reference is left out."""
+    try:
+        free.check_bounded(f_start_hz, f_end_hz)
+    except ValueError:
+        warnings.warn(f"no damper-free reference: without the damper a blade mode with damping_ratio = 0 lies in "
+                      f"{f_start_hz:g}-{f_end_hz:g} Hz, where its amplitude has no bound", UserWarning, stacklevel=2)
+        return False
+    return True
 
 
 def optimize_command(args) -> int:
@@ -917,10 +933,9 @@ def compare_command(args) -> int:
             progress(f"damper-free reference of {e.name}")
             by_key[key] = undamped_responses(e.design, list(e.responses))
         for label in e.responses:
-            if label in by_key[key]:
-                undamped[e.name, label] = by_key[key][label]
-            else:
-                undamped[e.name, label] = undamped_responses(e.design, [label])[label]
+            free = by_key[key][label] if label in by_key[key] else undamped_responses(e.design, [label]).get(label)
+            if free is not None:       # None: no bounded damper-free response (a note says so)
+                undamped[e.name, label] = free
     summary = compare_outputs(out, entries, undamped, shared)
     for row in summary["designs"]:                 # each response's status first, as frf
         print(f"{row['design']} {row['response']}: {row['status_message']}", file=sys.stderr)

@@ -1090,14 +1090,15 @@ def peak_checked_response(model, system_model, solve, harmonics, tolerance: floa
     ``system_model``) and :func:`~bladedamp.response.amplitude_check`, then :func:`with_peak_check`
     (not run on an implausible amplitude). One accuracy warning per call: where the
     peak check runs, its verdict (which includes the estimate) replaces the estimate's
-    AccuracyWarning; every other warning raised on the way is raised again at the caller of
-    ``frequency_response``."""
+    AccuracyWarning, and an implausible amplitude (its status says so) has none; every other
+    warning raised on the way is raised again at the caller of ``frequency_response``."""
     with warnings.catch_warnings(record=True) as raised:
         response = converged_response(system_model, solve, harmonics, tolerance, max_harmonic, estimate=estimate)
     response = with_peak_check(model, with_amplitude_check(response, blade_span(model)), check_peak, tolerance,
                                can_check)
+    said = response.peak_check is not None or "amplitude" in response.failed_checks   # the verdict, or beyond the model
     for w in raised:
-        if response.peak_check is None or not issubclass(w.category, AccuracyWarning):
+        if not said or not issubclass(w.category, AccuracyWarning):
             warnings.warn(w.message, w.category, stacklevel=3)     # this function, frequency_response, its caller
     return response
 

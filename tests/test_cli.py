@@ -449,6 +449,27 @@ def test_frf_leads_with_the_status_and_names_a_range_end_maximum(tmp_path, capsy
     assert "| EO1 | complete, verified | (1,) |" in summary and "(largest amplitude at the range end)" in summary
 
 
+def test_frf_calls_an_amplitude_beyond_the_model_a_failed_check(tmp_path, capsys):
+    """issue 32: a 0.05 g cylinder on blades without viscous damping reaches the end of its range
+    with a 1.69 m tip amplitude. The command leads with the failed amplitude check, not with a
+    success, and leaves out the damper-free reference (no bounded response without the damper)
+    with a note instead of a traceback."""
+    path = tmp_path / "undamped.toml"
+    path.write_text("[blade]\ndamping_ratio = 0.0\n\n[damper]\nmass_g = 0.05\n\n[analysis]\nharmonics = [1]\n")
+    out = tmp_path / "frf"
+    assert main(["frf", str(path), "--no-stop-check", "--no-peak-check", "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    summary, results = _outputs(out, "frf.png", "summary.md", "results.json")
+    r = results["responses"]["EO1"]
+    assert r["status"] == "check failed" and not r["success"] and r["peak_amplitude_mm"] > 1e3
+    assert "small-deformation" in r["status_message"] and f"EO1: {r['status_message']}" in err
+    assert "undamped_peak_amplitude_mm" not in r
+    assert [line for line in err.splitlines() if line.startswith("note: ")] == [
+        "note: no damper-free reference: without the damper a blade mode with damping_ratio = 0 lies in 90-105 Hz, "
+        "where its amplitude has no bound"], err
+    assert "Traceback" not in err
+
+
 # ---------------------------------------------------------------------------------------
 # what a user sees: the library's warnings as plain lines, no warning on the template, bars
 # ---------------------------------------------------------------------------------------
