@@ -1181,7 +1181,8 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
     error = max(direct, enriched) if np.isfinite(enriched) else direct
     met = error <= tolerance
     motion = ("settles on a periodic motion" if status == "periodic" else
-              f"settles on a drifting vibration, a damper rolling or walking ({check.message[0]}; its mean compared)")
+              f"settles on a drifting vibration, a damper keeps rolling or walking ({check.message[0]}; its mean "
+              "compared)")
     note = (f"{where} {motion}, {100 * direct:.2g} % from the branch's tip amplitudes (contact points separated "
             f"{separated:.0f} % of the period): harmonic error estimate {100 * error:.2g} %, "
             + ("within" if met else "above") + f" the tolerance {100 * tolerance:.2g} %")
