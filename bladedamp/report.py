@@ -201,7 +201,8 @@ def accuracy_section(summary: dict) -> str:
                 check = _harmonics(enriched(r["harmonics"]))
                 shown, within = "not estimated (see below)", "unknown"
                 notes.append(f"{kind}, harmonics {_harmonics(r['harmonics'])}: its error is unknown, since the peak "
-                             f"solved again with harmonics {check} did not converge (the peak passed the physical checks).")
+                             f"solved again with harmonics {check} did not converge (the peak passed the physical "
+                             "checks).")
             else:
                 shown, within = f"{fmt_number(err, '.2g')} %", "yes" if r["converged"] else "no"
             lines.append(f"| {kind} | {row['mass_g']:.3g} | {label} | {_harmonics(r['harmonics'])} | "

@@ -347,8 +347,8 @@ def harmonic_sentence(harmonics, error: float, tolerance: float, drifting: bool 
         return (f"the error of the {curve} could not be checked ({richer_harmonics(H)} did not converge at the peak); "
                 + ("check the peak with check_peak=True" if checkable else "run with harmonics='auto'"))
     if not np.isfinite(error):
-        return (f"{curve}, error not estimated: " + ("its peak may be off by tens of %" if one else "its accuracy is unknown")
-                + "; run with harmonics='auto'")
+        unknown = "its peak may be off by tens of %" if one else "its accuracy is unknown"
+        return f"{curve}, error not estimated: {unknown}; run with harmonics='auto'"
     if error <= tolerance:
         return f"{curve}, good to {percent(error)} (tolerance {percent(tolerance)})"
     if drifting:
