@@ -344,7 +344,8 @@ def harmonic_sentence(harmonics, error: float, tolerance: float, drifting: bool 
     one = H == (1,)
     curve = "one-harmonic curve" if one else f"harmonics {H}"
     if not np.isfinite(error) and estimated:
-        return (f"the error of the {curve} could not be checked ({richer_harmonics(H)} did not converge at the peak); "
+        subject = "the one-harmonic curve's error" if one else f"the error of harmonics {H}"
+        return (f"{subject} could not be checked: {richer_harmonics(H)} did not converge at the peak; "
                 + ("check the peak with check_peak=True" if checkable else "run with harmonics='auto'"))
     if not np.isfinite(error):
         unknown = "its peak may be off by tens of %" if one else "its accuracy is unknown"
@@ -462,10 +463,10 @@ def status_message(response) -> str:
                       + (f"error {percent(error)} (tolerance {percent(tolerance)})" if np.isfinite(error)
                          else "its error unknown"))
         else:
-            detail = (f"{budget}: the curve covers part of the range, its largest amplitude need not be the "
-                      "resonance; raise cpu_budget_s or point_budget")
+            detail = (f"{budget}: a partial curve, whose largest amplitude need not be the resonance; raise "
+                      "cpu_budget_s or point_budget")
     elif response.stopped_by:
-        detail = f"stopped by your condition: {response.stopped_by}"
+        detail = f"ended by the stop condition ({response.stopped_by}): a partial curve"
     else:
         detail = stop_sentence(response)
     # where the branch covers part of the range, its last point is no range end: the sentence says so
