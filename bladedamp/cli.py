@@ -610,6 +610,7 @@ def frf_command(args) -> int:
         if Notes.current is not None:
             Notes.current.said(v["status_message"])
     peaks = ", ".join(f"{k} {'largest amplitude at the range end' if v['peak_at_range_end'] else 'peak'} "
+                      f"{'(check failed) ' if v['status'] == 'check failed' else ''}"
                       f"{v['peak_amplitude_mm']:.4f} mm at {v['peak_frequency_hz']:.3f} Hz"
                       if v["peak_amplitude_mm"] is not None and math.isfinite(v["peak_amplitude_mm"])
                       else f"{k} no peak: no point computed (summary.md says why)"

@@ -463,6 +463,7 @@ def test_frf_calls_an_amplitude_beyond_the_model_a_failed_check(tmp_path, capsys
     r = results["responses"]["EO1"]
     assert r["status"] == "check failed" and not r["success"] and r["peak_amplitude_mm"] > 1e3
     assert "small-deformation" in r["status_message"] and f"EO1: {r['status_message']}" in err
+    assert "EO1 peak (check failed) " in err
     assert "undamped_peak_amplitude_mm" not in r
     assert [line for line in err.splitlines() if line.startswith("note: ")] == [
         "note: no damper-free reference: without the damper a blade mode with damping_ratio = 0 lies in 90-105 Hz, "

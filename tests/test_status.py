@@ -343,6 +343,14 @@ def test_an_amplitude_beyond_small_deformations_is_no_success(undamped_light_cyl
     assert "small-deformation" in first and "add damping" in first
 
 
+def test_the_span_is_the_blades_root_to_tip():
+    from bladedamp.disk import blade_span
+
+    td = dataclasses.replace(bd.reference_disk("cylinder", 1e-3), n_blades=4)
+    assert blade_span(td) == pytest.approx(0.2, rel=1e-12)                    # Table 1's 60 + 140 mm
+    assert blade_span(bd.MistunedDisk.from_tuned(td, [1.01, 0.99, 1.02, 1.0])) == pytest.approx(0.2, rel=1e-12)
+
+
 def test_the_amplitude_check_passes_the_reference_designs(complete):
     """The reference disk's 1 g cylinder (0.49 mm) and its damper-free blade (1.7 mm, 0.85 % of the
     span) lie far inside the bound; the largest random design (excitation x10, no damper) 8.5 %."""
