@@ -120,7 +120,9 @@ def undamped_responses(design, labels) -> dict:
     """{label: the damper-free DiskResponse} of ``design`` at each "EO<n>" of ``labels``: one
     harmonic (linear, exact) over the design's frequency range, widened until its resonance peak
     is inside (:func:`bladedamp.studies.mass.peak_response`; a damper shifts the resonance, so the
-    damper-free peak may lie outside the damped design's range)."""
+    damper-free peak may lie outside the damped design's range). A label whose damper-free disk
+    has no bounded response in the range (:func:`bladedamp.cli.bounded_without_damper`) is left out."""
+    from .cli import bounded_without_damper
     from .studies.mass import peak_response
 
     a = design.analysis
@@ -128,7 +130,8 @@ def undamped_responses(design, labels) -> dict:
     for label in labels:
         eo = int(TUNED_LABEL.match(label).group(1))
         disk = dataclasses.replace(design.disk_at(eo), damper=None)
-        out[label] = peak_response(disk, a.f_range_hz, harmonics=(1,), max_step=a.max_step)[2]
+        if bounded_without_damper(disk, *a.f_range_hz):      # else no reference (a note says why)
+            out[label] = peak_response(disk, a.f_range_hz, harmonics=(1,), max_step=a.max_step)[2]
     return out
 
 

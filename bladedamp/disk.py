@@ -23,6 +23,7 @@ force is a static load on the damper and the seating is part of the harmonic bal
 from __future__ import annotations
 
 import dataclasses
+import textwrap
 import warnings
 
 from dataclasses import dataclass, field
@@ -45,8 +46,9 @@ from .hbm.peaks import PeakSolver, first_harmonic_output
 from .hbm.start import robust_start
 from .hbm.fourier import HarmonicBasis
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, nearest_to_range, physical_checks, plot_branch,
-                       sampled_response, with_checks, with_range_end_estimate)
+from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, harmonic_sentence, nearest_to_range, percent,
+                       physical_checks, plot_branch, sampled_response, with_amplitude_check, with_checks,
+                       with_range_end_estimate)
 
 DAMPER_DOFS = ("uD_x", "uD_y", "uD_z", "phiD_x", "phiD_y", "phiD_z")
 # the automatic AFT sampling of a disk's branch (TunedDisk and MistunedDisk) may grow the samples
@@ -693,7 +695,9 @@ class TunedDisk:
         result above the tolerance says so).
         ``max_step`` is the largest arc-length step in scaled units (the frequency range is 1;
         smaller: more points). The result is ``success`` only if the branch reached the end and
-        passed :func:`bladedamp.response.physical_checks`; a range where no bounded response
+        passed :func:`bladedamp.response.physical_checks` and
+        :func:`bladedamp.response.amplitude_check` (a tip amplitude beyond small deformations,
+        10 % of the blade's span, fails it: status CHECK_FAILED); a range where no bounded response
         exists (:meth:`check_bounded`) is refused with a ValueError before any solve. Without
         dynamic excitation (``excitation`` zero, no ``extra_couplings``) the response is rest,
         exactly (:func:`rest_response`).
@@ -1059,6 +1063,15 @@ def rest_response(model, omega_start: float, omega_end: float, max_step: float, 
                                harmonics_converged=True)
 
 
+def blade_span(model) -> float:
+    """The span of the blades of ``model`` (a :class:`TunedDisk` or
+    :class:`~bladedamp.mistuned.MistunedDisk`) [m]: the tip point's distance from the blade
+    frame's origin, the root, the shortest blade's (the scale of
+    :func:`bladedamp.response.amplitude_check`)."""
+    blades = getattr(model, "blades", None) or [model.blade]
+    return min(float(np.linalg.norm(b.points["tip"])) for b in blades)
+
+
 def with_stop_check(model, response, f_start_hz: float, check_stop: bool):
     """``response`` of ``model.frequency_response`` (a :class:`TunedDisk` or
     :class:`~bladedamp.mistuned.MistunedDisk`) with its stop note (:func:`with_stop_note`): with
@@ -1074,15 +1087,18 @@ def peak_checked_response(model, system_model, solve, harmonics, tolerance: floa
     """The response of ``model.frequency_response`` (a :class:`TunedDisk` or
     :class:`~bladedamp.mistuned.MistunedDisk`) before its stop check: the branches of ``solve``
     with their harmonic error estimate (:func:`~bladedamp.hbm.accuracy.converged_response` on
-    ``system_model``), then :func:`with_peak_check`. One accuracy warning per call: where the
+    ``system_model``) and :func:`~bladedamp.response.amplitude_check`, then :func:`with_peak_check`
+    (not run on an implausible amplitude). One accuracy warning per call: where the
     peak check runs, its verdict (which includes the estimate) replaces the estimate's
-    AccuracyWarning; every other warning raised on the way is raised again at the caller of
-    ``frequency_response``."""
+    AccuracyWarning, and an implausible amplitude (its status says so) has none; every other
+    warning raised on the way is raised again at the caller of ``frequency_response``."""
     with warnings.catch_warnings(record=True) as raised:
         response = converged_response(system_model, solve, harmonics, tolerance, max_harmonic, estimate=estimate)
-    response = with_peak_check(model, response, check_peak, tolerance, can_check)
+    response = with_peak_check(model, with_amplitude_check(response, blade_span(model)), check_peak, tolerance,
+                               can_check)
+    said = response.peak_check is not None or "amplitude" in response.failed_checks   # the verdict, or beyond the model
     for w in raised:
-        if response.peak_check is None or not issubclass(w.category, AccuracyWarning):
+        if not said or not issubclass(w.category, AccuracyWarning):
             warnings.warn(w.message, w.category, stacklevel=3)     # this function, frequency_response, its caller
     return response
 
@@ -1124,7 +1140,8 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
     models the disk: ``can_check``, rigid platforms and no extra couplings); a branch that
     stopped early is left to the stop check, and is returned unchanged, as is one stopped by
     ``stop_above``."""
-    if not len(response.omega) or response.stopped_by or not response.reached_range_end:
+    if not len(response.omega) or response.stopped_by or not response.reached_range_end \
+            or "amplitude" in response.failed_checks:         # beyond the model: nothing to check in time
         return response
     enriched = response.harmonic_error
     if not check_peak:
@@ -1146,7 +1163,9 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
     if status not in ("periodic", "drifting"):
         found = (f"{where} finds no periodic motion ({check.message[0]}; the damper's contact points separated "
                  f"{separated:.0f} % of the period): the branch's peak is not a motion the disk settles on")
-        warnings.warn(found, AccuracyWarning, stacklevel=4)   # with_peak_check, peak_checked_response, the model, the caller
+        warnings.warn(f"at the peak, {f:.2f} Hz, the time integration finds no periodic motion: the curve's peak is "
+                      "not a motion the disk keeps; the time integration is the answer there",
+                      AccuracyWarning, stacklevel=4)   # with_peak_check, peak_checked_response, the model, the caller
         return dataclasses.replace(with_checks(response, {"peak_time_check": found}), peak_check=check)
     direct = float(np.abs(model.time_output_amplitudes(check)[0] - at_peak).max() / peak)
     if on_orbit:
@@ -1155,18 +1174,21 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
             note = (f"{where} leaves the branch for a coexisting periodic motion {left}; the branch's peak is not the "
                     "motion a disk started on it keeps (an unstable or coexisting solution): this is no harmonic error "
                     "estimate, peak_check(result, start='static') gives the motion reached from rest")
-            warnings.warn(note, AccuracyWarning, stacklevel=3)
+            warnings.warn(f"at the peak, {f:.2f} Hz, the time integration leaves the curve for another periodic motion "
+                          f"{percent(direct)} away: peak_check(result, start='static') gives the motion from rest",
+                          AccuracyWarning, stacklevel=3)
             return dataclasses.replace(response, peak_check=check, message=response.message + "; " + note)
     error = max(direct, enriched) if np.isfinite(enriched) else direct
     met = error <= tolerance
     motion = ("settles on a periodic motion" if status == "periodic" else
-              f"settles on a vibration whose first harmonics are steady while a damper keeps rolling or walking "
-              f"({check.message[0]}; its mean tip amplitudes compared)")
-    note = (f"{where} {motion}, {100 * direct:.2g} % from the branch's first-harmonic tip amplitudes (the damper's "
-            f"contact points separated {separated:.0f} % of the period): harmonic error estimate {100 * error:.2g} %, "
+              f"settles on a drifting vibration, a damper keeps rolling or walking ({check.message[0]}; its mean "
+              "compared)")
+    note = (f"{where} {motion}, {100 * direct:.2g} % from the branch's tip amplitudes (contact points separated "
+            f"{separated:.0f} % of the period): harmonic error estimate {100 * error:.2g} %, "
             + ("within" if met else "above") + f" the tolerance {100 * tolerance:.2g} %")
-    if not met:
-        warnings.warn(note, AccuracyWarning, stacklevel=4)
+    if not met:      # the sentence the result's status gives (bladedamp.response.status_message)
+        warnings.warn(harmonic_sentence(response.basis.harmonics, error, tolerance, status == "drifting"),
+                      AccuracyWarning, stacklevel=4)
     return dataclasses.replace(response, harmonic_error=error, harmonic_tolerance=tolerance, harmonics_converged=met,
                                peak_check=check, message=response.message + "; " + note)
 
@@ -1437,7 +1459,7 @@ class DiskResponse(FrequencyResponse):
         ax.grid(True, alpha=0.3)
         ax.legend()
         if not self.success:
-            ax.set_title(f"incomplete: {self.message}", fontsize=8)
+            ax.set_title(textwrap.fill(self.status_message, 100), fontsize=8)   # what it means, not the log
         if measured is not None:
             from .measurement import draw_measurement
 

@@ -46,6 +46,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import textwrap
 from dataclasses import dataclass, field
 from typing import ClassVar, Sequence
 
@@ -1390,7 +1391,7 @@ class MistunedResponse(FrequencyResponse):
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
         if not self.success:
-            ax.set_title(f"incomplete: {self.message}", fontsize=8)
+            ax.set_title(textwrap.fill(self.status_message, 100), fontsize=8)   # what it means, not the log
         if measured is not None:
             from .measurement import draw_measurement
 
