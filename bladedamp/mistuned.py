@@ -69,6 +69,7 @@ from .hbm.linsolve import BlockCondensation, BlockRing, one_blas_thread
 from .hbm.linsolve import factorize as lu_factorize
 from .hbm.peaks import PEAK_MAX_ITERATIONS, PeakSolver, first_harmonic_output
 from .hbm.fourier import HarmonicBasis
+from .hbm.monodromy import disk_monodromy
 from .hbm.system import Coupling, HarmonicBalanceSystem
 from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, physical_checks, refined_peak, sampled_response,
                        with_checks)
@@ -1238,6 +1239,28 @@ class MistunedDisk:
         from .timedomain import disk_time_response
 
         return disk_time_response(self, f_hz, **options)
+
+    def full_assembly(self) -> "MistunedDisk":
+        """This model (:class:`bladedamp.hbm.monodromy.AssemblyModel`; a full assembly when
+        :attr:`has_period_map`)."""
+        return self
+
+    def assembly_coefficients(self, full, coefficients, basis) -> np.ndarray:
+        """The solution ``coefficients`` (C * N,) or (C, N) as (C, N) (the model is its own
+        assembly ``full``)."""
+        return np.asarray(coefficients, dtype=float).reshape(basis.n_coeffs, full.n_dof)
+
+    @property
+    def has_period_map(self) -> bool:
+        """Whether the monodromy method has a period map: every blade in the model
+        (:class:`bladedamp.hbm.monodromy.PeriodMapModel`)."""
+        return self.n_sector == self.n_blades
+
+    def monodromy_matrix(self, coefficients, basis, omega: float, steps: int | None = None):
+        """(monodromy matrix, periodicity error) of the HBM solution ``coefficients`` at
+        ``omega`` [rad/s] (:func:`bladedamp.hbm.monodromy.disk_monodromy`)."""
+        result = disk_monodromy(self, coefficients, basis, omega, steps)
+        return result.matrix, result.periodicity_error
 
 
 @dataclass
