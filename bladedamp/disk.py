@@ -31,7 +31,7 @@ import numpy as np
 import scipy.linalg
 
 from . import validation
-from .blade import ModalBlade
+from .blade import PLATFORM_ANGLE, ModalBlade
 from .contact.laws import LinearNormalLaw
 from .contact.patch import dof_jacobian
 from .contact.point import (MAX_PASSES, PERIODIC_TOL, PointContactSamples, damper_contact_forces, normal_law_parameters,
@@ -430,8 +430,8 @@ class TunedDisk:
     damper: CylinderDamper | WedgeDamper | None
     n_blades: int = 16
     engine_order: int = 1
-    gamma_left: float = np.radians(35.0)
-    gamma_right: float = np.radians(35.0)
+    gamma_left: float = PLATFORM_ANGLE
+    gamma_right: float = PLATFORM_ANGLE
     damper_radius: float = 0.1
     excitation: np.ndarray = field(default_factory=lambda: np.array([0.1, 0, 0, 0, 0, 0]))
     rotor_speed_hz: float | None = None

@@ -54,7 +54,7 @@ import scipy.sparse as sp
 from numba import njit
 
 from . import validation
-from .blade import ModalBlade
+from .blade import PLATFORM_ANGLE, ModalBlade
 from .contact.laws import LinearNormalLaw
 from .contact.point import MAX_PASSES, PERIODIC_TOL
 from .damper.kinetics import seat
@@ -705,8 +705,8 @@ class MistunedDisk:
     dampers: object = None
     n_blades: int | None = None
     engine_order: int = 1
-    gamma_left: float | Sequence[float] = np.radians(35.0)
-    gamma_right: float | Sequence[float] = np.radians(35.0)
+    gamma_left: float | Sequence[float] = PLATFORM_ANGLE
+    gamma_right: float | Sequence[float] = PLATFORM_ANGLE
     damper_radius: float = 0.1
     excitation: np.ndarray = field(default_factory=lambda: np.array([0.1, 0, 0, 0, 0, 0]))
     rotor_speed_hz: float | None = None
