@@ -39,7 +39,7 @@ from .contact.point import (MAX_PASSES, PERIODIC_TOL, PointContactSamples, dampe
 from .damper.geometry import CylinderDamper, DamperGeometry, WedgeDamper
 from .damper.kinetics import centrifugal_force, seat
 from .hbm.accuracy import HARMONIC_TOLERANCE, AccuracyWarning, converged_response
-from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_POINT_BUDGET, Branch, Budget, continuation
+from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_MAX_STEP, DEFAULT_POINT_BUDGET, Branch, Budget, continuation
 from .hbm.nonlinear_modes import linear_stuck_mode
 from .hbm.peaks import PeakSolver, first_harmonic_output
 from .hbm.start import robust_start
@@ -404,6 +404,11 @@ def interblade_phase(engine_order, n_blades) -> float:
     return (-2 if direction == "backward" else 2) * np.pi * k / int(n_blades)
 
 
+# The default damper radius R of a disk model [m] (TunedDisk, MistunedDisk); the paper's
+# calibrated reference value is bladedamp.reference.DAMPER_RADIUS (26.1 mm).
+DEFAULT_DAMPER_RADIUS = 0.1
+
+
 @dataclass
 class TunedDisk:
     """Tuned bladed disk with one damper per blade pair (cyclic symmetry, Eq. 21-25).
@@ -432,7 +437,7 @@ class TunedDisk:
     engine_order: int = 1
     gamma_left: float = PLATFORM_ANGLE
     gamma_right: float = PLATFORM_ANGLE
-    damper_radius: float = 0.1
+    damper_radius: float = DEFAULT_DAMPER_RADIUS
     excitation: np.ndarray = field(default_factory=lambda: np.array([0.1, 0, 0, 0, 0, 0]))
     rotor_speed_hz: float | None = None
     damper_inertia: bool = True
@@ -675,7 +680,7 @@ class TunedDisk:
         return seat(self.damper_geometry(), self.centrifugal_force(f_hz)[0])[2]
 
     def frequency_response(self, f_start_hz: float, f_end_hz: float, harmonics="auto", n_samples=None,
-                           max_step: float = 0.02, harmonic_tolerance: float = HARMONIC_TOLERANCE,
+                           max_step: float = DEFAULT_MAX_STEP, harmonic_tolerance: float = HARMONIC_TOLERANCE,
                            max_harmonic: int = 7, extra_couplings=None, stop_above: float | None = None,
                            stop_direction: int = 0, estimate_harmonic_error: bool = True,
                            check_stop: bool = False, check_peak: bool = False,

@@ -58,12 +58,13 @@ from .blade import PLATFORM_ANGLE, ModalBlade
 from .contact.laws import LinearNormalLaw
 from .contact.point import MAX_PASSES, PERIODIC_TOL
 from .damper.kinetics import seat
-from .disk import (AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION, DAMPER_DOFS, STOP_CHECK_OFFSET_HZ,
+from .disk import (AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION, DAMPER_DOFS, DEFAULT_DAMPER_RADIUS,
+                   STOP_CHECK_OFFSET_HZ,
                    DamperContacts, TunedDisk, contact_point_maps, contact_rows, damper_weighted_scales,
                    fused_point_map_forces, interblade_phase, peak_checked_response, point_map_forces, rest_response,
                    rotor_speed_in_hz, time_at_peak, time_check_beyond, with_stop_check)
 from .hbm.accuracy import HARMONIC_TOLERANCE
-from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_POINT_BUDGET, Branch, Budget, continuation
+from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_MAX_STEP, DEFAULT_POINT_BUDGET, Branch, Budget, continuation
 from .hbm.start import robust_start
 from .hbm.linsolve import BlockCondensation, BlockRing, one_blas_thread
 from .hbm.linsolve import factorize as lu_factorize
@@ -707,7 +708,7 @@ class MistunedDisk:
     engine_order: int = 1
     gamma_left: float | Sequence[float] = PLATFORM_ANGLE
     gamma_right: float | Sequence[float] = PLATFORM_ANGLE
-    damper_radius: float = 0.1
+    damper_radius: float = DEFAULT_DAMPER_RADIUS
     excitation: np.ndarray = field(default_factory=lambda: np.array([0.1, 0, 0, 0, 0, 0]))
     rotor_speed_hz: float | None = None
     damper_inertia: bool = True
@@ -1029,7 +1030,7 @@ class MistunedDisk:
         return np.sqrt(s) * np.tile(np.concatenate(out), C)
 
     def frequency_response(self, f_start_hz: float, f_end_hz: float, harmonics="auto", n_samples=None,
-                           max_step: float = 0.02, tuned_peak_amplitude: float | None = None,
+                           max_step: float = DEFAULT_MAX_STEP, tuned_peak_amplitude: float | None = None,
                            harmonic_tolerance: float = HARMONIC_TOLERANCE, max_harmonic: int = 3,
                            estimate_harmonic_error: bool = True, check_stop: bool = False, check_peak: bool = False,
                            cpu_budget_s: float = DEFAULT_CPU_BUDGET_S, point_budget: int = DEFAULT_POINT_BUDGET,
@@ -1164,7 +1165,7 @@ class MistunedDisk:
         return damper_weighted_scales(scales, system.basis.n_coeffs, slice(self.n_sector * self.n_modes, None))
 
     @one_blas_thread
-    def extend_response(self, response: "MistunedResponse", f_end_hz: float, max_step: float = 0.02,
+    def extend_response(self, response: "MistunedResponse", f_end_hz: float, max_step: float = DEFAULT_MAX_STEP,
                         **continuation_options) -> "MistunedResponse":
         """``response`` continued from its end (or its start) to ``f_end_hz`` [Hz], beyond the
         range it covers, as one response: the wider range without recomputing the part known.

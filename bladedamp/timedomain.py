@@ -22,6 +22,7 @@ import numpy as np
 from numba import njit
 
 from .contact.point import SEPARATED, PointContactElement, slider_step
+from .hbm.continuation import DEFAULT_MAX_STEP
 from .io import Saveable
 
 
@@ -1088,7 +1089,7 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
     return DiskTimeResponse(omega, np.abs(out["tip_harmonic"]), steps_per_period=steps, **out)
 
 
-def hbm_tip_at(disk, f_hz, harmonics=(0, 1, 2, 3), pad_hz: float = 1.0, max_step: float = 0.02,
+def hbm_tip_at(disk, f_hz, harmonics=(0, 1, 2, 3), pad_hz: float = 1.0, max_step: float = DEFAULT_MAX_STEP,
                **continuation_options) -> np.ndarray:
     """First-harmonic tip amplitude of the harmonic balance at the exact frequencies ``f_hz``
     [Hz], to compare with a :class:`DiskTimeResponse`: the FRF by continuation over the range
