@@ -104,3 +104,27 @@ def test_no_import_cycles_among_bladedamp_modules():
         edges[importer] = edges[importer] - {imported}
     cycles = [c for c in strongly_connected_components(edges) if len(c) > 1]
     assert not cycles, f"import cycles among bladedamp modules: {cycles}"
+
+
+def test_the_monodromy_reaches_a_model_through_its_protocol():
+    """hbm.monodromy imports no model: the oscillator, the tuned disk and the full-assembly
+    mistuned disk implement PeriodMapModel (and the disks AssemblyModel); a mistuned sector model
+    (not every blade) and a model with extra couplings (the time integration has not got them)
+    have no period map, as when the method dispatched on the model's class."""
+    import bladedamp as bd
+    from bladedamp.disk import WithCouplings
+    from bladedamp.hbm.monodromy import AssemblyModel, PeriodMapModel, supports
+    from bladedamp.mistuned import MistunedDisk
+
+    osc = bd.FrictionOscillator()
+    disk = bd.reference_disk("cylinder", 1e-3)
+    full = MistunedDisk.from_tuned(disk)
+    sector = MistunedDisk.from_tuned(disk, n_sector=4)
+    for model in (osc, disk, full):
+        assert isinstance(model, PeriodMapModel) and supports(model)
+    for model in (disk, full):
+        assert isinstance(model, AssemblyModel)
+    assert full.full_assembly() is full and disk.full_assembly().n_sector == disk.n_blades
+    assert not supports(sector)
+    assert not supports(WithCouplings(disk, lambda basis: []))
+    assert not supports(object())

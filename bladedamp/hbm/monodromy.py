@@ -121,6 +121,7 @@ class PeriodMapModel(Protocol):
     def monodromy_matrix(self, coefficients, basis, omega: float, steps: int | None = None): ...
 
 
+@runtime_checkable
 class AssemblyModel(Protocol):
     """What :func:`disk_monodromy` asks of a bladed disk: ``full_assembly()``, the model with
     every blade and damper written out (a full-assembly MistunedDisk: itself; a TunedDisk:
