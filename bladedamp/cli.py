@@ -566,6 +566,7 @@ def frf_command(args) -> int:
     """``bladedamp frf``: the frequency response of the design at each of its engine orders."""
     import dataclasses
 
+    from .compare import bounded_without_damper
     from .report import frf_outputs
 
     t0 = time.perf_counter()
@@ -616,19 +617,6 @@ def frf_command(args) -> int:
                       else f"{k} no peak: no point computed (summary.md says why)"
                       for k, v in summary["responses"].items())
     return _done(out, t0, peaks)
-
-
-def bounded_without_damper(free, f_start_hz: float, f_end_hz: float) -> bool:
-    """Whether the damper-free disk ``free`` has a bounded response over the range
-    (:meth:`bladedamp.disk.TunedDisk.check_bounded`); where it has not (a blade mode without
-    viscous damping inside the range), a note says the reference is left out."""
-    try:
-        free.check_bounded(f_start_hz, f_end_hz)
-    except ValueError:
-        warnings.warn(f"no damper-free reference: without the damper a blade mode with damping_ratio = 0 lies in "
-                      f"{f_start_hz:g}-{f_end_hz:g} Hz, where its amplitude has no bound", UserWarning, stacklevel=2)
-        return False
-    return True
 
 
 def optimize_command(args) -> int:

@@ -181,7 +181,8 @@ def paper_section(s: dict, table1: list) -> str:
 
 def accuracy_section(summary: dict) -> str:
     """The paper's one-harmonic setting beside the converged harmonic balance."""
-    from .hbm.accuracy import HARMONIC_TOLERANCE, enriched
+    from .hbm.accuracy import HARMONIC_TOLERANCE
+    from .hbm.fourier import enriched
 
     tol = 100 * HARMONIC_TOLERANCE
     lines = ["", "## The paper's one-harmonic setting and the converged harmonic balance", "",

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .hbm.continuation import branch_checks
-from .hbm.fourier import HarmonicBasis
+from .hbm.fourier import HarmonicBasis, enriched
 from .io import Saveable
 
 
@@ -324,14 +324,6 @@ def percent(x: float) -> str:
     return f"{100 * x:.0f} %" if abs(100 * x) >= 10 else f"{100 * x:.2g} %"
 
 
-def richer_harmonics(harmonics) -> tuple[int, ...]:
-    """The set to try after ``harmonics``: with the static term and the next two harmonics
-    (:func:`bladedamp.hbm.accuracy.enriched`, the set the error estimate compares with)."""
-    from .hbm.accuracy import enriched
-
-    return enriched(harmonics)
-
-
 def harmonic_sentence(harmonics, error: float, tolerance: float, drifting: bool = False, estimated: bool = False,
                       checkable: bool = False) -> str:
     """One sentence on the harmonic accuracy of a curve computed with ``harmonics``, its error
@@ -345,7 +337,7 @@ def harmonic_sentence(harmonics, error: float, tolerance: float, drifting: bool 
     curve = "one-harmonic curve" if one else f"harmonics {H}"
     if not np.isfinite(error) and estimated:
         subject = "the one-harmonic curve's error" if one else f"the error of harmonics {H}"
-        return (f"{subject} could not be checked: {richer_harmonics(H)} did not converge at the peak; "
+        return (f"{subject} could not be checked: {enriched(H)} did not converge at the peak; "
                 + ("check the peak with check_peak=True" if checkable else "run with harmonics='auto'"))
     if not np.isfinite(error):
         unknown = "its peak may be off by tens of %" if one else "its accuracy is unknown"
@@ -357,9 +349,9 @@ def harmonic_sentence(harmonics, error: float, tolerance: float, drifting: bool 
                 f"{percent(error)} only (tolerance {percent(tolerance)})")
     if one:
         return (f"one-harmonic curve: its peak may be off by up to {percent(error)}; run with harmonics='auto' or "
-                f"{richer_harmonics(H)}")
+                f"{enriched(H)}")
     return (f"{curve}: the curve may be off by up to {percent(error)} (tolerance {percent(tolerance)}); "
-            f"run with harmonics {richer_harmonics(H)} or a larger max_harmonic")
+            f"run with harmonics {enriched(H)} or a larger max_harmonic")
 
 
 # A first-harmonic tip amplitude above this fraction of the blade's span (root to tip point) is

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from bladedamp import FrictionOscillator
-from bladedamp.hbm.accuracy import (AccuracyWarning, auto_sets, check_points, enriched, harmonic_error)
+from bladedamp.hbm.accuracy import (AccuracyWarning, auto_sets, check_points, harmonic_error)
+from bladedamp.hbm.fourier import enriched
 from bladedamp.hbm.continuation import NewtonResult
 from bladedamp.hbm.fourier import HarmonicBasis
 from bladedamp.response import physical_checks

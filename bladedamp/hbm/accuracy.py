@@ -40,7 +40,7 @@ import numpy as np
 
 from ..response import BUDGET_PREFIX, harmonic_sentence
 from .continuation import newton
-from .fourier import HarmonicBasis
+from .fourier import HarmonicBasis, enriched
 from .linsolve import one_blas_thread
 from .start import damped_newton
 
@@ -64,13 +64,6 @@ def auto_sets(max_harmonic: int) -> tuple[tuple[int, ...], ...]:
 
 class AccuracyWarning(UserWarning):
     """A harmonic balance answer whose harmonic error estimate exceeds the tolerance."""
-
-
-def enriched(harmonics) -> tuple[int, ...]:
-    """The set a branch computed with ``harmonics`` is checked against: with the static term
-    and the next two harmonics."""
-    h = tuple(harmonics)
-    return tuple(sorted(set(h) | {0, max(h) + 1, max(h) + 2}))
 
 
 @dataclass
