@@ -2,6 +2,33 @@
 
 Data flows one way: geometry and parameters -> model -> harmonic balance residual ->
 continuation solver -> result objects -> plots, reports and 3D views.
+
+Layers. A module imports only from the layers below its own (``a | b``: independent
+siblings), never from one above; import-linter checks it against the contracts in
+pyproject.toml (``[tool.importlinter]``, run by tests/test_layers.py, which also finds no
+import cycle). From the top:
+
+    front ends       cli > app > viz | compare > report | design (files) | compilation
+    studies          studies (mass, engine orders, platform angles, Monte Carlo, backbone)
+    reference        reference (the paper's disk: reference_disk)
+    disk models      mistuned > disk | oscillator
+    analyses         hbm.stability > hbm.monodromy > timedomain | hbm.accuracy | hbm.nonlinear_modes
+                     > response (the FRF result)
+    blade            solid | geometry (3D) > blade (modal blade, beam, files, the reference blade)
+                     > fe_formats | measurement (readers)
+    contact, damper  damper > contact
+    results on disk  io (save / load by class name; blade file tags)
+    engine           hbm.peaks > hbm.continuation | start | system | elements > hbm.fourier | linsolve
+    utilities        plotting | progress > palette | validation | lazy | _numba_cache
+
+The engine and its analyses (``bladedamp.hbm``) import no model: stability and the monodromy
+reach a model through the protocols it implements
+(:class:`bladedamp.hbm.monodromy.PeriodMapModel`, :class:`~bladedamp.hbm.monodromy.AssemblyModel`),
+and the engine core (Fourier, residual, elements, Newton, continuation, linear solvers) imports
+nothing outside hbm but validation. This package (its public names below) sits above every
+layer. Two back arrows are left, listed in the contract's ``ignore_imports``:
+``blade -> solid`` (``ModalBlade.from_solid``, a SolidModalBlade read by ``from_file``) and
+``disk -> mistuned`` (a TunedDisk's full assembly is ``MistunedDisk.from_tuned``).
 """
 from .lazy import lazy_attributes
 

@@ -83,6 +83,7 @@ class Notes:
         self._catcher = warnings.catch_warnings(record=True)
         self._records = []
         self._printed = 0
+        self._said = []
 
     def __enter__(self):
         self._records = self._catcher.__enter__()
@@ -98,8 +99,11 @@ class Notes:
 
     def lines(self) -> list[str]:
         """The distinct messages in the order they were first raised, each on one line."""
-        distinct = dict.fromkeys(" ".join(str(w.message).split()) for w in self._records)
-        return [line for line in distinct if line]
+        from .hbm.continuation import ConvergenceWarning
+
+        records = [w for w in self._records if not (self._said and issubclass(w.category, ConvergenceWarning))]
+        distinct = dict.fromkeys(" ".join(str(w.message).split()) for w in records)
+        return [line for line in distinct if line and not any(line in text for text in self._said)]
 
     def write(self, out: Path) -> None:
         """Add the messages to ``out``/summary.md (a Notes section) and ``out``/results.json (key
@@ -119,6 +123,13 @@ class Notes:
             data = json.loads(results.read_text())
             data["notes"] = lines
             write_json(results, data)
+
+    def said(self, text: str) -> None:
+        """Record ``text`` as already told to the user (a result's status line): a message it
+        contains is not repeated (:meth:`lines`, :meth:`write`, :meth:`show`), nor is a
+        continuation's ConvergenceWarning (where and why a branch stopped: the status line says
+        where, and what to do, for the branch the result kept)."""
+        self._said.append(" ".join(text.split()))
 
     def show(self, stream=None) -> None:
         """Print the messages not printed yet, one plain line each ("note: ...")."""
@@ -555,6 +566,7 @@ def frf_command(args) -> int:
     """``bladedamp frf``: the frequency response of the design at each of its engine orders."""
     import dataclasses
 
+    from .compare import bounded_without_damper
     from .report import frf_outputs
 
     t0 = time.perf_counter()
@@ -588,12 +600,18 @@ def frf_command(args) -> int:
     if design.disk.has_damper:      # the damper-free reference of the figure: linear, one harmonic is exact
         progress("damper-free reference responses")
         for eo in design.engine_orders:
-            undamped[f"EO{eo}"] = dataclasses.replace(design.disk_at(eo), damper=None).frequency_response(
-                a.f_start_hz, a.f_end_hz, harmonics=(1,), max_step=a.max_step, estimate_harmonic_error=False)
+            free = dataclasses.replace(design.disk_at(eo), damper=None)
+            if not bounded_without_damper(free, a.f_start_hz, a.f_end_hz):
+                continue
+            undamped[f"EO{eo}"] = free.frequency_response(a.f_start_hz, a.f_end_hz, harmonics=(1,), max_step=a.max_step,
+                                                          estimate_harmonic_error=False)
     summary = frf_outputs(out, design, responses, undamped, measured=measured)
     for k, v in summary["responses"].items():      # each response's status first
         print(f"{k}: {v['status_message']}", file=sys.stderr)
+        if Notes.current is not None:
+            Notes.current.said(v["status_message"])
     peaks = ", ".join(f"{k} {'largest amplitude at the range end' if v['peak_at_range_end'] else 'peak'} "
+                      f"{'(check failed) ' if v['status'] == 'check failed' else ''}"
                       f"{v['peak_amplitude_mm']:.4f} mm at {v['peak_frequency_hz']:.3f} Hz"
                       if v["peak_amplitude_mm"] is not None and math.isfinite(v["peak_amplitude_mm"])
                       else f"{k} no peak: no point computed (summary.md says why)"
@@ -745,6 +763,8 @@ def campbell_command(args) -> int:
     summary = campbell_outputs(out, design, diagram)
     for c in summary["crossings"]:
         print(f"EO {c['engine_order']}: {c['status_message']}", file=sys.stderr)
+        if Notes.current is not None:
+            Notes.current.said(c["status_message"])
     return _done(out, t0, ", ".join(
         f"EO {c['engine_order']} peak {c['peak_amplitude_mm']:.4f} mm at {c['peak_frequency_hz']:.3f} Hz, "
         f"{c['rotor_speed_rpm']:.0f} rpm" + ("" if c["found"] else " (no resonance found in the range)")
@@ -902,11 +922,14 @@ def compare_command(args) -> int:
             progress(f"damper-free reference of {e.name}")
             by_key[key] = undamped_responses(e.design, list(e.responses))
         for label in e.responses:
-            if label in by_key[key]:
-                undamped[e.name, label] = by_key[key][label]
-            else:
-                undamped[e.name, label] = undamped_responses(e.design, [label])[label]
+            free = by_key[key][label] if label in by_key[key] else undamped_responses(e.design, [label]).get(label)
+            if free is not None:       # None: no bounded damper-free response (a note says so)
+                undamped[e.name, label] = free
     summary = compare_outputs(out, entries, undamped, shared)
+    for row in summary["designs"]:                 # each response's status first, as frf
+        print(f"{row['design']} {row['response']}: {row['status_message']}", file=sys.stderr)
+        if Notes.current is not None:
+            Notes.current.said(row["status_message"])
     what = "; ".join(f"{row['design']} {row['response']} peak {row['peak_amplitude_mm']:.4f} mm at "
                      f"{row['peak_frequency_hz']:.3f} Hz" for row in summary["designs"])
     return _done(out, t0, what)

@@ -15,6 +15,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -120,7 +121,8 @@ def undamped_responses(design, labels) -> dict:
     """{label: the damper-free DiskResponse} of ``design`` at each "EO<n>" of ``labels``: one
     harmonic (linear, exact) over the design's frequency range, widened until its resonance peak
     is inside (:func:`bladedamp.studies.mass.peak_response`; a damper shifts the resonance, so the
-    damper-free peak may lie outside the damped design's range)."""
+    damper-free peak may lie outside the damped design's range). A label whose damper-free disk
+    has no bounded response in the range (:func:`bounded_without_damper`) is left out."""
     from .studies.mass import peak_response
 
     a = design.analysis
@@ -128,7 +130,8 @@ def undamped_responses(design, labels) -> dict:
     for label in labels:
         eo = int(TUNED_LABEL.match(label).group(1))
         disk = dataclasses.replace(design.disk_at(eo), damper=None)
-        out[label] = peak_response(disk, a.f_range_hz, harmonics=(1,), max_step=a.max_step)[2]
+        if bounded_without_damper(disk, *a.f_range_hz):      # else no reference (a note says why)
+            out[label] = peak_response(disk, a.f_range_hz, harmonics=(1,), max_step=a.max_step)[2]
     return out
 
 
@@ -241,3 +244,16 @@ def compare_outputs(out: Path, entries: list, undamped: dict, shared: bool) -> d
     lines += ["", "Files: " + ", ".join(f"`{f}`" for f in [*figures, "compare.csv", "compare.json"]) + ".", ""]
     (out / "summary.md").write_text("\n".join(lines))
     return summary
+
+
+def bounded_without_damper(free, f_start_hz: float, f_end_hz: float) -> bool:
+    """Whether the damper-free disk ``free`` has a bounded response over the range
+    (:meth:`bladedamp.disk.TunedDisk.check_bounded`); where it has not (a blade mode without
+    viscous damping inside the range), a note says the reference is left out."""
+    try:
+        free.check_bounded(f_start_hz, f_end_hz)
+    except ValueError:
+        warnings.warn(f"no damper-free reference: without the damper a blade mode with damping_ratio = 0 lies in "
+                      f"{f_start_hz:g}-{f_end_hz:g} Hz, where its amplitude has no bound", UserWarning, stacklevel=2)
+        return False
+    return True

@@ -11,7 +11,10 @@ Unknown tables and keys are errors (a typo must not pass silently).
 A blade of your own is modal data (``[blade] modal_file``), reduced FE matrices (``modal_file``
 an ``.op4``, ``.pch``, ``.mtx``, ``.mat`` or ``.full`` file with ``[blade.fe]`` and the point tables
 ``[blade.fe.OL]``, ``[blade.fe.OR]``, ``[blade.fe.tip]``, ``[blade.fe.excitation]``, optionally
-``[blade.fe.platform]``; :meth:`bladedamp.blade.ModalBlade.from_file`) or a closed surface mesh meshed as a
+``[blade.fe.platform]``; :meth:`bladedamp.blade.ModalBlade.from_file`), measured modes (``modal_file`` a
+UFF file, ``.uff``, ``.unv`` or ``.uf``, of dataset 55 or 2414 normal modes, with ``[blade.test]`` and the
+node tables ``[blade.test.OL]``, ``[blade.test.OR]``, ``[blade.test.tip]``, ``[blade.test.excitation]``;
+:meth:`bladedamp.blade.ModalBlade.from_test`) or a closed surface mesh meshed as a
 solid FE blade (``[blade] model = "solid"``, ``surface_file``, ``surface_units`` and the named
 regions ``[blade.regions.clamp]``, ``[blade.regions.OL]``, ``[blade.regions.OR]``, optionally
 ``[blade.regions.tip]``, each a plane or its own surface file; :class:`bladedamp.solid.SurfaceBladeGeometry`);
@@ -33,6 +36,7 @@ import numpy as np
 
 from .fe_formats import FE_SUFFIXES
 from .io import FileReadError, reading
+from .measurement import UFF_SUFFIXES
 
 
 class DesignError(FileReadError):
@@ -202,6 +206,14 @@ TABLES = {
                            "them (node, dofs) or by row numbers (rows), or rigidly linked to another point (link), "
                            "and its position."
        for name in ("OL", "OR", "tip", "excitation", "platform")},
+    "blade.test": "Measured mode files only ([blade] modal_file ending in .uff, .unv or .uf: UFF dataset 55 or 2414 "
+                  "normal modes; see ModalBlade.from_test and the README): the modal masses and units where the file "
+                  "does not give them. The node tables [blade.test.OL], [blade.test.OR], [blade.test.tip] and "
+                  "[blade.test.excitation] are then required, [blade.test.platform] optional. The frequencies and "
+                  "damping are the file's unless [blade] natural_frequencies_hz or damping_ratio is given.",
+    **{f"blade.test.{name}": f"Measured mode files only: the point {name} as a node of the file and, optionally, its "
+                             "position (default the node's coordinates in the file, dataset 15 or 2411)."
+       for name in ("OL", "OR", "tip", "excitation", "platform")},
     "damper": "The underplatform damper between neighbouring blades: kind, geometry, mass and contact.",
     "disk": "The tuned bladed disk: blades, engine order(s), platform angles, damper radius, excitation, speed.",
     "mistuning": "Blade frequency mistuning kappa (f_0 -> kappa f_0 for every mode of a blade); remove this table "
@@ -238,10 +250,10 @@ def _fe_fields(g) -> list[Field]:
     row = Number(1, 1e9, integer=True)
     rows = [
         Field("blade.fe", "mass", None, Text(MATRIX_NAME), "-",
-              "the mass matrix's name in the file (Abaqus: the mass file); default MAAX, MAA, M or MASS, whichever "
+              "the mass matrix's name in the file (Abaqus: the mass file); default MAAX, MAA, MXX, M or MASS, whichever "
               "the file holds (Abaqus: the _MASS file beside the _STIF one)", example="MAA"),
         Field("blade.fe", "stiffness", None, Text(MATRIX_NAME), "-",
-              "the stiffness matrix's name in the file (Abaqus: the stiffness file); default KAAX, KAA, K or "
+              "the stiffness matrix's name in the file (Abaqus: the stiffness file); default KAAX, KAA, KXX, K or "
               "STIFFNESS", example="KAA"),
         Field("blade.fe", "fixed_nodes", None, List(index), "-",
               "files that label rows by node (DMIG, Abaqus, Ansys): nodes clamped, all their DOF (e.g. the root "
@@ -265,6 +277,36 @@ def _fe_fields(g) -> list[Field]:
             Field(table, "position_mm", None, List(Number(-1e4, 1e4), 3), "mm",
                   "the point's position in the blade frame (x circumferential, y axial, z radial); required",
                   example=example),
+        ]
+    return rows
+
+
+# the points of a measured-modes blade (tables [blade.test.<name>]); platform is optional
+TEST_POINTS = ("OL", "OR", "tip", "excitation", "platform")
+
+
+def _test_fields(g) -> list[Field]:
+    """The keys of [blade.test] and [blade.test.<point>] (a UFF mode file as [blade] modal_file;
+    examples from the reference blade ``g``, a BeamBladeGeometry)."""
+    pts = {k: [round(1e3 * float(x), 6) + 0.0 for x in p] for k, p in g.points().items()}      # [mm]
+    rows = [
+        Field("blade.test", "modal_mass_kg", None,
+              Either((Number(0.0, 1e9, "right"), List(Number(0.0, 1e9, "right")))), "kg",
+              "the modal mass of each stored shape, one number or one per mode: 1.0 for mass-normalised shapes "
+              "(SI), 1000.0 for shapes mass-normalised in a file in mm, N, s and tonnes; default the file's (dataset "
+              "55 or 2414 record 12)", example=1.0),
+        Field("blade.test", "units", None, Choice(("SI",)), "-",
+              "for a file without a dataset 164 (its unit system): 'SI' states that it is in m, kg, N; default the "
+              "file's", example="SI"),
+    ]
+    for k, name in enumerate(TEST_POINTS):
+        table = f"blade.test.{name}"
+        rows += [
+            Field(table, "node", None, Number(-1e9, 1e9, integer=True), "-",
+                  "the point's node number in the file's mode shapes; required", example=11 + k),
+            Field(table, "position_mm", None, List(Number(-1e4, 1e4), 3), "mm",
+                  "the point's position in the blade frame (x circumferential, y axial, z radial); default the "
+                  "node's coordinates in the file", example=pts[name]),
         ]
     return rows
 
@@ -347,9 +389,9 @@ def _fields() -> list[Field]:
     exc_item = Number(-1e6, 1e6)
     rows = [
         Field("blade", "modal_file", None, Text(), "-",
-              "modal data at named points (npz or CSV, see ModalBlade.from_file) instead of the beam model; "
-              "needs OL, OR, tip and excitation; or reduced FE matrices (.op4, .pch, .mtx, .mat, .full) with "
-              "[blade.fe] and its point tables, n_modes and damping_ratio", example="my_blade.npz"),
+              "instead of the beam model: modal data at OL, OR, tip, excitation (npz, CSV), reduced FE matrices "
+              "(.op4, .pch, .mtx, .mat, .full; [blade.fe]) or measured modes (UFF 55/2414 .uff, .unv, .uf; "
+              "[blade.test])", example="my_blade.npz"),
         Field("blade", "model", "beam", Choice(("beam", "solid")), "-",
               "beam: the paper's beam FE model, rigid platforms at OL / OR; solid: 3D quadratic tetrahedra of the "
               "same geometry ([blade.beam] sections and material, the platform faces at [disk] gamma_left_deg / "
@@ -382,6 +424,7 @@ def _fields() -> list[Field]:
               "where the excitation acts; default the tip point", example=[0.0, 0.0, 200.0]),
         *_region_fields(g),
         *_fe_fields(g),
+        *_test_fields(g),
         Field("damper", "kind", "cylinder", Choice(("cylinder", "wedge", "none")), "-",
               "cylinder (rolls at EO = 0) or wedge (flat faces of height h_C); none: no damper"),
         Field("damper", "mass_g", 1.0, Number(0.0, 1000.0, "right"), "g",
@@ -918,6 +961,30 @@ def _fe_options(path: Path, v: dict, given: set, n_modes: int, damping) -> dict:
                 mass=fe["mass"], stiffness=fe["stiffness"])
 
 
+def _test_options(path: Path, v: dict, given: set) -> dict:
+    """ModalBlade.from_test's options for a measured mode file of [blade.test] and [blade.test.<point>]."""
+    t = v["blade.test"]
+    points, positions = {}, {}
+    for name in TEST_POINTS:
+        table = f"blade.test.{name}"
+        if not any(tt == table for tt, _ in given):
+            if name == "platform":
+                continue
+            raise DesignError(f"{path}: [{table}] is required with a measured mode file as [blade] modal_file: give "
+                              "node (the point's node number in the file) and, optionally, position_mm")
+        p = v[table]
+        if p["node"] is None:
+            raise DesignError(f"{path}: [{table}] node is required: the point's node number in the file")
+        points[name] = p["node"]
+        if p["position_mm"] is not None:
+            positions[name] = 1e-3 * np.array(p["position_mm"])
+    mass = t["modal_mass_kg"]
+    return dict(points=points, positions=positions or None,
+                damping_ratios=v["blade"]["damping_ratio"] if ("blade", "damping_ratio") in given else None,
+                modal_masses=None if mass is None else (mass if isinstance(mass, float) else list(mass)),
+                units=t["units"])
+
+
 def _build_blade(path: Path, v: dict, given: set):
     """(ModalBlade, BeamBladeGeometry or None) of [blade] and [blade.beam] (and [blade.regions.*]
     for a surface_file blade). A blade with its own platform faces sets v["disk"]'s platform angles
@@ -935,6 +1002,11 @@ def _build_blade(path: Path, v: dict, given: set):
                     or Path(b["modal_file"]).suffix.lower().lstrip(".") not in FE_SUFFIXES):
         raise DesignError(f"{path}: [{fe_keys[0][0]}] {fe_keys[0][1]} applies to an FE matrix file as [blade] "
                           f"modal_file (ending in {', '.join('.' + x for x in FE_SUFFIXES)}): add it or remove the key")
+    test_keys = sorted((t, k) for t, k in given if t == "blade.test" or t.startswith("blade.test."))
+    if test_keys and (b["modal_file"] is None
+                      or Path(b["modal_file"]).suffix.lower().lstrip(".") not in UFF_SUFFIXES):
+        raise DesignError(f"{path}: [{test_keys[0][0]}] {test_keys[0][1]} applies to a measured mode file as [blade] "
+                          f"modal_file (ending in {', '.join('.' + x for x in UFF_SUFFIXES)}): add it or remove the key")
     if surface and not solid:
         raise DesignError(f"{path}: [blade] surface_file is meshed as a solid FE blade: add model = \"solid\" to "
                           "[blade] (or remove surface_file)")
@@ -958,11 +1030,18 @@ def _build_blade(path: Path, v: dict, given: set):
             raise DesignError(f"{path}: [blade] modal_file needs ModalBlade.from_file, which this bladedamp "
                               "version does not have")
         file = _relative(path, b["modal_file"])
-        options = _fe_options(path, v, given, b["n_modes"], damping) if fe_file else {}
+        test_file = Path(b["modal_file"]).suffix.lower().lstrip(".") in UFF_SUFFIXES
+        if test_file:
+            options, load = _test_options(path, v, given), ModalBlade.from_test
+            keys = (" (the design file's keys: [blade.test] modal_mass_kg and units, [blade.test.<point>] position_mm, "
+                    "[blade] damping_ratio)")
+        else:
+            options = _fe_options(path, v, given, b["n_modes"], damping) if fe_file else {}
+            load, keys = ModalBlade.from_file, ""
         try:
-            blade = ModalBlade.from_file(file, **options)
+            blade = load(file, **options)
         except (OSError, ValueError, KeyError) as exc:
-            raise DesignError(f"{path}: [blade] modal_file = {_toml(b['modal_file'])}: {exc}") from None
+            raise DesignError(f"{path}: [blade] modal_file = {_toml(b['modal_file'])}: {exc}{keys}") from None
         faces = getattr(blade, "face_fields", {})        # a solid blade's file: its flexible platforms
         if faces:
             _platform_angles_of(path, v, given, {side: f.gamma for side, f in faces.items()},

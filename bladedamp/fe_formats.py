@@ -10,8 +10,13 @@ Fortran format of the numbers, e.g. ``1P,3E23.16``), then per column a line ICOL
 and its numbers: dense columns (IROW > 0) hold NW numbers from row IROW on; sparse columns
 (IROW = 0) hold NW words in strings, each led by IS = IROW + 65536 (L + 1) (L data words),
 or, when NROW < 0 ("bigmat"), by a line L, IROW (L - 1 data words). A double-precision
-number is two words. The column NCOL + 1 ends the matrix. Binary files: the same records
-as Fortran unformatted records (4-byte length markers, either byte order, 4-byte words).
+number is two words. The column NCOL + 1 ends the matrix. A header whose format ends in
+``|I16`` (a dimension over 8 digits) gives NCOL and NROW in 16 characters each. Binary files:
+the same records as Fortran unformatted records (4-byte length markers, either byte order) of
+4-byte words, or, written by Nastran's 64-bit integer build (e.g. ``mode=i8``), of 8-byte words:
+the header record is then 48 bytes (NCOL, NROW, FORM, TYPE as 8-byte integers and the name as
+two words of 4 characters each, not 24), every integer is 8 bytes and every real number,
+single or double precision, is one 8-byte word (the string lengths L count these words).
 A name written again (e.g. one QHH per Mach number) is read as NAME#2, NAME#3, ...
 OUTPUT4 does not record the node and DOF of a row: rows are numbered 1, 2, ... (in Nastran's
 a-set order: grid and scalar point IDs ascending, components 1-6 of a grid, one row per
@@ -32,7 +37,9 @@ lines are comments. Stiffness and mass are separate files (``job_STIF1.mtx``,
 
 MATLAB (``.mat``): v4 to v7 through :func:`scipy.io.loadmat`, v7.3 (HDF5) through h5py
 (the ``matlab`` extra);
-dense or sparse real variables; rows numbered 1, 2, ... as MATLAB indexes them.
+dense or sparse real variables, or fields of scalar structs named as MATLAB writes them
+(``nas.kaa.k0`` is field ``k0`` of field ``kaa`` of struct ``nas``); rows numbered 1, 2, ... as
+MATLAB indexes them.
 
 Ansys (``.full``, the assembled matrices of a modal or substructure run): through
 ansys-mapdl-reader (the ``ansys`` extra; it brings pyvista and vtk). The stiffness and mass of
@@ -62,9 +69,10 @@ from .io import MissingFileError, reading
 # file suffix -> format name, for ModalBlade.from_file
 FE_SUFFIXES = {"op4": "op4", "pch": "dmig", "mtx": "abaqus", "mat": "matlab", "full": "ansys"}
 
-# default matrix names, in the order they are looked for (case-insensitive)
-DEFAULT_MASS_NAMES = ("MAAX", "MAA", "M", "MASS")
-DEFAULT_STIFFNESS_NAMES = ("KAAX", "KAA", "K", "STIFFNESS")
+# default matrix names, in the order they are looked for (case-insensitive); KXX, MXX are the
+# names NX Nastran's EXTSEOUT(MATOP4=...) gives the a-set matrices in the .op4
+DEFAULT_MASS_NAMES = ("MAAX", "MAA", "MXX", "M", "MASS")
+DEFAULT_STIFFNESS_NAMES = ("KAAX", "KAA", "KXX", "K", "STIFFNESS")
 
 # relative tolerance of the symmetry check of entries given in both triangles: exports print
 # 7 to 17 significant digits
@@ -284,7 +292,7 @@ def read_op4(path) -> dict:
     data = path.read_bytes()
     if not data:
         raise ValueError(f"{path}: the file is empty; expected Nastran OUTPUT4 matrices")
-    if len(data) >= 4 and 24 in (struct.unpack("<i", data[:4])[0], struct.unpack(">i", data[:4])[0]):
+    if _op4_binary_layout(data) is not None:
         return _read_op4_binary(path, data)
     return _read_op4_text(path, data)
 
@@ -317,9 +325,19 @@ def _read_op4_text(path: Path, data: bytes) -> dict:
         if not lines[i].strip():
             i += 1
             continue
-        ncol, nrow, form, ntype = ints(i, 4, "a matrix header NCOL, NROW, FORM, TYPE, NAME, format")
-        name = lines[i][32:40].strip()
-        fmt = _OP4_FORMAT.search(lines[i][40:])
+        # NCOL and NROW in 16 characters where the format ends in |I16 (a dimension over 8 digits)
+        wide = lines[i].rstrip().upper().endswith("|I16")
+        if wide:
+            head = lines[i]
+            try:
+                ncol, nrow, form, ntype = (int(head[a:b]) for a, b in ((0, 16), (16, 32), (32, 40), (40, 48)))
+            except ValueError:
+                raise ValueError(f"{path}: line {i + 1}: expected a matrix header NCOL, NROW (16 characters each: "
+                                 f"the format ends in |I16), FORM, TYPE, NAME, format (got {head.rstrip()!r})") from None
+        else:
+            ncol, nrow, form, ntype = ints(i, 4, "a matrix header NCOL, NROW, FORM, TYPE, NAME, format")
+        name = lines[i][48:56].strip() if wide else lines[i][32:40].strip()
+        fmt = _OP4_FORMAT.search(lines[i][56:] if wide else lines[i][40:])
         if not name or fmt is None or ntype not in (1, 2, 3, 4) or ncol < 0:
             raise ValueError(f"{path}: line {i + 1}: expected a matrix header NCOL, NROW, FORM, TYPE (1-4), "
                              f"NAME, format such as 1P,3E23.16 (got {lines[i].rstrip()!r})")
@@ -401,8 +419,27 @@ def _read_op4_text(path: Path, data: bytes) -> dict:
     return matrices
 
 
+def _op4_binary_layout(data: bytes):
+    """(byte order, word size in bytes) of a binary OUTPUT4 file from its first record's
+    length marker: 24 (4-byte words: NCOL, NROW, FORM, TYPE and an 8-character name) or 48
+    (8-byte words, Nastran's 64-bit integer build: the four integers in 8 bytes each and the
+    name as two 8-byte words of 4 characters each); None for neither."""
+    if len(data) < 4:
+        return None
+    for order in ("<", ">"):
+        marker = struct.unpack(order + "i", data[:4])[0]
+        if marker in (24, 48):
+            return order, marker // 6
+    return None
+
+
 def _read_op4_binary(path: Path, data: bytes) -> dict:
-    order = "<" if struct.unpack("<i", data[:4])[0] == 24 else ">"
+    """Binary OUTPUT4: Fortran unformatted records (4-byte length markers) of words of 4 bytes
+    (a single-precision real is one word, a double-precision real two) or, from Nastran's 64-bit
+    integer build, of 8 bytes (every integer and every real, single or double, one word)."""
+    order, word = _op4_binary_layout(data)
+    integer = order + ("i" if word == 4 else "q")
+    header_bytes = 6 * word
     matrices = {}
     pos, record = 0, 0
 
@@ -420,31 +457,39 @@ def _read_op4_binary(path: Path, data: bytes) -> dict:
         pos = end + 4
         return body
 
+    def ints(body, count, at=0):
+        return struct.unpack(order + f"{count}{integer[-1]}", body[at * word:(at + count) * word])
+
     while pos < len(data):
         body = read_record()
-        if len(body) != 24:
-            raise ValueError(f"{path}: record {record}: {len(body)} bytes; expected a 24-byte matrix header")
-        ncol, nrow, form, ntype = struct.unpack(order + "4i", body[:16])
-        name = body[16:24].decode("ascii", "replace").strip()
+        if len(body) != header_bytes:
+            raise ValueError(f"{path}: record {record}: {len(body)} bytes; expected a {header_bytes}-byte matrix "
+                             f"header (NCOL, NROW, FORM, TYPE, NAME in {word}-byte words, as the file's first record)")
+        ncol, nrow, form, ntype = ints(body, 4)
+        raw_name = body[4 * word:]
+        if word == 8:                         # two words of 4 characters each
+            raw_name = raw_name[:4] + raw_name[8:12]
+        name = raw_name.decode("ascii", "replace").strip()
         if ntype not in (1, 2, 3, 4):
             raise ValueError(f"{path}: record {record}: matrix {name!r} has TYPE {ntype}; expected 1-4")
         bigmat = nrow < 0
         nrow = abs(nrow)
-        wpn = _op4_words_per_number(ntype)
-        real_fmt = "d" if wpn == 2 else "f"
+        # words per real number: 4-byte words hold a single (TYPE 1, 3) or half a double (2, 4)
+        wpn = _op4_words_per_number(ntype) if word == 4 else 1
+        real_fmt = "f" if word == 4 and wpn == 1 else "d"
         e = _Entries(name, "record")
         e.complex = ntype in (3, 4)
         while True:
             body = read_record()
-            if len(body) < 12:
+            if len(body) < 3 * word:
                 raise ValueError(f"{path}: record {record}: {len(body)} bytes; expected a column record of matrix {name}")
-            icol, irow, nw = struct.unpack(order + "3i", body[:12])
-            words = body[12:]
+            icol, irow, nw = ints(body, 3)
+            words = body[3 * word:]
             if icol == ncol + 1:              # end of the matrix: one dummy column
                 break
-            if len(words) != 4 * nw:
-                raise ValueError(f"{path}: record {record}: {len(words) // 4} data words; expected NW = {nw} "
-                                 f"(column {icol} of matrix {name})")
+            if len(words) != word * nw:
+                raise ValueError(f"{path}: record {record}: {len(words) // word} data words; expected NW = {nw} "
+                                 f"(column {icol} of matrix {name}, {word}-byte words)")
             if not 1 <= icol <= ncol:
                 raise ValueError(f"{path}: record {record}: column {icol} of matrix {name} is outside 1..{ncol + 1}")
 
@@ -459,21 +504,28 @@ def _read_op4_binary(path: Path, data: bytes) -> dict:
                 e.add_block(row0 - 1 + nz, icol - 1, values[nz], record)
 
             if irow > 0:
+                if nw % (wpn * (2 if e.complex else 1)):
+                    raise ValueError(f"{path}: record {record}: {nw} data words in column {icol} of matrix {name}; "
+                                     f"expected whole numbers of {wpn} word(s) each (TYPE {ntype})")
                 store(irow, words)
                 continue
             w = 0
             while w < nw:
                 if bigmat:
-                    length, row0 = struct.unpack(order + "2i", words[4 * w:4 * w + 8])
+                    if w + 2 > nw:
+                        raise ValueError(f"{path}: record {record}: a string header L, IROW at word {w} runs past "
+                                         f"the column's {nw} words")
+                    length, row0 = ints(words, 2, w)
                     n_words, start = length - 1, w + 2
                 else:
-                    (packed,) = struct.unpack(order + "i", words[4 * w:4 * w + 4])
+                    (packed,) = ints(words, 1, w)
                     n_words = packed // 65536 - 1
                     row0, start = packed - 65536 * (n_words + 1), w + 1
-                if n_words < 0 or n_words % wpn or start + n_words > nw:
+                per = wpn * (2 if e.complex else 1)
+                if n_words < 0 or n_words % per or start + n_words > nw:
                     raise ValueError(f"{path}: record {record}: a string of {n_words} words at word {w}; "
-                                     f"expected a multiple of {wpn} inside the column's {nw} words")
-                store(row0, words[4 * start:4 * (start + n_words)])
+                                     f"expected a multiple of {per} inside the column's {nw} words")
+                store(row0, words[word * start:word * (start + n_words)])
                 w = start + n_words
         matrices[_unique_name(matrices, name)] = (e, nrow, ncol, form)
     return matrices
@@ -678,7 +730,8 @@ def _abaqus_entries(path: Path, ints: np.ndarray, values: np.ndarray, numbers: n
 # MATLAB
 # --------------------------------------------------------------------------------------
 def read_matlab(path) -> dict:
-    """Real 2-D variables of a .mat file (v4-v7 or v7.3): name -> dense array or CSR matrix."""
+    """Variables of a .mat file (v4-v7 or v7.3): name -> dense array or CSR matrix; the fields of
+    a scalar struct (at any depth) as ``struct.field``, the struct itself not listed."""
     path = Path(path)
     import scipy.io
     try:
@@ -689,7 +742,19 @@ def read_matlab(path) -> dict:
         if _is_hdf5(path):                   # an HDF5 .mat without MATLAB's text header
             return _read_matlab_hdf5(path)
         raise ValueError(f"{path}: not a readable MATLAB .mat file ({err}); expected a MAT-file v4-v7.3") from None
-    return {k: v for k, v in data.items() if not k.startswith("__")}
+    out = {}
+
+    def add(name, value):
+        if isinstance(value, np.ndarray) and value.dtype.names and value.size == 1:    # a scalar struct
+            for field in value.dtype.names:
+                add(f"{name}.{field}", value.flat[0][field])
+        else:
+            out[name] = value
+
+    for k, v in data.items():
+        if not k.startswith("__"):
+            add(k, v)
+    return out
 
 
 def _is_hdf5(path: Path) -> bool:
@@ -707,10 +772,14 @@ def _read_matlab_hdf5(path: Path) -> dict:
         raise ValueError(f"{path}: a MATLAB v7.3 (HDF5) file needs h5py: pip install bladedamp[matlab]") from None
     out = {}
     with h5py.File(path, "r") as f:
-        for name, item in f.items():
-            if name.startswith("#"):
+        items = list(f.items())
+        while items:
+            name, item = items.pop(0)
+            if name.split(".")[-1].startswith("#"):
                 continue
-            if isinstance(item, h5py.Group) and "MATLAB_sparse" in item.attrs:
+            if isinstance(item, h5py.Group) and "MATLAB_sparse" not in item.attrs:    # a struct
+                items[:0] = [(f"{name}.{k}", v) for k, v in item.items()]
+            elif isinstance(item, h5py.Group) and "MATLAB_sparse" in item.attrs:
                 n_rows = int(item.attrs["MATLAB_sparse"])
                 jc = item["jc"][()]
                 data = item["data"][()] if "data" in item else np.zeros(0)

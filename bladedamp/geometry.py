@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import trimesh
 
-from .blade import BeamBladeGeometry, platform_section, reference_blade_geometry
+from .blade import PLATFORM_ANGLE, BeamBladeGeometry, platform_section, reference_blade_geometry
 from .damper.geometry import CylinderDamper, DamperGeometry, WedgeDamper
 
 __all__ = ["prism", "BladeMesh", "blade_mesh", "cylinder_mesh", "wedge_mesh", "damper_mesh", "SectorLayout",
@@ -182,8 +182,8 @@ def _prism_z(section_xy, z0: float, z1: float) -> trimesh.Trimesh:
     return mesh
 
 
-def blade_mesh(geometry: BeamBladeGeometry | None = None, gamma_left: float = np.radians(35.0),
-               gamma_right: float = np.radians(35.0), contact_centres=None, *, platform_edge: float | None = None,
+def blade_mesh(geometry: BeamBladeGeometry | None = None, gamma_left: float = PLATFORM_ANGLE,
+               gamma_right: float = PLATFORM_ANGLE, contact_centres=None, *, platform_edge: float | None = None,
                platform_length: float | None = None, face_inner_length: float = 2.5e-3, root_height: float = 10e-3,
                profile_points: int = 16) -> BladeMesh:
     """Blade of ``geometry`` (default: :func:`~bladedamp.blade.reference_blade_geometry`) in its own frame.

@@ -48,6 +48,19 @@ import numpy as np
 
 FORMAT_VERSION = 1
 META_KEY = "__bladedamp__"
+
+# Blade modal data files (bladedamp.blade.ModalBlade.save): no META_KEY entry, a ``format``
+# string naming the blade kind (format: bladedamp.blade's module docstring).
+MODAL_NPZ_FORMAT = "bladedamp.ModalBlade/1"
+# A solid FE blade's file (bladedamp.solid.SolidModalBlade.save): the ModalBlade keys plus its
+# flexible platforms' FE field, contact-face samples, surface and solid_info.
+SOLID_NPZ_FORMAT = "bladedamp.SolidModalBlade/2"
+# /2 writes solid_info with encode_value (typed); /1 files (solid_info in plain JSON, types
+# guessed on reading) are still read
+SOLID_NPZ_FORMATS_READ = ("bladedamp.SolidModalBlade/1", SOLID_NPZ_FORMAT)
+#: the reader of every blade file, resolved by name as every result class (this module imports
+#: no model or blade: it sits below them): ``ModalBlade.from_file`` (a SolidModalBlade for a solid's)
+BLADE_READER = "bladedamp.blade:ModalBlade"
 #: fields that hold a model, not data: stored as absent, loaded as None (see the module docstring)
 MODEL_FIELDS = ("disk", "system")
 
@@ -385,8 +398,6 @@ def load(path):
     Raises :class:`FileReadError` (a ValueError) naming the file for a file that is missing
     (:class:`MissingFileError`, also a FileNotFoundError), empty, truncated or corrupted, not an
     ``.npz``, not a saved result, or with broken metadata or a missing array (:func:`reading`)."""
-    from .blade import MODAL_NPZ_FORMAT, SOLID_NPZ_FORMATS_READ, ModalBlade
-
     path = npz_path(path)
     with reading(path, "saved bladedamp result"):
         with open_npz(path) as z:
@@ -403,6 +414,6 @@ def load(path):
             tag = str(z["format"]) if blade else None
         if META_KEY not in files:
             if tag in (MODAL_NPZ_FORMAT, *SOLID_NPZ_FORMATS_READ):   # a blade's modal data file
-                return ModalBlade.from_file(path)
+                return _resolve(BLADE_READER).from_file(path)
             raise ValueError(f"{path} is not a saved bladedamp result (no {META_KEY} entry)")
         return _rebuild(meta, "", arrays)

@@ -42,6 +42,8 @@ from . import palette
 from .io import Saveable, reading
 from .plotting import place_legend
 
+#: file suffixes read as Universal File Format (a design file's [blade] modal_file of measured modes)
+UFF_SUFFIXES = ("uff", "unv", "uf")
 G_STANDARD = 9.80665                     #: standard gravity [m/s^2], the unit "g"
 
 #: response quantity by its time derivative order: 0 displacement, 1 velocity, 2 acceleration

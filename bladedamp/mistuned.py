@@ -46,6 +46,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import textwrap
 from dataclasses import dataclass, field
 from typing import ClassVar, Sequence
 
@@ -54,21 +55,23 @@ import scipy.sparse as sp
 from numba import njit
 
 from . import validation
-from .blade import ModalBlade
+from .blade import PLATFORM_ANGLE, ModalBlade
 from .contact.laws import LinearNormalLaw
 from .contact.point import MAX_PASSES, PERIODIC_TOL
 from .damper.kinetics import seat
-from .disk import (AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION, DAMPER_DOFS, STOP_CHECK_OFFSET_HZ,
+from .disk import (AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION, DAMPER_DOFS, DEFAULT_DAMPER_RADIUS,
+                   STOP_CHECK_OFFSET_HZ,
                    DamperContacts, TunedDisk, contact_point_maps, contact_rows, damper_weighted_scales,
                    fused_point_map_forces, interblade_phase, peak_checked_response, point_map_forces, rest_response,
                    rotor_speed_in_hz, time_at_peak, time_check_beyond, with_stop_check)
 from .hbm.accuracy import HARMONIC_TOLERANCE
-from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_POINT_BUDGET, Branch, Budget, continuation
+from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_MAX_STEP, DEFAULT_POINT_BUDGET, Branch, Budget, continuation
 from .hbm.start import robust_start
 from .hbm.linsolve import BlockCondensation, BlockRing, one_blas_thread
 from .hbm.linsolve import factorize as lu_factorize
 from .hbm.peaks import PEAK_MAX_ITERATIONS, PeakSolver, first_harmonic_output
 from .hbm.fourier import HarmonicBasis
+from .hbm.monodromy import disk_monodromy
 from .hbm.system import Coupling, HarmonicBalanceSystem
 from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, physical_checks, refined_peak, sampled_response,
                        with_checks)
@@ -704,9 +707,9 @@ class MistunedDisk:
     dampers: object = None
     n_blades: int | None = None
     engine_order: int = 1
-    gamma_left: float | Sequence[float] = np.radians(35.0)
-    gamma_right: float | Sequence[float] = np.radians(35.0)
-    damper_radius: float = 0.1
+    gamma_left: float | Sequence[float] = PLATFORM_ANGLE
+    gamma_right: float | Sequence[float] = PLATFORM_ANGLE
+    damper_radius: float = DEFAULT_DAMPER_RADIUS
     excitation: np.ndarray = field(default_factory=lambda: np.array([0.1, 0, 0, 0, 0, 0]))
     rotor_speed_hz: float | None = None
     damper_inertia: bool = True
@@ -1028,7 +1031,7 @@ class MistunedDisk:
         return np.sqrt(s) * np.tile(np.concatenate(out), C)
 
     def frequency_response(self, f_start_hz: float, f_end_hz: float, harmonics="auto", n_samples=None,
-                           max_step: float = 0.02, tuned_peak_amplitude: float | None = None,
+                           max_step: float = DEFAULT_MAX_STEP, tuned_peak_amplitude: float | None = None,
                            harmonic_tolerance: float = HARMONIC_TOLERANCE, max_harmonic: int = 3,
                            estimate_harmonic_error: bool = True, check_stop: bool = False, check_peak: bool = False,
                            cpu_budget_s: float = DEFAULT_CPU_BUDGET_S, point_budget: int = DEFAULT_POINT_BUDGET,
@@ -1163,7 +1166,7 @@ class MistunedDisk:
         return damper_weighted_scales(scales, system.basis.n_coeffs, slice(self.n_sector * self.n_modes, None))
 
     @one_blas_thread
-    def extend_response(self, response: "MistunedResponse", f_end_hz: float, max_step: float = 0.02,
+    def extend_response(self, response: "MistunedResponse", f_end_hz: float, max_step: float = DEFAULT_MAX_STEP,
                         **continuation_options) -> "MistunedResponse":
         """``response`` continued from its end (or its start) to ``f_end_hz`` [Hz], beyond the
         range it covers, as one response: the wider range without recomputing the part known.
@@ -1238,6 +1241,28 @@ class MistunedDisk:
         from .timedomain import disk_time_response
 
         return disk_time_response(self, f_hz, **options)
+
+    def full_assembly(self) -> "MistunedDisk":
+        """This model (:class:`bladedamp.hbm.monodromy.AssemblyModel`; a full assembly when
+        :attr:`has_period_map`)."""
+        return self
+
+    def assembly_coefficients(self, full, coefficients, basis) -> np.ndarray:
+        """The solution ``coefficients`` (C * N,) or (C, N) as (C, N) (the model is its own
+        assembly ``full``)."""
+        return np.asarray(coefficients, dtype=float).reshape(basis.n_coeffs, full.n_dof)
+
+    @property
+    def has_period_map(self) -> bool:
+        """Whether the monodromy method has a period map: every blade in the model
+        (:class:`bladedamp.hbm.monodromy.PeriodMapModel`)."""
+        return self.n_sector == self.n_blades
+
+    def monodromy_matrix(self, coefficients, basis, omega: float, steps: int | None = None):
+        """(monodromy matrix, periodicity error) of the HBM solution ``coefficients`` at
+        ``omega`` [rad/s] (:func:`bladedamp.hbm.monodromy.disk_monodromy`)."""
+        result = disk_monodromy(self, coefficients, basis, omega, steps)
+        return result.matrix, result.periodicity_error
 
 
 @dataclass
@@ -1390,7 +1415,7 @@ class MistunedResponse(FrequencyResponse):
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
         if not self.success:
-            ax.set_title(f"incomplete: {self.message}", fontsize=8)
+            ax.set_title(textwrap.fill(self.status_message, 100), fontsize=8)   # what it means, not the log
         if measured is not None:
             from .measurement import draw_measurement
 

@@ -23,6 +23,7 @@ from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_POINT_BUDGET, Budget
 from .hbm.start import robust_start
 from .hbm.elements import CubicSpring
 from .hbm.fourier import HarmonicBasis
+from .hbm.monodromy import STEPS_PER_PERIOD, oscillator_monodromy
 from .hbm.system import Coupling, HarmonicBalanceSystem
 from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, physical_checks, sampled_response, with_checks,
                        with_range_end_estimate)
@@ -276,6 +277,20 @@ class FrictionOscillator:
         return np.array(rows)
 
     # ----- time integration -----------------------------------------------------------
+    @property
+    def has_period_map(self) -> bool:
+        """True: the monodromy method has this model's period map
+        (:class:`bladedamp.hbm.monodromy.PeriodMapModel`)."""
+        return True
+
+    def monodromy_matrix(self, coefficients, basis, omega: float, steps: int | None = None):
+        """(monodromy matrix (3, 3), periodicity error) of the HBM solution ``coefficients`` at
+        ``omega`` [rad/s] (:func:`bladedamp.hbm.monodromy.oscillator_monodromy`; ``steps`` per
+        period, None: ``STEPS_PER_PERIOD``)."""
+        mono, _, error = oscillator_monodromy(self, coefficients, basis, omega,
+                                              STEPS_PER_PERIOD if steps is None else steps)
+        return mono, error
+
     def time_response(self, f_hz, steps_per_period: int = 2048, max_periods: int = 5000,
                       min_periods: int = 20, tol: float = 1e-9, initial_displacement: float = 0.0,
                       initial_velocity: float = 0.0) -> TimeResponse:

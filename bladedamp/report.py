@@ -181,7 +181,8 @@ def paper_section(s: dict, table1: list) -> str:
 
 def accuracy_section(summary: dict) -> str:
     """The paper's one-harmonic setting beside the converged harmonic balance."""
-    from .hbm.accuracy import HARMONIC_TOLERANCE, enriched
+    from .hbm.accuracy import HARMONIC_TOLERANCE
+    from .hbm.fourier import enriched
 
     tol = 100 * HARMONIC_TOLERANCE
     lines = ["", "## The paper's one-harmonic setting and the converged harmonic balance", "",
@@ -200,10 +201,9 @@ def accuracy_section(summary: dict) -> str:
             if err is None or not np.isfinite(err):
                 check = _harmonics(enriched(r["harmonics"]))
                 shown, within = "not estimated (see below)", "unknown"
-                notes.append(f"{kind}, harmonics {_harmonics(r['harmonics'])}: the error could not be estimated. "
-                             f"The estimate solves the peak point again with harmonics {check}, starting from this "
-                             "solution; that solve did not converge, so the size of the truncation error there is "
-                             "unknown (the peak itself was computed and passed the physical checks).")
+                notes.append(f"{kind}, harmonics {_harmonics(r['harmonics'])}: its error is unknown, since the peak "
+                             f"solved again with harmonics {check} did not converge (the peak passed the physical "
+                             "checks).")
             else:
                 shown, within = f"{fmt_number(err, '.2g')} %", "yes" if r["converged"] else "no"
             lines.append(f"| {kind} | {row['mass_g']:.3g} | {label} | {_harmonics(r['harmonics'])} | "

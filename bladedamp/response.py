@@ -3,12 +3,14 @@ from __future__ import annotations
 
 import dataclasses
 import enum
+import re
+import textwrap
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from .hbm.continuation import branch_checks
-from .hbm.fourier import HarmonicBasis
+from .hbm.fourier import HarmonicBasis, enriched
 from .io import Saveable
 
 
@@ -93,6 +95,9 @@ def physical_checks(omega, omega_range, dissipation, excitation_work, max_step=N
             relative[suspect] = (fine / scale[suspect]).min(axis=1, initial=0.0)
         bad = relative < -SAMPLING_FLOOR
         how = f", confirmed with {REFINE_SAMPLES_FACTOR * n_samples} AFT samples per period"
+        if bad.any():         # the AFT's energy error of the result itself, at the solve's own samples
+            how = (f" with {REFINE_SAMPLES_FACTOR * n_samples} AFT samples per period; AFT energy error "
+                   f"{100 * own[bad].min():.3g} % with the solve's {n_samples}")
         if judge_solution_samples and not bad.any() and (own < -SAMPLING_FLOOR).any():
             bad, relative = own < -SAMPLING_FLOOR, own
             how = (f" with {n_samples} AFT samples per period: the AFT's energy error, since with "
@@ -152,8 +157,11 @@ def sampled_response(solve, n_samples, first: int, most: int, most_for_dissipati
     n_used = response.basis.n_samples
     failed_with = [str(t) for t in tried if t != n_used]
     note = ""
+    most = not response.success and n_used * SAMPLES_GROWTH > (
+        most if most_for_dissipation is None or not only_sampling_failed(response) else most_for_dissipation)
     if failed_with:
-        note += f"; AFT samples per period raised to {n_used} (the branch failed with {', '.join(failed_with)})"
+        note += (f"; AFT samples per period raised to {n_used}{' (the most)' if most else ''} (the branch failed "
+                 f"with {', '.join(failed_with)})")
     if empty is not None:
         note += f"; with {empty} AFT samples per period the branch kept no point" + (f": {stopped_by}" if stopped_by else "")
     if stopped_by:
@@ -219,27 +227,18 @@ class Status(enum.Enum):
 
 
 STATUS_EXPLANATIONS = {
-    Status.COMPLETE_VERIFIED: "the branch reached the end of the range, every check passed and the harmonic "
-                              "truncation's error of the first-harmonic amplitudes is estimated within its "
-                              "tolerance: the curve holds to that tolerance",
-    Status.COMPLETE_UNVERIFIED: "the branch reached the end of the range, but the error of its harmonic "
-                                "truncation was not estimated or could not be checked, so its peak may be off by "
-                                "more than the tolerance (a one-harmonic curve by tens of percent): run with "
-                                "harmonics='auto' or a richer set such as (0, 1, 2, 3), or check the peak by "
-                                "time integration (check_peak=True)",
-    Status.COMPLETE_ABOVE_TOLERANCE: "the branch reached the end of the range, but the estimated error of its "
-                                     "harmonic truncation is above the tolerance, so its amplitudes may be off by "
-                                     "about that much: run with more harmonics (harmonics='auto' with a larger "
-                                     "max_harmonic, or a richer set)",
-    Status.CHECK_FAILED: "the branch reached the end of the range but failed a physical check (failed_checks "
-                         "says which), so its numbers are not to be trusted: raise the AFT samples (n_samples) "
-                         "or shorten the steps (max_step), or look at the design where the check failed",
-    Status.STOPPED: "the branch did not reach the end of the range (a caller's stop condition, a failed check "
-                    "or a Newton failure; the message says which), so it covers part of the range only and its "
-                    "largest amplitude need not be the resonance: shorten the steps (max_step), or check the "
-                    "stop by time integration (check_stop=True)",
-    Status.OUT_OF_BUDGET: "the branch ran out of its point or CPU budget before the end of the range, so it "
-                          "covers part of the range only: raise the budget or narrow the range",
+    Status.COMPLETE_VERIFIED: "the whole range is computed and its harmonic error is within the tolerance: "
+                              "trust the curve to that tolerance",
+    Status.COMPLETE_UNVERIFIED: "the whole range is computed but its harmonic error is unknown: run with "
+                                "harmonics='auto' or check the peak (check_peak=True)",
+    Status.COMPLETE_ABOVE_TOLERANCE: "the whole range is computed but its amplitudes may be off by the error "
+                                     "estimate: run with a richer harmonic set",
+    Status.CHECK_FAILED: "the whole range is computed but a physical check failed (failed_checks): do not "
+                         "trust its numbers",
+    Status.STOPPED: "the branch stopped before the end of the range: its largest amplitude need not be the "
+                    "resonance",
+    Status.OUT_OF_BUDGET: "the CPU or point budget ran out: raise it (cpu_budget_s, point_budget) or narrow "
+                          "the range",
 }
 
 #: a response whose ``stopped_by`` starts with this word ran out of its point or CPU budget
@@ -312,40 +311,163 @@ def range_end_note(response) -> str:
     if end is None:
         return ""
     side = "above" if end == f.max() and f.max() > f.min() else "below"
-    note = (f"the largest amplitude is at the end of the computed range ({end:.6g} Hz), not a resonance: the "
-            f"resonance may lie {side} the range")
+    where = f"one may lie {side}"
     bounds = tuple(response.linear_natural_frequencies_hz or ())
     if len(bounds) == 2 and all(np.isfinite(bounds)):
         free, stuck = bounds
-        note += (f", between the natural frequencies of the linear systems without the friction contacts "
-                 f"({free:.6g} Hz) and with them stuck ({stuck:.6g} Hz)")
-    return note + "; compute over a wider range"
+        where += f", between {free:.4g} Hz (no contacts) and {stuck:.4g} Hz (stuck)"
+    return f"the largest amplitude is at the range end ({end:.6g} Hz), no resonance: {where}; widen the range"
+
+
+def percent(x: float) -> str:
+    """``x`` (a fraction) in percent for a sentence: two significant digits, whole numbers from 10 %."""
+    return f"{100 * x:.0f} %" if abs(100 * x) >= 10 else f"{100 * x:.2g} %"
+
+
+def harmonic_sentence(harmonics, error: float, tolerance: float, drifting: bool = False, estimated: bool = False,
+                      checkable: bool = False) -> str:
+    """One sentence on the harmonic accuracy of a curve computed with ``harmonics``, its error
+    estimate ``error`` (a fraction of the peak) held to ``tolerance``: what it means and what to
+    do. ``error`` nan: not estimated, or with ``estimated`` estimated but not verified (the
+    richer set did not converge at the peak; ``checkable``: the model's ``check_peak`` can check
+    it). ``drifting``: the time integration at the peak found a damper that keeps rolling or
+    walking (its mean compared), an error that a richer harmonic set does not remove."""
+    H = tuple(int(h) for h in harmonics)
+    one = H == (1,)
+    curve = "one-harmonic curve" if one else f"harmonics {H}"
+    if not np.isfinite(error) and estimated:
+        subject = "the one-harmonic curve's error" if one else f"the error of harmonics {H}"
+        return (f"{subject} could not be checked: {enriched(H)} did not converge at the peak; "
+                + ("check the peak with check_peak=True" if checkable else "run with harmonics='auto'"))
+    if not np.isfinite(error):
+        unknown = "its peak may be off by tens of %" if one else "its accuracy is unknown"
+        return f"{curve}, error not estimated: {unknown}; run with harmonics='auto'"
+    if error <= tolerance:
+        return f"{curve}, good to {percent(error)} (tolerance {percent(tolerance)})"
+    if drifting:
+        return (f"a damper keeps rolling at the peak, which no periodic curve holds: trust the curve to "
+                f"{percent(error)} only (tolerance {percent(tolerance)})")
+    if one:
+        return (f"one-harmonic curve: its peak may be off by up to {percent(error)}; run with harmonics='auto' or "
+                f"{enriched(H)}")
+    return (f"{curve}: the curve may be off by up to {percent(error)} (tolerance {percent(tolerance)}); "
+            f"run with harmonics {enriched(H)} or a larger max_harmonic")
+
+
+# A first-harmonic tip amplitude above this fraction of the blade's span (root to tip point) is
+# beyond the linear theory of small deformations the blade's modes rest on: the linear theory
+# overestimates the tip deflection of an end-loaded cantilever, against the elastica (Bisshopp &
+# Drucker 1945), by 1.0 % at a deflection of 10 % of its length, the product's 1 % accuracy target
+# (0.26 % at 5 %, 4 % at 20 %; tests/test_status.py integrates the elastica)
+PLAUSIBLE_TIP_DEFLECTION = 0.1
+
+
+def amplitude_check(response, span: float) -> dict[str, str]:
+    """{"amplitude": what was found} when the largest first-harmonic tip amplitude of
+    ``response`` (:meth:`FrequencyResponse.peak_curve`) [m] exceeds ``PLAUSIBLE_TIP_DEFLECTION``
+    of the blade's ``span`` [m] (the tip point's distance from the blade frame's origin, the
+    root); {} otherwise (and for an empty branch)."""
+    if not len(response.omega) or not (np.isfinite(span) and span > 0):
+        return {}
+    peak = float(np.max(response.peak_curve()))
+    if not peak > PLAUSIBLE_TIP_DEFLECTION * span:      # nan too: not plausible
+        if np.isfinite(peak):
+            return {}
+    return {"amplitude": (f"a tip amplitude of {1e3 * peak:.4g} mm is {percent(peak / span)} of the "
+                          f"{1e3 * span:.4g} mm blade, beyond small-deformation theory "
+                          f"({percent(PLAUSIBLE_TIP_DEFLECTION)})")}
+
+
+def with_amplitude_check(response, span: float):
+    """``response`` with :func:`amplitude_check`'s failure recorded (:func:`with_checks`: not
+    ``success``, status CHECK_FAILED where it reached the end of its range); unchanged where the
+    amplitude is plausible."""
+    return with_checks(response, amplitude_check(response, span))
+
+
+# what to do about each physical check that failed (:func:`status_message`), in this order
+CHECK_ADVICE = {
+    "amplitude": "add damping or check the excitation",
+    "peak_time_check": "the peak is not a motion the disk keeps; the time integration is the answer there",
+    "dissipation": "raise the AFT samples (n_samples)",
+    "step": "shorten max_step",
+    "range": "report it: the continuation left its range",
+}
+
+
+def check_sentence(failed: dict) -> str:
+    """One sentence on the physical checks ``failed`` ({check: what was found}): the first by
+    ``CHECK_ADVICE``'s order, what was found and what to do, and how many more."""
+    names = sorted(failed, key=lambda k: list(CHECK_ADVICE).index(k) if k in CHECK_ADVICE else len(CHECK_ADVICE))
+    first = names[0]
+    found = str(failed[first])
+    if first == "peak_time_check":
+        found = "the time integration at the peak finds no periodic motion"
+    elif first == "dissipation":      # the AFT's energy error at the solve's samples where stated, else the least
+        error = re.search(r"AFT energy error (\S+ %)", found) or re.search(r"down to (\S+ %)", found)
+        found = found.split(" (")[0] + (f", AFT energy error {error.group(1)}" if error else "")
+    more = f" (and {len(names) - 1} more: failed_checks)" if len(names) > 1 else ""
+    return f"{found}{more}: {CHECK_ADVICE.get(first, 'see failed_checks')}"
+
+
+def stop_sentence(response) -> str:
+    """One sentence on a branch that stopped before the end of its range: where, and why or
+    what to do, from its time integration beyond the stop (``stop_check``) when it has one."""
+    check = getattr(response, "stop_check", None)
+    if not len(response.omega):
+        where = "no point computed: the start failed"
+    else:
+        where = f"the branch ends at {response.frequency_hz[response.furthest_index()]:.2f} Hz"
+    if check is not None and len(getattr(check, "periodic", ())):
+        if not check.periodic[0]:
+            return (f"{where}; the time integration beyond finds no periodic motion (the damper hops or rolls): "
+                    "no curve exists there, use the time integration")
+        return f"{where}; a periodic motion exists beyond, which a richer set (harmonics='auto') may follow"
+    if response.failed_checks:
+        return f"{where}; {check_sentence(response.failed_checks)}"
+    if "stopped after max_points" in response.message:
+        return f"{where}, all its max_points = {len(response.omega)} points used: raise max_points"
+    more = "check_stop=True tells whether a periodic motion exists beyond" if hasattr(response, "stop_check") \
+        else "shorten max_step or run with harmonics='auto'"
+    return f"{where}; {more}"
 
 
 def status_message(response) -> str:
-    """One sentence that leads a response's report: its :class:`Status` (short name), the
-    particulars (the harmonic error against its tolerance, the reason of a stop, the failed
-    checks), the status's explanation, and :func:`range_end_note` when the largest amplitude
-    lies at an end of the range."""
+    """What a response's report leads with, one plain sentence (and a second one when its
+    largest amplitude lies at an end of the range, :func:`range_end_note`): its :class:`Status`
+    (the short name), then what it means for this result, with its numbers (the error estimate
+    and the harmonic set, where the branch stopped and why, the failed check), and what to do."""
     status = response_status(response)
     error, tolerance = float(response.harmonic_error), float(response.harmonic_tolerance)
-    if status is Status.COMPLETE_VERIFIED or status is Status.COMPLETE_ABOVE_TOLERANCE:
-        relation = "within" if status is Status.COMPLETE_VERIFIED else "above"
-        detail = (f"harmonic error estimate {100 * error:.2g} % {relation} the tolerance {100 * tolerance:.2g} % "
-                  f"(harmonics {tuple(response.basis.harmonics)})")
-    elif status is Status.COMPLETE_UNVERIFIED:
-        detail = (f"harmonic error not estimated (harmonics {tuple(response.basis.harmonics)})"
-                  if response.harmonics_converged is None else
-                  f"harmonic error not verified (harmonics {tuple(response.basis.harmonics)})")
+    H = tuple(response.basis.harmonics)
+    check = getattr(response, "peak_check", None)
+    drifting = check is not None and str(check.status[0]) == "drifting"
+    if status.complete:
+        detail = harmonic_sentence(H, error if np.isfinite(tolerance) else float("nan"), tolerance, drifting,
+                                   estimated=response.harmonics_converged is not None,
+                                   checkable=hasattr(response, "peak_check"))
     elif status is Status.CHECK_FAILED:
-        detail = "failed checks: " + "; ".join(f"{k}: {v}" for k, v in response.failed_checks.items())
-    elif status is Status.OUT_OF_BUDGET or response.stopped_by:
-        detail = response.stopped_by
+        detail = check_sentence(response.failed_checks)
+    elif status is Status.OUT_OF_BUDGET:
+        budget = response.stopped_by.removeprefix(BUDGET_PREFIX).lstrip(": ")
+        if response.reached_range_end and len(response.omega):
+            detail = (f"{budget} on a richer set; the complete curve of harmonics {H} is kept, "
+                      + (f"error {percent(error)} (tolerance {percent(tolerance)})" if np.isfinite(error)
+                         else "its error unknown"))
+        else:
+            detail = (f"{budget}: a partial curve, whose largest amplitude need not be the resonance; raise "
+                      "cpu_budget_s or point_budget")
+    elif response.stopped_by:
+        detail = f"ended by the stop condition ({response.stopped_by}): a partial curve"
     else:
-        detail = response.message
-    sentence = f"{status.value}: {detail}; {status.explanation}"
-    note = range_end_note(response)
-    return f"{sentence}; {note}." if note else f"{sentence}."
+        detail = stop_sentence(response)
+    # where the branch covers part of the range, its last point is no range end: the sentence says so
+    note = range_end_note(response) if response.reached_range_end else ""
+    if "amplitude" in response.failed_checks:
+        implausible = check_sentence({"amplitude": response.failed_checks["amplitude"]})
+        detail += "" if implausible in detail else "; " + implausible
+    sentence = f"{status.value}: {detail}."
+    return f"{sentence} {note[0].upper()}{note[1:]}." if note else sentence
 
 
 def with_range_end_estimate(model, response):
@@ -565,7 +687,7 @@ class FrequencyResponse(Saveable):
         ax.set_ylabel(f"|{self.dof_names[self._dof(dof)]}| harmonic {harmonic} [{unit}]")
         ax.grid(True, alpha=0.3)
         if not self.success:
-            ax.set_title(f"incomplete: {self.message}", fontsize=8)
+            ax.set_title(textwrap.fill(self.status_message, 100), fontsize=8)   # what it means, not the log
         ax.legend()
         if measured is not None:
             from .measurement import draw_measurement

@@ -121,8 +121,8 @@ import scipy.sparse
 import scipy.sparse.linalg
 
 from . import validation as check
-from .blade import (SHIFT_INVERT_SIGMA, SOLID_NPZ_FORMAT, BeamBladeGeometry, ModalBlade, PAPER_MODE_ORDER,
-                    platform_section)
+from .blade import (PLATFORM_ANGLE, SHIFT_INVERT_SIGMA, SOLID_NPZ_FORMAT, BeamBladeGeometry, ModalBlade,
+                    PAPER_MODE_ORDER, platform_section, reference_blade_geometry)
 from .io import MissingFileError, decode_value, encode_value
 
 __all__ = ["FE_HINT", "SOLID_NPZ_FORMAT", "SolidBladeGeometry", "SurfaceBladeGeometry", "PlaneRegion", "SurfacePatch",
@@ -182,7 +182,7 @@ class SolidBladeGeometry:
         Its platform_mass / platform_rotary_inertia (the beam's lumped plate) are not used: the
         solid has the platform prism itself. Its element counts are not used either.
     gamma_left, gamma_right : platform angles of the OL and OR contact faces [rad], in
-        (0, pi/2); default the reference 35 deg (bladedamp.reference.PLATFORM_ANGLE).
+        (0, pi/2); default the reference 35 deg (bladedamp.blade.PLATFORM_ANGLE).
     platform_edge : |x| of the platform edges [m] (None: 1.25 x platform_half_width, 15 mm).
     platform_length : axial (y) length of the platform [m] (None: 1.1 x the larger chord, 50 mm).
     face_inner_length : how far each underside continues past its contact point toward the
@@ -215,11 +215,9 @@ class SolidBladeGeometry:
 
     def __post_init__(self):
         if self.beam is None:
-            from .reference import reference_blade_geometry
             self.beam = reference_blade_geometry()
         if not isinstance(self.beam, BeamBladeGeometry):
             raise ValueError(f"beam must be a BeamBladeGeometry (got {type(self.beam).__name__})")
-        from .reference import PLATFORM_ANGLE
         for name in ("gamma_left", "gamma_right"):
             value = PLATFORM_ANGLE if getattr(self, name) is None else getattr(self, name)
             setattr(self, name, check.in_range(name, value, 0.0, np.pi / 2, closed="neither"))
@@ -760,7 +758,6 @@ class SurfaceBladeGeometry:
             import trimesh
         except ImportError as err:
             raise ImportError(f"{FE_HINT} (a surface blade reads its mesh with trimesh)") from err
-        from .reference import reference_blade_geometry
         self.scale = check.positive("scale", self.scale)
         self.feature_angle = check.in_range("feature_angle", self.feature_angle, 0.0, np.pi / 2, closed="neither")
         ref = reference_blade_geometry()
@@ -1067,7 +1064,6 @@ def cantilever_frequencies_hz(geometry: BeamBladeGeometry | None = None, theory:
     if theory not in CANTILEVER_THEORIES:
         raise ValueError(f"theory must be one of {CANTILEVER_THEORIES} (got {theory!r})")
     if geometry is None:
-        from .reference import reference_blade_geometry
         geometry = reference_blade_geometry()
     g = geometry
     sec = RectangularSection(g.airfoil_thickness_x, g.airfoil_chord_y)

@@ -21,7 +21,8 @@ from functools import cached_property
 import numpy as np
 from numba import njit
 
-from .contact.point import slider_step
+from .contact.point import SEPARATED, PointContactElement, slider_step
+from .hbm.continuation import DEFAULT_MAX_STEP
 from .io import Saveable
 
 
@@ -561,6 +562,61 @@ def highest_frequency(arrays: AssemblyArrays, x_static: np.ndarray) -> float:
     return float(np.sqrt(max(lam.max(), 0.0)))
 
 
+def series_value(X, basis, tau):
+    """x (N,) of the harmonic coefficients X (C, N) in ``basis`` at the phase tau = Omega t [rad]:
+    x = X_0 + sum_h (X_h^c cos(h tau) + X_h^s sin(h tau))."""
+    x = np.zeros(X.shape[1])
+    for h in basis.harmonics:
+        j = basis.cos_index(h)
+        x += X[j] if h == 0 else X[j] * np.cos(h * tau) + X[j + 1] * np.sin(h * tau)
+    return x
+
+
+def _disk_sliders(arrays, X, basis):
+    """(sliders (P, 2) [m] at t = 0, the tangential point motion's amplitude [m]) of the
+    assembly's solution X (C, N): each patch's points through the AFT's periodic return map
+    (:meth:`~bladedamp.contact.point.PointContactElement.samples`, the patch's k_T x weight, mu,
+    normal law, weights and approach -initial gap, as :func:`~bladedamp.timedomain.assembly_arrays`
+    and the HBM with the static harmonic), s = u - f / k_T at the first sample (t = 0), u when
+    separated."""
+    C = basis.n_coeffs
+    P = arrays.B.shape[0]
+    coeffs = (arrays.point_map @ X.T).T.reshape(C, P, 3)
+    sliders = np.zeros((P, 2))
+    amplitude = 0.0
+    start = 0
+    for geometry in arrays.geometries:
+        for patch in geometry.patches:
+            sl = slice(start, start + patch.n_points)
+            start += patch.n_points
+            k_t = patch.tangential_stiffness * patch.weights
+            element = PointContactElement(k_t, patch.friction_coefficient, patch.normal_law, patch.weights,
+                                          -np.asarray(patch.initial_gap, dtype=float) * np.ones(patch.n_points))
+            pts = element.samples(np.ascontiguousarray(coeffs[:, sl]).reshape(C, -1), basis)
+            u, f = pts.displacement[:, 0, :2], pts.force[:, 0, :2]
+            separated = pts.state[:, 0] == SEPARATED
+            sliders[sl] = np.where(separated[:, None], u, u - f / k_t[:, None])
+            ut = pts.displacement[:, :, :2]
+            amplitude = max(amplitude, float(np.abs(ut - ut.mean(axis=1, keepdims=True)).max()))
+    return sliders, amplitude
+
+
+def orbit_state(arrays, X, basis, omega: float, dt: float):
+    """(z (2 N + 2 P,), the tangential point motion's amplitude [m]) the state of the
+    central-difference integration (:func:`bladedamp.timedomain.disk_period`, time step ``dt``
+    [s]) on the periodic orbit of the full assembly's harmonic solution X (C, N) in ``basis``
+    (with the static harmonic) at ``omega`` [rad/s], at t = 0: z = (x(0), x(-dt), slider
+    positions (P, 2) row-major), x from the Fourier series and every friction slider from the
+    contact's periodic return map over one period of that motion (the AFT's, see
+    :mod:`bladedamp.hbm.monodromy`); ``arrays`` the assembly's :class:`~bladedamp.timedomain.AssemblyArrays`. The
+    start of the monodromy's period map and of a time integration that tests the orbit
+    (``disk_time_response(..., start_coefficients=...)``)."""
+    sliders, slider_amp = _disk_sliders(arrays, X, basis)
+    z = np.concatenate([series_value(X, basis, 0.0), series_value(X, basis, -omega * dt), sliders.ravel()])
+    return z, slider_amp
+
+
+
 @dataclass
 class DiskTimeResponse(Saveable):
     """Steady state of a bladed disk by time integration of the full assembly, one run per
@@ -882,8 +938,6 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
             x_prev = x.copy()
             slider = np.ascontiguousarray((arrays.point_map @ x).reshape(P, 3)[:, :2]) if P else np.zeros((0, 2))
         else:
-            from .hbm.monodromy import orbit_state
-
             z, _ = orbit_state(arrays, start_coefficients[i], start_basis, w, dt)
             x, x_prev = z[:N].copy(), z[N:2 * N].copy()
             slider = np.ascontiguousarray(z[2 * N:].reshape(P, 2))
@@ -1035,7 +1089,7 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
     return DiskTimeResponse(omega, np.abs(out["tip_harmonic"]), steps_per_period=steps, **out)
 
 
-def hbm_tip_at(disk, f_hz, harmonics=(0, 1, 2, 3), pad_hz: float = 1.0, max_step: float = 0.02,
+def hbm_tip_at(disk, f_hz, harmonics=(0, 1, 2, 3), pad_hz: float = 1.0, max_step: float = DEFAULT_MAX_STEP,
                **continuation_options) -> np.ndarray:
     """First-harmonic tip amplitude of the harmonic balance at the exact frequencies ``f_hz``
     [Hz], to compare with a :class:`DiskTimeResponse`: the FRF by continuation over the range
@@ -1043,12 +1097,12 @@ def hbm_tip_at(disk, f_hz, harmonics=(0, 1, 2, 3), pad_hz: float = 1.0, max_step
     corrected there by Newton on the HBM residual (to 1e-12 of the solution).
 
     ``harmonics=None`` uses ``frequency_response``'s default. Returns (n, 3) [m] for a
-    TunedDisk (the reference blade), (n, s, 3) for a MistunedDisk (every blade).
+    TunedDisk (the reference blade), (n, s, 3) for a model of s = ``disk.n_sector`` blades (a
+    MistunedDisk: every blade).
     """
     import warnings
 
     from . import validation
-    from .disk import TunedDisk
 
     f_hz = np.atleast_1d(np.asarray(validation.positive("f_hz (excitation frequency, Hz)", f_hz), dtype=float))
     validation.positive("pad_hz", pad_hz)
@@ -1079,5 +1133,6 @@ def hbm_tip_at(disk, f_hz, harmonics=(0, 1, 2, 3), pad_hz: float = 1.0, max_step
             raise RuntimeError(f"HBM Newton did not converge at {f} Hz")
         out.append(disk.output_amplitudes(sol.x.reshape(1, basis.n_coeffs, -1), basis)[0])
     out = np.array(out)                                              # (n, 3 s)
-    return out if isinstance(disk, TunedDisk) else out.reshape(len(f_hz), -1, 3)
+    n_sector = getattr(disk, "n_sector", None)          # blades written out (MistunedDisk); a TunedDisk: its sector
+    return out if n_sector is None else out.reshape(len(f_hz), n_sector, 3)
 

@@ -100,14 +100,14 @@ def plausible(name: str, value, low: float, high: float, unit: str, reason: str 
     is exempt (it means "absent" for a damper mass). Returns ``value`` unchanged.
 
     ``reason`` says where the range comes from; the message reads e.g. "damper mass = 1 kg is
-    outside the plausible range 1e-05-0.1 kg (...); SI units: masses in kg, lengths in m"."""
+    outside the plausible range 1e-05-0.1 kg (...): check its unit (SI: kg, m)", one sentence."""
     import warnings
 
     arr = np.asarray(value, dtype=float)
     outside = (arr != 0) & ((arr < low) | (arr > high))
     if np.any(outside):
         why = f" ({reason})" if reason else ""
-        warnings.warn(f"{name} = {value!r} {unit} is outside the plausible range {low:g}-{high:g} {unit}{why}; "
-                      "bladedamp takes SI units: masses in kg, lengths in m",
+        warnings.warn(f"{name} = {value!r} {unit} is outside the plausible range {low:g}-{high:g} {unit}{why}: "
+                      "check its unit (SI: kg, m)",
                       PlausibilityWarning, stacklevel=_outside_caller_level())
     return value

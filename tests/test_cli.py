@@ -441,12 +441,34 @@ def test_frf_leads_with_the_status_and_names_a_range_end_maximum(tmp_path, capsy
     assert r["peak_at_range_end"] and r["peak_frequency_hz"] == pytest.approx(105.0, abs=1e-9)
     free, stuck = r["linear_natural_frequencies_hz"]
     assert free == pytest.approx(95.0) and stuck == pytest.approx(109.65, abs=0.01)
-    assert r["status"] == "complete, verified" and "may lie above the range" in r["status_message"]
+    assert r["status"] == "complete, verified" and "may lie above" in r["status_message"]
     assert f"EO1: {r['status_message']}" in err                          # the status leads the output
     assert f"EO1 largest amplitude at the range end {r['peak_amplitude_mm']:.4f} mm at 105.000 Hz" in err
     assert "EO1 peak" not in err
     assert f"- **EO1**: {r['status_message']}" in summary
     assert "| EO1 | complete, verified | (1,) |" in summary and "(largest amplitude at the range end)" in summary
+
+
+def test_frf_calls_an_amplitude_beyond_the_model_a_failed_check(tmp_path, capsys):
+    """issue 32: a 0.05 g cylinder on blades without viscous damping reaches the end of its range
+    with a 1.69 m tip amplitude. The command leads with the failed amplitude check, not with a
+    success, and leaves out the damper-free reference (no bounded response without the damper)
+    with a note instead of a traceback."""
+    path = tmp_path / "undamped.toml"
+    path.write_text("[blade]\ndamping_ratio = 0.0\n\n[damper]\nmass_g = 0.05\n\n[analysis]\nharmonics = [1]\n")
+    out = tmp_path / "frf"
+    assert main(["frf", str(path), "--no-stop-check", "--no-peak-check", "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    summary, results = _outputs(out, "frf.png", "summary.md", "results.json")
+    r = results["responses"]["EO1"]
+    assert r["status"] == "check failed" and not r["success"] and r["peak_amplitude_mm"] > 1e3
+    assert "small-deformation" in r["status_message"] and f"EO1: {r['status_message']}" in err
+    assert "EO1 peak (check failed) " in err
+    assert "undamped_peak_amplitude_mm" not in r
+    assert [line for line in err.splitlines() if line.startswith("note: ")] == [
+        "note: no damper-free reference: without the damper a blade mode with damping_ratio = 0 lies in 90-105 Hz, "
+        "where its amplitude has no bound"], err
+    assert "Traceback" not in err
 
 
 # ---------------------------------------------------------------------------------------
@@ -457,8 +479,8 @@ WARNING_TEXT = re.compile(r"\w*Warning\b|\.py:\d+|File \"")     # a category, a 
 
 def test_frf_gives_the_library_warnings_as_plain_notes(small_design, tmp_path, capsys):
     """One harmonic on the 4-blade disk: the library raises an AccuracyWarning (its peak check's
-    verdict, once); the command prints it as one plain line, without category or source line,
-    and writes it to summary.md and results.json."""
+    verdict, once); the command says it as one plain line, without category or source line: the
+    response's status line, which the note does not repeat (Notes.said)."""
     import warnings
 
     from bladedamp.design import load_design
@@ -477,10 +499,12 @@ def test_frf_gives_the_library_warnings_as_plain_notes(small_design, tmp_path, c
     assert main(["frf", str(small_design), "--no-stop-check", "--out", str(out)]) == 0
     err = capsys.readouterr().err
     assert not WARNING_TEXT.search(err), err
-    assert [line for line in err.splitlines() if line.startswith("note: ")] == [f"note: {said}"], err
-    assert err.splitlines()[-1] == f"note: {said}"       # at the end of the run
+    # the warning is the sentence the result's status gives (issue 33: one plain sentence), said
+    # once, in the status line that leads the output, and not again as a note
+    assert f"EO1: complete, above tolerance: {said}." in err.splitlines(), err
+    assert err.count(said) == 1 and not [line for line in err.splitlines() if line.startswith("note: ")], err
     summary, results = _outputs(out, "summary.md", "results.json")
-    assert results["notes"] == [said] and f"## Notes\n\n- {said}\n" in summary
+    assert "notes" not in results and "## Notes" not in summary and summary.count(said) == 1
 
 
 def test_notes_merge_repeated_warnings_and_keep_numpy_and_numba_ones(capsys):

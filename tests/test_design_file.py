@@ -69,7 +69,8 @@ def test_template_comments_every_key_with_its_allowed_range_from_the_one_table()
             assert f.key not in table
         else:
             assert f.key in table, f.key
-        i = next(k for k, line in enumerate(lines) if line.startswith((f"{f.key} = ", f"# {f.key} = ")))
+        start = lines.index(f"[{f.table}]")         # the key's line in its own table (keys repeat across tables)
+        i = next(k for k, line in enumerate(lines) if k > start and line.startswith((f"{f.key} = ", f"# {f.key} = ")))
         comment = " ".join(line.lstrip("# ").strip() for line in lines[max(i - 4, 0):i] if line.startswith("#"))
         assert f"Allowed: {f.allowed}." in comment, (f.key, comment)
         assert f.reason in comment, f.key

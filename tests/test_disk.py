@@ -727,6 +727,9 @@ def test_check_peak_estimates_the_harmonic_error_by_time_integration(monkeypatch
     assert plain.peak_check is None and 0.02 < plain.harmonic_error < 0.08
     check = checked.peak_check
     assert check.status[0] == "drifting" and checked.success and "keeps rolling or walking" in checked.message
+    # its status: a drift, which a richer harmonic set does not remove, with the error it costs
+    assert "keeps rolling at the peak" in checked.status_message
+    assert f"to {100 * checked.harmonic_error:.2g} % only" in checked.status_message
     k = int(np.argmax(checked.tip_amplitude.max(axis=1)))
     assert check.frequency_hz[0] == checked.frequency_hz[k]
     direct = np.abs(check.tip_amplitude[0].max(axis=0) - checked.tip_amplitude[k]).max() / checked.tip_amplitude.max()

@@ -12,7 +12,7 @@ import scipy.linalg
 import scipy.sparse
 
 from bladedamp.blade import ModalBlade, beam_modes
-from bladedamp.fe_formats import read_fe_matrices, read_op4
+from bladedamp.fe_formats import read_fe_matrices, read_matlab, read_op4
 from bladedamp.reference import reference_blade_geometry
 
 DATA = Path(__file__).parent / "data" / "fe"
@@ -114,6 +114,210 @@ def test_nastran_craig_bampton_output4_blade():
     assert np.all(blade.natural_frequencies_hz[6:] >= clamped[:2] * (1 - 1e-12))
 
 
+def nastran_eigenvalue_table(path, title="(AFTER AUGMENTATION OF RESIDUAL VECTORS)"):
+    """The rows (mode, eigenvalue, cycles) of the REAL EIGENVALUES table under ``title`` of a
+    Nastran listing (.f06/.out), as printed: the numbers and their strings. A table continued on
+    the next pages (the title repeated) is one table; a row of mode 1 starts a new one."""
+    rows, inside = [], False
+    for line in Path(path).read_text(errors="replace").splitlines():
+        if "R E A L   E I G E N V A L U E S" in line:
+            inside = False
+        if title in line:
+            inside = True
+            continue
+        fields = line.split()
+        if inside and len(fields) == 7 and fields[0].isdigit() and fields[1].isdigit():
+            if fields[0] == "1":
+                rows = []
+            rows.append((int(fields[0]), fields[2], fields[4]))
+        elif inside and rows and line.startswith("1"):     # the next page ends the table
+            inside = False
+    return rows
+
+
+def half_unit(printed: str) -> float:
+    """Half a unit of the last printed digit of a number printed as d.ddddddE+xx."""
+    mantissa, exponent = printed.upper().split("E")
+    return 0.5 * 10.0 ** (int(exponent) - len(mantissa.split(".")[1]))
+
+
+def test_nastran_extseout_output4_gives_the_frequencies_nastran_printed():
+    """NX Nastran 9.1 EXTSEOUT(MATOP4=...) of a Craig-Bampton component (binary OUTPUT4, KXX and
+    MXX: 4 boundary grids x 6 DOF, rows 1-24, then 22 modal coordinates) beside the listing of
+    the same run. With the boundary clamped, the blade read from the file has the fixed-interface
+    eigenvalues that run printed (16 modes and 6 residual vectors, the table after augmentation).
+
+    Bounds: the eigenvalues lambda agree with the printed EIGENVALUE column to half a unit of its
+    7th digit. Nastran keeps eigenvalues in single precision (every modal stiffness in the file is
+    a float32 number) and prints CYCLES computed in single precision from them: the blade's
+    frequencies sqrt(lambda)/2 pi (double precision) agree with the CYCLES column to half a unit
+    of its last digit plus three float32 roundings (2 pi, the square root, the division: 3 x 2^-24
+    relative), and the same sums in float32 print exactly Nastran's digits."""
+    table = nastran_eigenvalue_table(DATA / "outboard.out")
+    assert [r[0] for r in table] == list(range(1, 23))
+    fe = read_fe_matrices(DATA / "outboard.op4")
+    assert fe.names == ("MXX", "KXX") and fe.n == 46 and fe.labels is None
+    K, M = fe.stiffness.toarray(), fe.mass.toarray()
+    lam = scipy.linalg.eigh(K[24:, 24:], M[24:, 24:], eigvals_only=True)
+    printed_lam = np.array([float(r[1]) for r in table])
+    assert np.all(np.abs(lam - printed_lam) <= [half_unit(r[1]) for r in table])
+    q = np.diag(K)[24:]
+    assert np.array_equal(q.astype(np.float32).astype(float), q)         # the file holds float32 eigenvalues
+
+    points = {p: (0.0, 0.0, 0.0) for p in ("OL", "OR", "tip", "excitation")}
+    blade = ModalBlade.from_file(DATA / "outboard.op4", dof_map={p: range(25, 31) for p in points}, points=points,
+                                 n_modes=22, damping_ratios=0.01, fixed_dofs=range(1, 25))
+    cycles = np.array([float(r[2]) for r in table])
+    bound = np.array([half_unit(r[2]) for r in table]) + 3 * 2.0**-24 * cycles
+    assert np.all(np.abs(blade.natural_frequencies_hz - cycles) <= bound)
+    single = np.sqrt(q.astype(np.float32)) / np.float32(2 * np.pi)
+    assert [f"{float(f):.6E}" for f in single] == [r[2] for r in table]
+
+
+def test_nastran_punch_dmig_gives_the_frequencies_nastran_printed():
+    """MSC Nastran 2013 SOL 103 of a free-free beam (4 CBAR, a CONM2, coupled mass; GRDSET
+    leaves T3 and R1 of grids 1-5, SUPORT on grid 3): the deck's PARAM,EXTOUT (matrixpch in
+    test_case.bdf) punched KAAX and MAAX (test_case.pch, 10 x 10, 10 significant digits) and a
+    run of the same deck without it printed the REAL EIGENVALUES table (test_case.f06, Givens,
+    7 digits; ExportNastranKM's README: comment out PARAM,EXTOUT for the modes run). The eigenvalues of the file's
+    (K, M), with no further boundary condition, are the printed ones.
+
+    Bounds: each eigenvalue agrees with its print to half a unit of the 7th digit (the two
+    rigid-body modes of the SUPORT Nastran prints as exactly 0.0) plus what the punch's rounding
+    to 10 digits (|dK_ij| <= 5e-10 |K_ij|, the same for M) can move it, to first order
+    5e-10 (|phi|'|K||phi| + lambda |phi|'|M||phi|) for the mass-normalised mode phi (up to
+    5.7e-8 relative for mode 3, twice its half unit; 4e-9 for mode 7), plus eigh's n eps lambda_max.
+    The CYCLES column: the same relative bound plus half a unit of its last digit and three
+    float32 roundings, as in the EXTSEOUT test."""
+    table = nastran_eigenvalue_table(DATA / "test_case.f06", title="R E A L   E I G E N V A L U E S")
+    assert [r[0] for r in table] == list(range(1, 11))
+    fe = read_fe_matrices(DATA / "test_case.pch")
+    assert fe.names == ("MAAX", "KAAX") and fe.n == 10
+    assert fe.labels.tolist() == [[g, c] for g in range(1, 6) for c in (3, 4)]
+    K, M = fe.stiffness.toarray(), fe.mass.toarray()
+    lam, phi = scipy.linalg.eigh(K, M)
+    assert [r[1] for r in table[:2]] == ["0.0", "0.0"]
+    printed = np.array([float(r[1]) for r in table])
+    rounding = 5e-10 * (np.einsum("ik,ij,jk->k", abs(phi), abs(K), abs(phi))
+                        + lam * np.einsum("ik,ij,jk->k", abs(phi), abs(M), abs(phi)))
+    half = np.array([half_unit(r[1]) if "E" in r[1] else 0.0 for r in table])
+    assert np.all(np.abs(lam - printed) <= half + rounding + 10 * np.finfo(float).eps * lam[-1])
+    cycles = np.array([float(r[2]) for r in table[2:]])
+    bound = (np.array([half_unit(r[2]) for r in table[2:]])
+             + (3 * 2.0**-24 + rounding[2:] / lam[2:]) * cycles)
+    assert np.all(np.abs(np.sqrt(lam[2:]) / (2 * np.pi) - cycles) <= bound)
+
+
+def test_matlab_file_of_nastran_system_matrices_gives_the_frequencies_nastran_printed():
+    """pyyeti's nas2cam.mat: MAT-file v5 written by Yeti (db('save'), pyyeti's
+    mk_nas2cam_mat.y) from what NX Nastran 9's NAS2CAM DMAP wrote in the SEMFREQ run
+    assemble.dat (inboard and outboard external superelements on residual SE 0); struct nas with
+    kaa.k0, maa.k0 the residual's a-set (54 DOF). assemble.out is that run's listing: its REAL
+    EIGENVALUES table of SE 0 holds all 54 modes, the first six rigid-body modes (AUTOSUP).
+
+    Bounds: NX keeps eigenvalues in single precision (the file's own nas.lambda.k0 holds float32
+    numbers), so an elastic eigenvalue of the file's (K, M) agrees with the printed one to half
+    a unit of its 7th digit plus one float32 rounding (2^-24 relative) plus eigh's n eps
+    lambda_max; the CYCLES column to half a unit plus 3.5 float32 roundings relative (the
+    rounding of lambda halved by the square root, and 2 pi, the square root, the division). The
+    rigid-body eigenvalues, printed and computed, are rounding noise below n eps lambda_max."""
+    table = nastran_eigenvalue_table(DATA / "assemble.out", title="(BEFORE AUGMENTATION OF RESIDUAL VECTORS)")
+    assert [r[0] for r in table] == list(range(1, 55))
+    fe = read_fe_matrices(DATA / "nas2cam.mat", mass="nas.maa.k0", stiffness="nas.kaa.k0")
+    assert fe.names == ("nas.maa.k0", "nas.kaa.k0") and fe.n == 54 and fe.labels is None
+    K, M = fe.stiffness.toarray(), fe.mass.toarray()
+    lam = scipy.linalg.eigh(K, M, eigvals_only=True)
+    noise = 54 * np.finfo(float).eps * lam[-1]
+    printed = np.array([float(r[1]) for r in table])
+    assert np.all(np.abs(lam[:6]) <= noise) and np.all(np.abs(printed[:6]) <= noise)
+    half = np.array([half_unit(r[1]) for r in table[6:]])
+    assert np.all(np.abs(lam[6:] - printed[6:]) <= half + 2.0**-24 * lam[6:] + noise)
+    cycles = np.array([float(r[2]) for r in table[6:]])
+    bound = np.array([half_unit(r[2]) for r in table[6:]]) + 3.5 * 2.0**-24 * cycles
+    assert np.all(np.abs(np.sqrt(lam[6:]) / (2 * np.pi) - cycles) <= bound)
+    own = read_matlab(DATA / "nas2cam.mat")["nas.lambda.k0"].ravel()
+    assert np.array_equal(own.astype(np.float32).astype(float), own)     # single precision
+
+
+def test_matlab_file_craig_bampton_blade_gives_the_frequencies_nastran_printed():
+    """The same nas2cam.mat holds the outboard superelement's KAA, MAA (nas.kaa.k101,
+    nas.maa.k101): the Craig-Bampton component of outboard.op4, rows ordered as nas.uset.k101
+    says, the 22 modal coordinates (SPOINTs 1995001-1995022) first, then grids 3, 11, 19, 27 x 6.
+    A blade read from the MAT-file with those grids clamped has the fixed-interface frequencies
+    the outboard run printed (outboard.out), with the bounds of the EXTSEOUT OUTPUT4 test: the
+    eigenvalues to half a unit of the 7th digit, the CYCLES column plus three float32 roundings."""
+    table = nastran_eigenvalue_table(DATA / "outboard.out")
+    uset = read_matlab(DATA / "nas2cam.mat")["nas.uset.k101"]
+    assert list(uset[:22, 0]) == list(range(1995001, 1995023)) and not uset[:22, 1].any()
+    assert uset[22:, :2].tolist() == [[g, c] for g in (3, 11, 19, 27) for c in range(1, 7)]
+    fe = read_fe_matrices(DATA / "nas2cam.mat", mass="nas.maa.k101", stiffness="nas.kaa.k101")
+    K, M = fe.stiffness.toarray(), fe.mass.toarray()
+    lam = scipy.linalg.eigh(K[:22, :22], M[:22, :22], eigvals_only=True)
+    assert np.all(np.abs(lam - [float(r[1]) for r in table]) <= [half_unit(r[1]) for r in table])
+    points = {p: (0.0, 0.0, 0.0) for p in ("OL", "OR", "tip", "excitation")}
+    blade = ModalBlade.from_file(DATA / "nas2cam.mat", mass="nas.maa.k101", stiffness="nas.kaa.k101",
+                                 dof_map={p: range(1, 7) for p in points}, points=points, n_modes=22,
+                                 damping_ratios=0.01, fixed_dofs=range(23, 47))
+    cycles = np.array([float(r[2]) for r in table])
+    bound = np.array([half_unit(r[2]) for r in table]) + 3 * 2.0**-24 * cycles
+    assert np.all(np.abs(blade.natural_frequencies_hz - cycles) <= bound)
+
+
+def test_matlab_struct_fields_are_named_as_matlab_writes_them(tmp_path):
+    """A scalar struct's fields (at any depth) are variables "struct.field", in v5 files
+    (scipy.io.savemat writes a dict as a struct) and in v7.3 (a struct is an HDF5 group)."""
+    M, K, _, _ = reference_matrices()
+    path = tmp_path / "v5.mat"
+    scipy.io.savemat(path, {"FEM": {"K": K, "M": M, "info": {"n": 3.0}}})
+    assert sorted(read_matlab(path)) == ["FEM.K", "FEM.M", "FEM.info.n"]
+    fe = read_fe_matrices(path, mass="FEM.M", stiffness="FEM.K")
+    np.testing.assert_array_equal(fe.stiffness.toarray(), K)
+    with pytest.raises(ValueError, match=r"no matrix named 'FEM\.X' \(mass\); the file holds \['FEM\.K'"):
+        read_fe_matrices(path, mass="FEM.X", stiffness="FEM.K")
+    h5py = pytest.importorskip("h5py")
+    path = tmp_path / "v73.mat"
+    with h5py.File(path, "w", userblock_size=512) as f:
+        g = f.create_group("FEM")
+        g.attrs["MATLAB_class"] = np.bytes_("struct")
+        g["K"], g["M"] = K.T, M.T                       # MATLAB stores column-major
+    fe = read_fe_matrices(path, mass="FEM.M", stiffness="FEM.K")
+    np.testing.assert_array_equal(fe.mass.toarray(), M)
+
+
+def test_nastran_64bit_binary_output4_equals_its_text_twin():
+    """MSC Nastran 2007 run with 8-byte integers (mode=i8) wrote the same four matrices (one of
+    10 000 001 columns) as text (header NCOL, NROW in 16 characters: format ...|I16) and as
+    binary in the 64-bit layout (48-byte headers, 8-byte integers and reals), dense, sparse and
+    sparse 'bigmat': the binary files give the text file's numbers exactly (16 digits carry a
+    double exactly)."""
+    text = read_op4(DATA / "nas_large_dim_bigmat_ascii.op4")
+    assert sorted(text) == ["MATD", "MATD21", "MATD22A", "MATDT"]
+    assert text["MATD"][1:3] == (19, 10000001) and text["MATDT"][1:3] == (10000001, 19)
+    for layout in ("bigmat", "nonbigmat", "dense"):
+        binary = read_op4(DATA / f"nas_large_dim_{layout}_binary.op4")
+        assert (DATA / f"nas_large_dim_{layout}_binary.op4").read_bytes()[:4] == struct.pack("<i", 48)
+        assert sorted(binary) == sorted(text)
+        for name, (a, nra, nca, _) in text.items():
+            b, nrb, ncb, _ = binary[name]
+            assert (nra, nca) == (nrb, ncb)
+            ka = sorted(zip(a.cols, a.rows, a.vals))
+            kb = sorted(zip(b.cols, b.rows, b.vals))
+            assert ka == kb and len(ka) > 0
+
+
+def test_nastran_64bit_big_endian_binary_output4():
+    """MSC Nastran (mode=i8) read the text file rd.op4 and wrote its matrices big-endian in the
+    64-bit binary layout (rdbin.op4, a dense 5 x 6, an empty 10 x 19 and a 1 x 1): the same numbers."""
+    text, binary = read_op4(DATA / "rd.op4"), read_op4(DATA / "rdbin.op4")
+    assert (DATA / "rdbin.op4").read_bytes()[:4] == struct.pack(">i", 48)
+    assert sorted(text) == sorted(binary) == ["R1", "R2", "R3"]
+    for name in text:
+        (a, nra, nca, _), (b, nrb, ncb, _) = text[name], binary[name]
+        assert (nra, nca) == (nrb, ncb)
+        assert sorted(zip(a.cols, a.rows, a.vals)) == sorted(zip(b.cols, b.rows, b.vals))
+    assert text["R1"][1:3] == (5, 6) and len(text["R1"][0].vals) == 20 and len(text["R2"][0].vals) == 0
+
+
 def test_abaqus_matrix_generate_beam_blade():
     """Abaqus *MATRIX GENERATE of one B33 beam element (nodes 1, 2 and internal node -1;
     MATRIX INPUT lines, lower triangle): the file's values land at (node, DOF) and the blade
@@ -183,13 +387,20 @@ def write_op4_text(path, matrices):
             fh.write(f"{n + 1:8d}{1:8d}{1:8d}\n{1.0:26.17E}\n")
 
 
-def write_op4_binary(path, matrices, order="<"):
+def write_op4_binary(path, matrices, order="<", word=4):
+    """Binary OUTPUT4, sparse strings, per the format's description: 4-byte words (a double is
+    two) or, as Nastran's 64-bit integer build writes, 8-byte words (48-byte header with the name
+    as two words of 4 characters; integers and doubles one 8-byte word each)."""
+    i = "i" if word == 4 else "q"
+    per_double = 8 // word
+
     def record(payload):
         return struct.pack(order + "i", len(payload)) + payload + struct.pack(order + "i", len(payload))
     out = b""
     for name, A in matrices.items():
         n = A.shape[0]
-        out += record(struct.pack(order + "4i", n, n, 6, 2) + f"{name:<8s}".encode())
+        label = f"{name:<8s}".encode() if word == 4 else f"{name[:4]:<8s}{name[4:8]:<8s}".encode()
+        out += record(struct.pack(order + "4" + i, n, n, 6, 2) + label)
         for j in range(n):
             words = b""                                   # sparse strings: IS = IROW + 65536 (L + 1)
             nz = np.flatnonzero(A[:, j])
@@ -197,10 +408,10 @@ def write_op4_binary(path, matrices, order="<"):
                 continue
             runs = np.split(nz, np.flatnonzero(np.diff(nz) > 1) + 1)
             for run in runs:
-                words += struct.pack(order + "i", int(run[0]) + 1 + 65536 * (2 * run.size + 1))
+                words += struct.pack(order + i, int(run[0]) + 1 + 65536 * (per_double * run.size + 1))
                 words += A[run, j].astype(order + "f8").tobytes()
-            out += record(struct.pack(order + "3i", j + 1, 0, len(words) // 4) + words)
-        out += record(struct.pack(order + "3i", n + 1, 1, 2) + np.float64(1.0).astype(order + "f8").tobytes())
+            out += record(struct.pack(order + "3" + i, j + 1, 0, len(words) // word) + words)
+        out += record(struct.pack(order + "3" + i, n + 1, 1, per_double) + np.float64(1.0).astype(order + "f8").tobytes())
     Path(path).write_bytes(out)
 
 
@@ -237,7 +448,8 @@ def write_matlab_v73(path, matrices):
         fh.write(b"MATLAB 7.3 MAT-file, written by the bladedamp tests".ljust(116) + b"\x00" * 8 + b"\x00\x02IM")
 
 
-@pytest.mark.parametrize("fmt", ["op4-text", "op4-binary-le", "op4-binary-be", "dmig", "abaqus", "mat-v5", "mat-v73"])
+@pytest.mark.parametrize("fmt", ["op4-text", "op4-binary-le", "op4-binary-be", "op4-binary-64-le", "op4-binary-64-be",
+                                 "dmig", "abaqus", "mat-v5", "mat-v73"])
 def test_reference_blade_matrices_in_every_format_give_the_same_frf(tmp_path, fmt):
     M, K, nodes, points = reference_matrices()
     direct = ModalBlade.from_matrices(M, K, {p: range(6 * k - 6, 6 * k) for p, k in nodes.items()}, points=points,
@@ -249,7 +461,7 @@ def test_reference_blade_matrices_in_every_format_give_the_same_frf(tmp_path, fm
         write_op4_text(path, {"KAA": K, "MAA": M})
     elif fmt.startswith("op4-binary"):
         path = tmp_path / "blade.op4"
-        write_op4_binary(path, {"KAA": K, "MAA": M}, "<" if fmt.endswith("le") else ">")
+        write_op4_binary(path, {"KAA": K, "MAA": M}, "<" if fmt.endswith("le") else ">", 8 if "-64-" in fmt else 4)
     elif fmt == "dmig":
         path = tmp_path / "blade.pch"
         write_dmig(path, {"KAAX": K, "MAAX": M})
@@ -297,6 +509,51 @@ def test_truncated_binary_output4(tmp_path):
     path = tmp_path / "cut.op4"
     path.write_bytes(data[:1000])
     with pytest.raises(ValueError, match=r"cut\.op4: record \d+ \(byte \d+\): .*expected a complete Fortran"):
+        read_op4(path)
+
+
+def test_bad_64bit_binary_output4(tmp_path):
+    """The 64-bit binary layout's bad files: truncated, a 32-bit header after a 64-bit one, a
+    string running past its column, a column whose word count disagrees with NW; and a text
+    header with |I16 whose wide fields are not numbers. One ValueError each naming the file, the
+    record (or line) and what was expected."""
+    data = (DATA / "nas_large_dim_bigmat_binary.op4").read_bytes()
+    path = tmp_path / "cut.op4"
+    path.write_bytes(data[:3000])
+    with pytest.raises(ValueError, match=r"cut\.op4: record \d+ \(byte \d+\): length marker \d+ does not match; "
+                                         r"expected a complete Fortran unformatted record"):
+        read_op4(path)
+    M, K, _, _ = reference_matrices()
+    write_op4_binary(tmp_path / "a.op4", {"KAA": K}, word=8)
+    write_op4_binary(tmp_path / "b.op4", {"MAA": M}, word=4)
+    path = tmp_path / "mixed.op4"
+    path.write_bytes((tmp_path / "a.op4").read_bytes() + (tmp_path / "b.op4").read_bytes())
+    with pytest.raises(ValueError, match=r"mixed\.op4: record \d+: 24 bytes; expected a 48-byte matrix header "
+                                         r"\(NCOL, NROW, FORM, TYPE, NAME in 8-byte words"):
+        read_op4(path)
+    good = bytearray((tmp_path / "a.op4").read_bytes())
+    # the first column record: marker (4 bytes), ICOL, IROW, NW (8 bytes each), IS of its first string
+    at = 4 + 48 + 4 + 4 + 24
+    irow_l = struct.unpack("<q", good[at:at + 8])[0]
+    bad = bytearray(good)
+    bad[at:at + 8] = struct.pack("<q", irow_l + 65536 * 100)          # a string 100 words longer
+    path.write_bytes(bytes(bad))
+    with pytest.raises(ValueError, match=r"mixed\.op4: record 2: a string of \d+ words at word 0; expected a "
+                                         r"multiple of 1 inside the column's \d+ words"):
+        read_op4(path)
+    bad = bytearray(good)
+    bad[at - 8:at] = struct.pack("<q", struct.unpack("<q", good[at - 8:at])[0] + 1)   # NW one word too many
+    path.write_bytes(bytes(bad))
+    with pytest.raises(ValueError, match=r"mixed\.op4: record 2: \d+ data words; expected NW = \d+ \(column 1 of "
+                                         r"matrix KAA, 8-byte words\)"):
+        read_op4(path)
+    lines = (DATA / "nas_large_dim_bigmat_ascii.op4").read_text().splitlines()
+    k = next(i for i, line in enumerate(lines) if line.endswith("|I16"))
+    lines[k] = "   nineteen     " + lines[k][16:]
+    path = tmp_path / "wide.op4"
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(ValueError, match=rf"wide\.op4: line {k + 1}: expected a matrix header NCOL, NROW \(16 "
+                                         r"characters each: the format ends in \|I16\)"):
         read_op4(path)
 
 
@@ -582,6 +839,21 @@ def test_cli_fe_blade_error_is_one_line_with_exit_code_2(tmp_path):
     assert len(lines) == 1 and "se.op4" in lines[0] and "row numbers" in lines[0], run.stderr
 
 
+def test_cli_bad_64bit_output4_blade_is_one_line_with_exit_code_2(tmp_path, capsys):
+    """A design file whose modal_file is a truncated 64-bit binary OUTPUT4: bladedamp frf stops with
+    one line naming the file, the record and what was expected, exit code 2."""
+    from conftest import one_error_line
+
+    from bladedamp.cli import main
+    M, K, _, _ = reference_matrices()
+    write_op4_binary(tmp_path / "whole.op4", {"KAA": K, "MAA": M}, word=8)
+    (tmp_path / "se.op4").write_bytes((tmp_path / "whole.op4").read_bytes()[:5100])
+    path = tmp_path / "design.toml"
+    path.write_text(FE_DESIGN.format(file="se.op4", fixed=[7]))
+    assert main(["frf", str(path), "--out", str(tmp_path / "out")]) == 2
+    one_error_line(capsys, "se.op4", "record", "expected a complete Fortran unformatted record")
+
+
 @pytest.mark.parametrize("suffix", ["op4", "pch", "mtx", "mat"])
 def test_missing_empty_or_folder_fe_files_are_one_file_read_error(tmp_path, suffix):
     from bladedamp.io import FileReadError, MissingFileError
@@ -594,3 +866,40 @@ def test_missing_empty_or_folder_fe_files_are_one_file_read_error(tmp_path, suff
     (tmp_path / f"dir.{suffix}").mkdir()
     with pytest.raises(FileReadError, match=rf"dir\.{suffix}: is a folder, not a finite-element matrix file"):
         read_fe_matrices(tmp_path / f"dir.{suffix}")
+
+
+def test_readme_fe_examples_run_from_the_files_in_the_repository(tmp_path, monkeypatch):
+    """The README's section on FE exports: its Python examples run (from the repository's root,
+    the Ansys one with the ansys extra) and its design file builds the blade it describes."""
+    import re
+    import warnings
+
+    from bladedamp.design import load_design
+    root = Path(__file__).parents[1]
+    text = (root / "README.md").read_text()
+    section = text[text.index("### Blades from Nastran, Abaqus, MATLAB and Ansys exports"):
+                   text.index("### A solid FE blade from the geometry")]
+    blocks = re.findall(r"```python\n(.*?)```", section, re.S)
+    assert len(blocks) == 4
+    monkeypatch.chdir(root)
+    namespace = {}
+    for code in blocks:
+        if "ansys" in code and not _has_ansys():
+            continue
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            exec(compile(code, "README.md", "exec"), namespace)
+        assert namespace["blade"].n_modes >= 1
+    (toml,) = re.findall(r"```toml\n(.*?)```", section, re.S)
+    path = tmp_path / "design.toml"
+    path.write_text(toml.replace('modal_file = "tests/', f'modal_file = "{root.as_posix()}/tests/'))
+    blade = load_design(path).disk.blade
+    assert blade.n_modes == 4 and set(blade.points) >= {"OL", "OR", "tip", "excitation", "platform"}
+
+
+def _has_ansys():
+    try:
+        import ansys.mapdl.reader  # noqa: F401
+    except ImportError:
+        return False
+    return True

@@ -243,6 +243,104 @@ def test_from_test_of_the_public_mode_file_needs_what_it_lacks():
     np.testing.assert_array_equal(blade.mode_shapes["tip"][:, 0], modes.shapes[modes.node_index(10), :, 0] / 2.0)
 
 
+# ----- the design file: [blade] modal_file of measured modes with [blade.test] ----------------
+TEST_DESIGN = """[blade]
+modal_file = "modes.uff"
+{extra}
+[blade.test.OL]
+node = 11
+
+[blade.test.OR]
+node = 12
+
+[blade.test.tip]
+node = 13
+
+[blade.test.excitation]
+node = 14
+{points}"""
+
+
+def write_test_design(tmp_path, extra="", points="", modes=None):
+    (tmp_path / "modes.uff").write_bytes((modes or DATA / "reference_blade_modes.uff").read_bytes())
+    path = tmp_path / "design.toml"
+    path.write_text(TEST_DESIGN.format(extra=extra, points=points))
+    return path
+
+
+def test_design_file_measured_modes_blade_is_from_test_with_the_same_arguments(tmp_path):
+    """[blade] modal_file = a UFF 55 file with the node tables [blade.test.*] builds the blade that
+    ModalBlade.from_test builds from the same file and nodes; [blade.test] modal_mass_kg, a
+    position_mm and [blade] damping_ratio reach it as modal_masses, positions and damping_ratios."""
+    from bladedamp.design import load_design
+    design = load_design(write_test_design(tmp_path))
+    want = bd.ModalBlade.from_test(DATA / "reference_blade_modes.uff", NODES)
+    got = design.disk.blade
+    np.testing.assert_array_equal(got.natural_frequencies_hz, want.natural_frequencies_hz)
+    np.testing.assert_array_equal(got.damping_ratios, want.damping_ratios)
+    for n in NODES:
+        np.testing.assert_array_equal(got.mode_shapes[n], want.mode_shapes[n])
+        np.testing.assert_array_equal(got.points[n], want.points[n])
+
+    design = load_design(write_test_design(tmp_path, extra="damping_ratio = 0.003\n\n[blade.test]\nmodal_mass_kg = 4.0\n",
+                                           points="position_mm = [1.0, 2.0, 3.0]\n"))
+    want = bd.ModalBlade.from_test(DATA / "reference_blade_modes.uff", NODES, modal_masses=4.0, damping_ratios=0.003,
+                                   positions={"excitation": (1e-3, 2e-3, 3e-3)})
+    got = design.disk.blade
+    np.testing.assert_array_equal(got.damping_ratios, want.damping_ratios)
+    np.testing.assert_array_equal(got.mode_shapes["tip"], want.mode_shapes["tip"])
+    np.testing.assert_allclose(got.points["excitation"], (1e-3, 2e-3, 3e-3), rtol=1e-15)
+    assert got.damping_ratios.tolist() == [0.003] * got.n_modes
+
+
+@pytest.mark.parametrize("extra, points, expected", [
+    ("", "\n[blade.test.platform]\nposition_mm = [0.0, 0.0, 1.0]\n", r"\[blade\.test\.platform\] node is required"),
+    ("n_modes = 2\n", "", r"\[blade\] n_modes applies to the beam model only"),
+    ("\n[blade.test]\nmodal_mass_kg = -1.0\n", "", r"\[blade\.test\] modal_mass_kg = -1\.0"),
+    ("\n[blade.test]\nunits = \"mm\"\n", "", r"\[blade\.test\] units = \"mm\""),
+])
+def test_design_file_measured_modes_errors_are_one_line_naming_the_key(tmp_path, extra, points, expected):
+    from bladedamp.design import DesignError, load_design
+    with pytest.raises(DesignError, match=expected) as info:
+        load_design(write_test_design(tmp_path, extra, points))
+    assert "\n" not in str(info.value)
+
+
+def test_design_file_measured_modes_bad_nodes_files_and_keys(tmp_path):
+    from bladedamp.design import DesignError, load_design
+    path = write_test_design(tmp_path)
+    path.write_text(path.read_text().replace("[blade.test.excitation]\nnode = 14\n", ""))
+    with pytest.raises(DesignError, match=r"\[blade\.test\.excitation\] is required with a measured mode file"):
+        load_design(path)
+    path = write_test_design(tmp_path)
+    path.write_text(path.read_text().replace("node = 13", "node = 99"))
+    with pytest.raises(DesignError, match=r"modal_file = \"modes\.uff\": .*modes\.uff: no node 99 in the mode shapes "
+                                          r".*\[blade\.test\.<point>\] position_mm"):
+        load_design(path)
+    path = write_test_design(tmp_path, modes=DATA / "pyuff_uff55_translation_rotation.uff")
+    with pytest.raises(DesignError, match=r"modes\.uff: no dataset 164 .*give units='SI'.*\(the design file's keys: "
+                                          r"\[blade\.test\] modal_mass_kg and units"):
+        load_design(path)
+    path = write_test_design(tmp_path)
+    path.write_text(path.read_text().replace('modal_file = "modes.uff"', 'modal_file = "blade.npz"'))
+    with pytest.raises(DesignError, match=r"\[blade\.test\.OL\] node applies to a measured mode file as \[blade\] "
+                                          r"modal_file \(ending in \.uff, \.unv, \.uf\)"):
+        load_design(path)
+    path = write_test_design(tmp_path)
+    (tmp_path / "modes.uff").write_text((DATA / "reference_blade_modes.uff").read_text()[:2000])
+    with pytest.raises(DesignError, match=r"modal_file = \"modes\.uff\": .*modes\.uff: line \d+: dataset .* has no "
+                                          r"closing -1 line"):
+        load_design(path)
+
+
+def test_cli_measured_modes_design_error_is_one_line_with_exit_code_2(tmp_path, capsys):
+    from conftest import one_error_line
+    path = write_test_design(tmp_path)
+    path.write_text(path.read_text().replace("node = 13", "node = 99"))
+    assert main(["frf", str(path), "--out", str(tmp_path / "o")]) == 2
+    one_error_line(capsys, "modes.uff", "no node 99")
+
+
 # ----- bad files ------------------------------------------------------------------------------
 def test_bad_files_give_one_error_naming_the_file(tmp_path):
     good = write_58(tmp_path / "a.uff", H)

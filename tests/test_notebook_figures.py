@@ -159,6 +159,22 @@ def test_mass_study_figure(disk_cache):
     check_figure(widgets.mass_study_figure(1.0, sweeps=sweeps, cache=disk_cache), "reference disk")
 
 
+def test_engine_order_study_figure():
+    """Figs. 7 and 8 over engine order from the best points of mass sweeps (the figure reads
+    only those: built by hand, the values notebook 03 finds; the cylinder rolls at EO 0)."""
+    def sweep(best_reduction, best_mass_g):
+        return {"best_reduction": best_reduction, "best_mass_g": best_mass_g}
+    studies = {"cylinder": [sweep(0.0, 0.3), sweep(0.71, 1.0), sweep(0.90, 3.0), sweep(0.96, 10.0)],
+               "wedge": [sweep(0.80, 0.3), sweep(0.82, 0.3), sweep(0.90, 3.0), sweep(0.96, 10.0)]}
+    fig = widgets.engine_order_study_figure(studies, (0, 1, 2, 8))
+    check_figure(fig, "reference disk")
+    left, right = fig.axes[:2]
+    np.testing.assert_allclose(left.get_lines()[0].get_ydata(), [100, 29, 10, 4])    # 1 - best reduction [%]
+    assert np.isnan(right.get_lines()[0].get_ydata()[0])         # no optimum where no mass damps
+    with pytest.raises(ValueError, match="studies"):
+        widgets.engine_order_study_figure(studies, (0, 1))
+
+
 def test_platform_angle_figure(disk_cache):
     check_figure(widgets.platform_angle_figure(35.0, cache=disk_cache), "reference disk")
 
@@ -180,3 +196,85 @@ def test_mistuning_explorer_figure(explorer, pattern):
     fig = explorer.figure(pattern, 0, 2.0)
     assert fig.amplification is not None
     check_figure(fig, "reference disk")
+
+
+# ---------------------------------------------------------------------------------------
+# every figure the notebooks show, their own cells' figures included (executed, slow)
+# ---------------------------------------------------------------------------------------
+#: what a notebook figure's title may name as its design: the contact point and the oscillator of
+#: notebook 01, the reference disk and its dampers, the blades of notebook 07
+NOTEBOOK_DESIGNS = ("friction contact point", "friction oscillator", "reference disk", "cylinder", "wedge", "blade")
+
+#: run first in the notebook's kernel (not saved): checks, with tests/figure_checks.py, every
+#: figure as it is shown (``plt.show`` and the inline backend's end-of-cell display, slider
+#: callbacks included) and keeps the problems with the first line of the cell that showed it
+FIGURE_WATCH = '''
+import sys as _sys
+_sys.path.insert(0, {tests!r})
+import matplotlib.pyplot as _plt
+from IPython import get_ipython as _get_ipython
+from figure_checks import figure_problems as _figure_problems, titles as _titles
+
+_figure_watch = {{"problems": [], "checked": set(), "count": 0, "cell": ""}}
+
+
+def _note_cell(info):
+    _figure_watch["cell"] = info.raw_cell.strip().splitlines()[0][:60] if info.raw_cell.strip() else ""
+
+
+def _check_open_figures(*args, **kwargs):
+    for _num in _plt.get_fignums():
+        _fig = _plt.figure(_num)
+        if id(_fig) in _figure_watch["checked"]:
+            continue
+        _figure_watch["checked"].add(id(_fig))
+        _figure_watch["count"] += 1
+        _found = _figure_problems(_fig, None)
+        if not any(d in t.lower() for t in _titles(_fig) for d in {designs!r}):
+            _found.append(f"no title names the design (titles: {{_titles(_fig)}})")
+        _figure_watch["problems"] += [f"cell {{_figure_watch['cell']!r}}: {{p}}" for p in _found]
+
+
+_show = _plt.show
+def _checked_show(*args, **kwargs):
+    _check_open_figures()
+    return _show(*args, **kwargs)
+_plt.show = _checked_show
+_get_ipython().events.register("pre_run_cell", _note_cell)
+_get_ipython().events.callbacks["post_execute"].insert(0, _check_open_figures)
+'''
+
+#: run last: the problems found, as JSON on stdout
+FIGURE_REPORT = 'import json as _json\nprint(_json.dumps({"count": _figure_watch["count"], "problems": _figure_watch["problems"]}))'
+
+
+def notebook_figure_problems(path, timeout=600) -> tuple[int, list[str]]:
+    """Executes the notebook at ``path`` (its folder the kernel's working directory) with
+    :data:`FIGURE_WATCH` run first; returns (figures checked, problems)."""
+    import json
+    import pathlib
+
+    nbformat = pytest.importorskip("nbformat")
+    pytest.importorskip("nbclient")
+    from notebook_client import execute_notebook
+    nb = nbformat.read(path, as_version=4)
+    tests = str(pathlib.Path(__file__).resolve().parent)
+    nb.cells.insert(0, nbformat.v4.new_code_cell(FIGURE_WATCH.format(tests=tests, designs=NOTEBOOK_DESIGNS)))
+    nb.cells.append(nbformat.v4.new_code_cell(FIGURE_REPORT))
+    execute_notebook(nb, pathlib.Path(path).parent, timeout=timeout)
+    text = "".join(out["text"] for out in nb.cells[-1].outputs if out.get("name") == "stdout")
+    report = json.loads(text)
+    return report["count"], report["problems"]
+
+
+NOTEBOOK_PATHS = sorted((__import__("pathlib").Path(__file__).resolve().parents[1] / "notebooks").glob("*.ipynb"))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("path", NOTEBOOK_PATHS, ids=lambda p: p.name[:2])
+def test_every_figure_a_notebook_shows(path):
+    """Every figure a notebook shows -- its helpers' and those its own cells draw -- keeps the
+    slide rules of tests/figure_checks.py, with a title naming the design shown."""
+    count, problems = notebook_figure_problems(path)
+    assert count > 0
+    assert not problems, f"{path.name}: {count} figures, problems:\n  " + "\n  ".join(problems)

@@ -257,3 +257,70 @@ def test_readme_gives_the_reading_order_and_run_time_of_every_notebook():
     assert [int(order) for order, _, _ in rows] == list(range(1, len(NOTEBOOKS) + 1))
     for _, name, time in rows:
         assert re.fullmatch(r"(\d+ min )?\d+ s|\d+ min", time.strip()), (name, time)
+
+
+# ---------------------------------------------------------------------------------------
+# pip install -e ".[notebooks]" brings what every notebook imports
+# ---------------------------------------------------------------------------------------
+def _requirement_names(requirements) -> set[str]:
+    from packaging.requirements import Requirement
+    from packaging.utils import canonicalize_name
+
+    return {canonicalize_name(Requirement(r).name) for r in requirements}
+
+
+def _installed_closure(names: set[str]) -> set[str]:
+    """``names`` and, through the installed distributions' own requirements (not their extras),
+    every distribution they pull in."""
+    from importlib import metadata
+
+    from packaging.requirements import Requirement
+    from packaging.utils import canonicalize_name
+
+    todo, seen = list(names), set()
+    while todo:
+        name = todo.pop()
+        if name in seen:
+            continue
+        seen.add(name)
+        try:
+            requires = metadata.distribution(name).requires or []
+        except metadata.PackageNotFoundError:
+            continue
+        for spec in requires:
+            req = Requirement(spec)
+            if req.marker is None or req.marker.evaluate({"extra": ""}):
+                todo.append(canonicalize_name(req.name))
+    return seen
+
+
+def test_the_notebooks_extra_brings_every_notebook_import():
+    """Every module a notebook imports is the standard library's, bladedamp's or a distribution
+    that bladedamp's dependencies with the ``notebooks`` extra install; the extra holds the
+    ``viz`` (3D views, notebooks 04 and 07) and ``fe`` (the solid blade, notebook 07) extras,
+    which bladedamp imports lazily inside the functions those notebooks call."""
+    import sys
+    import tomllib
+    from importlib import metadata
+
+    from packaging.utils import canonicalize_name
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    extras = project["optional-dependencies"]
+    wanted = _requirement_names(project["dependencies"]) | _requirement_names(extras["notebooks"])
+    for extra in ("viz", "fe"):
+        assert _requirement_names(extras[extra]) <= wanted, extra
+    installed = _installed_closure(wanted)
+    provided = metadata.packages_distributions()
+    missing = []
+    for path in NOTEBOOKS:
+        for cell in json.loads(path.read_text(encoding="utf-8"))["cells"]:
+            if cell["cell_type"] != "code":
+                continue
+            for module in re.findall(r"^\s*(?:from|import)\s+(\w+)", "".join(cell["source"]), re.MULTILINE):
+                if module in sys.stdlib_module_names or module == "bladedamp":
+                    continue
+                dists = {canonicalize_name(d) for d in provided.get(module, [])}
+                if not dists & installed:
+                    missing.append(f"{path.name}: {module} ({', '.join(sorted(dists)) or 'not installed'})")
+    assert not missing, missing

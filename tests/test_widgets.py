@@ -294,3 +294,31 @@ def test_interact_with_image_saves_the_first_figure_beside_the_widget():
 
     drawn = base64.b64decode(png) if isinstance(png, str) else png
     assert drawn[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_notebook_with_an_interactive_figure_executes_headless(tmp_path):
+    """A notebook whose cell calls interact_with_image runs headless through nbclient (what
+    ``jupyter nbconvert --execute`` and nbval drive; tests/notebook_client.py) without waiting for
+    a front end: the whole notebook within a 60 s timeout per cell and 90 s in all, and the saved
+    cell output holds the widget view and its still PNG."""
+    import time
+
+    nbformat = pytest.importorskip("nbformat")
+    pytest.importorskip("nbclient")
+    pytest.importorskip("ipywidgets")
+    from notebook_client import execute_notebook
+
+    cells = ["%matplotlib inline\nimport matplotlib.pyplot as plt\nfrom ipywidgets import FloatSlider\n"
+             "from bladedamp.viz import widgets as W",
+             "W.interact_with_image(W.interactive_view(W.hysteresis_figure),\n"
+             "                      amplitude_mm=FloatSlider(value=0.1, min=0.01, max=0.5, step=0.01))",
+             "print('after the interactive figure')"]
+    nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(c) for c in cells])
+    t0 = time.perf_counter()
+    execute_notebook(nb, tmp_path, timeout=60)
+    elapsed = time.perf_counter() - t0
+    assert elapsed < 90, elapsed
+    widget_outputs = [out for out in nb.cells[1].outputs if "application/vnd.jupyter.widget-view+json" in out.get("data", {})]
+    assert len(widget_outputs) == 1 and "image/png" in widget_outputs[0]["data"]
+    assert not any(out.get("name") == "stderr" for cell in nb.cells for out in cell.outputs)
+    assert nb.cells[2].outputs[0]["text"] == "after the interactive figure\n"

@@ -168,8 +168,8 @@ class Dashboard:
         text = (f"peak {1e3 * damped.peak_amplitude:.3f} mm at {damped.peak_frequency_hz:.2f} Hz, "
                 f"reduction {100 * damped.reduction(free):.1f} % against no damper ({damped.seconds:.1f} s)")
         if damped.method == "incomplete":
-            text += (f"<br>the branch stopped early ({damped.response.message}): the peak shown is the largest "
-                     "converged point, a lower bound")
+            text += (f"<br>{damped.response.status_message} The peak shown is the largest converged point, a lower "
+                     "bound.")
         error = float(getattr(damped.response, "harmonic_error", np.nan))
         if np.isfinite(error):
             text += (f"<br>one-harmonic balance (the paper's setting): its peak may be off by about "

@@ -38,9 +38,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..response import BUDGET_PREFIX
+from ..response import BUDGET_PREFIX, harmonic_sentence
 from .continuation import newton, stall_guard
-from .fourier import HarmonicBasis
+from .fourier import HarmonicBasis, enriched
 from .linsolve import one_blas_thread
 from .start import damped_newton
 
@@ -64,13 +64,6 @@ def auto_sets(max_harmonic: int) -> tuple[tuple[int, ...], ...]:
 
 class AccuracyWarning(UserWarning):
     """A harmonic balance answer whose harmonic error estimate exceeds the tolerance."""
-
-
-def enriched(harmonics) -> tuple[int, ...]:
-    """The set a branch computed with ``harmonics`` is checked against: with the static term
-    and the next two harmonics."""
-    h = tuple(harmonics)
-    return tuple(sorted(set(h) | {0, max(h) + 1, max(h) + 2}))
 
 
 @dataclass
@@ -182,7 +175,9 @@ def harmonic_error(model, response, harmonics=None, n_points: int = 5, tol: floa
 def annotate(response, check: HarmonicCheck, tolerance: float):
     """``response`` with its harmonic error estimate; the message says when it is above the
     tolerance or could not be checked (``success`` is left as the solver and the sanity checks
-    set it: an explicit harmonic set is the user's choice, the estimate tells its cost)."""
+    set it: an explicit harmonic set is the user's choice, the estimate tells its cost), and, for
+    a complete branch, an AccuracyWarning says it in the sentence its status gives
+    (:func:`bladedamp.response.harmonic_sentence`)."""
     met = bool(np.isfinite(check.error) and check.error <= tolerance)
     note = ""
     if not np.isfinite(check.error):
@@ -190,8 +185,10 @@ def annotate(response, check: HarmonicCheck, tolerance: float):
     elif not met:
         note = (f"harmonic error estimate {100 * check.error:.2g} % exceeds the tolerance "
                 f"{100 * tolerance:.2g} % (harmonics {check.harmonics} against {check.enriched})")
-    if note:
-        warnings.warn(note, AccuracyWarning, stacklevel=5)   # annotate, converged_response, its BLAS wrapper, the model, the caller
+    if note and response.success:   # the sentence the status gives (bladedamp.response.status_message); a
+        # branch that stopped or failed a check is said so by its status, whose advice is not the harmonics
+        warnings.warn(harmonic_sentence(check.harmonics, check.error, tolerance, estimated=True), AccuracyWarning,
+                      stacklevel=5)   # annotate, converged_response, its BLAS wrapper, the model, the caller
     message = response.message + ("; " + note if note else "")
     return dataclasses.replace(response, harmonic_error=check.error, harmonic_tolerance=tolerance,
                                harmonics_converged=met, message=message)
@@ -244,7 +241,8 @@ def converged_response(model, solve, harmonics="auto", tolerance: float = HARMON
                     kept = annotate(best[0], best[1], tolerance)
                     what = (f"not computed: {response.stopped_by}" if not len(response.omega) else
                             f"stopped before the end of the range: {response.stopped_by}")
-                    return dataclasses.replace(kept, success=False, stopped_by=response.stopped_by,
+                    return dataclasses.replace(kept, success=False, reached_end=kept.reached_range_end,
+                                               stopped_by=response.stopped_by,
                                                message=f"{kept.message}; harmonics {tuple(H)} {what}")
                 if response.stopped_by:
                     return response           # stopped as the caller asked: no estimate, no richer set

@@ -162,6 +162,9 @@ def stall_guard():
 # raised; a smaller one caps an analysis by its points.
 DEFAULT_CPU_BUDGET_S = 600.0
 DEFAULT_POINT_BUDGET = 1_000_000
+# The largest arc-length step [scaled units, the omega range is 1]: the default of continuation()
+# and of every model's frequency_response.
+DEFAULT_MAX_STEP = 0.02
 
 
 class Budget:
@@ -404,7 +407,7 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
     validation.finite("omega_end", omega_end)
     if omega_start == omega_end:
         raise ValueError("omega_end must differ from omega_start")
-    max_step = 0.02 if max_step is None else max_step
+    max_step = DEFAULT_MAX_STEP if max_step is None else max_step
     validation.in_range("max_step", max_step, 0.0, 1.0, closed="right")
     step = min(0.01, max_step) if step is None else step
     min_step = min(1e-7, step) if min_step is None else min_step

@@ -222,3 +222,10 @@ class HarmonicBasis:
         A += np.multiply(gyro, omega)
         dA = -2 * omega * inertia + gyro if derivative else None
         return A, dA
+
+
+def enriched(harmonics) -> tuple[int, ...]:
+    """The set a branch computed with ``harmonics`` is checked against: with the static term
+    and the next two harmonics."""
+    h = tuple(harmonics)
+    return tuple(sorted(set(h) | {0, max(h) + 1, max(h) + 2}))

@@ -85,14 +85,15 @@ AccuracyWarning (periodicity error above ``PERIODICITY_LIMIT``).
 """
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import NamedTuple, Protocol, runtime_checkable
 
 import numpy as np
 from numba import njit
 
 from .. import validation
-from ..contact.point import SEPARATED
-from ..timedomain import disk_period, oscillator_step
+from ..contact.point import SEPARATED, PointContactElement
+from ..timedomain import (MIN_STEPS_PER_PERIOD, assembly_arrays, disk_period, highest_frequency, orbit_state,
+                          oscillator_step, series_value)
 
 STEPS_PER_PERIOD = 2048       # central-difference steps per period of the period map
 FD_STEP = 1e-6                # finite-difference step of the monodromy matrix, relative to the state's scale
@@ -101,6 +102,36 @@ FD_STEP = 1e-6                # finite-difference step of the monodromy matrix, 
 # (4 and 16 blades, reference cylinder, stick and slip; most of it the HBM's static retention
 # spring, absent in the time domain); on the rolling 16-blade cylinder at 95.3 Hz: 0.67.
 PERIODICITY_LIMIT = 1e-2
+
+
+@runtime_checkable
+class PeriodMapModel(Protocol):
+    """What the monodromy method asks of a model (this module imports no model; the models
+    implement it: :class:`~bladedamp.oscillator.FrictionOscillator`,
+    :class:`~bladedamp.disk.TunedDisk`, :class:`~bladedamp.mistuned.MistunedDisk`).
+
+    ``has_period_map``: whether the model has a period map (a MistunedDisk only when every blade
+    is in the model). ``monodromy_matrix(coefficients, basis, omega, steps)``: (the monodromy
+    matrix (m, m), the periodicity error) of the HBM solution ``coefficients`` in ``basis`` at
+    ``omega`` [rad/s], ``steps`` per period (None: the model's default), by
+    :func:`oscillator_monodromy` or :func:`disk_monodromy`."""
+
+    has_period_map: bool
+
+    def monodromy_matrix(self, coefficients, basis, omega: float, steps: int | None = None): ...
+
+
+@runtime_checkable
+class AssemblyModel(Protocol):
+    """What :func:`disk_monodromy` asks of a bladed disk: ``full_assembly()``, the model with
+    every blade and damper written out (a full-assembly MistunedDisk: itself; a TunedDisk:
+    ``MistunedDisk.from_tuned(self)``), and ``assembly_coefficients(full, coefficients, basis)``,
+    the harmonic coefficients (C, N) on that assembly of the model's solution ``coefficients``
+    (C * n,) or (C, n) (a TunedDisk's sector turned blade by blade, Eq. 24-25)."""
+
+    def full_assembly(self): ...
+
+    def assembly_coefficients(self, full, coefficients, basis) -> np.ndarray: ...
 
 
 @njit(cache=True)
@@ -121,15 +152,6 @@ def oscillator_period_map(states, omega, m, c, k, k3, k_t, mu, n0, k_n, sin_a, c
     return out
 
 
-def _evaluate(X, basis, tau):
-    """x (N,) of the coefficients X (C, N) at the phase tau = Omega t [rad]."""
-    x = np.zeros(X.shape[1])
-    for h in basis.harmonics:
-        j = basis.cos_index(h)
-        x += X[j] if h == 0 else X[j] * np.cos(h * tau) + X[j + 1] * np.sin(h * tau)
-    return x
-
-
 def _oscillator_orbit_state(osc, coefficients, basis, omega, steps):
     """(z (3,), scale) of the HBM solution ``coefficients`` (C*1,) of ``osc`` at ``omega``:
     x(0), x(-dt) from the Fourier series and the slider from the AFT's periodic return map at
@@ -137,8 +159,6 @@ def _oscillator_orbit_state(osc, coefficients, basis, omega, steps):
     the step at t = 0; as the input of the period map (the slider before that step) it gives the
     same trajectory: a stuck slider does not move in the step, a slipping or separated one
     forgets its previous position."""
-    from ..contact.point import PointContactElement
-
     c = np.asarray(coefficients, dtype=float).ravel()
     dt = 2 * np.pi / omega / steps
 
@@ -149,7 +169,7 @@ def _oscillator_orbit_state(osc, coefficients, basis, omega, steps):
     s = u if pts.state[0, 0] == SEPARATED else u - f / osc.contact_stiffness
     scale = max(float(np.abs(basis.synthesis @ c).max()), 1e-300)
     X = c.reshape(-1, 1)
-    return np.array([_evaluate(X, basis, 0.0)[0], _evaluate(X, basis, -omega * dt)[0], s]), scale
+    return np.array([series_value(X, basis, 0.0)[0], series_value(X, basis, -omega * dt)[0], s]), scale
 
 
 def oscillator_monodromy(osc, coefficients, basis, omega: float, steps: int = STEPS_PER_PERIOD):
@@ -219,18 +239,14 @@ _ASSEMBLY_CACHE = {}      # id(model) -> (weak reference to the model, full asse
 
 
 def _disk_assembly(model):
-    """(the full-assembly MistunedDisk of ``model``, its :class:`~bladedamp.timedomain.AssemblyArrays`),
-    built once per model (a branch calls this at every point)."""
+    """(``model.full_assembly()``, its :class:`~bladedamp.timedomain.AssemblyArrays`), built once
+    per model (a branch calls this at every point)."""
     import weakref
-
-    from ..disk import TunedDisk
-    from ..mistuned import MistunedDisk
-    from ..timedomain import assembly_arrays
 
     hit = _ASSEMBLY_CACHE.get(id(model))
     if hit is not None and hit[0]() is model:
         return hit[1], hit[2]
-    full = MistunedDisk.from_tuned(model) if isinstance(model, TunedDisk) else model
+    full = model.full_assembly()
     arrays = assembly_arrays(full)
     _ASSEMBLY_CACHE.clear()
     _ASSEMBLY_CACHE[id(model)] = (weakref.ref(model), full, arrays)
@@ -239,80 +255,14 @@ def _disk_assembly(model):
 
 def assembly_coefficients(model, full, coefficients, basis) -> np.ndarray:
     """The harmonic coefficients (C, N) of the full assembly ``full`` of ``model``'s solution
-    ``coefficients`` (C * n,) or (C, n): unchanged for a MistunedDisk; for a TunedDisk's sector
-    (n = n_m blade modes + 6 damper coordinates) blade k's and damper k's harmonic h are the
-    sector's turned by e^{i h k dphi} (X = a - i b; the static term the same), Eq. 24-25."""
-    from ..disk import TunedDisk
-
-    C = basis.n_coeffs
-    if not isinstance(model, TunedDisk):
-        return np.asarray(coefficients, dtype=float).reshape(C, full.n_dof)
-    X = np.asarray(coefficients, dtype=float).reshape(C, -1)
-    nm = full.n_modes
-    out = np.zeros((C, full.n_dof))
-    blocks = [(full.blade_slice(k), slice(0, nm), k) for k in range(full.n_sector)]
-    if model.has_damper:
-        blocks += [(full.damper_slice(d), slice(nm, nm + 6), k) for d, k in enumerate(full.active_dampers)]
-    for target, source, k in blocks:
-        for h in basis.harmonics:
-            j = basis.cos_index(h)
-            if h == 0:
-                out[j, target] = X[j, source]
-                continue
-            z = (X[j, source] - 1j * X[j + 1, source]) * np.exp(1j * h * k * full.interblade_phase)
-            out[j, target], out[j + 1, target] = z.real, -z.imag
-    return out
-
-
-def _disk_sliders(arrays, X, basis):
-    """(sliders (P, 2) [m] at t = 0, the tangential point motion's amplitude [m]) of the
-    assembly's solution X (C, N): each patch's points through the AFT's periodic return map
-    (:meth:`~bladedamp.contact.point.PointContactElement.samples`, the patch's k_T x weight, mu,
-    normal law, weights and approach -initial gap, as :func:`~bladedamp.timedomain.assembly_arrays`
-    and the HBM with the static harmonic), s = u - f / k_T at the first sample (t = 0), u when
-    separated."""
-    from ..contact.point import PointContactElement
-
-    C = basis.n_coeffs
-    P = arrays.B.shape[0]
-    coeffs = (arrays.point_map @ X.T).T.reshape(C, P, 3)
-    sliders = np.zeros((P, 2))
-    amplitude = 0.0
-    start = 0
-    for geometry in arrays.geometries:
-        for patch in geometry.patches:
-            sl = slice(start, start + patch.n_points)
-            start += patch.n_points
-            k_t = patch.tangential_stiffness * patch.weights
-            element = PointContactElement(k_t, patch.friction_coefficient, patch.normal_law, patch.weights,
-                                          -np.asarray(patch.initial_gap, dtype=float) * np.ones(patch.n_points))
-            pts = element.samples(np.ascontiguousarray(coeffs[:, sl]).reshape(C, -1), basis)
-            u, f = pts.displacement[:, 0, :2], pts.force[:, 0, :2]
-            separated = pts.state[:, 0] == SEPARATED
-            sliders[sl] = np.where(separated[:, None], u, u - f / k_t[:, None])
-            ut = pts.displacement[:, :, :2]
-            amplitude = max(amplitude, float(np.abs(ut - ut.mean(axis=1, keepdims=True)).max()))
-    return sliders, amplitude
-
-
-def orbit_state(arrays, X, basis, omega: float, dt: float):
-    """(z (2 N + 2 P,), the tangential point motion's amplitude [m]) the state of the
-    central-difference integration (:func:`bladedamp.timedomain.disk_period`, time step ``dt``
-    [s]) on the periodic orbit of the full assembly's harmonic solution X (C, N) in ``basis``
-    (with the static harmonic) at ``omega`` [rad/s], at t = 0: z = (x(0), x(-dt), slider
-    positions (P, 2) row-major), x from the Fourier series and every friction slider from the
-    contact's periodic return map over one period of that motion (the AFT's, see the module
-    docstring); ``arrays`` the assembly's :class:`~bladedamp.timedomain.AssemblyArrays`. The
-    start of the monodromy's period map and of a time integration that tests the orbit
-    (``disk_time_response(..., start_coefficients=...)``)."""
-    sliders, slider_amp = _disk_sliders(arrays, X, basis)
-    z = np.concatenate([_evaluate(X, basis, 0.0), _evaluate(X, basis, -omega * dt), sliders.ravel()])
-    return z, slider_amp
+    ``coefficients`` (C * n,) or (C, n): ``model.assembly_coefficients`` (:class:`AssemblyModel`;
+    unchanged for a MistunedDisk, a TunedDisk's sector turned blade by blade, Eq. 24-25)."""
+    return model.assembly_coefficients(full, coefficients, basis)
 
 
 def full_assembly_coefficients(model, coefficients, basis) -> np.ndarray:
-    """:func:`assembly_coefficients` of ``model`` (a TunedDisk or a full-assembly MistunedDisk)
-    on its full assembly (``MistunedDisk.from_tuned`` for a TunedDisk): (C, N)."""
+    """:func:`assembly_coefficients` of ``model`` (an :class:`AssemblyModel`: a TunedDisk or a
+    full-assembly MistunedDisk) on its full assembly (``model.full_assembly()``): (C, N)."""
     full, _ = _disk_assembly(model)
     return assembly_coefficients(model, full, coefficients, basis)
 
@@ -338,8 +288,6 @@ def disk_monodromy(model, coefficients, basis, omega: float, steps: int | None =
     coordinates, damper translations, damper rotations), the steps per period and the
     finite-difference steps h (m,) (a column's rounding error is about eps |P(z)| / h). An
     AccuracyWarning when the periodicity error exceeds ``PERIODICITY_LIMIT``."""
-    from ..timedomain import MIN_STEPS_PER_PERIOD, highest_frequency
-
     if not basis.has_static:
         raise ValueError("method 'monodromy' of a bladed disk needs a solution with the static harmonic 0 "
                          f"(harmonics {tuple(basis.harmonics)}): the time integration seats the dampers under "
@@ -398,32 +346,22 @@ def disk_monodromy(model, coefficients, basis, omega: float, steps: int | None =
 
 
 def supports(model) -> bool:
-    """Whether the monodromy method has a period map for ``model``: a FrictionOscillator, a
-    TunedDisk or a full-assembly MistunedDisk (every blade in the model)."""
-    from ..disk import TunedDisk
-    from ..mistuned import MistunedDisk
-    from ..oscillator import FrictionOscillator
-
-    if isinstance(model, MistunedDisk):
-        return model.n_sector == model.n_blades
-    return isinstance(model, (FrictionOscillator, TunedDisk))
+    """Whether the monodromy method has a period map for ``model``: a :class:`PeriodMapModel`
+    whose ``has_period_map`` is true (a FrictionOscillator, a TunedDisk or a full-assembly
+    MistunedDisk, every blade in the model)."""
+    return isinstance(model, PeriodMapModel) and bool(model.has_period_map)
 
 
 def monodromy_multipliers(model, coefficients, basis, omega: float, steps: int | None = None):
     """(multipliers (m,) complex, largest modulus first; periodicity error) of ``model``'s HBM
-    solution ``coefficients`` at ``omega`` [rad/s] (see :func:`oscillator_monodromy`, m = 3,
-    and :func:`disk_monodromy`, m = 2 N + 2 P); ``steps`` per period (default STEPS_PER_PERIOD
-    for the oscillator, the disk's own rule for a disk)."""
-    from ..oscillator import FrictionOscillator
-
+    solution ``coefficients`` at ``omega`` [rad/s] (``model.monodromy_matrix``, a
+    :class:`PeriodMapModel`: :func:`oscillator_monodromy`, m = 3, and :func:`disk_monodromy`,
+    m = 2 N + 2 P); ``steps`` per period (default STEPS_PER_PERIOD for the oscillator, the
+    disk's own rule for a disk)."""
     if not supports(model):
         raise ValueError("method 'monodromy' has a period map for the FrictionOscillator, the TunedDisk and the "
                          f"full-assembly MistunedDisk only (got {type(model).__qualname__}); use method 'auto' "
                          "(Hill or determinant sign)")
-    if isinstance(model, FrictionOscillator):
-        mono, _, error = oscillator_monodromy(model, coefficients, basis, omega,
-                                              STEPS_PER_PERIOD if steps is None else steps)
-    else:
-        mono, _, error, _, _ = disk_monodromy(model, coefficients, basis, omega, steps)
+    mono, error = model.monodromy_matrix(coefficients, basis, omega, steps)
     mu = np.linalg.eigvals(mono).astype(complex)
     return mu[np.argsort(-np.abs(mu))], error

@@ -25,6 +25,7 @@ import dataclasses
 import html as _html
 import os
 import subprocess
+import textwrap
 from functools import lru_cache
 
 import numpy as np
@@ -143,13 +144,14 @@ def liftoff_figure(contact_height_mm: float = 2.0, force_n: float = 0.1, mass_g:
     import matplotlib.pyplot as plt
 
     m = liftoff_case(contact_height_mm, force_n, mass_g, f_range_hz)
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.4), sharey=True, constrained_layout=True)
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.8), sharey=True, constrained_layout=True)
     vmax = max(2.0, float(np.ceil(m.ratio.max())))
     for c, ax in enumerate(axes):
         sc = ax.scatter(m.eta_star, m.xi_star, c=m.ratio[c], s=140, cmap="viridis", vmin=0, vmax=vmax,
                         marker="s")
         lift = m.lifts_off[c]
-        ax.scatter(m.eta_star[lift], m.xi_star[lift], s=260, facecolors="none", edgecolors=palette.SLIP, lw=1.5)
+        ax.scatter(m.eta_star[lift], m.xi_star[lift], s=260, facecolors="none", edgecolors=palette.SLIP, lw=1.5,
+                   gid="reference")          # rings on the map's cells, not a series of their own
         ax.set_xlabel("eta* = eta / l_C [-] (along the damper)")
         ax.set_title(f"{('OL', 'OR')[c]}: max r = {m.ratio[c].max():.2f}")
         ax.set_xlim(-0.65, 0.65)
@@ -158,7 +160,7 @@ def liftoff_figure(contact_height_mm: float = 2.0, force_n: float = 0.1, mass_g:
     fig.colorbar(sc, ax=axes, label="lift-off ratio r [-] (ring: r > 1)")
     fig.suptitle(f"wedge {mass_g:g} g, h_C = {contact_height_mm:g} mm, F_x = {force_n:g} N: "
                  f"resonance {m.peak_frequency_hz:.2f} Hz, tip {1e3 * m.peak_amplitude:.3f} mm\n"
-                 + one_harmonic_label(m.harmonic_error), fontsize=10)
+                 + textwrap.fill(one_harmonic_label(m.harmonic_error), 110), fontsize=10)
     return fig
 
 
@@ -221,8 +223,8 @@ def cycle_figure(data, title: str = ""):
                    fontsize=8, loc="upper right", framealpha=0.9)
     for c in range(2):
         finite = np.isfinite(ratio[c])
-        axes[2].plot(np.arange(1, P + 1)[finite], ratio[c][finite], "o-", color=palette.series(c),
-                     label=("OL", "OR")[c])
+        axes[2].plot(np.arange(1, P + 1)[finite], ratio[c][finite], "o", color=palette.series(c), ms=5,
+                     label=("OL", "OR")[c])    # one value per point: markers (equal values are no flat curve)
         opened = ~finite
         if opened.any():   # a_static <= 0: r is infinite, marked at the top of the axis
             top = max(2.0, 1.1 * np.nanmax(np.where(np.isfinite(ratio), ratio, np.nan)))
@@ -231,8 +233,8 @@ def cycle_figure(data, title: str = ""):
     axes[2].axhline(1.0, color=palette.SEPARATED, lw=0.8, ls="--")
     axes[2].set_xlabel("point [-]")
     axes[2].set_ylabel("lift-off ratio r [-]")
-    axes[2].legend(fontsize=8)
     axes[2].grid(True, alpha=0.3)
+    axes[2].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0))   # beside the points, hiding none
     fig.suptitle(title or f"{data.frequency_hz:.2f} Hz, tip {1e3 * data.tip_amplitude:.3f} mm", fontsize=10)
     return fig
 

@@ -39,7 +39,7 @@ from ..plotting import place_legend, plain_log_ticks
 
 __all__ = ["interactive_view", "interact_with_image", "hysteresis_loop", "hysteresis_figure", "describing_function", "describing_function_figure",
            "oscillator_comparison", "oscillator_figure", "DiskFRF", "DiskFRFCache", "DEFAULT_CACHE", "disk_frf",
-           "undamped_frf", "disk_frf_figure", "mass_sweep_peaks", "mass_study_figure", "engine_order_figure",
+           "undamped_frf", "disk_frf_figure", "mass_sweep_peaks", "mass_study_figure", "engine_order_figure", "engine_order_study_figure",
            "contact_state_at_peak", "platform_angle_figure", "closed_form_jenkins"]
 
 # the slider callbacks set the slip force mu N; this splits it into mu and N (only the lift-off
@@ -617,6 +617,42 @@ def engine_order_figure(engine_order=1, kind="cylinder", mass_g=1.0, cache=None)
     return disk_frf_figure(mass_g, kind, engine_order, 35.0, cache)
 
 
+def engine_order_study_figure(studies: dict, engine_orders):
+    """The damping potential and the optimal mass over engine order (notebook 03, the paper's
+    Figs. 7 and 8 on a coarse mass grid): ``studies`` {kind: [:func:`mass_sweep_peaks` result per
+    engine order]}, ``engine_orders`` the engine orders of those results.
+
+    Left: the lowest resonance amplitude of the mass grid as a share of the damper-free peak,
+    1 - best_reduction [%] on a log axis (100 %: no mass damps). Right: the grid's best mass [g]
+    (not drawn where no mass reduces the peak by 1 % or more: no optimum). Returns the figure."""
+    engine_orders = [int(eo) for eo in engine_orders]
+    if any(len(sweeps) != len(engine_orders) for sweeps in studies.values()):
+        raise ValueError("studies: need one mass_sweep_peaks result per engine order for each damper")
+    fig, (ax, ax2) = _figure(1, 2, figsize=(11, 4.3))
+    for j, (kind, sweeps) in enumerate(studies.items()):
+        style = dict(color=palette.DAMPER.get(kind, palette.series(j)), marker="os^v"[j % 4], ms=max(9 - 3 * j, 4),
+                     label=kind)       # later kinds drawn smaller: equal points stay visible
+        left = [100 * (1 - sw["best_reduction"]) for sw in sweeps]
+        best = [sw["best_mass_g"] if sw["best_reduction"] >= 0.01 else np.nan for sw in sweeps]
+        ax.plot(engine_orders, left, **style)
+        ax2.plot(engine_orders, best, **style)
+    ax.set_yscale("log")
+    ax.set_ylabel("lowest resonance amplitude [% of no damper]")
+    ax.set_title("damping potential (Fig. 7): lower is better", fontsize=10)
+    ax2.set_yscale("log")
+    ax2.set_ylabel("best mass of the grid [g]")
+    ax2.set_title("optimal mass (Fig. 8)", fontsize=10)
+    for a in (ax, ax2):
+        plain_log_ticks(a.yaxis)
+        a.set_xticks(engine_orders)
+        a.set_xlabel("engine order EO [-]")
+        a.grid(True, which="both", alpha=0.3)
+        place_legend(a, fontsize=9)
+    fig.suptitle("reference disk: the best damper of a coarse mass grid over engine order", fontsize=11)
+    fig.tight_layout()
+    return fig
+
+
 def contact_state_at_peak(frf: DiskFRF, cache: DiskFRFCache | None = None):
     """Eq. 27 at the resonance of ``frf``: the :class:`bladedamp.studies.ContactState` of
     :func:`bladedamp.studies.contact_state` (normalised first-harmonic xi motion and force of both
@@ -715,6 +751,8 @@ class MistuningExplorer:
         axes[0].set_title(f"{pattern}" + ("" if pattern == "alternating" else f", seed {seed}")
                           + f", {std_percent:.1f} %", fontsize=9)
         r.plot(ax=axes[1], tuned=self.tuned_response)
+        axes[1].set_yscale("log")          # the least responding blade stays visible beside the largest
+        plain_log_ticks(axes[1].yaxis)
         model = "two-blade sector" if r.n_sector == 2 else f"{n} blades"
         axes[1].set_title(f"{model}: {len(r.omega)} points, " + ("cached" if elapsed < 0.05 else f"{elapsed:.1f} s"),
                           fontsize=9)
