@@ -450,3 +450,34 @@ def test_a_richer_set_that_fails_short_of_the_end_ends_the_automatic_choice():
         warnings.simplefilter("ignore")
         both = converged_response(osc, lambda H: full[H], max_harmonic=3)
     assert both.basis.harmonics == (0, 1, 2, 3) and "no richer set was tried" not in both.message
+
+
+@pytest.mark.parametrize("guard_stalls", [True, False])
+def test_the_richer_sets_branches_are_stall_guarded_for_the_disks_only(guard_stalls):
+    """``converged_response(guard_stalls=True)`` (the tuned and mistuned disks) computes a richer
+    set's branches, once a poorer set's reached the end, within the continuation's stall guard:
+    the zigzag branch of test_continuation_contract, continued inside that richer set's solve,
+    ends as stalled there, and runs to max_points without the option (the oscillator's) and in
+    the first set's solve either way."""
+    from test_continuation_contract import stalling_zigzag
+
+    from bladedamp.hbm.accuracy import converged_response
+    from bladedamp.hbm.continuation import continuation
+
+    osc = FrictionOscillator(**INCLINED)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        full = {H: osc.frequency_response(*RANGE_HZ, harmonics=H) for H in ((0, 1), (0, 1, 2, 3))}
+    ends = {}
+
+    def solve(H):
+        fun, x0, w0 = stalling_zigzag()
+        ends[H] = continuation(fun, x0, w0, 12.0, x_scale=1.0, residual_scale=1.0, max_step=0.05,
+                               max_points=1000).message
+        return full[H]
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        converged_response(osc, solve, max_harmonic=3, guard_stalls=guard_stalls)
+    assert "max_points" in ends[(0, 1)]
+    assert ("stalled" in ends[(0, 1, 2, 3)]) == guard_stalls, ends
