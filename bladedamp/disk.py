@@ -1133,13 +1133,15 @@ def peak_checked_response(model, system_model, solve, harmonics, tolerance: floa
     """The response of ``model.frequency_response`` (a :class:`TunedDisk` or
     :class:`~bladedamp.mistuned.MistunedDisk`) before its stop check: the branches of ``solve``
     with their harmonic error estimate (:func:`~bladedamp.hbm.accuracy.converged_response` on
-    ``system_model``) and :func:`~bladedamp.response.amplitude_check`, then :func:`with_peak_check`
-    (not run on an implausible amplitude). One accuracy warning per call: where the
+    ``system_model``, a richer set's stalled branches ended early once a poorer set's reached the
+    end: ``guard_stalls``) and :func:`~bladedamp.response.amplitude_check`, then
+    :func:`with_peak_check` (not run on an implausible amplitude). One accuracy warning per call: where the
     peak check runs, its verdict (which includes the estimate) replaces the estimate's
     AccuracyWarning, and an implausible amplitude (its status says so) has none; every other
     warning raised on the way is raised again at the caller of ``frequency_response``."""
     with warnings.catch_warnings(record=True) as raised:
-        response = converged_response(system_model, solve, harmonics, tolerance, max_harmonic, estimate=estimate)
+        response = converged_response(system_model, solve, harmonics, tolerance, max_harmonic, estimate=estimate,
+                                      guard_stalls=True)
     response = with_peak_check(model, with_amplitude_check(response, blade_span(model)), check_peak, tolerance,
                                can_check)
     said = response.peak_check is not None or "amplitude" in response.failed_checks   # the verdict, or beyond the model

@@ -401,3 +401,43 @@ def test_stop_when_ends_the_branch_at_the_first_point_it_names_and_nothing_is_re
     np.testing.assert_array_equal(free.omega[:len(b.omega)], b.omega)   # the same points up to the stop
     with pytest.raises(ValueError, match="stop_when"):
         continuation(fun, root(w0, -3.0), w0, w1, stop_when=1.0)
+
+
+def stalling_zigzag(c=10.0, a=0.1, b=20.0, creep=0.0, k=5.0):
+    """R(x, omega) = omega - c - a sin(b x) - g(x), g = k x for x < 0 (no fold: k > a b), creep x
+    for x >= 0: from x = -1 the branch rises to c, then folds every pi / b of x, its omega going
+    back and forth within c +- a while x grows (with ``creep`` > 0 it gets further by about
+    creep pi / b each fold): no point on it is met twice, so the retrace guard cannot end it; a
+    stall like the random EO >= 6 wedges' (benchmarks/README.md). Returns (fun, x0, omega0)."""
+    def fun(x, omega, jacobian=True):
+        slope = k if x[0] < 0 else creep
+        R = np.array([omega - c - a * np.sin(b * x[0]) - slope * x[0]])
+        return R, np.array([[-a * b * np.cos(b * x[0]) - slope]]), np.array([1.0])
+    return fun, np.array([-1.0]), c + a * np.sin(-b) - k
+
+
+def test_the_stall_guard_ends_a_stalled_branch_and_says_so():
+    """Within stall_guard(), the zigzag branch (range 4.9..12, its omega never above 10.1) ends
+    STALL_POINTS points after its furthest point, unsuccessful, its message saying it stalled
+    and where; stopped_by stays empty (a failure: the branch from the end and the retry follow).
+    Outside the context the same branch runs to max_points. A branch that folds but gets on (a
+    creep of 0.02 of the range per fold) is not ended."""
+    from bladedamp.hbm.continuation import STALL_POINTS, STALL_PROGRESS, stall_guard
+
+    fun, x0, w0 = stalling_zigzag()
+    w1 = 12.0
+    options = dict(x_scale=1.0, residual_scale=1.0, max_step=0.05, max_points=1000)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ConvergenceWarning)
+        free = continuation(fun, x0, w0, w1, **options)
+        with stall_guard():
+            guarded = continuation(fun, x0, w0, w1, **options)
+            creeping = continuation(stalling_zigzag(creep=0.5)[0], x0, w0, w1, **options)
+    assert not free.success and len(free.omega) == 1000 and "max_points" in free.message
+    assert len(free.turning_points) > 20 and free.omega.max() <= 10.1 + 1e-9
+    assert not guarded.success and not guarded.stopped_by and "stalled" in guarded.message
+    progress = (guarded.omega - w0) / (w1 - w0)
+    assert progress[-STALL_POINTS:].max() <= progress[:-STALL_POINTS].max() + STALL_PROGRESS
+    assert len(guarded.omega) < len(free.omega)
+    np.testing.assert_array_equal(guarded.omega, free.omega[:len(guarded.omega)])   # the same points up to there
+    assert creeping.success and len(creeping.turning_points) > 10, creeping.message

@@ -14,6 +14,8 @@ and the same factorisation gives the corrector's update and the next tangent.
 """
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import copy
 import time
 import warnings
@@ -119,6 +121,34 @@ def _det_sign(A, solve=None) -> int:
 # cylinder on the beam blade's own frequencies, (0, ..., 5), came back to a point 9 steps
 # earlier at 95.39 Hz and then reached the end), a loop returns at every step
 MAX_REVISITS = 200
+
+
+# The stall guard (:func:`stall_guard`): a branch whose furthest frequency has not grown by
+# STALL_PROGRESS of its range over its last STALL_POINTS points kept has stalled. Measured on the
+# random EO >= 6 wedges (benchmarks/README.md, issue 32 item 2): the richer harmonic sets' branches
+# stall near the first bending resonance with a fold every ~3 points, omega moving 5e-4 Hz a step
+# (2e-5 of the range) back and forth, for hundreds of points before the retrace guard or max_points
+# ends them.
+STALL_POINTS = 100
+STALL_PROGRESS = 1e-4
+_STALL_GUARD = contextvars.ContextVar("stall_guard", default=False)
+
+
+@contextlib.contextmanager
+def stall_guard():
+    """Within this context every :func:`continuation` branch also ends where it has stalled: no
+    point of its last STALL_POINTS got further into the range than STALL_PROGRESS x its width
+    beyond the furthest point before them. The branch is then unsuccessful, its message says it
+    stalled (a failure like the retrace guard's, not a ``stopped_by``: the branch from the end and
+    the retry follow as for any failed branch). Used by the disks' automatic harmonic choice
+    (:func:`bladedamp.hbm.accuracy.converged_response` with ``guard_stalls``) for a richer set's
+    branches once a poorer set's reached the end, where a branch that stalls costs time and cannot change the answer
+    unless it reaches the end: outside this context no branch is ended by it."""
+    token = _STALL_GUARD.set(True)
+    try:
+        yield
+    finally:
+        _STALL_GUARD.reset(token)
 
 
 # The default budget of one analysis (a model's frequency_response): CPU seconds
@@ -512,6 +542,7 @@ class ArcLengthContinuation:
         # previous one; measured there: 9 degrees, at the folds and corners of random disks 12 and
         # 102 and oscillator 136: 75-90 degrees) is not taken, and the sign is re-recorded instead.
         self.orientation = 0
+        self.stall_guard = _STALL_GUARD.get()
         self._scale = (None, None)      # (x_scale, scale()) of the last x_scale asked for
         self._e_last = _unit_last(self.n)
 
@@ -951,6 +982,7 @@ class ArcLengthContinuation:
         h = self.step
         hops = 0  # consecutive fixed-omega hops over corners
         revisits = 0  # returns to an earlier point (see retraced)
+        furthest, furthest_at = 0.0, 0  # progress into the range (scaled) and the point that made it (stall_guard)
         end_retries = 0  # steps past omega_end whose landing on omega_end failed
         next_tangent = None  # from the last corrector's factorisation (scaled, then unscaled)
         while len(points) < self.max_points:
@@ -1022,6 +1054,17 @@ class ArcLengthContinuation:
                               f"({new[n] / (2 * np.pi):.6g} Hz; {revisits} returns to earlier points, the last to point " \
                               f"{revisited} of {len(points)}: a loop or a back-and-forth between corners it cannot " \
                               f"leave); branch kept up to there"
+                    _warn(message, 3)
+                    break
+            if self.stall_guard:
+                progress = self.direction * (new[n] - self.omega_start) / self.w_scale
+                if progress > furthest + STALL_PROGRESS:
+                    furthest, furthest_at = progress, len(points) - 1
+                elif len(points) - 1 - furthest_at >= STALL_POINTS:
+                    w_far = self.omega_start + self.direction * furthest * self.w_scale
+                    message = f"continuation stalled at omega = {new[n]:.6g} rad/s ({new[n] / (2 * np.pi):.6g} Hz): " \
+                              f"its last {STALL_POINTS} points got no further than {STALL_PROGRESS:g} of the range " \
+                              f"beyond omega = {w_far:.6g} rad/s ({w_far / (2 * np.pi):.6g} Hz); branch kept up to there"
                     _warn(message, 3)
                     break
             self.x_scale = np.maximum(self.x_scale, np.abs(points[-1][:n]))
