@@ -959,14 +959,24 @@ class MistunedDisk:
             f1[j1, self.blade_slice(k)] = f * np.cos(theta)
             f1[j1 + 1, self.blade_slice(k)] = -f * np.sin(theta)
 
+        # the static harmonic's centrifugal force on each damper, radially outwards (its z): the
+        # laws built once, one per distinct damper (validation at the boundary, not per residual)
+        j0 = basis.cos_index(0) if basis.has_static else None
+        laws, radial = {}, []
+        if basis.has_static:
+            for d, k in enumerate(active):
+                key = id(self.sectors[k].damper)
+                if key not in laws:
+                    laws[key] = (self.sectors[k].centrifugal_law(), [])
+                laws[key][1].append(self.damper_slice(d).start + 2)
+            radial = [(law, np.array(z)) for law, z in laws.values()]
+
         def excitation(omega):
             f, df = f1.copy(), np.zeros((C, N))
-            if basis.has_static:
-                for d, k in enumerate(active):
-                    F, dF = self.sectors[k].centrifugal_force(omega / (2 * np.pi))
-                    z = self.damper_slice(d).start + 2       # radially outwards on the damper
-                    f[basis.cos_index(0), z] = F
-                    df[basis.cos_index(0), z] = dF
+            for law, z in radial:
+                F, dF = law(omega)
+                f[j0, z] = F
+                df[j0, z] = dF
             return f.ravel(), df.ravel()
 
         system = AssemblySystem(basis, mass.tocsr(), damp, stiff, excitation, couplings,
@@ -1139,7 +1149,7 @@ class MistunedDisk:
         j1, nm, s = basis.cos_index(1), self.n_modes, self.n_sector
         q1 = (coefficients[:, j1, :s * nm] - 1j * coefficients[:, j1 + 1, :s * nm]).reshape(-1, s, nm)
         tips = np.stack([b.shape("tip")[:3] for b in self.blades])            # (s, 3, nm)
-        return np.abs(np.einsum("pkm,kim->pki", q1, tips)).reshape(len(coefficients), -1)
+        return np.abs(np.einsum("pkm,kim->pki", q1, tips)).reshape(len(coefficients), 3 * s)
 
     def point_map(self, basis, point: str = "tip", directions=(0,), blade: int = 0) -> np.ndarray:
         """Real-form map (C*k, C*n_dof) from the unknowns of :meth:`hbm_system` to the motion of
