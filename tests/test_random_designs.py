@@ -28,6 +28,7 @@ from bladedamp import FrictionOscillator
 from bladedamp.blade import reference_blade
 from bladedamp.damper.geometry import ContactProperties, CylinderDamper, WedgeDamper
 from bladedamp.disk import DiskResponse, TunedDisk
+from bladedamp.mistuned import MistunedDisk
 from bladedamp.hbm.continuation import Branch
 from bladedamp.hbm.monodromy import full_assembly_coefficients
 from bladedamp import reference as ref
@@ -79,6 +80,8 @@ INCLINED_N_SAMPLES = None
 # a branch that needs more points than this at the suite's max_step has stalled
 MAX_POINTS = 2000
 N_TIME_CHECKS = 10
+# blades of the random mistuned rings (mistuned_design)
+MISTUNED_BLADES = ref.N_BLADES
 ROTOR_SPEED_95_HZ = 95.0   # EO = 0: the rotor speed of the EO = 1 resonance [Hz]
 
 
@@ -134,9 +137,26 @@ def make_disk(d: dict) -> TunedDisk:
     damper = (CylinderDamper(d["mass"], ref.CYLINDER_RADIUS, ref.DAMPER_LENGTH, contact) if d["damper"] == "cylinder"
               else WedgeDamper(d["mass"], ref.WEDGE_CONTACT_HEIGHT, ref.DAMPER_LENGTH, contact))
     base = ref.EXCITATION_TABLE1 if d["table1"] else ref.EXCITATION_FX
-    return TunedDisk(reference_blade(), damper, ref.N_BLADES, d["engine_order"], d["gamma_left"], d["gamma_right"],
+    return TunedDisk(reference_blade(), damper, d.get("n_blades", ref.N_BLADES), d["engine_order"], d["gamma_left"],
+                     d["gamma_right"],
                      ref.DAMPER_RADIUS, d["excitation_scale"] * base,
                      rotor_speed_hz=ROTOR_SPEED_95_HZ if d["engine_order"] == 0 else None)
+
+
+def mistuned_design(i: int, n_blades: int | None = None) -> dict:
+    """Parameters of random mistuned disk i: random disk i (:func:`disk_design`) on a ring of
+    ``n_blades`` blades (default MISTUNED_BLADES), blade k's frequencies times
+    kappa_k = 1 + sigma z_k, z_k standard normal, sigma uniform in 1-5 %."""
+    rng = np.random.default_rng([SEED, 2, i])
+    sigma = float(rng.uniform(0.01, 0.05))
+    n = MISTUNED_BLADES if n_blades is None else int(n_blades)
+    return dict(disk_design(i), kind=("mistuned", i), n_blades=n, sigma=sigma,
+                kappa=tuple(1.0 + sigma * rng.standard_normal(n)))
+
+
+def make_mistuned(d: dict) -> MistunedDisk:
+    """The full assembly of random mistuned disk ``d`` (:func:`mistuned_design`)."""
+    return MistunedDisk.from_tuned(make_disk(d), np.array(d["kappa"]))
 
 
 def disk_response(disk: TunedDisk, d: dict, check_stop: bool = True) -> DiskResponse:
