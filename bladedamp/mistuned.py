@@ -1102,9 +1102,23 @@ class MistunedDisk:
         def solve_sampled(H, n_samples):
             system = self.hbm_system(H, n_samples)
             scales = self.scales(system, w0, w1)
-            x0 = self.start_solution(system, w0, scales)
+            # the robust start (an excitation homotopy of the whole ring, which the budget cannot
+            # stop midway) is not begun once the budget has run out (the continuation then keeps no
+            # point and says so), and the start at the end of the range is computed once for the
+            # first try and its retry, which both ask for it
+            def start(w):
+                return np.zeros(system.n_unknowns) if budget.exhausted(w) else self.start_solution(system, w, scales)
+
+            at_end = []
+
+            def start_at_end():
+                if not at_end:
+                    at_end.append(start(w1))
+                return at_end[0].copy()
+
+            x0 = start(w0)
             branch = continuation(system.residual, x0, w0, w1, x_scale=scales, factorize=system.factorize,
-                                  max_step=max_step, start_at_end=lambda: self.start_solution(system, w1, scales),
+                                  max_step=max_step, start_at_end=start_at_end,
                                   retry_x_scale=self.retry_scales(system, scales), budget=budget,
                                   **continuation_options)
             response = MistunedResponse.from_branch(self, system, branch, tuned_peak_amplitude)
