@@ -601,6 +601,12 @@ class TunedDisk:
             return lambda omega: (c, 0.0)
         return lambda omega: (c * omega ** 2, 2 * c * omega)
 
+    def centrifugal_law(self):
+        """A function omega [rad/s, the excitation frequency] -> (F_CG [N], dF_CG / dOmega_E
+        [N s/rad]) of Eq. 26 whose parameters are validated once, here: for a residual that
+        evaluates it at every call (:meth:`centrifugal_force` validates its arguments at each)."""
+        return self._centrifugal_law()
+
     def approach_function(self, geometry: DamperGeometry, basis: HarmonicBasis):
         """The static approach of ``geometry``'s contact points under this disk's F_CG (Eq. 26):
         a function omega [rad/s, the residual's excitation frequency] -> (per-point static

@@ -962,14 +962,24 @@ class MistunedDisk:
             f1[j1, self.blade_slice(k)] = f * np.cos(theta)
             f1[j1 + 1, self.blade_slice(k)] = -f * np.sin(theta)
 
+        # the static harmonic's centrifugal force on each damper, radially outwards (its z): the
+        # laws built once, one per distinct damper (validation at the boundary, not per residual)
+        j0 = basis.cos_index(0) if basis.has_static else None
+        laws, radial = {}, []
+        if basis.has_static:
+            for d, k in enumerate(active):
+                key = id(self.sectors[k].damper)
+                if key not in laws:
+                    laws[key] = (self.sectors[k].centrifugal_law(), [])
+                laws[key][1].append(self.damper_slice(d).start + 2)
+            radial = [(law, np.array(z)) for law, z in laws.values()]
+
         def excitation(omega):
             f, df = f1.copy(), np.zeros((C, N))
-            if basis.has_static:
-                for d, k in enumerate(active):
-                    F, dF = self.sectors[k].centrifugal_force(omega / (2 * np.pi))
-                    z = self.damper_slice(d).start + 2       # radially outwards on the damper
-                    f[basis.cos_index(0), z] = F
-                    df[basis.cos_index(0), z] = dF
+            for law, z in radial:
+                F, dF = law(omega)
+                f[j0, z] = F
+                df[j0, z] = dF
             return f.ravel(), df.ravel()
 
         system = AssemblySystem(basis, mass.tocsr(), damp, stiff, excitation, couplings,
@@ -1095,9 +1105,23 @@ class MistunedDisk:
         def solve_sampled(H, n_samples):
             system = self.hbm_system(H, n_samples)
             scales = self.scales(system, w0, w1)
-            x0 = self.start_solution(system, w0, scales)
+            # the robust start (an excitation homotopy of the whole ring, which the budget cannot
+            # stop midway) is not begun once the budget has run out (the continuation then keeps no
+            # point and says so), and the start at the end of the range is computed once for the
+            # first try and its retry, which both ask for it
+            def start(w):
+                return np.zeros(system.n_unknowns) if budget.exhausted(w) else self.start_solution(system, w, scales)
+
+            at_end = []
+
+            def start_at_end():
+                if not at_end:
+                    at_end.append(start(w1))
+                return at_end[0].copy()
+
+            x0 = start(w0)
             branch = continuation(system.residual, x0, w0, w1, x_scale=scales, factorize=system.factorize,
-                                  max_step=max_step, start_at_end=lambda: self.start_solution(system, w1, scales),
+                                  max_step=max_step, start_at_end=start_at_end,
                                   retry_x_scale=self.retry_scales(system, scales), budget=budget,
                                   **continuation_options)
             response = MistunedResponse.from_branch(self, system, branch, tuned_peak_amplitude)
@@ -1142,7 +1166,7 @@ class MistunedDisk:
         j1, nm, s = basis.cos_index(1), self.n_modes, self.n_sector
         q1 = (coefficients[:, j1, :s * nm] - 1j * coefficients[:, j1 + 1, :s * nm]).reshape(-1, s, nm)
         tips = np.stack([b.shape("tip")[:3] for b in self.blades])            # (s, 3, nm)
-        return np.abs(np.einsum("pkm,kim->pki", q1, tips)).reshape(len(coefficients), -1)
+        return np.abs(np.einsum("pkm,kim->pki", q1, tips)).reshape(len(coefficients), 3 * s)
 
     def point_map(self, basis, point: str = "tip", directions=(0,), blade: int = 0) -> np.ndarray:
         """Real-form map (C*k, C*n_dof) from the unknowns of :meth:`hbm_system` to the motion of

@@ -756,3 +756,20 @@ def test_check_stop_of_the_mistuned_assembly_says_what_the_time_integration_foun
     back = load(cut.save(tmp_path / "cut"))
     assert back.message == cut.message and back.stop_check.periodic[0]
     np.testing.assert_array_equal(back.stop_check.tip_amplitude, check.tip_amplitude)
+
+
+def test_a_budget_spent_before_the_start_keeps_no_point_and_says_so():
+    """A budget that has run out before the first point: the robust start is not begun, the
+    response keeps no point (an empty branch's amplitudes are (0, 3 s), no exception) and its
+    status is OUT_OF_BUDGET with the frequency where it ran out."""
+    md = MistunedDisk.from_tuned(tuned(3), [0.98, 1.0, 1.02])
+    starts = []
+    solve_start = md.start_solution
+    md.start_solution = lambda *args: starts.append(args[1]) or solve_start(*args)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = md.frequency_response(90.0, 100.0, cpu_budget_s=1e-9)
+    assert not starts, f"robust starts begun after the budget ran out, at {starts} rad/s"
+    assert r.status.name == "OUT_OF_BUDGET" and not len(r.omega), r.message
+    assert r.tip_amplitude.shape == (0, 3, 3) and r.stopped_by.startswith("budget")
+    assert "ran out at 90 Hz" in r.message, r.message

@@ -27,10 +27,12 @@ import bladedamp as bd
 from bladedamp import FrictionOscillator
 from bladedamp.blade import reference_blade
 from bladedamp.damper.geometry import ContactProperties, CylinderDamper, WedgeDamper
-from bladedamp.disk import DiskResponse, TunedDisk
+from bladedamp.disk import DiskResponse, TunedDisk, with_peak_check
+from bladedamp.mistuned import MistunedDisk
 from bladedamp.hbm.continuation import Branch
 from bladedamp.hbm.monodromy import full_assembly_coefficients
 from bladedamp import reference as ref
+from bladedamp.response import Status
 
 SEED = 20261201
 N_DISKS = 160
@@ -79,6 +81,36 @@ INCLINED_N_SAMPLES = None
 # a branch that needs more points than this at the suite's max_step has stalled
 MAX_POINTS = 2000
 N_TIME_CHECKS = 10
+# The mistuned section (issue 32 item 7): N_MISTUNED random mistuned disks, random disk i of this
+# generator written out as a full ring of MISTUNED_BLADES blades (not the reference 16: the default
+# FRF of a 16-blade random mistuned disk took 43-103 CPU s, 7 of 10 over 90 s, and a ring's cost
+# grows about as its blades^1.5 (points ~ sqrt(s) for s separate blade resonances, each point ~ s);
+# benchmarks/README.md has the numbers), blade mistuning 1-5 % std, each run by default
+# (harmonics 'auto') with a CPU budget of MISTUNED_CPU_BUDGET_S; every answer that reads as
+# complete and verified is cross-checked by the library's own time integration at its peak
+# (bladedamp.disk.with_peak_check, started on the HBM state).
+# Budget 30 CPU s, not the issue's 60: measured on the 40 designs at 4 blades with 60 s, each
+# finished within 28 CPU s or ran past 60, so the shares are the same and the section's CPU time
+# falls from 1236 to about 800 CPU s (about 7 min of wall time on 2 cores; benchmarks/README.md).
+# A start or an error estimate begun before the budget ran out is finished: the overrun measured
+# was at most 16 CPU s, hence MISTUNED_OVERRUN_S.
+N_MISTUNED = 40
+MISTUNED_BLADES = 4
+MISTUNED_CPU_BUDGET_S = 30.0
+MISTUNED_OVERRUN_S = 30.0
+# Complete-and-verified answers that the time integration at their peak contradicts (measured
+# 2026-12-07, 4 of the 13 complete-verified; the slow test fails on any other and on any of these
+# that stops being contradicted, so that this list stays true): issue 32 item 1's work
+KNOWN_MISTUNED_CONTRADICTIONS = {
+    11: "(0, 1, 2, 3) verified by (0..5); at the peak, 98.78 Hz, the time integration from the HBM state does not "
+        "settle (the first harmonics change by 4e-4 per period after 4000 periods)",
+    14: "(0, 1, 2, 3) verified by (0..5); at the peak, 94.80 Hz, the time integration from the HBM state does not "
+        "settle (a residual drift of 0.0023 of the amplitude, the damper separated 21 % of the period)",
+    17: "(0, 1, 2, 3) verified by (0..5); the time integration at the peak, 95.40 Hz, settles 1 % from the "
+        "branch, just above the 1 % tolerance",
+    27: "(0, 1, 2, 3) verified by (0..5) within 1 %; the time integration at the peak, 101.96 Hz, settles 15 % "
+        "from the branch (the damper stuck all the period)",
+}
 ROTOR_SPEED_95_HZ = 95.0   # EO = 0: the rotor speed of the EO = 1 resonance [Hz]
 
 
@@ -134,9 +166,26 @@ def make_disk(d: dict) -> TunedDisk:
     damper = (CylinderDamper(d["mass"], ref.CYLINDER_RADIUS, ref.DAMPER_LENGTH, contact) if d["damper"] == "cylinder"
               else WedgeDamper(d["mass"], ref.WEDGE_CONTACT_HEIGHT, ref.DAMPER_LENGTH, contact))
     base = ref.EXCITATION_TABLE1 if d["table1"] else ref.EXCITATION_FX
-    return TunedDisk(reference_blade(), damper, ref.N_BLADES, d["engine_order"], d["gamma_left"], d["gamma_right"],
+    return TunedDisk(reference_blade(), damper, d.get("n_blades", ref.N_BLADES), d["engine_order"], d["gamma_left"],
+                     d["gamma_right"],
                      ref.DAMPER_RADIUS, d["excitation_scale"] * base,
                      rotor_speed_hz=ROTOR_SPEED_95_HZ if d["engine_order"] == 0 else None)
+
+
+def mistuned_design(i: int, n_blades: int | None = None) -> dict:
+    """Parameters of random mistuned disk i: random disk i (:func:`disk_design`) on a ring of
+    ``n_blades`` blades (default MISTUNED_BLADES), blade k's frequencies times
+    kappa_k = 1 + sigma z_k, z_k standard normal, sigma uniform in 1-5 %."""
+    rng = np.random.default_rng([SEED, 2, i])
+    sigma = float(rng.uniform(0.01, 0.05))
+    n = MISTUNED_BLADES if n_blades is None else int(n_blades)
+    return dict(disk_design(i), kind=("mistuned", i), n_blades=n, sigma=sigma,
+                kappa=tuple(1.0 + sigma * rng.standard_normal(n)))
+
+
+def make_mistuned(d: dict) -> MistunedDisk:
+    """The full assembly of random mistuned disk ``d`` (:func:`mistuned_design`)."""
+    return MistunedDisk.from_tuned(make_disk(d), np.array(d["kappa"]))
 
 
 def disk_response(disk: TunedDisk, d: dict, check_stop: bool = True) -> DiskResponse:
@@ -229,6 +278,51 @@ def run_design(d: dict) -> dict:
                 no_periodic_motion=no_periodic_motion, seconds=time.perf_counter() - t0)
 
 
+def run_mistuned(d: dict, time_check: bool = True) -> dict:
+    """The default frequency response of random mistuned disk ``d`` (:func:`mistuned_design`)
+    within MISTUNED_CPU_BUDGET_S, its status and CPU seconds; an answer whose status is
+    COMPLETE_VERIFIED is checked by the time integration at its peak (``time_check``:
+    :func:`bladedamp.disk.with_peak_check`, the library's check_peak): ``contradicted`` holds the
+    message where that check no longer finds the answer complete and verified (a periodic motion
+    farther from the branch's peak than the harmonic tolerance, or none)."""
+    disk = make_mistuned(d)
+    t0 = time.process_time()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = disk.frequency_response(d["f_start"], d["f_end"], max_step=d["max_step"], max_points=MAX_POINTS,
+                                    cpu_budget_s=MISTUNED_CPU_BUDGET_S)
+        cpu = time.process_time() - t0
+        contradicted, checked_cpu = None, 0.0
+        if time_check and r.status is Status.COMPLETE_VERIFIED:
+            t1 = time.process_time()
+            checked = with_peak_check(disk, r, True, r.harmonic_tolerance)
+            checked_cpu = time.process_time() - t1
+            if checked.status is not Status.COMPLETE_VERIFIED:
+                contradicted = checked.message
+    return dict(kind=d["kind"], status=r.status, message=r.message, cpu=cpu, check_cpu=checked_cpu,
+                points=len(r.omega), harmonics=r.basis.harmonics, contradicted=contradicted)
+
+
+def mistuned_summary(results) -> str:
+    """The shares of complete-verified, complete-unverified (or above its tolerance),
+    stopped-with-reason and out-of-budget answers, and every design's line."""
+    n = len(results)
+    groups = {"complete, verified": [Status.COMPLETE_VERIFIED],
+              "complete, unverified or above tolerance": [Status.COMPLETE_UNVERIFIED, Status.COMPLETE_ABOVE_TOLERANCE],
+              "stopped with a reason": [Status.STOPPED, Status.CHECK_FAILED],
+              "out of budget": [Status.OUT_OF_BUDGET]}
+    counts = {k: sum(r["status"] in v for r in results) for k, v in groups.items()}
+    cpu = np.array([r["cpu"] for r in results])
+    lines = [f"random mistuned disks ({MISTUNED_BLADES} blades, budget {MISTUNED_CPU_BUDGET_S:g} CPU s): "
+             + "; ".join(f"{k} {c} of {n} ({100 * c / n:.0f} %)" for k, c in counts.items())
+             + f"; CPU s median {np.median(cpu):.1f}, max {cpu.max():.1f}, {cpu.sum():.0f} in all, time checks "
+               f"{sum(r['check_cpu'] for r in results):.0f} s"]
+    for r in results:
+        lines.append(f"  {r['kind']}: {r['status'].name}, {r['cpu']:.1f} CPU s, {r['points']} points, harmonics "
+                     f"{r['harmonics']}" + (f", CONTRADICTED: {r['contradicted']}" if r["contradicted"] else ""))
+    return "\n".join(lines)
+
+
 def all_designs():
     return [disk_design(i) for i in range(N_DISKS)] + [oscillator_design(i) for i in range(N_OSCILLATORS)]
 
@@ -297,6 +391,46 @@ def test_random_designs_share():
     share, answered, text = summary(results)
     print("\n" + text)
     assert share >= SHARE_REQUIRED and answered >= ANSWERED_REQUIRED, text
+
+
+# ----- the mistuned section ----------------------------------------------------------------------
+# fast: random mistuned disk 4 on a ring of 3 blades (a 0.088 g cylinder at EO 7, mistuning 3.7 %)
+FAST_MISTUNED = 4
+
+
+def test_random_mistuned_disk_ends_with_a_status_within_its_budget():
+    """One small random mistuned disk by default: it ends within its CPU budget (plus the
+    analysis' last point and its bookkeeping) with a status, and a complete answer covers its
+    range."""
+    d = mistuned_design(FAST_MISTUNED, 3)
+    r = run_mistuned(d, time_check=False)
+    assert isinstance(r["status"], Status), r
+    assert r["cpu"] <= MISTUNED_CPU_BUDGET_S + MISTUNED_OVERRUN_S, r
+    assert r["status"].complete and r["points"] > 1, mistuned_summary([r])
+
+
+@pytest.mark.slow
+def test_random_mistuned_designs():
+    """Issue 32 item 7: N_MISTUNED random mistuned disks; prints the shares of each status and
+    fails on any complete-and-verified answer that the time integration at its peak contradicts
+    (but those of KNOWN_MISTUNED_CONTRADICTIONS), and on any design that overruns its budget by more
+    than MISTUNED_OVERRUN_S."""
+    results = run_all_mistuned([mistuned_design(i) for i in range(N_MISTUNED)])
+    text = mistuned_summary(results)
+    print("\n" + text)
+    contradicted = {r["kind"][1] for r in results if r["contradicted"]}
+    assert contradicted <= set(KNOWN_MISTUNED_CONTRADICTIONS), f"new contradictions {contradicted - set(KNOWN_MISTUNED_CONTRADICTIONS)}\n{text}"
+    assert contradicted >= set(KNOWN_MISTUNED_CONTRADICTIONS), \
+        f"no longer contradicted (remove from KNOWN_MISTUNED_CONTRADICTIONS): {set(KNOWN_MISTUNED_CONTRADICTIONS) - contradicted}"
+    assert all(r["cpu"] <= MISTUNED_CPU_BUDGET_S + MISTUNED_OVERRUN_S for r in results), text
+
+
+def run_all_mistuned(designs, processes=None):
+    processes = processes or min(2, os.cpu_count() or 1)
+    if processes <= 1:
+        return [run_mistuned(d) for d in designs]
+    with ProcessPoolExecutor(processes) as pool:
+        return list(pool.map(run_mistuned, designs, chunksize=1))
 
 
 def stopped_disk(i: int):
@@ -525,7 +659,10 @@ if __name__ == "__main__":
     args = [a for a in sys.argv[1:] if not a.startswith("--")]
     procs = int(args[0]) if args else None
     t = time.perf_counter()
-    if "--default" in sys.argv:
+    if "--mistuned" in sys.argv:
+        # python tests/test_random_designs.py [processes] --mistuned: the mistuned section's shares
+        print(mistuned_summary(run_all_mistuned([mistuned_design(i) for i in range(N_MISTUNED)], procs)))
+    elif "--default" in sys.argv:
         indices = [int(i) for i in sys.argv[sys.argv.index("--default") + 1].split(",")]
         with ProcessPoolExecutor(procs or 2) as pool:
             answers = list(pool.map(default_answer, indices, chunksize=1))
