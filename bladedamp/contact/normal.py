@@ -21,12 +21,15 @@ dN/da [N/m]. A caller working in u_zeta takes dN/du_zeta = -dN/da.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import guvectorize, njit
 
 LAW_LINEAR, LAW_POWER = 0, 1
 """Kind codes of the normal laws (:func:`normal_force`)."""
 
 
+# numba's on-disk cache of a kernel is keyed on its own source file: after editing this
+# function, clear the cache (or touch contact/point.py and timedomain.py), or their cached
+# kernels keep the old law.
 @njit(cache=True)
 def normal_force(law_kind, p0, p1, p2, weight, approach):
     """(N [N], dN/da [N/m]) of one point: ``law_kind`` LAW_LINEAR (p0 = k_N [N/m]) or
@@ -43,27 +46,25 @@ def normal_force(law_kind, p0, p1, p2, weight, approach):
     return n_ref * ratio ** p2, n_ref * p2 / p1 * ratio ** (p2 - 1.0)
 
 
-@njit(cache=True)
-def _normal_force_loop(kind, p0, p1, p2, weight, approach, normal, stiffness):
-    for i in range(approach.shape[0]):
-        normal[i], stiffness[i] = normal_force(kind[i], p0[i], p1[i], p2[i], weight[i], approach[i])
+@guvectorize(["void(int64, float64, float64, float64, float64, float64, float64[:], float64[:])"],
+             "(),(),(),(),(),()->(),()", cache=True)
+def _normal_force_ufunc(kind, p0, p1, p2, weight, approach, normal, stiffness):
+    normal[0], stiffness[0] = normal_force(kind, p0, p1, p2, weight, approach)
 
 
 def normal_forces(law_kind, law_params, weight, approach):
     """:func:`normal_force` over arrays: (N [N], dN/da [N/m]), each of the broadcast shape of
     ``law_kind`` (int, LAW_LINEAR or LAW_POWER), ``law_params`` (..., 3) (p0, p1, p2 on the last
     axis), ``weight`` [-] and ``approach`` a [m]."""
-    kind = np.asarray(law_kind, dtype=np.int64)
-    if not np.all((kind == LAW_LINEAR) | (kind == LAW_POWER)):
+    if isinstance(law_kind, (int, np.integer)):         # one law (the law classes): no array test
+        kind = law_kind
+        known = law_kind in (LAW_LINEAR, LAW_POWER)
+    else:
+        kind = np.asarray(law_kind, dtype=np.int64)
+        known = np.all((kind == LAW_LINEAR) | (kind == LAW_POWER))
+    if not known:
         raise ValueError(f"law_kind must be LAW_LINEAR ({LAW_LINEAR}) or LAW_POWER ({LAW_POWER})")
     params = np.asarray(law_params, dtype=float)
     if params.ndim == 0 or params.shape[-1] != 3:
         raise ValueError(f"law_params must have 3 entries on its last axis (got shape {params.shape})")
-    arrays = np.broadcast_arrays(kind, params[..., 0], params[..., 1], params[..., 2],
-                                 np.asarray(weight, dtype=float), np.asarray(approach, dtype=float))
-    shape = arrays[0].shape
-    flat = [np.ascontiguousarray(x).reshape(-1) for x in arrays]
-    normal = np.empty(flat[0].shape[0])
-    stiffness = np.empty(flat[0].shape[0])
-    _normal_force_loop(*flat, normal, stiffness)
-    return normal.reshape(shape), stiffness.reshape(shape)
+    return _normal_force_ufunc(kind, params[..., 0], params[..., 1], params[..., 2], weight, approach)
