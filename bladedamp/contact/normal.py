@@ -46,10 +46,20 @@ def normal_force(law_kind, p0, p1, p2, weight, approach):
     return n_ref * ratio ** p2, n_ref * p2 / p1 * ratio ** (p2 - 1.0)
 
 
-@guvectorize(["void(int64, float64, float64, float64, float64, float64, float64[:], float64[:])"],
-             "(),(),(),(),(),()->(),()", cache=True)
-def _normal_force_ufunc(kind, p0, p1, p2, weight, approach, normal, stiffness):
+def _normal_force_into(kind, p0, p1, p2, weight, approach, normal, stiffness):
     normal[0], stiffness[0] = normal_force(kind, p0, p1, p2, weight, approach)
+
+
+_GUFUNC = []
+
+
+def _normal_force_gufunc():
+    """:func:`normal_force` as a numpy gufunc (numpy broadcasts), built at the first call, not
+    at import (building it starts numba's compiler, which importing the package does not)."""
+    if not _GUFUNC:
+        _GUFUNC.append(guvectorize(["void(int64, float64, float64, float64, float64, float64, float64[:], float64[:])"],
+                                   "(),(),(),(),(),()->(),()", cache=True)(_normal_force_into))
+    return _GUFUNC[0]
 
 
 def normal_forces(law_kind, law_params, weight, approach):
@@ -67,4 +77,4 @@ def normal_forces(law_kind, law_params, weight, approach):
     params = np.asarray(law_params, dtype=float)
     if params.ndim == 0 or params.shape[-1] != 3:
         raise ValueError(f"law_params must have 3 entries on its last axis (got shape {params.shape})")
-    return _normal_force_ufunc(kind, params[..., 0], params[..., 1], params[..., 2], weight, approach)
+    return _normal_force_gufunc()(kind, params[..., 0], params[..., 1], params[..., 2], weight, approach)
