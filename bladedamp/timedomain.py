@@ -21,6 +21,8 @@ from functools import cached_property
 import numpy as np
 from numba import njit
 
+from .contact.laws import normal_law_parameters
+from .contact.normal import normal_force, normal_forces
 from .contact.point import SEPARATED, PointContactElement, slider_step
 from .hbm.continuation import DEFAULT_MAX_STEP
 from .io import Saveable
@@ -160,26 +162,12 @@ class TimeResponse(Saveable):
 # limit; accuracy asks for 512 (MIN_STEPS_PER_PERIOD). Cost: ~20 / 36 us per step for the
 # 16-blade reference assembly (160 unknowns, 160 / 800 contact points) on the 2-core test box.
 
-_LAW_LINEAR, _LAW_POWER = 0, 1          # as contact.point.LAW_LINEAR / LAW_POWER
 # Fewest steps per period by default (accuracy, not stability): the central differences shorten
 # the modal mass by (Omega dt)^2 / 12, which moves a resonance and, on the steep flank of the
 # lightly damped stuck 1F peak, changes the amplitude ~25x as much. Measured on the reference
 # 1 g cylinder at 95 Hz (stuck; HBM 0.226976 mm): 287 steps (the stability limit x 0.8)
 # 0.226339 mm (-0.28 %), 574 steps 0.226781 mm (-0.086 %): second order.
 MIN_STEPS_PER_PERIOD = 512
-
-
-@njit(cache=True)
-def _normal_force(law_kind, p0, p1, p2, weight, approach):
-    """(N, dN/da) of one point (contact.laws: linear k_N w a, or power w N_ref (a / a_ref)^p)."""
-    if approach <= 0.0:
-        return 0.0, 0.0
-    if law_kind == _LAW_LINEAR:
-        k = p0 * weight
-        return k * approach, k
-    ratio = approach / p1
-    n_ref = p0 * weight
-    return n_ref * ratio ** p2, n_ref * p2 / p1 * ratio ** (p2 - 1.0)
 
 
 @njit(cache=True)
@@ -252,8 +240,8 @@ def disk_period(steps, dt, n_q, m_q, c_q, k_q, minv, f_static, f_cos, f_sin,
             for e in range(b_nnz[p, 2]):
                 c = b_col[p, 2, e]
                 u2 += B[p, 2, c] * w[base + c]
-            normal, _ = _normal_force(law_kind[p], law_par[p, 0], law_par[p, 1], law_par[p, 2], weight[p],
-                                      offset[p] - u2)
+            normal, _ = normal_force(law_kind[p], law_par[p, 0], law_par[p, 1], law_par[p, 2], weight[p],
+                                     offset[p] - u2)             # approach a = offset - u_zeta
             s0 = slider[p, 0]
             s1 = slider[p, 1]
             f0, f1, n0, n1, st = slider_step(u0, u1, s0, s1, k_t[p], mu[p] * normal, normal > 0.0)
@@ -384,8 +372,6 @@ def assembly_arrays(disk) -> AssemblyArrays:
     """
     import scipy.sparse as sp
 
-    from .contact.point import normal_law_parameters
-
     if any(b.flexible_platform for b in disk.blades):
         raise ValueError("time_response models rigid platforms at the OL / OR control points only; the blades "
                          "carry flexible platforms (solid FE blades): use blade.rigid_platform_blade() for them")
@@ -474,18 +460,11 @@ def assembly_arrays(disk) -> AssemblyArrays:
                            mass=M, **arr)
 
 
-def _normal_law_numpy(arrays: AssemblyArrays, approach: np.ndarray):
-    """(N, dN/da) of every point (numpy version of :func:`_normal_force`)."""
-    a = np.maximum(approach, 0.0)
-    p0, p1, p2 = arrays.law_par.T
-    linear = arrays.law_kind == _LAW_LINEAR
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = np.where(linear, 1.0, a / np.where(linear, 1.0, p1))
-        n_pow = p0 * arrays.weight * ratio ** p2
-        k_pow = np.where(a > 0, p0 * arrays.weight * p2 / np.where(linear, 1.0, p1) * ratio ** (p2 - 1.0), 0.0)
-    normal = np.where(linear, p0 * arrays.weight * a, n_pow)
-    stiff = np.where(approach > 0, np.where(linear, p0 * arrays.weight, k_pow), 0.0)
-    return normal, stiff
+def point_normal_forces(arrays: AssemblyArrays, approach: np.ndarray):
+    """(N [N], dN/da [N/m]) (P,) of every contact point of the assembly at the approaches
+    ``approach`` (P,) [m] (a = offset - u_zeta): :func:`bladedamp.contact.normal.normal_forces`
+    with the points' law kinds, parameters and weights."""
+    return normal_forces(arrays.law_kind, arrays.law_par, arrays.weight, approach)
 
 
 def _static_state(arrays: AssemblyArrays, f_static: np.ndarray, tol: float = 1e-12, max_iter: int = 60):
@@ -515,14 +494,14 @@ def _static_state(arrays: AssemblyArrays, f_static: np.ndarray, tol: float = 1e-
     n_free = np.zeros(N)
     n_free[arrays.n_q:] = 1e-12 * (arrays.law_par[:, 0].max() + arrays.k_t.sum())
     for _ in range(max_iter):
-        normal, dn = _normal_law_numpy(arrays, arrays.offset - Z @ x)
+        normal, dn = point_normal_forces(arrays, arrays.offset - Z @ x)
         R = K @ x - Z.T @ normal - f_static
         J = (K + Z.T @ sp.diags(dn) @ Z + sp.diags(n_free)).tocsc()
         dx = -spsolve(J, R)
         x = x + dx
         if np.abs(R).max() <= tol * scale and np.linalg.norm(dx) <= 1e-9 * (np.linalg.norm(x) + 1e-300):
             return x
-    normal, _ = _normal_law_numpy(arrays, arrays.offset - Z @ x)
+    normal, _ = point_normal_forces(arrays, arrays.offset - Z @ x)
     R = K @ x - Z.T @ normal - f_static
     if np.abs(R).max() > 1e-8 * scale:
         raise RuntimeError(f"static equilibrium under the centrifugal load did not converge (residual {np.abs(R).max():.3g} N)")
@@ -541,9 +520,9 @@ def highest_frequency(arrays: AssemblyArrays, x_static: np.ndarray) -> float:
         W = arrays.point_map
         approach = arrays.offset - W[2::3] @ x_static
         a_ref = np.where(approach > 0, 2.0 * approach, np.maximum(approach.max(), 0.0) * 2.0)
-        _, kn = _normal_law_numpy(arrays, a_ref)
+        _, kn = point_normal_forces(arrays, a_ref)
         if not np.any(kn > 0):
-            kn = _normal_law_numpy(arrays, np.full_like(approach, 1e-9))[1]
+            kn = point_normal_forces(arrays, np.full_like(approach, 1e-9))[1]
         k = np.column_stack([arrays.k_t, arrays.k_t, kn]).ravel()
         K = K + W.T @ sp.diags(k) @ W
     # M^-1/2 K M^-1/2 (M block diagonal: modal masses, 6 x 6 damper inertias)

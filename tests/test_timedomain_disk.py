@@ -168,7 +168,7 @@ def test_static_state_with_a_misfit_is_the_seating():
     frictionless) carries the same per-point normal loads as the HBM's rigid-platform seating
     (kinetics.seat) to 1e-6, and leaves the same points open."""
     from bladedamp.damper.kinetics import seat
-    from bladedamp.timedomain import _normal_law_numpy, _static_state, assembly_arrays
+    from bladedamp.timedomain import _static_state, assembly_arrays, point_normal_forces
 
     xi = np.repeat(np.linspace(-1.0, 1.0, 3), 3)                  # 3 x 3 points, xi-major
     disk = small_disk(small_wedge(), initial_gaps=np.array([5e-6 * (1 + xi), 5e-6 * (1 - xi)]))
@@ -176,7 +176,7 @@ def test_static_state_with_a_misfit_is_the_seating():
     w = 2 * np.pi * 97.0
     f = arrays.system.excitation(w)[0].reshape(3, -1)
     x0 = _static_state(arrays, f[0])
-    loads, _ = _normal_law_numpy(arrays, arrays.offset - arrays.point_map[2::3] @ x0)
+    loads, _ = point_normal_forces(arrays, arrays.offset - arrays.point_map[2::3] @ x0)
     geometry = disk.damper_geometry()
     _, approach, _ = seat(geometry, disk.centrifugal_force(97.0)[0])
     ref = np.concatenate([p.normal_law.force(approach[c], p.weights)[0] for c, p in enumerate(geometry.patches)])

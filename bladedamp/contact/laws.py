@@ -3,7 +3,10 @@
 A law describes a whole contact area; the points of a discretised patch carry a share
 ``weight`` of it (weights sum to 1), so a patch of 1 point and a patch of 100 points
 under the same law have the same total stiffness. The approach ``a`` [m] is positive
-when the bodies press into each other; ``a <= 0`` is lift-off (zero force).
+when the bodies press into each other; ``a <= 0`` is lift-off (zero force). The law itself
+(N and dN/da of one point) is written once, in :mod:`bladedamp.contact.normal`; a law object
+here is its kind code and parameters (:func:`normal_law_parameters`) with the checks of its
+inputs and the inverse (approach for a load).
 """
 from __future__ import annotations
 
@@ -12,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import validation
+from .normal import LAW_LINEAR, LAW_POWER, normal_forces
 
 
 @dataclass(frozen=True)
@@ -29,11 +33,18 @@ class LinearNormalLaw:
     def __post_init__(self):
         validation.positive("normal stiffness k_N", self.stiffness)
 
+    kind = LAW_LINEAR
+
+    @property
+    def parameters(self) -> np.ndarray:
+        """(k_N, 0, 0): the parameters of :func:`bladedamp.contact.normal.normal_force`."""
+        return np.array([float(self.stiffness), 0.0, 0.0])
+
     def force(self, approach: np.ndarray, weight: np.ndarray):
-        """Normal force [N] and its derivative in the approach [N/m], same shape as ``approach``."""
-        k = self.stiffness * weight
-        pressed = approach > 0
-        return np.where(pressed, k * approach, 0.0), np.where(pressed, k, 0.0)
+        """Normal force N [N] and its derivative dN/da [N/m] at the approach a [m] of points of
+        ``weight`` [-], both of the broadcast shape of ``approach`` and ``weight``
+        (:func:`bladedamp.contact.normal.normal_forces`)."""
+        return normal_forces(self.kind, self.parameters, weight, approach)
 
     def approach_for_load(self, load: np.ndarray, weight: np.ndarray) -> np.ndarray:
         """Static approach [m] at which a point of ``weight`` carries ``load`` [N]."""
@@ -76,12 +87,16 @@ class RoughnessNormalLaw:
         """a_ref = p N_ref / k_ref [m]."""
         return self.exponent * self.reference_load / self.stiffness
 
+    kind = LAW_POWER
+
+    @property
+    def parameters(self) -> np.ndarray:
+        """(N_ref, a_ref, p): the parameters of :func:`bladedamp.contact.normal.normal_force`."""
+        return np.array([float(self.reference_load), float(self.reference_approach), float(self.exponent)])
+
     def force(self, approach: np.ndarray, weight: np.ndarray):
-        a_ref, p = self.reference_approach, self.exponent
-        ratio = np.maximum(approach, 0.0) / a_ref
-        n_ref = self.reference_load * weight
-        # lift-off (a <= 0): no force and no stiffness (for p = 1, 0**0 would give 1)
-        return n_ref * ratio ** p, np.where(approach > 0, n_ref * p / a_ref * ratio ** (p - 1), 0.0)
+        """As :meth:`LinearNormalLaw.force`."""
+        return normal_forces(self.kind, self.parameters, weight, approach)
 
     def approach_for_load(self, load: np.ndarray, weight: np.ndarray) -> np.ndarray:
         ratio = np.maximum(np.asarray(load, dtype=float), 0.0) / (self.reference_load * weight)
@@ -93,3 +108,14 @@ class RoughnessNormalLaw:
 
 
 NormalLaw = LinearNormalLaw | RoughnessNormalLaw
+
+
+def normal_law_parameters(law):
+    """(kind, parameters (3,)) of a normal law the fused kernels evaluate themselves
+    (:func:`bladedamp.contact.normal.normal_force`), or None.
+
+    LinearNormalLaw: (LAW_LINEAR, [k_N, 0, 0]); RoughnessNormalLaw: (LAW_POWER, [N_ref, a_ref, p]).
+    Exact types only (a subclass may change ``force``)."""
+    if type(law) in (LinearNormalLaw, RoughnessNormalLaw):
+        return law.kind, law.parameters
+    return None

@@ -34,7 +34,8 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from .laws import LinearNormalLaw, RoughnessNormalLaw
+from .laws import normal_law_parameters
+from .normal import normal_force
 
 STICK, SLIP, SEPARATED = 0, 1, 2
 
@@ -553,21 +554,6 @@ def _return_map(ut, normal, dnormal, seat, seat_rate, synthesis, k_t, mu, s_star
         passes[p, 1] = n_jac
 
 
-LAW_LINEAR, LAW_POWER = 0, 1
-
-
-def normal_law_parameters(law):
-    """(kind, parameters) of a normal law the fused kernel evaluates itself, or None.
-
-    LinearNormalLaw: (LAW_LINEAR, [k_N, 0, 0]); RoughnessNormalLaw: (LAW_POWER, [N_ref, a_ref, p]).
-    Exact types only (a subclass may change ``force``)."""
-    if type(law) is LinearNormalLaw:
-        return LAW_LINEAR, np.array([float(law.stiffness), 0.0, 0.0])
-    if type(law) is RoughnessNormalLaw:
-        return LAW_POWER, np.array([float(law.reference_load), float(law.reference_approach), float(law.exponent)])
-    return None
-
-
 @njit(cache=True)
 def point_work(synthesis, analysis):
     """Work arrays of :func:`point_harmonics` for the synthesis (T, C) and analysis (C, T) of a
@@ -624,26 +610,17 @@ def point_harmonics(c, synthesis, analysis, kt, mu, w, off, law_kind, law_params
         ut[t, 0] = x0
         ut[t, 1] = x1
         uz[t] = x2
-    # normal law N(a), a = offset - u_zeta (as laws.py); dnormal = dN/du_zeta = -dN/da
-    k_law = law_params[0]
-    a_ref = law_params[1]
-    expo = law_params[2]
+    # normal law N(a) (contact.normal), approach a = offset - u_zeta; this kernel's convention:
+    # dnormal = dN/du_zeta = -dN/da
+    p0 = law_params[0]
+    p1 = law_params[1]
+    p2 = law_params[2]
     for t in range(T):
         app = off - uz[t]
         approach[0, t] = app
-        if app > 0.0:
-            if law_kind == LAW_LINEAR:
-                kw = k_law * w
-                normal[t] = kw * app
-                dnormal[t] = -kw
-            else:
-                ratio = app / a_ref
-                n_ref = k_law * w
-                normal[t] = n_ref * ratio ** expo
-                dnormal[t] = -(n_ref * expo / a_ref * ratio ** (expo - 1.0))
-        else:
-            normal[t] = 0.0
-            dnormal[t] = 0.0
+        n_t, dn_da = normal_force(law_kind, p0, p1, p2, w, app)
+        normal[t] = n_t
+        dnormal[t] = 0.0 - dn_da         # (+0.0 at lift-off, not -0.0)
     touchdown_seats(approach, seats, seat_rates)
     if static_index >= 0:
         s0 = c[static_index, 0]
