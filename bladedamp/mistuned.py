@@ -286,7 +286,7 @@ class AssemblyContacts:
             # as DamperContacts.harmonic_forces: Euler's identity for linear normal laws, else
             # a central difference in omega of all dampers at once
             domega = np.empty(force.shape)
-            if not (self.linear_normal_laws and _euler_rate(offsets, doffsets, blocks, local, force, domega)):
+            if not (self.linear_normal_laws and euler_rate(offsets, doffsets, blocks, local, force, domega)):
                 h = 1e-6 * omega
                 fp, _ = self._forces(local, basis, offsets + h * doffsets, False)
                 fm, _ = self._forces(local, basis, offsets - h * doffsets, False)
@@ -348,7 +348,7 @@ HOMOGENEOUS_TOL = 1e-12
 
 
 @njit(cache=True)
-def _euler_rate(offsets, doffsets, blocks, local, force, domega):
+def euler_rate(offsets, doffsets, blocks, local, force, domega):
     """d force / d omega (C, n_d, L) [N s/rad] into ``domega`` by Euler's identity for linear
     normal laws, when the static approach's omega-derivative is homogeneous: doffsets = kappa_d
     offsets (n_d, 2, P) [m, m s/rad] for every damper d to :data:`HOMOGENEOUS_TOL` of its
@@ -573,7 +573,7 @@ class AssemblySystem(HarmonicBalanceSystem):
         order of the scipy / numpy operations they replaced, so the numbers are the same (tested),
         and the sparse Jacobian is a copy of one template matrix (:attr:`_jacobian_template`)
         holding the new values: every Jacobian of the system shares the template's index arrays
-        (do not change them in place; :func:`~bladedamp.hbm.continuation._bordered` relies on
+        (do not change them in place; :func:`~bladedamp.hbm.continuation.bordered_matrix` relies on
         them to reuse its bordered pattern). Measured on a Monte Carlo 16-blade disk (n = 320, the contact
         kernel's result held fixed, medians of 15 alternating runs): 63 against 112 us with the
         Jacobian, 14 against 26 us without."""

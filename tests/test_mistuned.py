@@ -655,11 +655,11 @@ def test_residual_kernels_give_the_numbers_of_the_scipy_operations(harmonics):
 
 def test_euler_rate_is_the_numpy_formula_to_rounding():
     """AssemblyContacts.evaluate's d force / d omega by Euler's identity (one numba call,
-    mistuned._euler_rate) equals the numpy formula it replaced, kappa_d = doffsets_d . offsets_d
+    mistuned.euler_rate) equals the numpy formula it replaced, kappa_d = doffsets_d . offsets_d
     / |offsets_d|^2 and (force - J local) kappa, to 1e-12 of its largest entry at a stuck and a
     slipping state; an approach rate that is not homogeneous (one entry moved) is refused,
     domega left as it was, and evaluate takes the central difference there."""
-    from bladedamp.mistuned import _euler_rate
+    from bladedamp.mistuned import euler_rate
 
     md = MistunedDisk.from_tuned(reference_disk("cylinder", 1e-3), mt.random_kappa(16, 0.02, seed=5))
     system = md.hbm_system((1,))
@@ -678,8 +678,8 @@ def test_euler_rate_is_the_numpy_formula_to_rounding():
         skewed = doffsets.copy()
         skewed[3, 1, 2] *= 1.001
         out = np.full(force.shape, 7.0)
-        assert not _euler_rate(offsets, skewed, blocks, local, force, out) and np.all(out == 7.0)
-        assert _euler_rate(offsets, doffsets, blocks, local, force, out) and np.array_equal(out, domega)
+        assert not euler_rate(offsets, skewed, blocks, local, force, out) and np.all(out == 7.0)
+        assert euler_rate(offsets, doffsets, blocks, local, force, out) and np.array_equal(out, domega)
 
 
 def test_dampers_of_one_kind_evaluate_their_static_approach_once():
@@ -703,7 +703,7 @@ def test_sixteen_blades_take_the_sparse_jacobian_and_the_ring_solves_it_as_the_d
     """Above AssemblySystem.ring_dense_limit unknowns the ring's systems return a sparse
     Jacobian: the same entries as the dense assembly, and the ring's solution of its bordered
     matrix (the continuation's, bordered in CSC) equal to that of the dense one to 1e-12."""
-    from bladedamp.hbm.continuation import _bordered
+    from bladedamp.hbm.continuation import bordered_matrix
 
     md = MistunedDisk.from_tuned(reference_disk("cylinder", 1e-3), mt.random_kappa(16, 0.02, seed=5))
     system = md.hbm_system((1,))
@@ -720,7 +720,7 @@ def test_sixteen_blades_take_the_sparse_jacobian_and_the_ring_solves_it_as_the_d
     assert np.array_equal(R, R_d) and np.array_equal(Rw, Rw_d) and np.array_equal(J.toarray(), J_d)
     rng = np.random.default_rng(0)
     row, scale, b = rng.standard_normal(J_d.shape[0] + 1), rng.uniform(0.5, 2, J_d.shape[0]), rng.standard_normal(J_d.shape[0] + 1)
-    A, A_d = _bordered(J, Rw, row, scale, 0.3), _bordered(J_d, Rw, row, scale, 0.3)
+    A, A_d = bordered_matrix(J, Rw, row, scale, 0.3), bordered_matrix(J_d, Rw, row, scale, 0.3)
     assert np.array_equal(A.toarray(), A_d)
     y, y_d = system.factorize(A)(b), system.factorize(A_d)(b)
     assert np.abs(y - y_d).max() <= 1e-12 * np.abs(y_d).max()

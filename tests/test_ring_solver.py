@@ -255,25 +255,25 @@ def test_mistuned_frf_with_the_ring_equals_the_condensation(n, f_range, sparse, 
 
 
 def test_one_column_substitutions_give_the_many_column_numbers():
-    """The ring's one-column paths (the solves' right-hand sides: _mm_sub and _lu_solve with a
-    single column, _lu_solve_transposed) sum each row in a register: the same numbers, bit for
+    """The ring's one-column paths (the solves' right-hand sides: mm_subtract and lu_solve_inplace with a
+    single column, lu_solve_transposed_inplace) sum each row in a register: the same numbers, bit for
     bit, as the many-column loops (which subtract term by term in memory) on the same column."""
-    from bladedamp.hbm.linsolve import _lu, _lu_solve, _lu_solve_transposed, _mm_sub
+    from bladedamp.hbm.linsolve import lu_factor_inplace, lu_solve_inplace, lu_solve_transposed_inplace, mm_subtract
 
     rng = np.random.default_rng(11)
     q = 21
     W = rng.standard_normal((q, q)) + q * np.eye(q)
     piv = np.empty(q, dtype=np.intp)
-    _lu(W, piv)
+    lu_factor_inplace(W, piv)
     A, B, C = rng.standard_normal((q, 13)), rng.standard_normal((13, 1)), rng.standard_normal((q, 1))
     wide, wide_C = np.hstack([B, rng.standard_normal((13, 2))]), np.hstack([C, np.zeros((q, 2))])
-    _mm_sub(A, B, C)
-    _mm_sub(A, wide, wide_C)
+    mm_subtract(A, B, C)
+    mm_subtract(A, wide, wide_C)
     assert np.array_equal(C[:, 0], wide_C[:, 0])
     b = rng.standard_normal((q, 1))
     b_wide = np.hstack([b, rng.standard_normal((q, 3))])
-    _lu_solve(W, piv, b)
-    _lu_solve(W, piv, b_wide)
+    lu_solve_inplace(W, piv, b)
+    lu_solve_inplace(W, piv, b_wide)
     assert np.array_equal(b[:, 0], b_wide[:, 0])
     x = rng.standard_normal(q)
     expected = x.copy()                 # W^-T x term by term, as the loops were
@@ -287,5 +287,5 @@ def test_one_column_substitutions_give_the_many_column_numbers():
     for c in range(q - 1, -1, -1):
         if piv[c] != c:
             expected[c], expected[piv[c]] = expected[piv[c]], expected[c]
-    _lu_solve_transposed(W, piv, x)
+    lu_solve_transposed_inplace(W, piv, x)
     assert np.array_equal(x, expected)

@@ -371,7 +371,7 @@ def _iterate_passes(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s0,
 @njit(cache=True)
 def _point_return_map(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s0, s1, static_index, max_passes, tol,
                       want_jac, f_out, df_out, state_out, ds, ds_begin, transfer, closed_form, stuck_rows):
-    """Periodic return map of one point (see :func:`_return_map`).
+    """Periodic return map of one point (see :func:`return_map`).
 
     ut (T,2); normal, dnormal (T,); s0, s1 the initial slider position; outputs f_out (T,>=2),
     df_out (T,>=2,3C) (rows 0, 1 written; untouched without the Jacobian), state_out (T,);
@@ -525,8 +525,8 @@ def _point_return_map(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s
 
 
 @njit(cache=True)
-def _return_map(ut, normal, dnormal, seat, seat_rate, synthesis, k_t, mu, s_start, static_index,
-                max_passes, tol, want_jac, f_out, df_out, state_out, slip_work, passes, closed_form):
+def return_map(ut, normal, dnormal, seat, seat_rate, synthesis, k_t, mu, s_start, static_index,
+               max_passes, tol, want_jac, f_out, df_out, state_out, slip_work, passes, closed_form):
     """Tangential forces of P points over T samples (see module docstring).
 
     ut (P,T,2) tangential displacement samples; normal (P,T) normal load N >= 0;
@@ -903,7 +903,7 @@ def point_contact_forces(coeffs, basis, tangential_stiffness, friction_coefficie
     state = np.empty((P, T), dtype=np.int8)
     slip_work = np.zeros(P)
     passes = np.zeros((P, 2), dtype=np.int64)
-    _return_map(np.ascontiguousarray(disp[:, :, :2]), np.ascontiguousarray(normal),
+    return_map(np.ascontiguousarray(disp[:, :, :2]), np.ascontiguousarray(normal),
                 np.ascontiguousarray(dnormal), seat, seat_rate, basis.synthesis, k_t, mu, s_start, static_index,
                 max_passes, tol, jacobian, f_t, df, state, slip_work, passes, closed_form)
     force = np.empty((P, T, 3))
