@@ -24,7 +24,7 @@ Time sampling (AFT): the contact forces are evaluated at ``n_samples`` instants 
 in a tuned travelling wave blade k's motion is blade 0's shifted by k dphi; the discrete friction
 laws are shift-invariant only when that shift is a whole number of samples. Each damper is
 therefore sampled on its own grid, shifted by its phase k dphi (a rotation of its harmonic
-coefficients before the AFT and back after it, :meth:`AssemblyContacts._grid_rotations`;
+coefficients before the AFT and back after it, :meth:`AssemblyContacts.grid_rotations`;
 nothing to do where the shift is whole samples, n = 16 and EO = 1 at 64 samples): a tuned full
 assembly equals the cyclic solution to rounding at any ``n_samples``, and the default is the
 tuned disk's (64 for one harmonic at any n; before, it was rounded up to a multiple of
@@ -115,7 +115,7 @@ class AssemblyContacts:
     contacts: list[DamperContacts]
     n_local: int = 0
     #: (n_d,) phase [rad] of each damper's motion in a tuned travelling wave (k dphi for the
-    #: damper on blade k), or None; damper d is sampled on a grid shifted by it (:meth:`_grid_rotations`)
+    #: damper on blade k), or None; damper d is sampled on a grid shifted by it (:meth:`grid_rotations`)
     grid_phase: np.ndarray | None = None
     _batch: tuple | None = field(default=None, init=False, repr=False)
     _index: dict = field(default_factory=dict, init=False, repr=False)
@@ -138,8 +138,11 @@ class AssemblyContacts:
         """Local coordinates per damper L: 12 (rigid platforms) or 12 + 2 n_m (flexible)."""
         return self.n_local // max(self.n_dampers, 1)
 
-    def _stacked(self):
-        """Batched point data of all dampers, or None if their patches do not share a normal law."""
+    def stacked_points(self):
+        """The points of all dampers as one batch: ``(True, point maps (n_d, 2, P, 3, m), k_T
+        (2 n_d P,) [N/m per point], mu (2 n_d P,), weights (2 n_d P,), normal law)`` (each damper's
+        :meth:`DamperContacts.stacked_points` stacked), or None if the dampers' batches differ in
+        normal law or point-map shape or one damper has none. Cached."""
         if self._batch is None:
             stacks = [c.stacked_points() for c in self.contacts]
             ok = all(s is not None for s in stacks) and all(
@@ -161,7 +164,7 @@ class AssemblyContacts:
             self._index[C] = ((a * L * nd + L * d + m).ravel(), (b * L * nd + L * d + k).ravel())
         return self._index[C]
 
-    def _grid_rotations(self, basis):
+    def grid_rotations(self, basis):
         """(n_d, C, C) rotations R_d of the harmonic coefficients that sample damper d on the
         grid omega t_j - grid_phase_d (coefficients R_d c on the common grid), or None when every
         phase is a whole number of samples (the common grid then serves every damper exactly).
@@ -193,11 +196,13 @@ class AssemblyContacts:
             self._rotations[key] = R
         return self._rotations[key]
 
-    def _forces(self, local, basis, offsets, jacobian):
-        """Forces (C, n_d, L) and Jacobian blocks (n_d, C, L, C, L) or None, each damper sampled
+    def forces_at(self, local, basis, offsets, jacobian):
+        """Forces (C, n_d, L) [N, N m] and Jacobian blocks (n_d, C, L, C, L) or None at the local
+        coefficients ``local`` (C, n_d, L) with the static approach ``offsets`` (n_d, 2, P) [m]
+        (no omega: the approach is given, :meth:`approach` gives it), each damper sampled
         on its own grid where the interblade shift is not a whole number of samples
-        (:meth:`_grid_rotations`), else all on the common grid (:meth:`_forces_on_grid`)."""
-        R = self._grid_rotations(basis)
+        (:meth:`grid_rotations`), else all on the common grid (:meth:`_forces_on_grid`)."""
+        R = self.grid_rotations(basis)
         if R is None:
             return self._forces_on_grid(local, basis, offsets, jacobian)
         force, blocks = self._forces_on_grid(_rotated(R, np.ascontiguousarray(local, dtype=float), False), basis,
@@ -210,18 +215,18 @@ class AssemblyContacts:
         Batched dampers with rigid platforms and a normal law the fused kernel knows go through
         :func:`~bladedamp.disk.fused_point_map_forces` (one numba call: point motion, normal
         law, return map, AFT and the projections); otherwise (flexible platforms too,
-        whose point maps the fused kernel does not take) :meth:`_forces_numpy`."""
-        stack = self._stacked()
+        whose point maps the fused kernel does not take) :meth:`forces_at_numpy`."""
+        stack = self.stacked_points()
         fused = None if stack is None else fused_point_map_forces(stack[1], local, basis, stack[2], stack[3], stack[5],
                                                                   stack[4], offsets, jacobian)
-        return self._forces_numpy(local, basis, offsets, jacobian) if fused is None else fused
+        return self.forces_at_numpy(local, basis, offsets, jacobian) if fused is None else fused
 
-    def _forces_numpy(self, local, basis, offsets, jacobian):
-        """:meth:`_forces` through :func:`~bladedamp.disk.point_map_forces` (the point-contact
+    def forces_at_numpy(self, local, basis, offsets, jacobian):
+        """:meth:`forces_at` through :func:`~bladedamp.disk.point_map_forces` (the point-contact
         kernel and numpy projections; the reference of the fused kernel; any normal law and
         flexible platforms)."""
         C, nd, L = basis.n_coeffs, self.n_dampers, self.damper_local
-        stack = self._stacked()
+        stack = self.stacked_points()
         if stack is None:
             force = np.zeros((C, nd, L))
             blocks = np.zeros((nd, C, L, C, L)) if jacobian else None
@@ -243,8 +248,9 @@ class AssemblyContacts:
             blocks[:, :, q, :, :, q, :] = q_blocks[:, q]
         return force, blocks.reshape(nd, C, L, C, L)
 
-    def _approach(self, omega):
-        """Static approach (n_d, 2, P) of every damper and its omega-derivative (last omega cached;
+    def approach(self, omega):
+        """Static approach (n_d, 2, P) [m] of every damper and its omega-derivative [m s/rad] at
+        ``omega`` [rad/s], as ``(offsets, doffsets)`` (last omega cached;
         dampers that share their approach function, the same damper at every position, evaluate
         it once: 16 calls were 0.05 of a residual's 0.9 ms)."""
         last = self._last_approach            # one read: the element may be shared by threads
@@ -277,8 +283,8 @@ class AssemblyContacts:
         (C, n_d, L) or None)``; damper d's block in its own (coefficient, coordinate) order."""
         C, nd, L = basis.n_coeffs, self.n_dampers, self.damper_local
         local = np.asarray(local).reshape(C, nd, L)
-        offsets, doffsets = self._approach(omega)
-        force, blocks = self._forces(local, basis, offsets, jacobian)
+        offsets, doffsets = self.approach(omega)
+        force, blocks = self.forces_at(local, basis, offsets, jacobian)
         if not jacobian:
             return force, None, None
         domega = None
@@ -288,8 +294,8 @@ class AssemblyContacts:
             domega = np.empty(force.shape)
             if not (self.linear_normal_laws and euler_rate(offsets, doffsets, blocks, local, force, domega)):
                 h = 1e-6 * omega
-                fp, _ = self._forces(local, basis, offsets + h * doffsets, False)
-                fm, _ = self._forces(local, basis, offsets - h * doffsets, False)
+                fp, _ = self.forces_at(local, basis, offsets + h * doffsets, False)
+                fm, _ = self.forces_at(local, basis, offsets - h * doffsets, False)
                 domega = (fp - fm) / (2 * h)
         return force, blocks.reshape(nd, C * L, C * L), domega
 
@@ -305,7 +311,7 @@ class AssemblyContacts:
 @njit(cache=True)
 def _rotated(R, values, transposed):
     """(C, n_d, L) coefficients rotated damper by damper: R_d values_d, or R_d^T values_d
-    (``transposed``), R (n_d, C, C) (:meth:`AssemblyContacts._grid_rotations`)."""
+    (``transposed``), R (n_d, C, C) (:meth:`AssemblyContacts.grid_rotations`)."""
     C, nd, L = values.shape
     out = np.zeros(values.shape)
     for d in range(nd):
@@ -853,7 +859,7 @@ class MistunedDisk:
     # ----- harmonic balance ------------------------------------------------------------
     def default_samples(self, harmonics) -> int:
         """HarmonicBasis' default sample count, as the tuned disk's: each damper is sampled on a
-        grid shifted by its interblade phase (:meth:`AssemblyContacts._grid_rotations`), so the
+        grid shifted by its interblade phase (:meth:`AssemblyContacts.grid_rotations`), so the
         count need not be a multiple of n / gcd(n, EO) (see the module notes)."""
         return HarmonicBasis(tuple(harmonics)).n_samples
 

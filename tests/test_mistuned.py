@@ -178,7 +178,7 @@ def test_jacobian_against_finite_differences_and_generic_assembly():
     sparse Jacobian equals central differences of the residual (and dR/domega), and the
     residual / Jacobian equal HarmonicBalanceSystem's generic sparse assembly. 64 samples on 3
     blades: the interblade shift is 21.3 samples, so each damper is sampled on its own grid and
-    its forces and Jacobian blocks rotated back (AssemblyContacts._grid_rotations), checked here too."""
+    its forces and Jacobian blocks rotated back (AssemblyContacts.grid_rotations), checked here too."""
     td = tuned(3, 1)
     dampers = [dataclasses.replace(td.damper, mass=m) for m in (0.5e-3, 1e-3, 2e-3)]
     md = MistunedDisk.from_tuned(td, kappa=[0.98, 1.0, 1.03], dampers=dampers)
@@ -186,7 +186,7 @@ def test_jacobian_against_finite_differences_and_generic_assembly():
     i = int(np.argmax(r.tip_amplitude[:, 0, 0]))
     x, w = r.coefficients[i].ravel(), r.omega[i]
     s = md.hbm_system()
-    assert s.basis.n_samples == 64 and s.couplings[0].element._grid_rotations(s.basis) is not None
+    assert s.basis.n_samples == 64 and s.couplings[0].element.grid_rotations(s.basis) is not None
     R, J, Rw = s.residual(x, w)
     generic = HarmonicBalanceSystem(s.basis, s.mass, s.damping, s.stiffness, s.excitation, s.couplings)
     Rg, Jg, Rwg = generic.residual(x, w)
@@ -668,8 +668,8 @@ def test_euler_rate_is_the_numpy_formula_to_rounding():
     x0 = md.initial_guess(system, w)
     for x in (x0, 3 * x0):
         local = (system._contact[0] @ x).reshape(C, element.n_dampers, element.damper_local)
-        offsets, doffsets = element._approach(w)
-        force, blocks = element._forces(local, system.basis, offsets, True)
+        offsets, doffsets = element.approach(w)
+        force, blocks = element.forces_at(local, system.basis, offsets, True)
         norms = np.einsum("dqp,dqp->d", offsets, offsets)
         kappa = np.where(norms > 0, np.einsum("dqp,dqp->d", doffsets, offsets) / np.where(norms > 0, norms, 1), 0.0)
         expected = (force - np.einsum("dambn,bdn->adm", blocks, local)) * kappa[None, :, None]
@@ -694,7 +694,7 @@ def test_dampers_of_one_kind_evaluate_their_static_approach_once():
     for md, functions in ((same, 1), (own, 4)):
         element = md.hbm_system((1,)).couplings[0].element
         assert len({id(c.approach) for c in element.contacts}) == functions
-        offsets, doffsets = element._approach(w)
+        offsets, doffsets = element.approach(w)
         assert np.array_equal(offsets, np.array([c.approach(w)[0] for c in element.contacts]))
         assert np.array_equal(doffsets, np.array([c.approach(w)[1] for c in element.contacts]))
 

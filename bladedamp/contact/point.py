@@ -970,7 +970,7 @@ class PointContactElement:
         C, P = basis.n_coeffs, self.n_points
         law = normal_law_parameters(self.normal_law)
         if law is None:
-            return self._harmonic_forces_from_samples(local, basis, jacobian)
+            return self.harmonic_forces_from_samples(local, basis, jacobian)
         force = np.empty((C, P, 3))
         jac = np.empty((C, P, 3, C, P, 3)) if jacobian else np.empty((1, 1, 1, 1, 1, 1))
         point_contact_harmonics(np.ascontiguousarray(np.reshape(local, (C, P, 3)), dtype=float), basis.synthesis,
@@ -979,8 +979,10 @@ class PointContactElement:
                                 MAX_PASSES, PERIODIC_TOL, jacobian, True, force, jac)
         return force.reshape(C, 3 * P), (jac.reshape(C * 3 * P, C * 3 * P) if jacobian else None), None
 
-    def _harmonic_forces_from_samples(self, local, basis, jacobian):
-        """:meth:`harmonic_forces` by the analysis of :meth:`samples` (any normal law)."""
+    def harmonic_forces_from_samples(self, local, basis, jacobian):
+        """:meth:`harmonic_forces` by the analysis of :meth:`samples` (any normal law): force
+        coefficients (C, 3P) [N], Jacobian (C*3P, C*3P) [N/m] or None (``jacobian`` False), and
+        None, of ``local`` (C, 3P) [m]; the reference of the fused kernel."""
         C, P = basis.n_coeffs, self.n_points
         pts = self.samples(local, basis, jacobian)
         force = basis.to_coeffs(np.moveaxis(pts.force, 1, 0)).reshape(C, 3 * P)
