@@ -405,18 +405,35 @@ class AssemblySystem(HarmonicBalanceSystem):
     Same residual as the generic sparse path of HarmonicBalanceSystem (tested against it); the
     contact term T^T J_c T is formed damper by damper as small dense products on the 2 n_m + 6
     structural DOFs each damper touches, and the Jacobian's CSC pattern is computed once.
+
+    Attributes formed once when built (read-only; shared by :meth:`with_linear_parts` copies
+    except ``linear_coo``), with N = n_unknowns:
+
+    * ``linear_coo``: [K_0, M_2, G] (N, N) of :meth:`dynamic_stiffness` (A = K_0 - Omega^2 M_2
+      + Omega G) as scipy COO matrices, their entries in the Jacobian pattern's order;
+    * ``contact_blocks``: ``(T, T^T, Tb, Tb^T, idx)`` of the contact map T (C n_local, N) (CSR):
+      Tb (n_d, C L, m) the rows of damper d restricted to its m structural columns idx (n_d, m),
+      or None (no couplings, or dampers touching different numbers of DOFs);
+    * ``jacobian_pattern``: ``(inverse, indices, indptr, nnz)``: the CSC pattern (int32 indices,
+      indptr) of the Jacobian's nnz entries and, for each summed term (linear parts' entries,
+      then each damper's m x m block), the index of the entry it adds to;
+    * ``jacobian_template``: the (N, N) CSC matrix of that pattern each sparse Jacobian copies
+      (its index arrays shared);
+    * ``dense_index``: (nnz,) row-major flat position of each pattern entry in the dense Jacobian;
+    * ``condensation_solver``: the damper-condensation factorization (callable on a dense
+      Jacobian), or None; ``ring_solver``: the :class:`~bladedamp.hbm.linsolve.BlockRing` set
+      up by :meth:`use_ring`, or None.
     """
 
     def __post_init__(self):
         basis, N = self.basis, self.n_dof
         C = basis.n_coeffs
-        self._sparse_dynamic_stiffness(1.0)
         self._linear_parts()
-        parts = self._lin
+        parts = self.linear_coo
         rows = [p.row for p in parts]
         cols = [p.col for p in parts]
-        self._contact = None
-        self._condensation = None
+        self.contact_blocks = None
+        self.condensation_solver = None
         if self.couplings:
             c = self.couplings[0]
             T = sp.csr_matrix(c.matrix)
@@ -430,22 +447,22 @@ class AssemblySystem(HarmonicBalanceSystem):
                 idx.append(cols_d)
             if len({len(i) for i in idx}) == 1:
                 Tb, idx = np.array(Tb), np.array(idx)
-                self._contact = (T, T.T.tocsr(), Tb, np.swapaxes(Tb, 1, 2).copy(), idx)
+                self.contact_blocks = (T, T.T.tocsr(), Tb, np.swapaxes(Tb, 1, 2).copy(), idx)
                 m = idx.shape[1]
                 rows.append(np.broadcast_to(idx[:, :, None], (nd, m, m)).ravel())
                 cols.append(np.broadcast_to(idx[:, None, :], (nd, m, m)).ravel())
-                self._condensation = self._damper_condensation(idx)
+                self.condensation_solver = self._damper_condensation(idx)
         rows, cols = np.concatenate(rows), np.concatenate(cols)
         key = cols.astype(np.int64) * N * C + rows
         unique, inverse = np.unique(key, return_inverse=True)
         n = N * C
-        self._pattern = (inverse, (unique % n).astype(np.int32),
+        self.jacobian_pattern = (inverse, (unique % n).astype(np.int32),
                          np.searchsorted(unique // n, np.arange(n + 1)).astype(np.int32), len(unique))
         # the sparse Jacobian's matrix: each evaluation is a shallow copy holding new values, its
         # index arrays shared (scipy's constructor checks them anew: 11 against 2 us)
-        self._jacobian_template = sp.csc_matrix((np.zeros(len(unique)),) + self._pattern[1:3], shape=(n, n))
+        self.jacobian_template = sp.csc_matrix((np.zeros(len(unique)),) + self.jacobian_pattern[1:3], shape=(n, n))
         # dense position (row-major) of each pattern entry, for the dense Jacobian
-        self._dense_index = (unique % n) * n + unique // n
+        self.dense_index = (unique % n) * n + unique // n
         self.dense = n <= self.dense_limit
 
     def with_linear_parts(self, damping, stiffness) -> "AssemblySystem":
@@ -456,11 +473,9 @@ class AssemblySystem(HarmonicBalanceSystem):
         built anew with these matrices. This system is left as it is.
 
         Raises ValueError if the sparsity of the linear parts differs from this system's."""
-        other = copy.copy(self)
-        other.damping, other.stiffness, other._sparse_parts = damping, stiffness, None
-        other._sparse_dynamic_stiffness(1.0)
+        other = self.with_matrices(damping, stiffness)
         other._linear_parts()
-        if any(not (np.array_equal(a.row, b.row) and np.array_equal(a.col, b.col)) for a, b in zip(other._lin, self._lin)):
+        if any(not (np.array_equal(a.row, b.row) and np.array_equal(a.col, b.col)) for a, b in zip(other.linear_coo, self.linear_coo)):
             raise ValueError("damping and stiffness must have the sparsity of the system's own (its Jacobian's "
                              "pattern is shared)")
         return other
@@ -512,7 +527,7 @@ class AssemblySystem(HarmonicBalanceSystem):
     #: loaded machine), the linear solver's time per FRF point 0.9-1.6x less at 16 blades, 3x at
     #: 64, 17-22x at 128; and the ring gives det A's sign (``solve.sign``), the condensation not
     ring_min_blades = 2
-    _ring = None
+    ring_solver = None
     _ring_blades = 0
     _solvers = ("auto", "ring", "condensation", "lu")
 
@@ -521,24 +536,24 @@ class AssemblySystem(HarmonicBalanceSystem):
         ``n_modes`` modal coordinates each (unknowns harmonic-major, blades first, then the
         dampers) whose d-th damper sits between blade ``positions[d]`` and the next; True if the
         contact map has that pattern (each damper couples exactly those two blades)."""
-        self._ring, self._ring_blades = None, 0
+        self.ring_solver, self._ring_blades = None, 0
         N, C = self.n_dof, self.basis.n_coeffs
         nd = len(positions)
-        if n_blades < 2 or N != n_blades * n_modes + 6 * nd or (nd and self._condensation is None):
+        if n_blades < 2 or N != n_blades * n_modes + 6 * nd or (nd and self.condensation_solver is None):
             return False
         groups = (np.arange(C)[None, :, None] * N + np.arange(n_blades)[:, None, None] * n_modes
                   + np.arange(n_modes)[None, None, :]).reshape(n_blades, C * n_modes)
         links = np.asarray(positions, dtype=np.intp)
         interior = None
         if nd:
-            cond = self._condensation
+            cond = self.condensation_solver
             interior = cond.interior
             for d, k in enumerate(links):
                 pair = np.concatenate([groups[k], groups[(k + 1) % n_blades]])
                 if cond.coupled[d].size != pair.size or not np.array_equal(np.sort(cond.coupled[d]), np.sort(pair)):
                     return False
         try:
-            self._ring = BlockRing(groups, interior, links, self.n_unknowns)
+            self.ring_solver = BlockRing(groups, interior, links, self.n_unknowns)
         except ValueError:                   # the unknowns are not blades and dampers only
             return False
         self._ring_blades = n_blades
@@ -548,7 +563,7 @@ class AssemblySystem(HarmonicBalanceSystem):
         """Whether :meth:`factorize` takes the ring: set up by :meth:`use_ring` and chosen by
         :attr:`linear_solver`."""
         solver = self.linear_solver
-        return self._ring is not None and (solver == "ring" or (solver == "auto" and
+        return self.ring_solver is not None and (solver == "ring" or (solver == "auto" and
                                                                 self._ring_blades >= self.ring_min_blades))
 
     def factorize(self, A):
@@ -560,16 +575,17 @@ class AssemblySystem(HarmonicBalanceSystem):
         if solver not in self._solvers:
             raise ValueError(f"linear_solver must be one of {self._solvers} (got {solver!r})")
         if self.uses_ring():
-            return self._ring(A)
-        if solver != "lu" and self._condensation is not None and not sp.issparse(A):
-            return self._condensation(A)
+            return self.ring_solver(A)
+        if solver != "lu" and self.condensation_solver is not None and not sp.issparse(A):
+            return self.condensation_solver(A)
         return lu_factorize(A)
 
     def _linear_parts(self):
         """The linear parts K_0, M_2, G (:meth:`_sparse_dynamic_stiffness`) as the residual uses
         them: COO (their values in the Jacobian's pattern order) and CSC arrays (data, indices,
         indptr) for :func:`_linear_residual`."""
-        self._lin = [m.tocoo() for m in self._sparse_parts]
+        self._sparse_dynamic_stiffness(1.0)         # forms the parts (once)
+        self.linear_coo = [m.tocoo() for m in self._sparse_parts]
         self._csc = tuple((m.data, m.indices, m.indptr) for m in self._sparse_parts)
 
     def residual(self, x, omega, jacobian=True):
@@ -577,13 +593,13 @@ class AssemblySystem(HarmonicBalanceSystem):
         the contact map's products and the Jacobian's values are formed in numba kernels
         (:func:`_linear_residual`, :func:`_csr_matvec_add`, :func:`_jacobian_values`) in the
         order of the scipy / numpy operations they replaced, so the numbers are the same (tested),
-        and the sparse Jacobian is a copy of one template matrix (:attr:`_jacobian_template`)
+        and the sparse Jacobian is a copy of one template matrix (:attr:`jacobian_template`)
         holding the new values: every Jacobian of the system shares the template's index arrays
         (do not change them in place; :func:`~bladedamp.hbm.continuation.bordered_matrix` relies on
         them to reuse its bordered pattern). Measured on a Monte Carlo 16-blade disk (n = 320, the contact
         kernel's result held fixed, medians of 15 alternating runs): 63 against 112 us with the
         Jacobian, 14 against 26 us without."""
-        if self.couplings and self._contact is None:
+        if self.couplings and self.contact_blocks is None:
             return super().residual(x, omega, jacobian)
         basis = self.basis
         C = basis.n_coeffs
@@ -594,7 +610,7 @@ class AssemblySystem(HarmonicBalanceSystem):
         _linear_residual(self._csc, x, omega ** 2, omega, -2 * omega, f, df, jacobian, R, Rw, m2x, gx)
         contact = np.empty(0)
         if self.couplings:
-            T, TT, Tb, TbT, _ = self._contact
+            T, TT, Tb, TbT, _ = self.contact_blocks
             element = self.couplings[0].element
             local = np.zeros(T.shape[0])
             _csr_matvec_add(T.data, T.indices, T.indptr, x, local)
@@ -606,15 +622,15 @@ class AssemblySystem(HarmonicBalanceSystem):
                     _csr_matvec_add(TT.data, TT.indices, TT.indptr, np.ascontiguousarray(domega).ravel(), Rw)
         if not jacobian:
             return R, None, None
-        inverse, indices, indptr, nnz = self._pattern
+        inverse, indices, indptr, nnz = self.jacobian_pattern
         data = np.zeros(nnz)
-        _jacobian_values(inverse, self._lin[0].data, self._lin[1].data, self._lin[2].data, -omega ** 2, omega,
+        _jacobian_values(inverse, self.linear_coo[0].data, self.linear_coo[1].data, self.linear_coo[2].data, -omega ** 2, omega,
                          contact, data)
         if self.dense:
             J = np.zeros(n * n)
-            J[self._dense_index] = data
+            J[self.dense_index] = data
             return R, J.reshape(n, n), Rw
-        J = copy.copy(self._jacobian_template)
+        J = copy.copy(self.jacobian_template)
         J.data = data
         return R, J, Rw
 

@@ -1302,6 +1302,12 @@ class SolidModes:
         """(n_dofs,) displacement of the centrifugal static step [m] (None at rest)."""
         return self._fe.get("static_displacement")
 
+    @property
+    def vertex_dofs(self) -> np.ndarray:
+        """(3, n_vertices) int: the index in :attr:`vectors`' rows and :attr:`static_displacement`
+        of the x, y, z displacement of each mesh vertex (the P2 elements' vertex DOFs)."""
+        return self._fe["basis_k"].nodal_dofs
+
     # -- evaluation ----------------------------------------------------------------------
     def _face_quadrature(self, name: str):
         """Quadrature of a boundary face: points (N, 3) [m], weights (N,) [m^2], values (N, 3, n)."""
@@ -1752,7 +1758,7 @@ class BladeSurface:
         mesh = modes.mesh
         tri = boundary_faces(mesh.tets, mesh.vertices)
         used, faces = np.unique(tri.T, return_inverse=True)
-        dofs = modes._fe["basis_k"].nodal_dofs[:, used]                       # (3, n_v) P2 vertex DOF
+        dofs = modes.vertex_dofs[:, used]                       # (3, n_v) P2 vertex DOF
         shapes = modes.vectors[dofs.T][:, :, list(mode_indices)]              # (n_v, 3, n_m)
         return cls(vertices=mesh.vertices[:, used].T.copy(), faces=faces.reshape(-1, 3).astype(np.int64),
                    shapes=shapes)

@@ -576,8 +576,8 @@ def test_mistuned_copies_share_the_tuned_setup_with_the_same_residuals():
     assert np.array_equal([b.natural_frequencies_hz for b in copy.blades], [b.natural_frequencies_hz for b in fresh.blades])
     shared, own = copy.hbm_system((1,)), fresh.hbm_system((1,))
     source = assembly.hbm_system((1,))
-    assert shared.couplings[0] is source.couplings[0] and shared._pattern is source._pattern
-    assert shared._ring is source._ring and shared.mass is source.mass
+    assert shared.couplings[0] is source.couplings[0] and shared.jacobian_pattern is source.jacobian_pattern
+    assert shared.ring_solver is source.ring_solver and shared.mass is source.mass
     assert own.couplings[0] is not source.couplings[0]
     w = 2 * np.pi * 95.0
     x = fresh.initial_guess(own, w)
@@ -602,13 +602,13 @@ def scipy_residual(system, x, omega, jacobian=True):
     import scipy.sparse as sp
 
     C = system.basis.n_coeffs
-    K0, M2, G = system._sparse_parts
+    K0, M2, G = (m.tocsc() for m in system.linear_coo)      # the CSC parts back (same order, no duplicates)
     f, df = system.excitation(omega)
     m2x, gx = M2 @ x, G @ x
     R = K0 @ x - omega ** 2 * m2x + omega * gx - f
     Rw = -2 * omega * m2x + gx - df if jacobian else None
-    values = [system._lin[0].data, -omega ** 2 * system._lin[1].data, omega * system._lin[2].data]
-    T, TT, Tb, TbT, _ = system._contact
+    values = [system.linear_coo[0].data, -omega ** 2 * system.linear_coo[1].data, omega * system.linear_coo[2].data]
+    T, TT, Tb, TbT, _ = system.contact_blocks
     element = system.couplings[0].element
     force, blocks, domega = element.evaluate((T @ x).reshape(C, element.n_local), system.basis, omega, jacobian)
     R += TT @ force.ravel()
@@ -618,12 +618,12 @@ def scipy_residual(system, x, omega, jacobian=True):
             Rw += TT @ domega.ravel()
     if not jacobian:
         return R, None, None
-    inverse, indices, indptr, nnz = system._pattern
+    inverse, indices, indptr, nnz = system.jacobian_pattern
     data = np.bincount(inverse, weights=np.concatenate(values), minlength=nnz)
     n = x.size
     if system.dense:
         J = np.zeros(n * n)
-        J[system._dense_index] = data
+        J[system.dense_index] = data
         return R, J.reshape(n, n), Rw
     return R, sp.csc_matrix((data, indices, indptr), shape=(n, n)), Rw
 
@@ -646,7 +646,7 @@ def test_residual_kernels_give_the_numbers_of_the_scipy_operations(harmonics):
             assert got[2] is not None and np.abs(got[2]).max() > 0
             for a, b in zip(got, ref):
                 if hasattr(a, "toarray"):
-                    assert a.indices is system._jacobian_template.indices and a.indptr is system._jacobian_template.indptr
+                    assert a.indices is system.jacobian_template.indices and a.indptr is system.jacobian_template.indptr
                     assert np.array_equal(a.indices, b.indices) and np.array_equal(a.indptr, b.indptr)
                     a, b = a.data, b.data
                 assert np.array_equal(a, b)
@@ -667,7 +667,7 @@ def test_euler_rate_is_the_numpy_formula_to_rounding():
     w = 2 * np.pi * 95.0
     x0 = md.initial_guess(system, w)
     for x in (x0, 3 * x0):
-        local = (system._contact[0] @ x).reshape(C, element.n_dampers, element.damper_local)
+        local = (system.contact_blocks[0] @ x).reshape(C, element.n_dampers, element.damper_local)
         offsets, doffsets = element.approach(w)
         force, blocks = element.forces_at(local, system.basis, offsets, True)
         norms = np.einsum("dqp,dqp->d", offsets, offsets)
