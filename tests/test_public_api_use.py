@@ -5,7 +5,8 @@ names) is private to the module that defines it: a ``def``/``class`` of that nam
 class-body assignment, or an attribute assigned on ``self``/``cls`` there. An ast scan of
 bladedamp/, tests/ and benchmarks/ fails, naming file:line, on
 
-* ``from bladedamp... import _name`` (or a relative import of a private name inside the package);
+* ``from bladedamp... import _name`` (or a relative import of a private name inside the package),
+  ``import bladedamp._module``;
 * ``obj._name`` with ``obj`` not ``self``/``cls``, where ``_name`` is a private name of bladedamp
   and the file is not a module that defines it (tests and benchmarks define none);
 * ``getattr/setattr/hasattr/delattr(obj, "_name")`` (``monkeypatch.setattr`` too) likewise.
@@ -70,6 +71,12 @@ def violations(tree: ast.AST, path: str, in_package: bool, private: dict[str, se
                 for alias in node.names:
                     if is_private(alias.name) and (path, alias.name) not in ALLOWED:
                         out.append(f"{path}:{node.lineno}: imports the private name {alias.name} from {module or '.'}")
+        elif isinstance(node, ast.Import):
+            for alias in node.names:
+                parts = alias.name.split(".")
+                if parts[0] == "bladedamp" and any(is_private(p) for p in parts[1:]) and \
+                        (path, parts[-1]) not in ALLOWED:
+                    out.append(f"{path}:{node.lineno}: imports the private module {alias.name}")
         elif isinstance(node, ast.Attribute):
             if isinstance(node.value, ast.Name) and node.value.id in ("self", "cls"):
                 continue
@@ -117,9 +124,10 @@ def test_the_scan_reports_each_kind_of_use():
                     "element._batch = (False,)\n"
                     "x = element.stacked()._batch\n"
                     "monkeypatch.setattr(mod, '_kernel', None)\n"
-                    "getattr(element, '_batch')\n")
+                    "getattr(element, '_batch')\n"
+                    "import bladedamp._numba_cache\n")
     found = violations(bad, "bladedamp/b.py", True, private)
-    assert [f.split(":")[1] for f in found] == ["1", "2", "3", "4", "5", "6"], found
+    assert [f.split(":")[1] for f in found] == ["1", "2", "3", "4", "5", "6", "7"], found
     assert all(f.startswith("bladedamp/b.py:") for f in found)
     good = ast.parse("from bladedamp.a import kernel\n"
                      "self._batch = (False,)\n"
