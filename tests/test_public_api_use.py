@@ -127,7 +127,7 @@ def test_the_scan_reports_each_kind_of_use():
                     "getattr(element, '_batch')\n"
                     "import bladedamp._numba_cache\n")
     found = violations(bad, "bladedamp/b.py", True, private)
-    assert [f.split(":")[1] for f in found] == ["1", "2", "3", "4", "5", "6", "7"], found
+    assert sorted(int(f.split(":")[1]) for f in found) == [1, 2, 3, 4, 5, 6, 7], found
     assert all(f.startswith("bladedamp/b.py:") for f in found)
     good = ast.parse("from bladedamp.a import kernel\n"
                      "self._batch = (False,)\n"
