@@ -1312,7 +1312,7 @@ class SolidModes:
     def face_quadrature(self, name: str):
         """Quadrature (order 4) of the boundary face ``name`` (a named facet set of the mesh, e.g.
         "tip"; ValueError naming the faces otherwise): points (N, 3) [m], weights (N,) [m^2] and
-        the n mode shapes of :attr:`vectors` at the points (N, 3, n) [m per unit modal coordinate]."""
+        the n columns of :attr:`vectors` (mode shapes, in their units) at the points (N, 3, n)."""
         from skfem import FacetBasis
         fe = self._fe
         if name not in fe["facets"]:
