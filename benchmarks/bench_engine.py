@@ -126,7 +126,7 @@ def part_a(repeat):
             fun()
         return (time.perf_counter() - t0) / n * 1e6
 
-    from bladedamp.contact.point import _return_map
+    from bladedamp.contact.point import return_map
     basis = system.basis
     T, C = basis.n_samples, basis.n_coeffs
     ut = np.zeros((1, T, 2))
@@ -140,7 +140,7 @@ def part_a(repeat):
         "residual only": per_call(lambda: system.residual(x, w, jacobian=False)),
         "  contact harmonic_forces (AFT + Jacobian)": per_call(
             lambda: coupling.element.harmonic_forces(local, basis, w, True)),
-        "    numba return map alone": per_call(lambda: _return_map(*args)),
+        "    numba return map alone": per_call(lambda: return_map(*args)),
         "  dynamic stiffness A(Omega), dA/dOmega": per_call(lambda: system.dynamic_stiffness(w)),
         "  same, its Omega-independent parts built anew": per_call(
             lambda: basis.dynamic_stiffness(w, system.mass, system.damping, system.stiffness)),

@@ -38,7 +38,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 
 import numpy as np  # noqa: E402
 
-from bladedamp.hbm.continuation import _bordered, continuation  # noqa: E402
+from bladedamp.hbm.continuation import bordered_matrix, continuation  # noqa: E402
 from bladedamp.hbm.linsolve import one_blas_thread  # noqa: E402
 from bladedamp.mistuned import MistunedDisk  # noqa: E402
 from bladedamp.reference import reference_disk  # noqa: E402
@@ -154,7 +154,7 @@ def crossover(blades, repeat=20):
         system = md.hbm_system(HARMONICS)
         w = 2 * np.pi * 95.0
         R, J, Rw = system.residual(md.initial_guess(system, w), w)
-        A = _bordered(J, Rw, np.random.default_rng(0).standard_normal(J.shape[0] + 1), np.ones(J.shape[0]), 1.0)
+        A = bordered_matrix(J, Rw, np.random.default_rng(0).standard_normal(J.shape[0] + 1), np.ones(J.shape[0]), 1.0)
         rhs = np.ones(A.shape[0])
         best = {}
         for solver in (OLD, NEW):

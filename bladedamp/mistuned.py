@@ -24,7 +24,7 @@ Time sampling (AFT): the contact forces are evaluated at ``n_samples`` instants 
 in a tuned travelling wave blade k's motion is blade 0's shifted by k dphi; the discrete friction
 laws are shift-invariant only when that shift is a whole number of samples. Each damper is
 therefore sampled on its own grid, shifted by its phase k dphi (a rotation of its harmonic
-coefficients before the AFT and back after it, :meth:`AssemblyContacts._grid_rotations`;
+coefficients before the AFT and back after it, :meth:`AssemblyContacts.grid_rotations`;
 nothing to do where the shift is whole samples, n = 16 and EO = 1 at 64 samples): a tuned full
 assembly equals the cyclic solution to rounding at any ``n_samples``, and the default is the
 tuned disk's (64 for one harmonic at any n; before, it was rounded up to a multiple of
@@ -115,7 +115,7 @@ class AssemblyContacts:
     contacts: list[DamperContacts]
     n_local: int = 0
     #: (n_d,) phase [rad] of each damper's motion in a tuned travelling wave (k dphi for the
-    #: damper on blade k), or None; damper d is sampled on a grid shifted by it (:meth:`_grid_rotations`)
+    #: damper on blade k), or None; damper d is sampled on a grid shifted by it (:meth:`grid_rotations`)
     grid_phase: np.ndarray | None = None
     _batch: tuple | None = field(default=None, init=False, repr=False)
     _index: dict = field(default_factory=dict, init=False, repr=False)
@@ -138,8 +138,11 @@ class AssemblyContacts:
         """Local coordinates per damper L: 12 (rigid platforms) or 12 + 2 n_m (flexible)."""
         return self.n_local // max(self.n_dampers, 1)
 
-    def _stacked(self):
-        """Batched point data of all dampers, or None if their patches do not share a normal law."""
+    def stacked_points(self):
+        """The points of all dampers as one batch: ``(True, point maps (n_d, 2, P, 3, m), k_T
+        (2 n_d P,) [N/m per point], mu (2 n_d P,), weights (2 n_d P,), normal law)`` (each damper's
+        :meth:`DamperContacts.stacked_points` stacked), or None if the dampers' batches differ in
+        normal law or point-map shape or one damper has none. Cached."""
         if self._batch is None:
             stacks = [c.stacked_points() for c in self.contacts]
             ok = all(s is not None for s in stacks) and all(
@@ -161,7 +164,7 @@ class AssemblyContacts:
             self._index[C] = ((a * L * nd + L * d + m).ravel(), (b * L * nd + L * d + k).ravel())
         return self._index[C]
 
-    def _grid_rotations(self, basis):
+    def grid_rotations(self, basis):
         """(n_d, C, C) rotations R_d of the harmonic coefficients that sample damper d on the
         grid omega t_j - grid_phase_d (coefficients R_d c on the common grid), or None when every
         phase is a whole number of samples (the common grid then serves every damper exactly).
@@ -193,11 +196,13 @@ class AssemblyContacts:
             self._rotations[key] = R
         return self._rotations[key]
 
-    def _forces(self, local, basis, offsets, jacobian):
-        """Forces (C, n_d, L) and Jacobian blocks (n_d, C, L, C, L) or None, each damper sampled
+    def forces_at(self, local, basis, offsets, jacobian):
+        """Forces (C, n_d, L) [N, N m] and Jacobian blocks (n_d, C, L, C, L) or None at the local
+        coefficients ``local`` (C, n_d, L) with the static approach ``offsets`` (n_d, 2, P) [m]
+        (no omega: the approach is given, :meth:`approach` gives it), each damper sampled
         on its own grid where the interblade shift is not a whole number of samples
-        (:meth:`_grid_rotations`), else all on the common grid (:meth:`_forces_on_grid`)."""
-        R = self._grid_rotations(basis)
+        (:meth:`grid_rotations`), else all on the common grid (:meth:`_forces_on_grid`)."""
+        R = self.grid_rotations(basis)
         if R is None:
             return self._forces_on_grid(local, basis, offsets, jacobian)
         force, blocks = self._forces_on_grid(_rotated(R, np.ascontiguousarray(local, dtype=float), False), basis,
@@ -210,18 +215,18 @@ class AssemblyContacts:
         Batched dampers with rigid platforms and a normal law the fused kernel knows go through
         :func:`~bladedamp.disk.fused_point_map_forces` (one numba call: point motion, normal
         law, return map, AFT and the projections); otherwise (flexible platforms too,
-        whose point maps the fused kernel does not take) :meth:`_forces_numpy`."""
-        stack = self._stacked()
+        whose point maps the fused kernel does not take) :meth:`forces_at_numpy`."""
+        stack = self.stacked_points()
         fused = None if stack is None else fused_point_map_forces(stack[1], local, basis, stack[2], stack[3], stack[5],
                                                                   stack[4], offsets, jacobian)
-        return self._forces_numpy(local, basis, offsets, jacobian) if fused is None else fused
+        return self.forces_at_numpy(local, basis, offsets, jacobian) if fused is None else fused
 
-    def _forces_numpy(self, local, basis, offsets, jacobian):
-        """:meth:`_forces` through :func:`~bladedamp.disk.point_map_forces` (the point-contact
+    def forces_at_numpy(self, local, basis, offsets, jacobian):
+        """:meth:`forces_at` through :func:`~bladedamp.disk.point_map_forces` (the point-contact
         kernel and numpy projections; the reference of the fused kernel; any normal law and
         flexible platforms)."""
         C, nd, L = basis.n_coeffs, self.n_dampers, self.damper_local
-        stack = self._stacked()
+        stack = self.stacked_points()
         if stack is None:
             force = np.zeros((C, nd, L))
             blocks = np.zeros((nd, C, L, C, L)) if jacobian else None
@@ -243,8 +248,9 @@ class AssemblyContacts:
             blocks[:, :, q, :, :, q, :] = q_blocks[:, q]
         return force, blocks.reshape(nd, C, L, C, L)
 
-    def _approach(self, omega):
-        """Static approach (n_d, 2, P) of every damper and its omega-derivative (last omega cached;
+    def approach(self, omega):
+        """Static approach (n_d, 2, P) [m] of every damper and its omega-derivative [m s/rad] at
+        ``omega`` [rad/s], as ``(offsets, doffsets)`` (last omega cached;
         dampers that share their approach function, the same damper at every position, evaluate
         it once: 16 calls were 0.05 of a residual's 0.9 ms)."""
         last = self._last_approach            # one read: the element may be shared by threads
@@ -277,8 +283,8 @@ class AssemblyContacts:
         (C, n_d, L) or None)``; damper d's block in its own (coefficient, coordinate) order."""
         C, nd, L = basis.n_coeffs, self.n_dampers, self.damper_local
         local = np.asarray(local).reshape(C, nd, L)
-        offsets, doffsets = self._approach(omega)
-        force, blocks = self._forces(local, basis, offsets, jacobian)
+        offsets, doffsets = self.approach(omega)
+        force, blocks = self.forces_at(local, basis, offsets, jacobian)
         if not jacobian:
             return force, None, None
         domega = None
@@ -286,10 +292,10 @@ class AssemblyContacts:
             # as DamperContacts.harmonic_forces: Euler's identity for linear normal laws, else
             # a central difference in omega of all dampers at once
             domega = np.empty(force.shape)
-            if not (self.linear_normal_laws and _euler_rate(offsets, doffsets, blocks, local, force, domega)):
+            if not (self.linear_normal_laws and euler_rate(offsets, doffsets, blocks, local, force, domega)):
                 h = 1e-6 * omega
-                fp, _ = self._forces(local, basis, offsets + h * doffsets, False)
-                fm, _ = self._forces(local, basis, offsets - h * doffsets, False)
+                fp, _ = self.forces_at(local, basis, offsets + h * doffsets, False)
+                fm, _ = self.forces_at(local, basis, offsets - h * doffsets, False)
                 domega = (fp - fm) / (2 * h)
         return force, blocks.reshape(nd, C * L, C * L), domega
 
@@ -305,7 +311,7 @@ class AssemblyContacts:
 @njit(cache=True)
 def _rotated(R, values, transposed):
     """(C, n_d, L) coefficients rotated damper by damper: R_d values_d, or R_d^T values_d
-    (``transposed``), R (n_d, C, C) (:meth:`AssemblyContacts._grid_rotations`)."""
+    (``transposed``), R (n_d, C, C) (:meth:`AssemblyContacts.grid_rotations`)."""
     C, nd, L = values.shape
     out = np.zeros(values.shape)
     for d in range(nd):
@@ -348,7 +354,7 @@ HOMOGENEOUS_TOL = 1e-12
 
 
 @njit(cache=True)
-def _euler_rate(offsets, doffsets, blocks, local, force, domega):
+def euler_rate(offsets, doffsets, blocks, local, force, domega):
     """d force / d omega (C, n_d, L) [N s/rad] into ``domega`` by Euler's identity for linear
     normal laws, when the static approach's omega-derivative is homogeneous: doffsets = kappa_d
     offsets (n_d, 2, P) [m, m s/rad] for every damper d to :data:`HOMOGENEOUS_TOL` of its
@@ -399,18 +405,35 @@ class AssemblySystem(HarmonicBalanceSystem):
     Same residual as the generic sparse path of HarmonicBalanceSystem (tested against it); the
     contact term T^T J_c T is formed damper by damper as small dense products on the 2 n_m + 6
     structural DOFs each damper touches, and the Jacobian's CSC pattern is computed once.
+
+    Attributes formed once when built (read-only; shared by :meth:`with_linear_parts` copies
+    except ``linear_coo``), with N = n_unknowns:
+
+    * ``linear_coo``: [K_0, M_2, G] (N, N) of :meth:`dynamic_stiffness` (A = K_0 - Omega^2 M_2
+      + Omega G) as scipy COO matrices, their entries in the Jacobian pattern's order;
+    * ``contact_blocks``: ``(T, T^T, Tb, Tb^T, idx)`` of the contact map T (C n_local, N) (CSR):
+      Tb (n_d, C L, m) the rows of damper d restricted to its m structural columns idx (n_d, m),
+      or None (no couplings, or dampers touching different numbers of DOFs);
+    * ``jacobian_pattern``: ``(inverse, indices, indptr, nnz)``: the CSC pattern (int32 indices,
+      indptr) of the Jacobian's nnz entries and, for each summed term (linear parts' entries,
+      then each damper's m x m block), the index of the entry it adds to;
+    * ``jacobian_template``: the (N, N) CSC matrix of that pattern each sparse Jacobian copies
+      (its index arrays shared);
+    * ``dense_index``: (nnz,) row-major flat position of each pattern entry in the dense Jacobian;
+    * ``condensation_solver``: the damper-condensation factorization (callable on a dense
+      Jacobian), or None; ``ring_solver``: the :class:`~bladedamp.hbm.linsolve.BlockRing` set
+      up by :meth:`use_ring`, or None.
     """
 
     def __post_init__(self):
         basis, N = self.basis, self.n_dof
         C = basis.n_coeffs
-        self._sparse_dynamic_stiffness(1.0)
         self._linear_parts()
-        parts = self._lin
+        parts = self.linear_coo
         rows = [p.row for p in parts]
         cols = [p.col for p in parts]
-        self._contact = None
-        self._condensation = None
+        self.contact_blocks = None
+        self.condensation_solver = None
         if self.couplings:
             c = self.couplings[0]
             T = sp.csr_matrix(c.matrix)
@@ -424,22 +447,22 @@ class AssemblySystem(HarmonicBalanceSystem):
                 idx.append(cols_d)
             if len({len(i) for i in idx}) == 1:
                 Tb, idx = np.array(Tb), np.array(idx)
-                self._contact = (T, T.T.tocsr(), Tb, np.swapaxes(Tb, 1, 2).copy(), idx)
+                self.contact_blocks = (T, T.T.tocsr(), Tb, np.swapaxes(Tb, 1, 2).copy(), idx)
                 m = idx.shape[1]
                 rows.append(np.broadcast_to(idx[:, :, None], (nd, m, m)).ravel())
                 cols.append(np.broadcast_to(idx[:, None, :], (nd, m, m)).ravel())
-                self._condensation = self._damper_condensation(idx)
+                self.condensation_solver = self._damper_condensation(idx)
         rows, cols = np.concatenate(rows), np.concatenate(cols)
         key = cols.astype(np.int64) * N * C + rows
         unique, inverse = np.unique(key, return_inverse=True)
         n = N * C
-        self._pattern = (inverse, (unique % n).astype(np.int32),
+        self.jacobian_pattern = (inverse, (unique % n).astype(np.int32),
                          np.searchsorted(unique // n, np.arange(n + 1)).astype(np.int32), len(unique))
         # the sparse Jacobian's matrix: each evaluation is a shallow copy holding new values, its
         # index arrays shared (scipy's constructor checks them anew: 11 against 2 us)
-        self._jacobian_template = sp.csc_matrix((np.zeros(len(unique)),) + self._pattern[1:3], shape=(n, n))
+        self.jacobian_template = sp.csc_matrix((np.zeros(len(unique)),) + self.jacobian_pattern[1:3], shape=(n, n))
         # dense position (row-major) of each pattern entry, for the dense Jacobian
-        self._dense_index = (unique % n) * n + unique // n
+        self.dense_index = (unique % n) * n + unique // n
         self.dense = n <= self.dense_limit
 
     def with_linear_parts(self, damping, stiffness) -> "AssemblySystem":
@@ -450,11 +473,9 @@ class AssemblySystem(HarmonicBalanceSystem):
         built anew with these matrices. This system is left as it is.
 
         Raises ValueError if the sparsity of the linear parts differs from this system's."""
-        other = copy.copy(self)
-        other.damping, other.stiffness, other._sparse_parts = damping, stiffness, None
-        other._sparse_dynamic_stiffness(1.0)
+        other = self.with_matrices(damping, stiffness)
         other._linear_parts()
-        if any(not (np.array_equal(a.row, b.row) and np.array_equal(a.col, b.col)) for a, b in zip(other._lin, self._lin)):
+        if any(not (np.array_equal(a.row, b.row) and np.array_equal(a.col, b.col)) for a, b in zip(other.linear_coo, self.linear_coo)):
             raise ValueError("damping and stiffness must have the sparsity of the system's own (its Jacobian's "
                              "pattern is shared)")
         return other
@@ -506,7 +527,7 @@ class AssemblySystem(HarmonicBalanceSystem):
     #: loaded machine), the linear solver's time per FRF point 0.9-1.6x less at 16 blades, 3x at
     #: 64, 17-22x at 128; and the ring gives det A's sign (``solve.sign``), the condensation not
     ring_min_blades = 2
-    _ring = None
+    ring_solver = None
     _ring_blades = 0
     _solvers = ("auto", "ring", "condensation", "lu")
 
@@ -515,24 +536,24 @@ class AssemblySystem(HarmonicBalanceSystem):
         ``n_modes`` modal coordinates each (unknowns harmonic-major, blades first, then the
         dampers) whose d-th damper sits between blade ``positions[d]`` and the next; True if the
         contact map has that pattern (each damper couples exactly those two blades)."""
-        self._ring, self._ring_blades = None, 0
+        self.ring_solver, self._ring_blades = None, 0
         N, C = self.n_dof, self.basis.n_coeffs
         nd = len(positions)
-        if n_blades < 2 or N != n_blades * n_modes + 6 * nd or (nd and self._condensation is None):
+        if n_blades < 2 or N != n_blades * n_modes + 6 * nd or (nd and self.condensation_solver is None):
             return False
         groups = (np.arange(C)[None, :, None] * N + np.arange(n_blades)[:, None, None] * n_modes
                   + np.arange(n_modes)[None, None, :]).reshape(n_blades, C * n_modes)
         links = np.asarray(positions, dtype=np.intp)
         interior = None
         if nd:
-            cond = self._condensation
+            cond = self.condensation_solver
             interior = cond.interior
             for d, k in enumerate(links):
                 pair = np.concatenate([groups[k], groups[(k + 1) % n_blades]])
                 if cond.coupled[d].size != pair.size or not np.array_equal(np.sort(cond.coupled[d]), np.sort(pair)):
                     return False
         try:
-            self._ring = BlockRing(groups, interior, links, self.n_unknowns)
+            self.ring_solver = BlockRing(groups, interior, links, self.n_unknowns)
         except ValueError:                   # the unknowns are not blades and dampers only
             return False
         self._ring_blades = n_blades
@@ -542,7 +563,7 @@ class AssemblySystem(HarmonicBalanceSystem):
         """Whether :meth:`factorize` takes the ring: set up by :meth:`use_ring` and chosen by
         :attr:`linear_solver`."""
         solver = self.linear_solver
-        return self._ring is not None and (solver == "ring" or (solver == "auto" and
+        return self.ring_solver is not None and (solver == "ring" or (solver == "auto" and
                                                                 self._ring_blades >= self.ring_min_blades))
 
     def factorize(self, A):
@@ -554,16 +575,17 @@ class AssemblySystem(HarmonicBalanceSystem):
         if solver not in self._solvers:
             raise ValueError(f"linear_solver must be one of {self._solvers} (got {solver!r})")
         if self.uses_ring():
-            return self._ring(A)
-        if solver != "lu" and self._condensation is not None and not sp.issparse(A):
-            return self._condensation(A)
+            return self.ring_solver(A)
+        if solver != "lu" and self.condensation_solver is not None and not sp.issparse(A):
+            return self.condensation_solver(A)
         return lu_factorize(A)
 
     def _linear_parts(self):
         """The linear parts K_0, M_2, G (:meth:`_sparse_dynamic_stiffness`) as the residual uses
         them: COO (their values in the Jacobian's pattern order) and CSC arrays (data, indices,
         indptr) for :func:`_linear_residual`."""
-        self._lin = [m.tocoo() for m in self._sparse_parts]
+        self._sparse_dynamic_stiffness(1.0)         # forms the parts (once)
+        self.linear_coo = [m.tocoo() for m in self._sparse_parts]
         self._csc = tuple((m.data, m.indices, m.indptr) for m in self._sparse_parts)
 
     def residual(self, x, omega, jacobian=True):
@@ -571,13 +593,13 @@ class AssemblySystem(HarmonicBalanceSystem):
         the contact map's products and the Jacobian's values are formed in numba kernels
         (:func:`_linear_residual`, :func:`_csr_matvec_add`, :func:`_jacobian_values`) in the
         order of the scipy / numpy operations they replaced, so the numbers are the same (tested),
-        and the sparse Jacobian is a copy of one template matrix (:attr:`_jacobian_template`)
+        and the sparse Jacobian is a copy of one template matrix (:attr:`jacobian_template`)
         holding the new values: every Jacobian of the system shares the template's index arrays
-        (do not change them in place; :func:`~bladedamp.hbm.continuation._bordered` relies on
+        (do not change them in place; :func:`~bladedamp.hbm.continuation.bordered_matrix` relies on
         them to reuse its bordered pattern). Measured on a Monte Carlo 16-blade disk (n = 320, the contact
         kernel's result held fixed, medians of 15 alternating runs): 63 against 112 us with the
         Jacobian, 14 against 26 us without."""
-        if self.couplings and self._contact is None:
+        if self.couplings and self.contact_blocks is None:
             return super().residual(x, omega, jacobian)
         basis = self.basis
         C = basis.n_coeffs
@@ -588,7 +610,7 @@ class AssemblySystem(HarmonicBalanceSystem):
         _linear_residual(self._csc, x, omega ** 2, omega, -2 * omega, f, df, jacobian, R, Rw, m2x, gx)
         contact = np.empty(0)
         if self.couplings:
-            T, TT, Tb, TbT, _ = self._contact
+            T, TT, Tb, TbT, _ = self.contact_blocks
             element = self.couplings[0].element
             local = np.zeros(T.shape[0])
             _csr_matvec_add(T.data, T.indices, T.indptr, x, local)
@@ -600,15 +622,15 @@ class AssemblySystem(HarmonicBalanceSystem):
                     _csr_matvec_add(TT.data, TT.indices, TT.indptr, np.ascontiguousarray(domega).ravel(), Rw)
         if not jacobian:
             return R, None, None
-        inverse, indices, indptr, nnz = self._pattern
+        inverse, indices, indptr, nnz = self.jacobian_pattern
         data = np.zeros(nnz)
-        _jacobian_values(inverse, self._lin[0].data, self._lin[1].data, self._lin[2].data, -omega ** 2, omega,
+        _jacobian_values(inverse, self.linear_coo[0].data, self.linear_coo[1].data, self.linear_coo[2].data, -omega ** 2, omega,
                          contact, data)
         if self.dense:
             J = np.zeros(n * n)
-            J[self._dense_index] = data
+            J[self.dense_index] = data
             return R, J.reshape(n, n), Rw
-        J = copy.copy(self._jacobian_template)
+        J = copy.copy(self.jacobian_template)
         J.data = data
         return R, J, Rw
 
@@ -853,7 +875,7 @@ class MistunedDisk:
     # ----- harmonic balance ------------------------------------------------------------
     def default_samples(self, harmonics) -> int:
         """HarmonicBasis' default sample count, as the tuned disk's: each damper is sampled on a
-        grid shifted by its interblade phase (:meth:`AssemblyContacts._grid_rotations`), so the
+        grid shifted by its interblade phase (:meth:`AssemblyContacts.grid_rotations`), so the
         count need not be a multiple of n / gcd(n, EO) (see the module notes)."""
         return HarmonicBasis(tuple(harmonics)).n_samples
 

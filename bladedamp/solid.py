@@ -1302,9 +1302,17 @@ class SolidModes:
         """(n_dofs,) displacement of the centrifugal static step [m] (None at rest)."""
         return self._fe.get("static_displacement")
 
+    @property
+    def vertex_dofs(self) -> np.ndarray:
+        """(3, n_vertices) int: the index in :attr:`vectors`' rows and :attr:`static_displacement`
+        of the x, y, z displacement of each mesh vertex (the P2 elements' vertex DOFs)."""
+        return self._fe["basis_k"].nodal_dofs
+
     # -- evaluation ----------------------------------------------------------------------
-    def _face_quadrature(self, name: str):
-        """Quadrature of a boundary face: points (N, 3) [m], weights (N,) [m^2], values (N, 3, n)."""
+    def face_quadrature(self, name: str):
+        """Quadrature (order 4) of the boundary face ``name`` (a named facet set of the mesh, e.g.
+        "tip"; ValueError naming the faces otherwise): points (N, 3) [m], weights (N,) [m^2] and
+        the n columns of :attr:`vectors` (mode shapes, in their units) at the points (N, 3, n)."""
         from skfem import FacetBasis
         fe = self._fe
         if name not in fe["facets"]:
@@ -1376,7 +1384,7 @@ class SolidModes:
             pos = np.asarray(pos, dtype=float)
             region = self.geometry.fit_region(name, pos)
             if region[0] == "face":
-                quad = self._face_quadrature(region[1])
+                quad = self.face_quadrature(region[1])
             elif region[0] == "platform":
                 quad = self._volume_quadrature(np.flatnonzero(self.mesh.platform))
             elif region[0] == "section":
@@ -1400,7 +1408,7 @@ class SolidModes:
         # evaluate 0.1 um inside the platform (a point exactly on the face may miss every
         # element by rounding); the displacement changes by ~1e-4 of itself over that
         inside = pts - 1e-7 * frame[2]
-        x, w, u = self._face_quadrature(side)
+        x, w, u = self.face_quadrature(side)
         motion, residual, _ = rigid_fit(x, w, u, centre)
         return ContactFaceModes(side=side, centre=centre, frame=frame, xi=XI.ravel(), eta=ETA.ravel(),
                                 points=pts, shapes=self.displacements_at(inside), rigid_motion=motion,
@@ -1567,7 +1575,7 @@ def solid_modes(geometry: SolidBladeGeometry | BeamBladeGeometry | None = None,
                        seconds={"mesh": mesh.seconds, "assemble": t1 - t0, "solve": t2 - t1}, _fe=fe,
                        rotor_speed_hz=rotor_speed_hz, hub_radius=hub_radius)
     # names from the tip motion, signs: tip u_x > 0 (F), u_y > 0 (E), phi_z > 0 (T), u_z > 0 (A)
-    x, w, u = modes._face_quadrature("tip")
+    x, w, u = modes.face_quadrature("tip")
     centroid = (w @ x) / w.sum()
     motion, residual, N = rigid_fit(x, w, u, centroid)
     names, families, fractions = classify_tip_motion(motion, N, residual)
@@ -1752,7 +1760,7 @@ class BladeSurface:
         mesh = modes.mesh
         tri = boundary_faces(mesh.tets, mesh.vertices)
         used, faces = np.unique(tri.T, return_inverse=True)
-        dofs = modes._fe["basis_k"].nodal_dofs[:, used]                       # (3, n_v) P2 vertex DOF
+        dofs = modes.vertex_dofs[:, used]                       # (3, n_v) P2 vertex DOF
         shapes = modes.vectors[dofs.T][:, :, list(mode_indices)]              # (n_v, 3, n_m)
         return cls(vertices=mesh.vertices[:, used].T.copy(), faces=faces.reshape(-1, 3).astype(np.int64),
                    shapes=shapes)

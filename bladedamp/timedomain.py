@@ -467,7 +467,7 @@ def point_normal_forces(arrays: AssemblyArrays, approach: np.ndarray):
     return normal_forces(arrays.law_kind, arrays.law_par, arrays.weight, approach)
 
 
-def _static_state(arrays: AssemblyArrays, f_static: np.ndarray, tol: float = 1e-12, max_iter: int = 60):
+def frictionless_static_state(arrays: AssemblyArrays, f_static: np.ndarray, tol: float = 1e-12, max_iter: int = 60):
     """Static equilibrium under the centrifugal load F_CG (Eq. 26) with frictionless contacts:
     K x - Z^T N(offset - Z x) = f_static, Z the normal displacement of every point. Newton
     from every damper seated on rigid platforms (:func:`~bladedamp.damper.kinetics.seat`); the
@@ -708,7 +708,7 @@ class DiskTimeResponse(Saveable):
 _DOF = ("u_x", "u_y", "u_z", "phi_x", "phi_y", "phi_z")
 
 
-def _drift_verdict(means, scale, tol):
+def drift_verdict(means, scale, tol):
     """(damper, coordinate, rate per period) if the period means (W+1, n_d, 6) of the damper
     coordinates move steadily: monotonic over the window (net change >= 0.9 x the sum of the
     per-period changes), at an undiminished rate (second half >= 0.8 x first half) that is
@@ -793,7 +793,7 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
 
     Each frequency f_hz [Hz] is a separate run: the assembly starts at rest in its static
     equilibrium under the centrifugal load F_CG = m R Omega_E^2 / EO^2 (Eq. 26, constant during
-    the run; :func:`_static_state`: frictionless seating on the flexible blades, every slider
+    the run; :func:`frictionless_static_state`: frictionless seating on the flexible blades, every slider
     at its point's tangential displacement, so no tangential force), then the harmonic
     excitation of the HBM (blade k's tip load f cos(Omega t + k dphi), dphi = 2 pi EO / n, as
     :meth:`MistunedDisk.hbm_system`) is switched on at t = 0. Or, with ``start_coefficients``
@@ -879,7 +879,7 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
     for w in omega:
         f = system.excitation(w)[0].reshape(C, N)        # rows: static (F_CG), cos, sin (basis (0, 1))
         loads.append(f)
-        x0 = _static_state(arrays, f[0])
+        x0 = frictionless_static_state(arrays, f[0])
         statics.append(x0)
         w_max = max(w_max, highest_frequency(arrays, x0))
     dt_limit = 2.0 / w_max
@@ -963,7 +963,7 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
             W = drift_periods
             if nd == 0 or p <= W or not (settled or p % max(W // 4, 1) == 0):
                 continue
-            verdict = _drift_verdict(np.array(mean_hist[-W - 1:]), np.repeat(scale, 3), tol)
+            verdict = drift_verdict(np.array(mean_hist[-W - 1:]), np.repeat(scale, 3), tol)
             trend = None
             if not settled and p >= 4 * W:
                 # first harmonics that fluctuate from period to period (undamped ringing of the
@@ -1012,7 +1012,7 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
             # the period-to-period map after max_periods: converging (a lightly damped transient)
             # or not (no periodic motion)
             p = max_periods
-            verdict = _drift_verdict(np.array(mean_hist[-drift_periods - 1:]), np.repeat(scale, 3), tol) \
+            verdict = drift_verdict(np.array(mean_hist[-drift_periods - 1:]), np.repeat(scale, 3), tol) \
                 if nd and p > drift_periods else None
             conv = map_convergence(np.array(tip_hist), decay_rate * 2 * np.pi / w, settle_tol, fluctuation_tol)
             converged, residual, q, L = conv.converged, conv.residual, conv.contraction, conv.block

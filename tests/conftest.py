@@ -84,7 +84,7 @@ def one_error_line(capsys, *needles) -> str:
 
 def scale_columns(J, s):
     """J diag(s) for dense or sparse J (sparse: a CSC copy). With :func:`border`, the reference
-    of bladedamp.hbm.continuation._bordered (the bordered continuation matrix in one pass)."""
+    of bladedamp.hbm.continuation.bordered_matrix (the bordered continuation matrix in one pass)."""
     if sp.issparse(J):
         J = sp.csc_matrix(J, copy=True)
         J.data *= np.repeat(s, np.diff(J.indptr))

@@ -505,8 +505,8 @@ def test_element_fused_kernel_equals_the_analysed_samples(harmonics, law_name):
     local = c.reshape(C, 3 * P)
     force, jac, none = element.harmonic_forces(local, basis)
     force_only, no_jac, _ = element.harmonic_forces(local, basis, jacobian=False)
-    ref_force, ref_jac, _ = element._harmonic_forces_from_samples(local, basis, True)
-    ref_only, _, _ = element._harmonic_forces_from_samples(local, basis, False)
+    ref_force, ref_jac, _ = element.harmonic_forces_from_samples(local, basis, True)
+    ref_only, _, _ = element.harmonic_forces_from_samples(local, basis, False)
     counts = np.bincount(element.samples(local, basis).state.ravel(), minlength=3)
     assert np.all(counts > 0), f"not all contact states covered: {counts}"
     assert none is None and no_jac is None and jac.shape == (3 * C * P,) * 2

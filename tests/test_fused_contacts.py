@@ -1,9 +1,9 @@
 """The fused contact kernel of the mistuned assembly (contact.point.damper_contact_forces).
 
-AssemblyContacts._forces evaluates all contact points of all dampers in one numba call
+AssemblyContacts.forces_at evaluates all contact points of all dampers in one numba call
 (point motion, normal law, return map, AFT, projection to the dampers' 12 relative
 coordinates and the Jacobian blocks). The reference is the previous numpy path,
-AssemblyContacts._forces_numpy (point_contact_forces plus einsum projections), on the
+AssemblyContacts.forces_at_numpy (point_contact_forces plus einsum projections), on the
 16-blade reference disks with random mistuning: cylinder and wedge dampers, linear and
 rough (power-law) normal contact, one harmonic and a static term with harmonics 0, 1, 2,
 at converged Newton points (stick and slip) and at random large motions (stick, slip and
@@ -43,12 +43,12 @@ def contact_state(system, x, omega):
     c = system.couplings[0]
     element = c.element
     local = (c.matrix @ x).reshape(system.basis.n_coeffs, element.n_dampers, 12)
-    return element, local, element._approach(omega)[0]
+    return element, local, element.approach(omega)[0]
 
 
 def state_counts(element, local, basis, offsets):
     """Samples in stick, slip and lift-off over all points (from point_contact_forces)."""
-    _, B, k_t, mu, weights, law = element._stacked()
+    _, B, k_t, mu, weights, law = element.stacked_points()
     C, nd = basis.n_coeffs, element.n_dampers
     coeffs = np.einsum("dqpij,cdqj->cdqpi", B, local.reshape(C, nd, 2, 6)).reshape(C, -1, 3)
     pts = point_contact_forces(coeffs, basis, k_t, mu, law, weights, np.ravel(offsets), jacobian=False)
@@ -73,10 +73,10 @@ def relative(a, b):
 
 def compare(element, local, basis, offsets):
     """Largest relative difference fused - numpy of (forces, Jacobian blocks, forces without Jacobian)."""
-    f_new, j_new = element._forces(local, basis, offsets, True)
-    f_old, j_old = element._forces_numpy(local, basis, offsets, True)
-    g_new, none = element._forces(local, basis, offsets, False)
-    g_old, _ = element._forces_numpy(local, basis, offsets, False)
+    f_new, j_new = element.forces_at(local, basis, offsets, True)
+    f_old, j_old = element.forces_at_numpy(local, basis, offsets, True)
+    g_new, none = element.forces_at(local, basis, offsets, False)
+    g_old, _ = element.forces_at_numpy(local, basis, offsets, False)
     assert none is None and j_new.shape == j_old.shape == (element.n_dampers,) + (basis.n_coeffs, 12) * 2
     return relative(f_new, f_old), relative(j_new, j_old), relative(g_new, g_old)
 
@@ -125,7 +125,7 @@ def test_fused_kernel_power_law(harmonics):
     rng = np.random.default_rng(3)
     basis = system.basis
     element = system.couplings[0].element
-    assert normal_law_parameters(element._stacked()[5]) is not None
+    assert normal_law_parameters(element.stacked_points()[5]) is not None
     for scale in (0.0, 3.0):
         element, local, offsets = contact_state(system, x0 * (1 + scale * rng.standard_normal(x0.size)), w)
         e_f, e_j, e_g = compare(element, local, basis, offsets)
@@ -143,11 +143,15 @@ def test_unknown_normal_law_falls_back_to_the_numpy_path():
     w = 2 * np.pi * 97.0
     x0 = md.initial_guess(system, w)
     element, local, offsets = contact_state(system, 2 * x0, w)
-    f_ref, j_ref = element._forces(local, system.basis, offsets, True)
-    law = element._stacked()[5]
-    element._batch = element._batch[:5] + (OtherLaw(law.stiffness),)
-    assert normal_law_parameters(element._stacked()[5]) is None
-    f, j = element._forces(local, system.basis, offsets, True)
+    f_ref, j_ref = element.forces_at(local, system.basis, offsets, True)
+    law = element.stacked_points()[5]
+    # the same dampers with every patch's law an OtherLaw of the same stiffness, built anew
+    contacts = [dataclasses.replace(c, geometry=dataclasses.replace(c.geometry, patches=tuple(
+        dataclasses.replace(p, normal_law=OtherLaw(law.stiffness)) for p in c.geometry.patches)))
+        for c in element.contacts]
+    other = dataclasses.replace(element, contacts=contacts)
+    assert normal_law_parameters(other.stacked_points()[5]) is None
+    f, j = other.forces_at(local, system.basis, offsets, True)
     assert relative(f, f_ref) < 1e-12 and relative(j, j_ref) < 1e-12
 
 
@@ -160,7 +164,7 @@ def test_fused_jacobian_against_central_differences():
     x, w = converged_point(md, system, CONVERGED_PATH["cylinder"])
     element, local, offsets = contact_state(system, x, w)
     C = basis.n_coeffs
-    _, blocks = element._forces(local, basis, offsets, True)
+    _, blocks = element.forces_at(local, basis, offsets, True)
     size = np.maximum(np.abs(local).max(axis=0), 1e-3 * np.abs(local).max())   # (n_d, 12)
     fd = np.zeros_like(blocks)
     for a in range(C):
@@ -170,7 +174,7 @@ def test_fused_jacobian_against_central_differences():
             lp[a, :, m] += h
             lm[a, :, m] -= h
             # each damper's forces depend on its own coordinates only: all dampers at once
-            diff = (element._forces(lp, basis, offsets, True)[0] - element._forces(lm, basis, offsets, True)[0])
+            diff = (element.forces_at(lp, basis, offsets, True)[0] - element.forces_at(lm, basis, offsets, True)[0])
             fd[:, :, :, a, m] = np.moveaxis(diff / (2 * h[None, :, None]), 1, 0)
     err = relative(blocks * size[:, None, None, None, :], fd * size[:, None, None, None, :])
     print(f"\n[fused Jacobian vs central differences] {state_counts(element, local, basis, offsets)}: {err:.1e}")
@@ -179,7 +183,7 @@ def test_fused_jacobian_against_central_differences():
 
 def kernel(element, local, basis, offsets, max_passes=20, tol=1e-10, closed_form=True):
     """(forces, Jacobian blocks) of damper_contact_forces with the given return-map settings."""
-    _, B, k_t, mu, weights, law = element._stacked()
+    _, B, k_t, mu, weights, law = element.stacked_points()
     kind, params = normal_law_parameters(law)
     C, nd = basis.n_coeffs, element.n_dampers
     force, blocks = np.empty((C, nd, 12)), np.empty((nd, C, 12, C, 12))
@@ -204,7 +208,7 @@ def test_fused_closed_form_jacobian_is_the_many_pass_limit(kind, harmonics):
         f_new, j_new = kernel(element, local, basis, offsets)
         f_ref, j_ref = kernel(element, local, basis, offsets, 5000, 1e-14, closed_form=False)
         f_old, j_old = kernel(element, local, basis, offsets, closed_form=False)
-        f_used, j_used = element._forces(local, basis, offsets, True)
+        f_used, j_used = element.forces_at(local, basis, offsets, True)
         assert np.array_equal(f_used, f_new) and np.array_equal(j_used, j_new)
         e_j, e_old, e_f = relative(j_new, j_ref), relative(j_old, j_ref), relative(f_new, f_ref)
         print(f"\n[{kind} {harmonics} {label}] {state_counts(element, local, basis, offsets)}: Jacobian vs 5000 "

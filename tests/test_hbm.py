@@ -1,4 +1,5 @@
 """Harmonic balance engine: Fourier basis, residual Jacobian, continuation through folds, failures."""
+import dataclasses
 import warnings
 
 import numpy as np
@@ -107,7 +108,6 @@ def test_system_dynamic_stiffness_from_cached_parts_is_the_basis_one():
         A_only, none = system.dynamic_stiffness(omega, derivative=False)
         assert none is None and np.array_equal(A_only, A_ref) and A_only is not A
         A += 1.0                                    # the caller may change what it got
-    assert all(np.array_equal(a, b) for a, b in zip(system._dense_parts, (K0, M2, G)))
 
 
 def _maps_with_zero_rows_and_columns():
@@ -167,10 +167,10 @@ def test_residual_through_the_restricted_maps_equals_the_dense_one(monkeypatch, 
 
     def evaluate(threshold):
         monkeypatch.setattr(system_module, "PRUNE_MIN_SAVING", threshold)
-        for c in system.couplings:
-            c._support = None
-        restricted = [c.support() is not None for c in system.couplings]
-        return system.residual(x, omega), restricted
+        # the same system with new couplings, which find their support anew under the threshold
+        fresh = dataclasses.replace(system, couplings=[dataclasses.replace(c) for c in system.couplings])
+        restricted = [c.support() is not None for c in fresh.couplings]
+        return fresh.residual(x, omega), restricted
 
     (R, J, Rw), restricted = evaluate(1)
     (R_d, J_d, Rw_d), dense = evaluate(np.inf)

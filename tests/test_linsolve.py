@@ -12,7 +12,7 @@ import scipy.sparse as sp
 from conftest import border, scale_columns
 
 from bladedamp import FrictionOscillator
-from bladedamp.hbm.continuation import _bordered
+from bladedamp.hbm.continuation import bordered_matrix
 from bladedamp.hbm.linsolve import BlockCondensation, factorize
 from bladedamp.mistuned import MistunedDisk
 from bladedamp.reference import reference_disk
@@ -116,7 +116,7 @@ def test_condensation_on_mistuned_jacobians(kind, harmonics):
     x = md.initial_guess(system, w)
     x = x * (1 + 0.3 * np.random.default_rng(0).standard_normal(x.size))   # some slip and lift-off
     R, J, Rw = system.residual(x, w)
-    assert isinstance(J, np.ndarray) and system._condensation is not None
+    assert isinstance(J, np.ndarray) and system.condensation_solver is not None
     A = border(J, Rw, np.random.default_rng(1).standard_normal(J.shape[0] + 1))
     for M in (J, A):
         b = np.random.default_rng(2).standard_normal(M.shape[0])
@@ -141,7 +141,7 @@ def test_bordered_forms_the_indices_once_per_pattern():
     previous = None
     for M in (J, J2, other):
         column, row, scale = rng.standard_normal(n), rng.standard_normal(n + 1), rng.uniform(0.5, 2, n)
-        A = _bordered(M, column, row, scale, factor)
+        A = bordered_matrix(M, column, row, scale, factor)
         B = border(scale_columns(M, scale * factor), column * factor, row)
         assert A.shape == (n + 1, n + 1) and np.array_equal(A.toarray(), B.toarray())
         assert np.array_equal(A.indices, B.indices) and np.array_equal(A.indptr, B.indptr)

@@ -178,7 +178,7 @@ def test_jacobian_against_finite_differences_and_generic_assembly():
     sparse Jacobian equals central differences of the residual (and dR/domega), and the
     residual / Jacobian equal HarmonicBalanceSystem's generic sparse assembly. 64 samples on 3
     blades: the interblade shift is 21.3 samples, so each damper is sampled on its own grid and
-    its forces and Jacobian blocks rotated back (AssemblyContacts._grid_rotations), checked here too."""
+    its forces and Jacobian blocks rotated back (AssemblyContacts.grid_rotations), checked here too."""
     td = tuned(3, 1)
     dampers = [dataclasses.replace(td.damper, mass=m) for m in (0.5e-3, 1e-3, 2e-3)]
     md = MistunedDisk.from_tuned(td, kappa=[0.98, 1.0, 1.03], dampers=dampers)
@@ -186,7 +186,7 @@ def test_jacobian_against_finite_differences_and_generic_assembly():
     i = int(np.argmax(r.tip_amplitude[:, 0, 0]))
     x, w = r.coefficients[i].ravel(), r.omega[i]
     s = md.hbm_system()
-    assert s.basis.n_samples == 64 and s.couplings[0].element._grid_rotations(s.basis) is not None
+    assert s.basis.n_samples == 64 and s.couplings[0].element.grid_rotations(s.basis) is not None
     R, J, Rw = s.residual(x, w)
     generic = HarmonicBalanceSystem(s.basis, s.mass, s.damping, s.stiffness, s.excitation, s.couplings)
     Rg, Jg, Rwg = generic.residual(x, w)
@@ -576,8 +576,8 @@ def test_mistuned_copies_share_the_tuned_setup_with_the_same_residuals():
     assert np.array_equal([b.natural_frequencies_hz for b in copy.blades], [b.natural_frequencies_hz for b in fresh.blades])
     shared, own = copy.hbm_system((1,)), fresh.hbm_system((1,))
     source = assembly.hbm_system((1,))
-    assert shared.couplings[0] is source.couplings[0] and shared._pattern is source._pattern
-    assert shared._ring is source._ring and shared.mass is source.mass
+    assert shared.couplings[0] is source.couplings[0] and shared.jacobian_pattern is source.jacobian_pattern
+    assert shared.ring_solver is source.ring_solver and shared.mass is source.mass
     assert own.couplings[0] is not source.couplings[0]
     w = 2 * np.pi * 95.0
     x = fresh.initial_guess(own, w)
@@ -602,13 +602,13 @@ def scipy_residual(system, x, omega, jacobian=True):
     import scipy.sparse as sp
 
     C = system.basis.n_coeffs
-    K0, M2, G = system._sparse_parts
+    K0, M2, G = (m.tocsc() for m in system.linear_coo)      # the CSC parts back (same order, no duplicates)
     f, df = system.excitation(omega)
     m2x, gx = M2 @ x, G @ x
     R = K0 @ x - omega ** 2 * m2x + omega * gx - f
     Rw = -2 * omega * m2x + gx - df if jacobian else None
-    values = [system._lin[0].data, -omega ** 2 * system._lin[1].data, omega * system._lin[2].data]
-    T, TT, Tb, TbT, _ = system._contact
+    values = [system.linear_coo[0].data, -omega ** 2 * system.linear_coo[1].data, omega * system.linear_coo[2].data]
+    T, TT, Tb, TbT, _ = system.contact_blocks
     element = system.couplings[0].element
     force, blocks, domega = element.evaluate((T @ x).reshape(C, element.n_local), system.basis, omega, jacobian)
     R += TT @ force.ravel()
@@ -618,12 +618,12 @@ def scipy_residual(system, x, omega, jacobian=True):
             Rw += TT @ domega.ravel()
     if not jacobian:
         return R, None, None
-    inverse, indices, indptr, nnz = system._pattern
+    inverse, indices, indptr, nnz = system.jacobian_pattern
     data = np.bincount(inverse, weights=np.concatenate(values), minlength=nnz)
     n = x.size
     if system.dense:
         J = np.zeros(n * n)
-        J[system._dense_index] = data
+        J[system.dense_index] = data
         return R, J.reshape(n, n), Rw
     return R, sp.csc_matrix((data, indices, indptr), shape=(n, n)), Rw
 
@@ -646,7 +646,7 @@ def test_residual_kernels_give_the_numbers_of_the_scipy_operations(harmonics):
             assert got[2] is not None and np.abs(got[2]).max() > 0
             for a, b in zip(got, ref):
                 if hasattr(a, "toarray"):
-                    assert a.indices is system._jacobian_template.indices and a.indptr is system._jacobian_template.indptr
+                    assert a.indices is system.jacobian_template.indices and a.indptr is system.jacobian_template.indptr
                     assert np.array_equal(a.indices, b.indices) and np.array_equal(a.indptr, b.indptr)
                     a, b = a.data, b.data
                 assert np.array_equal(a, b)
@@ -655,11 +655,11 @@ def test_residual_kernels_give_the_numbers_of_the_scipy_operations(harmonics):
 
 def test_euler_rate_is_the_numpy_formula_to_rounding():
     """AssemblyContacts.evaluate's d force / d omega by Euler's identity (one numba call,
-    mistuned._euler_rate) equals the numpy formula it replaced, kappa_d = doffsets_d . offsets_d
+    mistuned.euler_rate) equals the numpy formula it replaced, kappa_d = doffsets_d . offsets_d
     / |offsets_d|^2 and (force - J local) kappa, to 1e-12 of its largest entry at a stuck and a
     slipping state; an approach rate that is not homogeneous (one entry moved) is refused,
     domega left as it was, and evaluate takes the central difference there."""
-    from bladedamp.mistuned import _euler_rate
+    from bladedamp.mistuned import euler_rate
 
     md = MistunedDisk.from_tuned(reference_disk("cylinder", 1e-3), mt.random_kappa(16, 0.02, seed=5))
     system = md.hbm_system((1,))
@@ -667,9 +667,9 @@ def test_euler_rate_is_the_numpy_formula_to_rounding():
     w = 2 * np.pi * 95.0
     x0 = md.initial_guess(system, w)
     for x in (x0, 3 * x0):
-        local = (system._contact[0] @ x).reshape(C, element.n_dampers, element.damper_local)
-        offsets, doffsets = element._approach(w)
-        force, blocks = element._forces(local, system.basis, offsets, True)
+        local = (system.contact_blocks[0] @ x).reshape(C, element.n_dampers, element.damper_local)
+        offsets, doffsets = element.approach(w)
+        force, blocks = element.forces_at(local, system.basis, offsets, True)
         norms = np.einsum("dqp,dqp->d", offsets, offsets)
         kappa = np.where(norms > 0, np.einsum("dqp,dqp->d", doffsets, offsets) / np.where(norms > 0, norms, 1), 0.0)
         expected = (force - np.einsum("dambn,bdn->adm", blocks, local)) * kappa[None, :, None]
@@ -678,8 +678,8 @@ def test_euler_rate_is_the_numpy_formula_to_rounding():
         skewed = doffsets.copy()
         skewed[3, 1, 2] *= 1.001
         out = np.full(force.shape, 7.0)
-        assert not _euler_rate(offsets, skewed, blocks, local, force, out) and np.all(out == 7.0)
-        assert _euler_rate(offsets, doffsets, blocks, local, force, out) and np.array_equal(out, domega)
+        assert not euler_rate(offsets, skewed, blocks, local, force, out) and np.all(out == 7.0)
+        assert euler_rate(offsets, doffsets, blocks, local, force, out) and np.array_equal(out, domega)
 
 
 def test_dampers_of_one_kind_evaluate_their_static_approach_once():
@@ -694,7 +694,7 @@ def test_dampers_of_one_kind_evaluate_their_static_approach_once():
     for md, functions in ((same, 1), (own, 4)):
         element = md.hbm_system((1,)).couplings[0].element
         assert len({id(c.approach) for c in element.contacts}) == functions
-        offsets, doffsets = element._approach(w)
+        offsets, doffsets = element.approach(w)
         assert np.array_equal(offsets, np.array([c.approach(w)[0] for c in element.contacts]))
         assert np.array_equal(doffsets, np.array([c.approach(w)[1] for c in element.contacts]))
 
@@ -703,7 +703,7 @@ def test_sixteen_blades_take_the_sparse_jacobian_and_the_ring_solves_it_as_the_d
     """Above AssemblySystem.ring_dense_limit unknowns the ring's systems return a sparse
     Jacobian: the same entries as the dense assembly, and the ring's solution of its bordered
     matrix (the continuation's, bordered in CSC) equal to that of the dense one to 1e-12."""
-    from bladedamp.hbm.continuation import _bordered
+    from bladedamp.hbm.continuation import bordered_matrix
 
     md = MistunedDisk.from_tuned(reference_disk("cylinder", 1e-3), mt.random_kappa(16, 0.02, seed=5))
     system = md.hbm_system((1,))
@@ -720,7 +720,7 @@ def test_sixteen_blades_take_the_sparse_jacobian_and_the_ring_solves_it_as_the_d
     assert np.array_equal(R, R_d) and np.array_equal(Rw, Rw_d) and np.array_equal(J.toarray(), J_d)
     rng = np.random.default_rng(0)
     row, scale, b = rng.standard_normal(J_d.shape[0] + 1), rng.uniform(0.5, 2, J_d.shape[0]), rng.standard_normal(J_d.shape[0] + 1)
-    A, A_d = _bordered(J, Rw, row, scale, 0.3), _bordered(J_d, Rw, row, scale, 0.3)
+    A, A_d = bordered_matrix(J, Rw, row, scale, 0.3), bordered_matrix(J_d, Rw, row, scale, 0.3)
     assert np.array_equal(A.toarray(), A_d)
     y, y_d = system.factorize(A)(b), system.factorize(A_d)(b)
     assert np.abs(y - y_d).max() <= 1e-12 * np.abs(y_d).max()

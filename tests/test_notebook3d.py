@@ -37,11 +37,10 @@ def test_embedding_and_saving_start_no_server(cylinder_frf, tmp_path):
     link = nb3.save_scene(scene, tmp_path / "views" / "maps.html")
     assert (tmp_path / "views" / "maps.html").read_text(encoding="utf-8") == scene.html()
     assert "maps.html" in link.data and "<a href=" in link.data
-    assert not mv._LIVE and scene._window.server_proc is None
+    assert not mv.LIVE_VIEWS and scene.vis.window.server_proc is None
 
 
 def test_liftoff_callback_is_memoised_and_follows_the_physics():
-    nb3._liftoff_case.cache_clear()
     low = nb3.liftoff_case(2.0, 0.05)
     t = time.perf_counter()
     assert nb3.liftoff_case(2.0, 0.05 + 1e-9) is low                 # same key after rounding: cached

@@ -177,7 +177,7 @@ def test_ring_on_mistuned_jacobians(kind, harmonics, n):
     disk = dataclasses.replace(reference_disk(kind, 1e-3), n_blades=n)
     md = MistunedDisk.from_tuned(disk, mt.random_kappa(n, 0.02, seed=[0, n]))
     system, J, A = jacobians(md, harmonics)
-    assert system._ring is not None and system.linear_solver == "auto"
+    assert system.ring_solver is not None and system.linear_solver == "auto"
     for M in (J, A, sp.csc_matrix(A)):
         solve = system.factorize(M)
         assert solve.method == "ring"
@@ -199,7 +199,7 @@ def test_ring_on_sectors_and_missing_dampers():
     gaps = MistunedDisk(sector.blades[:1] * 6, [disk.damper, None, disk.damper, disk.damper, None, disk.damper])
     for md, harmonics in ((sector, (1, 2)), (gaps, (1,))):
         system, J, A = jacobians(md, harmonics)
-        assert system._ring is not None
+        assert system.ring_solver is not None
         for M in (A, sp.csc_matrix(A)):
             solve = system.factorize(M)
             assert solve.method == "ring"
@@ -208,7 +208,7 @@ def test_ring_on_sectors_and_missing_dampers():
             assert np.abs(solve(b) - y_lu).max() < 1e-10 * np.abs(y_lu).max()
     one = MistunedDisk.from_tuned(dataclasses.replace(disk, n_blades=8), [1.0], n_sector=1)
     system, J, A = jacobians(one, (1,))
-    assert system._ring is None
+    assert system.ring_solver is None
     assert not hasattr(system.factorize(A), "method")          # BlockCondensation's solve
 
 
@@ -255,25 +255,25 @@ def test_mistuned_frf_with_the_ring_equals_the_condensation(n, f_range, sparse, 
 
 
 def test_one_column_substitutions_give_the_many_column_numbers():
-    """The ring's one-column paths (the solves' right-hand sides: _mm_sub and _lu_solve with a
-    single column, _lu_solve_transposed) sum each row in a register: the same numbers, bit for
+    """The ring's one-column paths (the solves' right-hand sides: mm_subtract and lu_solve_inplace with a
+    single column, lu_solve_transposed_inplace) sum each row in a register: the same numbers, bit for
     bit, as the many-column loops (which subtract term by term in memory) on the same column."""
-    from bladedamp.hbm.linsolve import _lu, _lu_solve, _lu_solve_transposed, _mm_sub
+    from bladedamp.hbm.linsolve import lu_factor_inplace, lu_solve_inplace, lu_solve_transposed_inplace, mm_subtract
 
     rng = np.random.default_rng(11)
     q = 21
     W = rng.standard_normal((q, q)) + q * np.eye(q)
     piv = np.empty(q, dtype=np.intp)
-    _lu(W, piv)
+    lu_factor_inplace(W, piv)
     A, B, C = rng.standard_normal((q, 13)), rng.standard_normal((13, 1)), rng.standard_normal((q, 1))
     wide, wide_C = np.hstack([B, rng.standard_normal((13, 2))]), np.hstack([C, np.zeros((q, 2))])
-    _mm_sub(A, B, C)
-    _mm_sub(A, wide, wide_C)
+    mm_subtract(A, B, C)
+    mm_subtract(A, wide, wide_C)
     assert np.array_equal(C[:, 0], wide_C[:, 0])
     b = rng.standard_normal((q, 1))
     b_wide = np.hstack([b, rng.standard_normal((q, 3))])
-    _lu_solve(W, piv, b)
-    _lu_solve(W, piv, b_wide)
+    lu_solve_inplace(W, piv, b)
+    lu_solve_inplace(W, piv, b_wide)
     assert np.array_equal(b[:, 0], b_wide[:, 0])
     x = rng.standard_normal(q)
     expected = x.copy()                 # W^-T x term by term, as the loops were
@@ -287,5 +287,5 @@ def test_one_column_substitutions_give_the_many_column_numbers():
     for c in range(q - 1, -1, -1):
         if piv[c] != c:
             expected[c], expected[piv[c]] = expected[piv[c]], expected[c]
-    _lu_solve_transposed(W, piv, x)
+    lu_solve_transposed_inplace(W, piv, x)
     assert np.array_equal(x, expected)

@@ -199,8 +199,8 @@ def test_branch_and_bound_of_the_mass_grid_keeps_the_optimum(monkeypatch):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         pruned = optimal_mass(disk, bounds=(0.3e-3, 3e-3), grid_per_decade=3, xatol=0.1)
-        plain_case = mass._robust_peak_case
-        monkeypatch.setattr(mass, "_robust_peak_case", lambda case: plain_case(case[:-1] + (np.inf,)))
+        plain_case = mass.robust_peak_case
+        monkeypatch.setattr(mass, "robust_peak_case", lambda case: plain_case(case[:-1] + (np.inf,)))
         plain = optimal_mass(disk, bounds=(0.3e-3, 3e-3), grid_per_decade=3, xatol=0.1)
     assert pruned.stopped_masses and not plain.stopped_masses and not pruned.failed_masses
     assert (pruned.mass, pruned.peak_amplitude, pruned.bracket) == (plain.mass, plain.peak_amplitude, plain.bracket)
@@ -221,8 +221,8 @@ def test_complete_grid_solves_the_stopped_masses_as_the_unpruned_search_does(mon
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         complete = optimal_mass(disk, bounds=(0.3e-3, 3e-3), grid_per_decade=3, xatol=0.1, complete_grid=True)
-        plain_case = mass._robust_peak_case
-        monkeypatch.setattr(mass, "_robust_peak_case", lambda case: plain_case(case[:-1] + (np.inf,)))
+        plain_case = mass.robust_peak_case
+        monkeypatch.setattr(mass, "robust_peak_case", lambda case: plain_case(case[:-1] + (np.inf,)))
         plain = optimal_mass(disk, bounds=(0.3e-3, 3e-3), grid_per_decade=3, xatol=0.1)
     assert (complete.mass, complete.peak_amplitude) == (plain.mass, plain.peak_amplitude)
     assert np.all(np.isfinite(complete.grid_peak_amplitude))

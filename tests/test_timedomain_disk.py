@@ -21,7 +21,7 @@ from bladedamp.disk import TunedDisk
 from bladedamp.mistuned import MistunedDisk
 from bladedamp.reference import (DAMPER_RADIUS, EXCITATION_FX, PLATFORM_ANGLE, reference_contact,
                                  reference_damper)
-from bladedamp.timedomain import DiskTimeResponse, _drift_verdict, hbm_tip_at, map_convergence
+from bladedamp.timedomain import DiskTimeResponse, drift_verdict, hbm_tip_at, map_convergence
 
 # The HBM harmonics of the validation: None is frequency_response's default ("auto", the
 # harmonics chosen to its tolerance). Forcing (1,) here must make the wedge test fail.
@@ -168,14 +168,14 @@ def test_static_state_with_a_misfit_is_the_seating():
     frictionless) carries the same per-point normal loads as the HBM's rigid-platform seating
     (kinetics.seat) to 1e-6, and leaves the same points open."""
     from bladedamp.damper.kinetics import seat
-    from bladedamp.timedomain import _static_state, assembly_arrays, point_normal_forces
+    from bladedamp.timedomain import frictionless_static_state, assembly_arrays, point_normal_forces
 
     xi = np.repeat(np.linspace(-1.0, 1.0, 3), 3)                  # 3 x 3 points, xi-major
     disk = small_disk(small_wedge(), initial_gaps=np.array([5e-6 * (1 + xi), 5e-6 * (1 - xi)]))
     arrays = assembly_arrays(MistunedDisk.from_tuned(disk))
     w = 2 * np.pi * 97.0
     f = arrays.system.excitation(w)[0].reshape(3, -1)
-    x0 = _static_state(arrays, f[0])
+    x0 = frictionless_static_state(arrays, f[0])
     loads, _ = point_normal_forces(arrays, arrays.offset - arrays.point_map[2::3] @ x0)
     geometry = disk.damper_geometry()
     _, approach, _ = seat(geometry, disk.centrifugal_force(97.0)[0])
@@ -194,17 +194,17 @@ def test_drift_verdict():
     base = np.zeros((W + 1, 2, 6))
     drifting = base.copy()
     drifting[:, 1, 4] = 1e-5 * p[:, 0, 0]                           # phi_y of damper 1: 1e-5 rad / period
-    d, a, rate = _drift_verdict(drifting, scale, 1e-5)
+    d, a, rate = drift_verdict(drifting, scale, 1e-5)
     assert (d, a) == (1, 4) and rate == pytest.approx(1e-5)
     decaying = base.copy()
     decaying[:, 0, 4] = 1e-3 * 0.9 ** p[:, 0, 0]                    # settles geometrically
-    assert _drift_verdict(decaying, scale, 1e-5) is None
+    assert drift_verdict(decaying, scale, 1e-5) is None
     beating = base.copy()
     beating[:, 0, 2] = 1e-7 * np.sin(2 * np.pi * p[:, 0, 0] / 30)  # a beat of the transient
-    assert _drift_verdict(beating, scale, 1e-5) is None
+    assert drift_verdict(beating, scale, 1e-5) is None
     slow = base.copy()
     slow[:, 0, 4] = 1e-9 * p[:, 0, 0]                               # below 10 tol of the amplitude
-    assert _drift_verdict(slow, scale, 1e-5) is None
+    assert drift_verdict(slow, scale, 1e-5) is None
 
 
 def test_map_convergence_bounds_the_residual_drift():

@@ -118,7 +118,7 @@ def test_static_html_is_standalone_and_starts_no_server(cylinder_frf, tmp_path):
     path = scene.save_html(tmp_path / "map.html")
     html = open(path, encoding="utf-8").read()
     assert "MeshCat.Viewer" in html and html.count("fetch(\"data:application/octet-binary;base64,") > 10
-    assert scene._window.server_proc is None
+    assert scene.vis.window.server_proc is None
     shown = mv.show(cylinder_frf, path=tmp_path / "ods.html", n_frames=4)
     assert isinstance(shown, mv.Scene) and (tmp_path / "ods.html").stat().st_size > len(html) // 2
 

@@ -371,7 +371,7 @@ def _iterate_passes(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s0,
 @njit(cache=True)
 def _point_return_map(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s0, s1, static_index, max_passes, tol,
                       want_jac, f_out, df_out, state_out, ds, ds_begin, transfer, closed_form, stuck_rows):
-    """Periodic return map of one point (see :func:`_return_map`).
+    """Periodic return map of one point (see :func:`return_map`).
 
     ut (T,2); normal, dnormal (T,); s0, s1 the initial slider position; outputs f_out (T,>=2),
     df_out (T,>=2,3C) (rows 0, 1 written; untouched without the Jacobian), state_out (T,);
@@ -525,8 +525,8 @@ def _point_return_map(ut, normal, dnormal, seat, seat_rate, synthesis, kt, mu, s
 
 
 @njit(cache=True)
-def _return_map(ut, normal, dnormal, seat, seat_rate, synthesis, k_t, mu, s_start, static_index,
-                max_passes, tol, want_jac, f_out, df_out, state_out, slip_work, passes, closed_form):
+def return_map(ut, normal, dnormal, seat, seat_rate, synthesis, k_t, mu, s_start, static_index,
+               max_passes, tol, want_jac, f_out, df_out, state_out, slip_work, passes, closed_form):
     """Tangential forces of P points over T samples (see module docstring).
 
     ut (P,T,2) tangential displacement samples; normal (P,T) normal load N >= 0;
@@ -903,7 +903,7 @@ def point_contact_forces(coeffs, basis, tangential_stiffness, friction_coefficie
     state = np.empty((P, T), dtype=np.int8)
     slip_work = np.zeros(P)
     passes = np.zeros((P, 2), dtype=np.int64)
-    _return_map(np.ascontiguousarray(disp[:, :, :2]), np.ascontiguousarray(normal),
+    return_map(np.ascontiguousarray(disp[:, :, :2]), np.ascontiguousarray(normal),
                 np.ascontiguousarray(dnormal), seat, seat_rate, basis.synthesis, k_t, mu, s_start, static_index,
                 max_passes, tol, jacobian, f_t, df, state, slip_work, passes, closed_form)
     force = np.empty((P, T, 3))
@@ -970,7 +970,7 @@ class PointContactElement:
         C, P = basis.n_coeffs, self.n_points
         law = normal_law_parameters(self.normal_law)
         if law is None:
-            return self._harmonic_forces_from_samples(local, basis, jacobian)
+            return self.harmonic_forces_from_samples(local, basis, jacobian)
         force = np.empty((C, P, 3))
         jac = np.empty((C, P, 3, C, P, 3)) if jacobian else np.empty((1, 1, 1, 1, 1, 1))
         point_contact_harmonics(np.ascontiguousarray(np.reshape(local, (C, P, 3)), dtype=float), basis.synthesis,
@@ -979,8 +979,10 @@ class PointContactElement:
                                 MAX_PASSES, PERIODIC_TOL, jacobian, True, force, jac)
         return force.reshape(C, 3 * P), (jac.reshape(C * 3 * P, C * 3 * P) if jacobian else None), None
 
-    def _harmonic_forces_from_samples(self, local, basis, jacobian):
-        """:meth:`harmonic_forces` by the analysis of :meth:`samples` (any normal law)."""
+    def harmonic_forces_from_samples(self, local, basis, jacobian):
+        """:meth:`harmonic_forces` by the analysis of :meth:`samples` (any normal law): force
+        coefficients (C, 3P) [N], Jacobian (C*3P, C*3P) [N/m] or None (``jacobian`` False), and
+        None, of ``local`` (C, 3P) [m]; the reference of the fused kernel."""
         C, P = basis.n_coeffs, self.n_points
         pts = self.samples(local, basis, jacobian)
         force = basis.to_coeffs(np.moveaxis(pts.force, 1, 0)).reshape(C, 3 * P)

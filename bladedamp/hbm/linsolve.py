@@ -593,7 +593,7 @@ def _ring_gather_csc(data, indices, indptr, owner, local, links, D, Up, Lo, col,
 
 
 @njit(cache=True)
-def _mm_sub(A, B, C):
+def mm_subtract(A, B, C):
     """C -= A @ B (2D, in place; C shares no memory with A or B). Each C[i, j] has a_il b_lj
     subtracted in the order of l; with one column (the solves' right-hand sides) in a register
     rather than in memory, which the compiler cannot do itself (C might overlap B): the same
@@ -613,7 +613,7 @@ def _mm_sub(A, B, C):
 
 
 @njit(cache=True)
-def _lu(W, piv):
+def lu_factor_inplace(W, piv):
     """In-place LU with partial pivoting of the square W (LAPACK getrf layout: unit L below the
     diagonal, U on and above, row swaps piv[c] <-> c in order). Returns (sign of det, log |det|,
     1-norm of W before); sign 0 if a pivot is zero or not finite."""
@@ -651,9 +651,9 @@ def _lu(W, piv):
 
 
 @njit(cache=True)
-def _lu_solve(W, piv, B):
-    """B <- W^-1 B in place (B: (q, k)) with the factors of :func:`_lu`. One column (k = 1) is
-    substituted with each row's sum in a register (as :func:`_mm_sub`; the same numbers)."""
+def lu_solve_inplace(W, piv, B):
+    """B <- W^-1 B in place (B: (q, k)) with the factors of :func:`lu_factor_inplace`. One column (k = 1) is
+    substituted with each row's sum in a register (as :func:`mm_subtract`; the same numbers)."""
     q, k = B.shape
     for c in range(q):
         p = piv[c]
@@ -688,9 +688,9 @@ def _lu_solve(W, piv, B):
 
 
 @njit(cache=True)
-def _lu_solve_transposed(W, piv, x):
-    """x <- W^-T x in place (x: (q,)) with the factors of :func:`_lu` (each row's sum in a
-    register, as :func:`_lu_solve`)."""
+def lu_solve_transposed_inplace(W, piv, x):
+    """x <- W^-T x in place (x: (q,)) with the factors of :func:`lu_factor_inplace` (each row's sum in a
+    register, as :func:`lu_solve_inplace`)."""
     q = x.size
     for i in range(q):
         s = x[i]
@@ -710,24 +710,24 @@ def _lu_solve_transposed(W, piv, x):
 
 @njit(cache=True)
 def _inverse_norm1(W, piv):
-    """Estimate of ||W^-1||_1 from the factors of :func:`_lu` (Hager's method, two steps as
+    """Estimate of ||W^-1||_1 from the factors of :func:`lu_factor_inplace` (Hager's method, two steps as
     LAPACK's dlacon starts: a lower bound, in practice within a small factor)."""
     q = W.shape[0]
     y = np.full((q, 1), 1.0 / q)
-    _lu_solve(W, piv, y)
+    lu_solve_inplace(W, piv, y)
     est = 0.0
     xi = np.empty(q)
     for i in range(q):
         est += abs(y[i, 0])
         xi[i] = 1.0 if y[i, 0] >= 0 else -1.0
-    _lu_solve_transposed(W, piv, xi)
+    lu_solve_transposed_inplace(W, piv, xi)
     j = 0
     for i in range(q):
         if abs(xi[i]) > abs(xi[j]):
             j = i
     e = np.zeros((q, 1))
     e[j, 0] = 1.0
-    _lu_solve(W, piv, e)
+    lu_solve_inplace(W, piv, e)
     s = 0.0
     for i in range(q):
         s += abs(e[i, 0])
@@ -747,16 +747,16 @@ def _ring_condense(Aqq, Aqc, Acq, links, D, Up, Lo, col, row, qpiv, X):
     S = np.empty((c2, c2))
     sign, logdet, worst, d_corner = 1.0, 0.0, 0.0, 0.0
     for j in range(m):
-        s, l, norm = _lu(Aqq[j], qpiv[j])
+        s, l, norm = lu_factor_inplace(Aqq[j], qpiv[j])
         if s == 0.0:
             return 0.0, -np.inf, np.inf, 0.0
         sign *= s
         logdet += l
         worst = max(worst, norm * _inverse_norm1(Aqq[j], qpiv[j]))
         X[j] = Aqc[j]
-        _lu_solve(Aqq[j], qpiv[j], X[j])
+        lu_solve_inplace(Aqq[j], qpiv[j], X[j])
         S[:] = 0.0
-        _mm_sub(Acq[j], X[j], S)                 # S = -Acq X
+        mm_subtract(Acq[j], X[j], S)                 # S = -Acq X
         a = links[j]
         a1 = (a + 1) % n
         for i in range(b):
@@ -806,21 +806,21 @@ def _ring_factor(D, Up, Lo, col, row, corner, P, ppiv, X, Y, F, Z, zpiv):
             Fk[b, i] = row[k, i]
         Pk[:] = D[k]
         if k > 0:
-            _mm_sub(Lo[k - 1], X[k - 1], Pk)
-            _mm_sub(Lo[k - 1], Y[k - 1], E)
-            _mm_sub(F[k - 1], X[k - 1], Fk)
-        s, l, norm = _lu(Pk, ppiv[k])
+            mm_subtract(Lo[k - 1], X[k - 1], Pk)
+            mm_subtract(Lo[k - 1], Y[k - 1], E)
+            mm_subtract(F[k - 1], X[k - 1], Fk)
+        s, l, norm = lu_factor_inplace(Pk, ppiv[k])
         if s == 0.0:
             return 0.0, -np.inf, np.inf
         sign *= s
         logdet += l
         worst = max(worst, norm * _inverse_norm1(Pk, ppiv[k]))
-        _lu_solve(Pk, ppiv[k], E)                   # Y[k] = P_k^-1 E_k
+        lu_solve_inplace(Pk, ppiv[k], E)                   # Y[k] = P_k^-1 E_k
         if k < n - 2:
             X[k] = Up[k]
-            _lu_solve(Pk, ppiv[k], X[k])
-        _mm_sub(Fk, E, Z)
-    s, l, _ = _lu(Z, zpiv)
+            lu_solve_inplace(Pk, ppiv[k], X[k])
+        mm_subtract(Fk, E, Z)
+    s, l, _ = lu_factor_inplace(Z, zpiv)
     if s == 0.0:
         return 0.0, -np.inf, worst
     return sign * s, logdet + l, worst
@@ -851,9 +851,9 @@ def _ring_substitute(Qlu, qpiv, X, Acq, links, groups, interior, size, bordered,
         for i in range(nq):
             for c in range(nr):
                 yq[j, i, c] = r[interior[j, i], c]
-        _lu_solve(Qlu[j], qpiv[j], yq[j])
+        lu_solve_inplace(Qlu[j], qpiv[j], yq[j])
         t[:] = 0.0
-        _mm_sub(Acq[j], yq[j], t)                    # t = -Acq yq
+        mm_subtract(Acq[j], yq[j], t)                    # t = -Acq yq
         a = links[j]
         a1 = (a + 1) % n
         for i in range(b):
@@ -867,17 +867,17 @@ def _ring_substitute(Qlu, qpiv, X, Acq, links, groups, interior, size, bordered,
             gz[i, c] += xr[n - 1, i, c]
     for k in range(n - 1):                          # forward: w_k = P_k^-1 (r_k - A[k, k-1] w_{k-1})
         if k > 0:
-            _mm_sub(Lo[k - 1], xr[k - 1], xr[k])
-        _lu_solve(P[k], ppiv[k], xr[k])
-        _mm_sub(F[k], xr[k], gz)
-    _lu_solve(Z, zpiv, gz)
+            mm_subtract(Lo[k - 1], xr[k - 1], xr[k])
+        lu_solve_inplace(P[k], ppiv[k], xr[k])
+        mm_subtract(F[k], xr[k], gz)
+    lu_solve_inplace(Z, zpiv, gz)
     for i in range(b):
         for c in range(nr):
             xr[n - 1, i, c] = gz[i, c]
     for k in range(n - 2, -1, -1):                  # back: x_k = w_k - Y_k x_Z - X_k x_{k+1}
-        _mm_sub(Y[k], gz, xr[k])
+        mm_subtract(Y[k], gz, xr[k])
         if k < n - 2:
-            _mm_sub(Xc[k], xr[k + 1], xr[k])
+            mm_subtract(Xc[k], xr[k + 1], xr[k])
     for k in range(n):
         for i in range(b):
             for c in range(nr):

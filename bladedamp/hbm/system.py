@@ -11,6 +11,7 @@ Jacobian. Because the same ``T_e`` maps displacements out and forces back, the J
 """
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, field
 from typing import Callable, Protocol
 
@@ -170,6 +171,16 @@ class HarmonicBalanceSystem:
             self._sparse_parts = (K0.tocsc(), M2.tocsc(), G.tocsc())
         K0, M2, G = self._sparse_parts
         return (K0 - omega ** 2 * M2 + omega * G).tocsc(), (-2 * omega * M2 + G).tocsc()
+
+    def with_matrices(self, damping, stiffness) -> "HarmonicBalanceSystem":
+        """A shallow copy of this system with other damping and stiffness matrices (n_dof, n_dof)
+        (the units of :attr:`damping` and :attr:`stiffness`); the basis, mass, excitation,
+        couplings and static stiffness are shared, the cached Omega-independent parts of the
+        dynamic stiffness are formed anew on first use. This system is left as it is."""
+        other = copy.copy(self)
+        other.damping, other.stiffness = damping, stiffness
+        other._sparse_parts = other._dense_parts = None
+        return other
 
     def dynamic_stiffness(self, omega: float, derivative: bool = True):
         """(A, dA/domega) of the linear part at ``omega`` [rad/s] (the residual's variable): the

@@ -352,7 +352,11 @@ def log_mass_grid(bounds, grid_per_decade: float = GRID_PER_DECADE):
     return loggrid, masses
 
 
-def _robust_peak_case(case):
+def robust_peak_case(case):
+    """:func:`robust_peak` of one case ``(disk, f_range_hz, harmonics, attempts, downward,
+    give_up_above, stop_above)`` (the arguments of the same names, in this order): the unit of
+    work :func:`optimal_mass` sends to :func:`~bladedamp.progress.parallel_map` (a module-level
+    function, so that worker processes can pickle it)."""
     disk, f_range, harmonics, attempts, downward, give_up_above, stop_above = case
     return robust_peak(disk, f_range, harmonics, attempts=attempts, downward=downward, give_up_above=give_up_above,
                        stop_above=stop_above)
@@ -447,14 +451,14 @@ def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0),
         for k in range(0, len(order), wave):
             chunk, best = order[k:k + wave], best_so_far()
             cases = [(with_mass(disk, m), f_range_hz, harmonics, ROBUST_ATTEMPTS[:1], False, best, best) for m in chunk]
-            for m, ev in zip(chunk, parallel_map(_robust_peak_case, cases, processes)):
+            for m, ev in zip(chunk, parallel_map(robust_peak_case, cases, processes)):
                 record(m, ev)
             if progress:
                 progress(min(k + wave, len(order)), len(order))
         best = best_so_far()
         retry = [m for m in masses if not evaluations[m].success and not evaluations[m].lower_bound > best]
         cases = [(with_mass(disk, m), f_range_hz, harmonics, ROBUST_ATTEMPTS[1:], True, best, np.inf) for m in retry]
-        for m, ev in zip(retry, parallel_map(_robust_peak_case, cases, processes)):
+        for m, ev in zip(retry, parallel_map(robust_peak_case, cases, processes)):
             ev.attempts += evaluations[m].attempts
             record(m, ev)
         return [evaluations[m].peak_amplitude if evaluations[m].success else np.nan for m in masses]
@@ -463,7 +467,7 @@ def optimal_mass(disk: TunedDisk, bounds=(1e-5, 1e-2), f_range_hz=(90.0, 105.0),
     if complete_grid and np.isfinite(logm):
         rest = [float(m) for m in grid_m if evaluations[float(m)].stopped_above]
         cases = [(with_mass(disk, m), f_range_hz, harmonics, ROBUST_ATTEMPTS, True, np.inf, np.inf) for m in rest]
-        for m, ev in zip(rest, parallel_map(_robust_peak_case, cases, processes)):
+        for m, ev in zip(rest, parallel_map(robust_peak_case, cases, processes)):
             ev.attempts += evaluations[m].attempts
             record(m, ev)
     grid_p = np.array([evaluations[float(m)].peak_amplitude for m in grid_m])

@@ -222,7 +222,8 @@ class Scene:
         return view
 
 
-_LIVE = set()
+#: the LiveView objects whose server process is running (each closed at interpreter exit)
+LIVE_VIEWS: set = set()
 
 
 class LiveView:
@@ -239,7 +240,7 @@ class LiveView:
         env["PYTHONPATH"] = root + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
         self.server_proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=env,
                                             start_new_session=True)
-        _LIVE.add(self)
+        LIVE_VIEWS.add(self)
         self.vis = None
         try:
             zmq_url = web_url = None
@@ -278,7 +279,7 @@ class LiveView:
         self.server_proc.wait()
         if self.server_proc.stdout is not None:
             self.server_proc.stdout.close()
-        _LIVE.discard(self)
+        LIVE_VIEWS.discard(self)
 
     def __enter__(self):
         return self
@@ -289,7 +290,7 @@ class LiveView:
 
 @atexit.register
 def _close_all():
-    for view in list(_LIVE):
+    for view in list(LIVE_VIEWS):
         view.close()
 
 
