@@ -15,11 +15,9 @@ where it ended). Run from the repository root; one design at a time.
 from __future__ import annotations
 
 import argparse
-import cProfile
 import os
 import sys
 import time
-import warnings
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
@@ -28,8 +26,8 @@ sys.path[:0] = [ROOT, os.path.join(ROOT, "benchmarks"), os.path.join(ROOT, "test
 
 import numpy as np  # noqa: E402
 
-from bench_random_cost import BRANCHES, describe, instrument  # noqa: E402
-from test_random_designs import MAX_POINTS, make_mistuned, mistuned_design  # noqa: E402
+from bench_random_cost import BRANCHES, describe, instrument, profiled_response  # noqa: E402
+from test_random_designs import make_mistuned, mistuned_design  # noqa: E402
 
 
 def seeds(text):
@@ -44,19 +42,7 @@ def solve(seed, budget, blades, profile=None):
     t = time.process_time()
     disk = make_mistuned(d)
     build = time.process_time() - t
-    BRANCHES.clear()
-    prof = cProfile.Profile() if profile else None
-    t = time.process_time()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        if prof:
-            prof.enable()
-        r = disk.frequency_response(d["f_start"], d["f_end"], max_step=d["max_step"], max_points=MAX_POINTS,
-                                    cpu_budget_s=budget)
-        if prof:
-            prof.disable()
-            prof.dump_stats(profile)
-    cpu = time.process_time() - t
+    r, cpu = profiled_response(disk, d, budget, profile)
     peak = r.tip_amplitude[:, :, 0].max() if len(r.omega) else np.nan
     print(f"seed {seed}: {describe(d)}, {d['n_blades']} blades, mistuning std {100 * d['sigma']:.2f} %")
     print(f"  {cpu:.1f} CPU s (model built in {build:.2f} s), status {r.status.name}, harmonics {r.basis.harmonics}, "

@@ -72,9 +72,10 @@ def describe(d):
             f"{d['f_start']:.1f}-{d['f_end']:.1f} Hz")
 
 
-def solve(seed, budget, profile=None):
-    d = disk_design(seed)
-    disk = make_disk(d)
+def profiled_response(disk, d, budget, profile=None):
+    """(response, CPU s) of the suite's default FRF of random design ``d`` on ``disk`` within
+    ``budget`` CPU s; with ``profile`` (a path) its cProfile statistics are written there.
+    BRANCHES is cleared first, so it holds this run's branches after."""
     BRANCHES.clear()
     prof = cProfile.Profile() if profile else None
     t = time.process_time()
@@ -87,7 +88,13 @@ def solve(seed, budget, profile=None):
         if prof:
             prof.disable()
             prof.dump_stats(profile)
-    cpu = time.process_time() - t
+    return r, time.process_time() - t
+
+
+def solve(seed, budget, profile=None):
+    d = disk_design(seed)
+    disk = make_disk(d)
+    r, cpu = profiled_response(disk, d, budget, profile)
     f, a = r.peak() if len(r.omega) else (np.nan, np.nan)
     print(f"seed {seed}: {describe(d)}")
     print(f"  {cpu:.1f} CPU s, status {r.status.name}, harmonics {r.basis.harmonics}, samples {r.basis.n_samples}, "
