@@ -99,16 +99,22 @@ MISTUNED_BLADES = 4
 MISTUNED_CPU_BUDGET_S = 30.0
 # Complete-and-verified answers that the time integration at their peak contradicts (measured
 # 2026-12-07, 4 of the 13 complete-verified; the slow test fails on any other and prints those of
-# these it did not see): issue 32 item 1's work
+# these it did not see): issue 32 item 1's work. Diagnosed on branch contradict (benchmarks/README.md,
+# "Why the time integration contradicts four complete-and-verified answers"): none is a harmonic
+# truncation error.
 KNOWN_MISTUNED_CONTRADICTIONS = {
     11: "(0, 1, 2, 3) verified by (0..5); at the peak, 98.78 Hz, the time integration from the HBM state does not "
-        "settle (the first harmonics change by 4e-4 per period after 4000 periods)",
+        "settle (the first harmonics change by 4e-4 per period after 4000 periods): the peak lies on an unstable "
+        "part of the branch (monodromy: a complex pair |mu| 1.15 at 98.70-98.90 Hz)",
     14: "(0, 1, 2, 3) verified by (0..5); at the peak, 94.80 Hz, the time integration from the HBM state does not "
-        "settle (a residual drift of 0.0023 of the amplitude, the damper separated 21 % of the period)",
-    17: "(0, 1, 2, 3) verified by (0..5); the time integration at the peak, 95.40 Hz, settles 1 % from the "
-        "branch, just above the 1 % tolerance",
+        "settle (a residual drift of 0.0023 of the amplitude, the damper separated 21 % of the period), growing to "
+        "+49 % while (0..7) agrees within 0.7 %: a coexisting hopping motion or an instability, not resolved",
+    17: "(0, 1, 2, 3) verified by (0..5) at 0.96 %; the time integration at the peak, 95.40 Hz, settles 1.03 % from "
+        "the branch, within its own step-count spread (0.91-1.03 % at 577-2308 steps a period): at the tolerance, "
+        "not resolved by the check",
     27: "(0, 1, 2, 3) verified by (0..5) within 1 %; the time integration at the peak, 101.96 Hz, settles 15 % "
-        "from the branch (the damper stuck all the period)",
+        "from the branch (the damper stuck all the period): the stuck linear response (shakedown); the slipping "
+        "branch holds a mean roll moment on the cylinders only by the HBM's static retention spring",
 }
 ROTOR_SPEED_95_HZ = 95.0   # EO = 0: the rotor speed of the EO = 1 resonance [Hz]
 
