@@ -10,9 +10,8 @@ So every answer is checked against an enriched harmonic set:
   points spread along it) the solution is lifted into the enriched set ``H+`` (the static term
   and the next two harmonics added) and solved again at the same frequency by Newton (and, where
   the plain Newton does not converge, by the damped Newton with a line search of the robust
-  start: measured on the reference 1 g cylinder with (0, ..., 7), whose peak point the plain
-  Newton could not solve with (0, ..., 9), so its estimate was "not verified"; damped it
-  converges there to 0.53 %; where neither converges, once more with
+  start, which converges at peak points the plain Newton cannot solve (benchmarks/README.md,
+  'Moved from the package's docstrings', accuracy.py); where neither converges, once more with
   :data:`ENRICHED_SAMPLES_GROWTH` x the AFT samples). The
   largest change of the first-harmonic output amplitudes (the blade tips, the oscillator's x),
   relative to the branch's peak amplitude, is the error estimate of ``H``. It is an
@@ -210,8 +209,9 @@ def converged_response(model, solve, harmonics="auto", tolerance: float = HARMON
     for a study that estimates it on a representative case instead (the Monte Carlo's first disk).
     ``guard_stalls``: a richer set's branches, once a poorer set's reached the end, are computed
     within :func:`~bladedamp.hbm.continuation.stall_guard` (a stalled branch ends early). Not for
-    the oscillator: measured on random oscillator 95 (damping ratio 1.7e-3), whose (0, ..., 7)
-    branch reaches the end only past a stretch the guard ends (benchmarks/README.md)."""
+    the oscillator: a lightly damped oscillator's richer branch may reach the end only past a
+    stretch the guard ends (benchmarks/README.md, 'Moved from the package's docstrings',
+    accuracy.py)."""
     if isinstance(harmonics, str):
         if harmonics != "auto":
             raise ValueError(f"harmonics must be 'auto' or a tuple of integers >= 0 (got {harmonics!r})")
@@ -249,8 +249,8 @@ def converged_response(model, solve, harmonics="auto", tolerance: float = HARMON
                 if best is not None and best[0].success and not response.reached_range_end:
                     # a richer set whose every branch (both ends, retry, finer samples) failed short
                     # of the end where a poorer set's reached it: the richer sets after it are not
-                    # tried (on the random EO >= 6 wedges they failed the same way, at the same
-                    # stall, for most of the analysis' time: benchmarks/README.md); the poorer
+                    # tried (they fail the same way, at the same stall, for most of the analysis'
+                    # time: benchmarks/README.md, 'Cost of the default FRF on random disks'); the poorer
                     # set's complete branch is the answer, its estimate saying how far it is
                     kept = annotate(best[0], best[1], tolerance)
                     where = (f"its branch got no further than {response.frequency_hz[response.furthest_index()]:.6g} Hz"
