@@ -1,6 +1,6 @@
 """Solid (3D finite-element) blade from geometry: the parametric blade or a user's closed surface
 mesh (STL), gmsh tetrahedra, quadratic linear elasticity (scikit-fem), clamped-root modes, and a
-:class:`~bladedamp.blade.ModalBlade` with the beam blade's named points (issue 16).
+:class:`~bladedamp.blade.ModalBlade` with the beam blade's named points.
 
 Needs the ``fe`` extra (``pip install 'bladedamp[fe]'``: gmsh and scikit-fem); without it every
 entry point raises an ImportError saying so.
