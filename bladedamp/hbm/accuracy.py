@@ -156,9 +156,8 @@ def harmonic_error(model, response, harmonics=None, n_points: int = 5, tol: floa
         for k, i in enumerate(idx):
             a = _enriched_amplitudes(model, response.coefficients[i], basis, system, float(w[i]), scales, tol)
             if a is None:
-                # Newton fails on the AFT's sampling of a contact event, not on the harmonics
-                # (random oscillator 154's (0..9) peak, 1024 samples: the lift-off instant between
-                # samples; it converges with 4096, 0.18 % off, as the time integration): once more
+                # Newton may fail on the AFT's sampling of a contact event (a lift-off instant
+                # between samples), not on the harmonics: once more
                 # with ENRICHED_SAMPLES_GROWTH x the samples (the change then includes the branch's
                 # own sampling error too)
                 if finer is None:
