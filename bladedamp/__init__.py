@@ -5,7 +5,7 @@ continuation solver -> result objects -> plots, reports and 3D views.
 
 Layers. A module imports only from the layers below its own (``a | b``: independent
 siblings), never from one above; import-linter checks it against the contracts in
-pyproject.toml (``[tool.importlinter]``, run by tests/test_layers.py, which also finds no
+pyproject.toml (``[tool.importlinter]``, run by the test suite, which also finds no
 import cycle). From the top:
 
     front ends       cli > app > viz | compare > report | design (files) | compilation

@@ -95,19 +95,18 @@ MODAL_CSV_COLUMNS = ("mode", "mode_name", "frequency_hz", "damping_ratio", "poin
 # ModalBlade.from_matrices: a mode v is a rigid-body mode if K v vanishes to rounding,
 # max|K v| <= RIGID_MODE_TOLERANCE * max(|K| |v|) (|.| entry-wise). Scale-free, unlike a
 # threshold on omega^2 (the beam model's max K_ii / M_ii is 2e14 1/s^2, 5e8 times its 1F
-# omega^2, and grows as h^-4 with refinement). Measured on the beam model: the unclamped beam's
-# six rigid modes 3e-15 to 5e-13 (20 and 200 elements); the clamped blade's 1F 1.6e-6 (20
-# elements, the reference mesh), 5.7e-10 (200 elements) and 2e-11 at 600 elements, where the
-# beam is so ill-conditioned that its 1F is 9 % off anyway.
+# omega^2, and grows as h^-4 with refinement). It lies between the beam model's rigid modes
+# (rounding) and its clamped 1F at any useful refinement (benchmarks/README.md, 'Moved from the
+# package's docstrings', blade.py).
 RIGID_MODE_TOLERANCE = 1e-11
 # ModalBlade.from_matrices(solver="sparse"): shift-invert about omega^2 = -(2 pi 1 Hz)^2, just
 # below every blade frequency, so the nearest eigenvalues are the lowest and K - sigma M is
 # regular even when K has rigid-body modes (which are then found and refused).
 SHIFT_INVERT_SIGMA = -(2.0 * np.pi * 1.0) ** 2
 # ModalBlade.from_matrices(solver="auto"): dense eigh (all modes) up to this many free DOF,
-# shift-invert above. Dense eigh of 1000 DOF took 12 s on this 2-core machine under load
-# (load average 9), 1800 DOF 25 s; shift-invert of the 1800 DOF 5 s (dense input) or 0.1 s
-# (sparse input). Craig-Bampton blades have tens to hundreds of DOF: dense, the most robust.
+# shift-invert above (dense eigh grows as n^3; timings: benchmarks/README.md, 'Moved from the
+# package's docstrings', blade.py). Craig-Bampton blades have tens to hundreds of DOF: dense,
+# the most robust.
 DENSE_SOLVER_MAX_DOF = 500
 
 # DOF indices inside a 6-vector.
@@ -174,9 +173,8 @@ def torsion_constant_polygon(polygon, n_cells: int = 40) -> float:
 
     Finite differences (5-point Laplacian) on square cells, ``n_cells`` and 2 ``n_cells``
     across the smaller side of the bounding box, a cell inside if its centre is; the staircase
-    boundary makes the error O(h), removed by Richardson extrapolation 2 J(h/2) - J(h). Measured:
-    a 30 x 5 mm rectangle 0.06 % from the series (:func:`torsion_constant_rectangle`) with the
-    default; the reference platform prism's section changes by 0.07 % from n_cells 40 to 80.
+    boundary makes the error O(h), removed by Richardson extrapolation 2 J(h/2) - J(h); about
+    0.1 % at the default (checked against :func:`torsion_constant_rectangle`).
     """
     poly = np.asarray(polygon, dtype=float)
     if poly.ndim != 2 or poly.shape[1] != 2 or poly.shape[0] < 3:
@@ -1152,9 +1150,8 @@ class PlatformBlock:
     Left out: the y-twist's inertia (its own frequency sqrt(k_w / (rho chord_y^3 / 12 I_p,xz)),
     12.6 kHz for the reference prism, 15 times 1T) and the local deformation where the thin
     blade enters the block (the coupling is not a rigid spine, and the block's y-twist also
-    shears the blade's section at the faces). Measured on the reference solid (4.5 mm): 1T
-    850.8 Hz; the beam 869.3 Hz with k_w, 903.2 held (the solid with a rigid platform: 906.9),
-    809.8 free (tests/test_solid_blade.py).
+    shears the blade's section at the faces). With k_w the beam's 1T is within a few per cent
+    of the solid blade's (benchmarks/README.md, 'Moved from the package's docstrings', blade.py).
 
     Attributes
     ----------

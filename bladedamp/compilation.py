@@ -3,8 +3,7 @@
 The kernels (the contact return map and its Jacobian, the ring solver of the full assembly, the
 time integrators, the monodromy period map) are compiled by numba on their first call and kept
 in the per-user cache (:mod:`bladedamp._numba_cache`). On a cold cache that compilation is most
-of the first call: measured in ``benchmarks/bench_startup.py`` (the reference FRF's first call
-in a fresh process with an empty cache against one with the cache filled). :func:`precompile`
+of the first call (benchmarks/README.md, 'Start-up and the numba compile cost'). :func:`precompile`
 moves it out of that first call: run it once after installing (``bladedamp precompile``, e.g.
 in a Docker image or a lab machine's set-up), and every later process loads the compiled code.
 
@@ -13,8 +12,8 @@ argument types of real use (numba compiles one version per type signature): a fl
 inclined friction oscillator (with and without the Jacobian, the closed-form and the iterated
 slider derivative), the reference disk's residual, a 4-blade full assembly (the ring solver),
 the time integration of both, and the monodromy of both. A kernel already in the cache is
-only loaded. ``tests/test_compilation.py`` checks that after it, in a new process, the
-reference disk's FRF, a mistuned FRF and the time integrations compile nothing.
+only loaded. After it, in a new process, the reference disk's FRF, a mistuned FRF and the
+time integrations compile nothing.
 """
 from __future__ import annotations
 
@@ -24,9 +23,9 @@ import sys
 import time
 import warnings
 
-# [s] compiling every kernel on an empty cache: bladedamp.precompile() took 27.5-31 s on the
-# 2-core machine (benchmarks/README.md, "Start-up and the numba compile cost"); a command
-# compiles the kernels it uses, at most that
+# [s] compiling every kernel on an empty cache, an upper bound of bladedamp.precompile()'s time
+# (benchmarks/README.md, "Start-up and the numba compile cost"); a command compiles the kernels
+# it uses, at most that
 COLD_COMPILE_SECONDS = 30
 
 

@@ -53,31 +53,27 @@ from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, harmonic_senten
 
 DAMPER_DOFS = ("uD_x", "uD_y", "uD_z", "phiD_x", "phiD_y", "phiD_z")
 # the automatic AFT sampling of a disk's branch (TunedDisk and MistunedDisk) may grow the samples
-# this much (one step of bladedamp.response.sampled_response: a disk's branch costs about 3x more with 4x the
-# samples; measured on random disks 7 (retraced with 64 samples, reached the end with 256) and
-# 56 (negative contact dissipation -2.2e-5 of the excitation work, confirmed with 1024))
+# this much (one step of bladedamp.response.sampled_response): the smallest growth that cures the
+# sampling failures of the random designs (benchmarks/README.md, 'Moved from the package's
+# docstrings', disk.py, 'AFT sample growth')
 AUTO_SAMPLES_GROWTH = 4
-# ... and this much when the branch reached the end and failed only the dissipation check (the
-# AFT's sampling error: random disk 56 failed it with 256 samples and passes with 1024)
+# ... and this much when the branch reached the end and failed only the dissipation check (an AFT
+# sampling error, which needs more samples than a retrace does)
 AUTO_SAMPLES_GROWTH_DISSIPATION = 16
 # A disk's branch that fails (from either end of the range) is tried once more with the damper's
 # unknowns weighing less in the arc length (their scale there DAMPER_ARC_SCALE x unknown_scales:
-# the continuation's retry_x_scale), so that the branch is measured by the blades' motion and the
+# the continuation's retry_x_scale), so that the arc length follows the blades' motion and the
 # frequency. The damper is slaved to the platforms, and in gross slip a light damper's rotation
-# is held by its inertia alone: measured on random disks 16 and 102 (0.04 g cylinders, EO 8), one
-# damper rotation coefficient took 95-97 % of the arc length over the last 200 points near the
-# undamped 1F, and the branches from both ends crawled to the 2000-point cap 1 rad/s apart (a
-# fixed-frequency Newton crosses that gap in 6 steps of 4-7 iterations); weighted, 102 reaches the
-# end in 228 points. Over the 160 random disks of tests/test_random_designs.py, 143 pass with the
-# retry (16, 102 and 124 by it). The weighting from the first try passed the same 143 with 100,
-# and with 10 lost 130 while curing 150; it is only a retry because the points then follow the
-# blades, fewer of them fall near a fold, and a peak taken from the points moves (the README's
-# tip-stop peak, at a hardening fold: 0.4811 mm with 100 from the first try against 0.4839 mm).
+# is held by its inertia alone, so its rotation coefficients can take almost all of the arc
+# length and the branch crawls. It is a retry, not the first try, because the weighted points
+# follow the blades, fewer of them fall near a fold, and a peak taken from the points moves
+# (benchmarks/README.md, 'Moved from the package's docstrings', disk.py, 'DAMPER_ARC_SCALE').
 # The oscillator has no such unknown.
 DAMPER_ARC_SCALE = 100.0
 
-STOP_CHECK_OFFSET_HZ = 0.05   # [Hz] stop_check's frequency beyond the furthest point (0.3 rad/s, as
-# measured on the failing random disks, see with_stop_note)
+STOP_CHECK_OFFSET_HZ = 0.05   # [Hz] stop_check's frequency beyond the furthest point (0.3 rad/s; the
+# offset at which the time integration tells the stopped random designs (benchmarks/README.md,
+# 'Moved from the package's docstrings', disk.py, 'with_stop_note'))
 
 
 def damper_weighted_scales(scales: np.ndarray, n_coeffs: int, damper_unknowns: slice) -> np.ndarray:
@@ -174,10 +170,8 @@ def fused_point_map_forces(B, local, basis, k_t, mu, law, weights, offsets, jaco
     law, return map, AFT, the projections B^T f and B^T (df/dc) B, without the point samples).
     Returns (force (C, n_d, 12), Jacobian blocks (n_d, C, 12, C, 12) with patch q of damper d in
     [d, :, 6q:6q+6, :, 6q:6q+6], or None), or None where the kernel does not apply (flexible
-    platforms' maps, a normal law it does not know). Measured at the reference disks' peaks, one
-    damper with its Jacobian (best of 5 x 200 calls): 0.059 against 0.280 ms (cylinder, one
-    harmonic), 0.25 / 0.88 ms (wedge), 0.15 / 0.40 ms (cylinder, (0, 1, 2, 3)); the same forces
-    to 2e-16. The tuned reference FRF at max_step 0.02: 0.67 s against 1.21 s."""
+    platforms' maps, a normal law it does not know). The same forces as :func:`point_map_forces`
+    to rounding (timings: benchmarks/README.md, 'Moved from the package's docstrings', disk.py)."""
     params = normal_law_parameters(law)
     if B.shape[-1] != 6 or params is None:
         return None
@@ -503,8 +497,7 @@ class TunedDisk:
         platform carries half of it (OL offset -dz/2, OR offset +dz/2, radially). This keeps
         the model mirror-symmetric: exchanging gamma_L and gamma_R gives the mirror image of
         the assembly (the paper: "the same results are obtained if the left and right platform
-        angle are exchanged"); carrying all of dz on one side breaks that (measured: 1.8 %
-        on the 1 g cylinder's EO = 1 peak for 35 / 55 deg).
+        angle are exchanged"); carrying all of dz on one side breaks that.
         """
         p_ol, p_or = self.blade.points["OL"], self.blade.points["OR"]
         cg = p_ol - geometry.centres[0]                      # damper CG in blade i's frame (OL centre on OL)
@@ -534,10 +527,9 @@ class TunedDisk:
         be too weak: the mean tangential force left by slip onset (frictional shakedown) is
         independent of the mean position, so only this spring balances it; at 1e-6 the
         reference cylinder's (0, 1, 2, 3) continuation stalls at slip onset (~95.0 Hz, Newton
-        2-cycles in the static axial position). Measured on the reference FRFs (92-104 Hz,
-        harmonics (0, 1, 2, 3)): wedge 0.28 g peak 0.32178 / 0.32182 / 0.32201 / 0.32477 mm at
-        1e-6 / 1e-4 / 1e-3 / 1e-2, cylinder 1 g 0.48973 / 0.48997 / 0.49064 mm at 1e-4 / 1e-3 /
-        1e-2 (1e-6 does not converge): 1e-4 is within ~0.01 % of the weak-spring limit.
+        2-cycles in the static axial position). 1e-4 keeps the reference peaks within ~0.01 % of
+        the weak-spring limit (benchmarks/README.md, 'Moved from the package's docstrings',
+        disk.py, 'static_retention').
         """
         basis = HarmonicBasis(tuple(harmonics), n_samples)
         C, nm = basis.n_coeffs, self.blade.n_modes
@@ -700,11 +692,9 @@ class TunedDisk:
         amplitudes are converged to ``harmonic_tolerance`` (relative to the peak; see
         :mod:`bladedamp.hbm.accuracy`); a tuple such as ``(1,)`` (the paper's setting) or
         ``(0, 1, 2, 3)`` is used as given, and its error estimate is reported. ``max_harmonic``
-        caps the automatic choice (default 7: measured on the reference FRFs, 90-105 Hz, the
-        1 g cylinder meets 1 % with (0, ..., 5) (0.5 %), the 0.3 g wedge with (0, ..., 7)
-        (0.99 %); (0, 1, 2, 3) is 2-5 % off for both. The cost grows with the harmonics: about
-        5 / 9 / 19 / 27 s for the wedge's (0, 1) / (0..3) / (0..5) / (0..7) on the 2-core box; a
-        result above the tolerance says so).
+        caps the automatic choice (default 7: the smallest cap at which both reference disks meet
+        1 %; the cost grows with the harmonics (benchmarks/README.md, 'Moved from the package's
+        docstrings', disk.py, 'max_harmonic'); a result above the tolerance says so).
         ``max_step`` is the largest arc-length step in scaled units (the frequency range is 1;
         smaller: more points). The result is ``success`` only if the branch reached the end and
         passed :func:`bladedamp.response.physical_checks` and
@@ -870,8 +860,7 @@ class TunedDisk:
         the response curve by the peak condition (:class:`bladedamp.hbm.peaks.PeakSolver`); None
         where it is not solved (at an end of the branch, a fold next to the sample, a Newton solve
         that does not converge). ``extra_couplings``: those the response was computed with (see
-        :meth:`frequency_response`). The branch only has to bracket the peak: measured on the
-        reference disks at max_step 0.1, within 8.3e-6 of a dense branch's largest point
+        :meth:`frequency_response`). The branch only has to bracket the peak
         (:data:`bladedamp.studies.mass.PEAK_SEARCH_MAX_STEP`)."""
         validation.integer("direction", direction, minimum=0, maximum=2)
         basis = response.basis
@@ -1171,21 +1160,18 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
       direct one (the time integration settles to about 5e-4 of the amplitude at its defaults).
       ``harmonic_error`` becomes the larger of it and the enriched set's, or it alone where the
       enriched set's Newton failed at the peak ("not verified"), held to ``tolerance``
-      (``harmonics_converged``). Measured on random disks of tests/test_random_designs.py whose
-      (0, 1) peak the enriched (0, 1, 2, 3) cannot solve (light wedges, the damper separated
-      96-99 % of the period: brief impacts): disk 63 0.83 % (met), disk 67 4.1 % (not met).
+      (``harmonics_converged``). This is the estimate where the enriched set cannot solve the
+      peak (as for light wedges whose damper is separated most of the period: brief impacts).
     * "Drifting" there (the first harmonics settle while a damper keeps rolling or walking, as the
-      reference 1 g cylinder in its slip range, 95.1-96.1 Hz: tests/test_timedomain_disk.py, where
-      the HBM is within 2 % of the mean tip amplitudes): compared as above, with the time
+      reference 1 g cylinder in its slip range, 95.1-96.1 Hz): compared as above, with the time
       integration's mean tip amplitudes, and the message says the damper drifts.
     * Periodic or drifting, but farther from the branch than its one-period defect allows for a
       motion that stays on it (:func:`orbit_departure`): the motion left the branch for a
       coexisting one. A note, not a harmonic error estimate (``harmonic_error`` and
       ``harmonics_converged`` stay the enriched set's); ``peak_check(result, start='static')``
       gives the motion reached from rest.
-    * Not settled or unstable there (the vibration does not settle: random disks 51 and 87,
-      cylinders of 7.1 and 3.4 g at EO 7 and 8, whose (0, 1) branches reach the end unverified,
-      the damper separated 87 and 19 % of the period): the branch's peak is not a motion the disk
+    * Not settled or unstable there (the vibration does not settle): the branch's peak is not a
+      motion the disk
       settles on, so the response is not ``success`` (its ``failed_checks`` has
       ``peak_time_check``), whatever the harmonic set.
 
@@ -1277,9 +1263,7 @@ def stop_verdict(check, harmonics) -> str:
     the motion there is not periodic (no harmonic-balance branch represents it), or it is
     periodic, and the branch did not reach it (cut by max_points, or lost by the harmonic set: a
     richer set may follow it). It is the motion reached from the static equilibrium, what a test
-    rig run up to that speed would see; a periodic solution may coexist with it (random disk
-    154: the time integration from rest is periodic at 94.85 Hz and not at 94.19 Hz, where the
-    (0, 1, 2, 3) branch went through)."""
+    rig run up to that speed would see; a periodic solution may coexist with it."""
     f = check.frequency_hz[0]
     tip = 1e3 * check.tip_amplitude[0, :, 0].max()
     separated = 100 * check.point_state[0][..., 2].mean()
@@ -1301,17 +1285,12 @@ def with_stop_note(response, f_start_hz: float | None = None, check=None):
     """A failed ``response`` (a :class:`DiskResponse` or a
     :class:`~bladedamp.mistuned.MistunedResponse`) with what the damper did where its branch got furthest (the share
     of the period its contact points stick, slip and are separated there) and how to tell
-    whether a periodic motion exists just beyond (:meth:`TunedDisk.stop_check`). Measured on
-    the 17 random disks of tests/test_random_designs.py whose branch does not reach the end
-    (dampers of 0.02-7 g at EO 3-8, stopping at the 1F resonance): 0.3 rad/s beyond (disk 2:
-    0.27; disk 105, which keeps no point, at its start), the full assembly's time integration
-    over 4000 periods is not periodic for 13 of them (the damper hops, separated
-    21-99.8 % of the period, or a cylinder keeps rolling), so no harmonic-balance branch can go
-    on; for 4 it is periodic with the damper separated 80-100 % of the period (brief impacts,
-    which (0, 1, 2, 3) cannot follow). A response that kept no point (the start failed) gets how to
-    tell at the start ``f_start_hz`` [Hz] (random disk 105, a 0.025 g wedge: periodic there by time
-    integration, separated 80 % of the period; the robust start finds no solution with (0, 1, 2, 3)
-    nor (0, ..., 5), one with (0, ..., 7)). ``check``: the time integration there
+    whether a periodic motion exists just beyond (:meth:`TunedDisk.stop_check`, at
+    STOP_CHECK_OFFSET_HZ beyond the furthest point): where a branch stops, the damper hops,
+    keeps rolling or makes brief impacts that the harmonic set cannot follow (benchmarks/README.md,
+    'Moved from the package's docstrings', disk.py, 'with_stop_note'). A response that kept no
+    point (the start failed) gets how to tell at the start ``f_start_hz`` [Hz]. ``check``: the
+    time integration there
     (:meth:`TunedDisk.stop_check`), whose verdict (:func:`stop_verdict`) replaces how to tell, and
     which the result keeps as its ``stop_check``. A successful one is returned unchanged, and so
     is one that reached the end of its range (it failed a check, not stopped: the note would

@@ -481,16 +481,14 @@ class AssemblySystem(HarmonicBalanceSystem):
         return other
 
     #: systems with at most this many unknowns return a dense Jacobian (an n x n copy per
-    #: evaluation is cheaper than sparse assembly and LU below this size; measured at n = 320:
-    #: dense with damper condensation 0.3 ms against 1.1 ms for splu)
+    #: evaluation is cheaper than sparse assembly and LU below this size; benchmarks/README.md,
+    #: 'Moved from the package's docstrings', mistuned.py, 'dense_limit')
     dense_limit = 1500
     #: with the ring solver (:meth:`uses_ring`), systems with more unknowns than this return a
     #: sparse Jacobian: the ring gathers its blocks from the CSC arrays, so the dense n x n
-    #: Jacobian and its bordered copy (0.8 MB each at n = 320) are only memory traffic. Measured
-    #: on the Monte Carlo's 16-blade disks (n = 320, the same 8 disks alternately in one process,
-    #: identical peaks; the continuation's CSC bordering in one pass): 0.298 against 0.377 s CPU
-    #: per disk, on a machine loaded by other processes (load average 4-5), where that traffic
-    #: costs most. Small assemblies (the tests' 2-6 blades, n <= 120) stay dense
+    #: Jacobian and its bordered copy (0.8 MB each at n = 320) are only memory traffic
+    #: (benchmarks/README.md, 'Moved from the package's docstrings', mistuned.py,
+    #: 'ring_dense_limit'). Small assemblies (2-6 blades, n <= 120) stay dense
     ring_dense_limit = 200
 
     def _damper_condensation(self, idx):
@@ -521,11 +519,10 @@ class AssemblySystem(HarmonicBalanceSystem):
     #: O(n) in the blades), "condensation" (damper coordinates condensed, dense LU of the
     #: blades' Schur complement, for dense Jacobians; sparse LU for sparse ones), "lu"
     linear_solver = "auto"
-    #: blades from which "auto" takes the ring: every ring. Measured (benchmarks/README.md,
-    #: bench_mistuned_scaling.py): no crossover to resolve, factorise + solve of the bordered
-    #: Jacobian 0.7-2.2x the condensation's speed at 2-16 blades (within the noise of the
-    #: loaded machine), the linear solver's time per FRF point 0.9-1.6x less at 16 blades, 3x at
-    #: 64, 17-22x at 128; and the ring gives det A's sign (``solve.sign``), the condensation not
+    #: blades from which "auto" takes the ring: every ring. The ring is no slower than the
+    #: condensation at any count and faster the more blades (benchmarks/README.md, 'Mistuned full
+    #: assembly: cost per FRF point against the number of blades'), and it gives det A's sign
+    #: (``solve.sign``), the condensation not
     ring_min_blades = 2
     ring_solver = None
     _ring_blades = 0
@@ -596,9 +593,8 @@ class AssemblySystem(HarmonicBalanceSystem):
         and the sparse Jacobian is a copy of one template matrix (:attr:`jacobian_template`)
         holding the new values: every Jacobian of the system shares the template's index arrays
         (do not change them in place; :func:`~bladedamp.hbm.continuation.bordered_matrix` relies on
-        them to reuse its bordered pattern). Measured on a Monte Carlo 16-blade disk (n = 320, the contact
-        kernel's result held fixed, medians of 15 alternating runs): 63 against 112 us with the
-        Jacobian, 14 against 26 us without."""
+        them to reuse its bordered pattern; timings: benchmarks/README.md, 'Moved from the
+        package's docstrings', mistuned.py)."""
         if self.couplings and self.contact_blocks is None:
             return super().residual(x, omega, jacobian)
         basis = self.basis
@@ -802,9 +798,8 @@ class MistunedDisk:
         excitation, the Jacobian's sparsity and the ring solver's set-up do not depend on the
         blades' frequencies, so they are built once here (and kept) and shared by every copy.
         The residuals are bit-identical to those of :meth:`from_tuned` with the same factors
-        (tested). Measured on the 16-blade reference disk: the copy with its system 5 ms against
-        32 ms for ``from_tuned`` and its system built anew (a Monte Carlo disk,
-        :func:`bladedamp.studies.mistuning.monte_carlo`, takes ~0.3 s)."""
+        (tested), and the copy costs a fraction of ``from_tuned`` with its system built anew
+        (benchmarks/README.md, 'Moved from the package's docstrings', mistuned.py)."""
         kappa = np.asarray(validation.positive("kappa (mistuning factors)", kappa), dtype=float)
         if kappa.shape != (self.n_sector,):
             raise ValueError(f"kappa (mistuning factors) must have {self.n_sector} entries, one per blade "
@@ -1081,8 +1076,7 @@ class MistunedDisk:
         branch fails (:func:`bladedamp.response.sampled_response`, as the tuned disk).
         ``estimate_harmonic_error=False`` (given harmonics only) skips the error estimate, which
         costs about as much as a one-harmonic FRF of the assembly (5 enriched Newton solves of
-        the full assembly with the static term; measured on the Monte Carlo's reference disks:
-        0.72 of 1.56 s per disk); the result then says "not estimated".
+        the full assembly with the static term); the result then says "not estimated".
         ``check_stop``: where the branch ends before the end of the range, integrate the assembly
         in time just beyond where it got furthest (:meth:`stop_check`, at ``f_start_hz`` when no
         point was kept) and put the verdict in the result, as :meth:`TunedDisk.frequency_response`
@@ -1381,8 +1375,8 @@ class MistunedResponse(FrequencyResponse):
             return peak, freq
         a = self.tip_amplitude[:, :, direction]
         # the margin is taken from the largest sample, not the largest parabola: on a coarse
-        # branch a parabola through unevenly spaced samples can overshoot the curve (by 2.3 % on
-        # a random disk of tests/test_mistuned.py), and would push the true largest peak out
+        # branch a parabola through unevenly spaced samples can overshoot the curve (by a few
+        # per cent), and would push the true largest peak out
         threshold = (1 - validation.in_range("solve_within", solve_within, 0.0, 1.0)) * a.max()
         local = (a[1:-1] >= a[:-2]) & (a[1:-1] >= a[2:])
         interior = local & (a[1:-1] >= threshold)

@@ -30,12 +30,13 @@ from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, physical_checks
 from .timedomain import TimeResponse, oscillator_steady_state
 
 # most AFT samples per period the automatic sampling may choose (sampled_response; one DOF:
-# a branch with 4096 samples takes 5-45 s, measured on the random oscillators that need it)
+# a branch with 4096 samples takes tens of seconds: benchmarks/README.md, 'Moved from the
+# package's docstrings', oscillator.py)
 MAX_AUTO_SAMPLES = 4096
 # the automatic sampling's first choice for an inclined contact (its normal load varies and
-# lifts off: the kink of the normal force is under-resolved by 64 samples; measured on random
-# oscillator 4 at 1.3 rad/s: contact dissipation -14 %, +1.6 %, +0.1 % of the excitation work
-# at 64, 256, 1024 samples, and random oscillators 43, 137, 156 stall with 64 and pass with 256)
+# lifts off: the kink of the normal force is under-resolved by 64 samples; 256 is the smallest
+# count tried at which the inclined random oscillators pass: benchmarks/README.md, 'Moved from
+# the package's docstrings', oscillator.py)
 INCLINED_FIRST_SAMPLES = 256
 
 
@@ -185,8 +186,8 @@ class FrictionOscillator:
         work and the contact's work bound (its AFT energy error); where it is not, the samples
         grow as above. At ``MAX_AUTO_SAMPLES`` the growth ends and the dissipation is judged as
         the disks' is, re-evaluated with ``REFINE_SAMPLES_FACTOR`` x the samples (a contact whose
-        lift-off makes the AFT converge slowly, e.g. random oscillators 95 and 117 of the test
-        suite, would otherwise be refused its accurate harmonic set).
+        lift-off makes the AFT converge slowly would otherwise be refused its accurate harmonic
+        set).
         A range where no bounded response exists (:meth:`check_bounded`) is refused with a
         ValueError before any solve.
         ``cpu_budget_s`` [s] and ``point_budget``: the CPU time (``time.process_time``) and the

@@ -9,7 +9,7 @@ Given by the paper (Panning, Sextro, Popp; Table 1 and text):
 Calibrated, on these two results of the paper only:
   (1) the undamped 1F tip resonance amplitude 1.7 mm under F_x = 0.1 N -> blade chord
       (in :func:`reference_blade_geometry`, :mod:`bladedamp.blade`; its thickness sets the FE 1F to Table 1's
-      95 Hz): measured 1.6996 mm;
+      95 Hz): the calibrated model gives 1.6996 mm;
   (2) the cylinder's optimal mass ~1 g with ~71 % reduction at EO = 1 -> the tangential contact
       stiffness per length (sets the achievable reduction: a stiffer contact dissipates more
       before it slips) and the damper radius R (the preload m R Omega^2 scales with m R, so R

@@ -437,7 +437,7 @@ def readme_summary(summary: dict) -> str:
     """The README's summary of the report: per section of report.md, its verdicts counted and
     every row that does not hold (quantity, paper, ours, tolerance), so that the README mirrors
     the report's verdicts, the rows that differ included. Between :data:`README_BEGIN` and
-    :data:`README_END` in the README (tests/test_report.py checks it against a recorded run)."""
+    :data:`README_END` in the README."""
     report = reproduce_report(summary)
     sections = []
     for line in report.splitlines():

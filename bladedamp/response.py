@@ -52,15 +52,11 @@ def physical_checks(omega, omega_range, dissipation, excitation_work, max_step=N
       of the excitation work and the contact's own ``work_bound``. A force-harmonic error eps
       (the sampling's) shifts the contact's work by up to eps times its bound, so off resonance,
       where the excitation work nearly vanishes but a stuck or elastic contact still stores
-      energy, the excitation work alone judged a rounding-sized force error as a failure:
-      random oscillator 95 ((0, 1, 2, 3), inclined, 0.509 rad/s) had -5.9e-4 of the excitation
-      work at 4096 samples and +2.4e-5, +4.8e-7, +1.3e-8 at 16384, 65536, 262144 (an error of
-      either sign that converges to >= 0). Measured: random disk 6 (a 0.094 g wedge at slip onset),
-      one contact point at -3.8e-8 with 64 samples, -6e-18 with 256 and 1024; random disk 11
-      (a 6.4 g wedge, (1,)) -1.2e-7 at 1024; inclined oscillators -3e-6..-3.5e-4 at 4096.
+      energy, the excitation work alone would judge a rounding-sized force error as a failure
+      (an error of either sign that converges to >= 0 with the samples; examples:
+      benchmarks/README.md, 'Moved from the package's docstrings', response.py).
       Without ``refine`` the floor is the sampling error's order, -(2 pi / T)^2 of the
-      excitation work (measured on a nearly stuck contact, EO 0 wedge: -2.6e-4 at T = 64,
-      -2.9e-5 at T = 256). With ``judge_solution_samples`` the dissipation at the solve's own T
+      excitation work. With ``judge_solution_samples`` the dissipation at the solve's own T
       samples, which the result reports, is held to the same floor: a point below
       -``SAMPLING_FLOOR`` of its energy scale there fails even where the refined value passes
       (the AFT's energy error on the contact's own scale is then larger than the floor; more
@@ -127,15 +123,12 @@ def sampled_response(solve, n_samples, first: int, most: int, most_for_dissipati
 
     A negative dissipation is the AFT's sampling error (see :func:`physical_checks`), and the
     forces' harmonics carry an error of the same order, which a lightly damped resonance
-    amplifies: on random oscillator 95 (inclined contact, damping ratio 1.7e-3, separated 72 %
-    of the period, near its second-order superharmonic resonance) the contact dissipation was
-    -12 % of the excitation work with 256 samples and the branch turned back; random oscillators
-    117 and 154 stalled with 256 samples and reached the end with 4096, every check passing.
+    amplifies until the branch turns back or stalls (examples: benchmarks/README.md, 'Moved from
+    the package's docstrings', response.py).
     ``most_for_dissipation`` (default ``most``): a branch that reached the end of its range and
     failed only the dissipation check may grow up to this many samples. Its failure is the AFT's
     sampling error, which more samples cure at the cost of one more branch, whereas a branch
-    that stalled with 4x the samples seldom reaches the end with 16x (random disk 56: -1.2e-6
-    of the excitation work with 256 samples, confirmed with 4096; every check passes with 1024).
+    that stalled with 4x the samples seldom reaches the end with 16x.
     The finer branch replaces the coarser unless it keeps no point; the message says how the
     samples were chosen."""
     if n_samples is not None:
@@ -358,7 +351,7 @@ def harmonic_sentence(harmonics, error: float, tolerance: float, drifting: bool 
 # beyond the linear theory of small deformations the blade's modes rest on: the linear theory
 # overestimates the tip deflection of an end-loaded cantilever, against the elastica (Bisshopp &
 # Drucker 1945), by 1.0 % at a deflection of 10 % of its length, the product's 1 % accuracy target
-# (0.26 % at 5 %, 4 % at 20 %; tests/test_status.py integrates the elastica)
+# (0.26 % at 5 %, 4 % at 20 %)
 PLAUSIBLE_TIP_DEFLECTION = 0.1
 
 

@@ -1,6 +1,6 @@
 """Solid (3D finite-element) blade from geometry: the parametric blade or a user's closed surface
 mesh (STL), gmsh tetrahedra, quadratic linear elasticity (scikit-fem), clamped-root modes, and a
-:class:`~bladedamp.blade.ModalBlade` with the beam blade's named points (issue 16).
+:class:`~bladedamp.blade.ModalBlade` with the beam blade's named points.
 
 Needs the ``fe`` extra (``pip install 'bladedamp[fe]'``: gmsh and scikit-fem); without it every
 entry point raises an ImportError saying so.
@@ -71,7 +71,7 @@ the new boundary. The modal pipeline is then the parametric blade's (:func:`soli
 :func:`solid_blade`, ``ModalBlade.from_solid(SurfaceBladeGeometry(...))``); points other than
 OL, OR and the tip are fitted over the elements within one element size of them. Checked
 against the parametric path (the reference solid's surface written to STL in mm and read back:
-frequencies within the mesh tolerance, the same contact faces and shapes; tests/test_solid_blade.py).
+frequencies within the mesh tolerance, the same contact faces and shapes).
 
 Named points (the beam blade's: "OL", "OR", "platform", "tip", "excitation")
 -----------------------------------------------------------------------------
@@ -101,9 +101,9 @@ disks and the 3D view use: the ModalBlade part, the exact FE field at the two co
 (:class:`ContactFaceField`: the quadratic tetrahedra touching each face, 106 per face at 9 mm),
 the surface, the contact-face samples, the fit residuals and ``solid_info``; not the whole FE
 model (``modes``). Read back (:meth:`~bladedamp.blade.ModalBlade.from_file`) it is a
-SolidModalBlade with the same flexible platforms: the tuned disk's FRF is the same to the bit
-(tests/test_solid_blade.py). The file (compressed) is 129 kB for the 9 mm reference blade
-(14 400 DOF) and 207 kB at 6 mm (28 800 DOF; the whole model's mode vectors alone would be 2.3 MB). There is no
+SolidModalBlade with the same flexible platforms: the tuned disk's FRF is the same to the bit.
+The file (compressed) is a few hundred kB for the reference blade, a tenth of the whole model's
+mode vectors (benchmarks/README.md, 'Moved from the package's docstrings', solid.py). There is no
 CSV form (a CSV blade has rigid platforms): ``save`` refuses ``.csv``.
 """
 from __future__ import annotations
@@ -140,10 +140,9 @@ FAMILIES = ("F", "E", "T", "A")
 # Beam-like modes of the reference solid have < 1e-2 (their tip face moves rigidly).
 PLATE_MODE_RESIDUAL = 0.5
 # Default element size [m]: 6 mm, 28 800 DOF for the reference blade (the mirrored quarter mesh
-# has at least one element through the half thickness 2.3 mm), 7 s on this 2-core machine.
-# Measured convergence (gmsh 4.15, symmetric mesh; 1F / 1T [Hz]): 12 mm 98.72 / 865.5,
-# 9 mm 98.52 / 857.8, 6 mm 98.31 / 853.3, 4.5 mm 98.21 / 850.8, 3 mm (103 000 DOF) 98.14 / 849.5:
-# at 6 mm 1F is 0.2 % and 1T 0.5 % above the 3 mm values, below what the contact model resolves.
+# has at least one element through the half thickness 2.3 mm). At 6 mm 1F is 0.2 % and 1T 0.5 %
+# above the 3 mm values, below what the contact model resolves (convergence and cost:
+# benchmarks/README.md, 'Moved from the package's docstrings', solid.py).
 DEFAULT_ELEMENT_SIZE = 6e-3
 # Samples of the raw contact-face displacement: cell midpoints of an (n_xi, n_eta) grid over the
 # face (xi across the face, up the slope for OL; eta = y along the damper axis), like
@@ -361,7 +360,7 @@ def mesh_blade(geometry: SolidBladeGeometry | BeamBladeGeometry | None = None,
     mesh, and so the modes, are exactly symmetric. An unsymmetric tetrahedral mesh gives the
     modes components the symmetry forbids (about 1e-5 of the mode's largest, e.g. phi_z at OL in
     1F), and the tuned disk's continuation with a static harmonic crawls on them (with (0, 1):
-    3662 points instead of 564 for the reference 1 g cylinder; see tests/test_solid_blade.py).
+    several times the points of the symmetric mesh's).
     ``algorithm`` is gmsh's Mesh.Algorithm3D (1 Delaunay); ``optimize`` runs gmsh's
     tetrahedron quality optimisation. gmsh runs on one thread, so the same arguments give the
     same mesh.
@@ -1110,7 +1109,7 @@ def warping_constant_rectangle(side_a: float, side_b: float, n_terms: int = 50) 
     and a square's 1.3440e-4 a^6 are the values of sectionproperties' finite-element warping analysis
     (version 3.10, Pilkey's method: Pilkey, Analysis and Design of Elastic Beams, 2002) to 1e-8 and
     2e-6. A solid rectangle is not thin-walled: Vlasov's torsion with this C_w is an approximation
-    (its check is the solid plain plate, tests/test_solid_blade.py).
+    (checked on the solid plain plate).
     """
     a = check.positive("side_a", side_a)
     b = check.positive("side_b", side_b)
@@ -1482,8 +1481,7 @@ def _eigen(K, M, free: np.ndarray, n_modes: int):
     Mf = M[free][:, free].tocsc()
     # K - sigma M with sigma < 0 is symmetric positive definite: SuperLU in symmetric mode
     # (minimum degree on A^T + A, diagonal pivots) fills in far less than its default COLAMD.
-    # Measured on a 21 500 DOF reference solid: L + U 7.2e6 against 13.8e6 entries, factorisation
-    # 0.5 s against 1.6 s, eigsh 2.3 s against 3.8 s; 62 000 DOF: eigsh 10.6 s against 15.9 s.
+    # (Fill-in and timings: benchmarks/README.md, 'Moved from the package's docstrings', solid.py.)
     lu = scipy.sparse.linalg.splu((Kf - SHIFT_INVERT_SIGMA * Mf).tocsc(), permc_spec="MMD_AT_PLUS_A",
                                   diag_pivot_thresh=0.0, options={"SymmetricMode": True})
     op = scipy.sparse.linalg.LinearOperator(Kf.shape, matvec=lu.solve, dtype=float)

@@ -156,17 +156,17 @@ class TimeResponse(Saveable):
 # Newton iteration on non-smooth stick / slip / lift-off transitions. An implicit scheme
 # (Newmark, HHT) could take ~10x longer steps but each step needs a Newton solve of the whole
 # assembly over a non-smooth contact law, which costs more than the 10 explicit steps it
-# replaces (and adds numerical damping with HHT) - an estimate, not measured here. The stiff
+# replaces (and adds numerical damping with HHT) - an estimate. The stiff
 # direction (damper on its contacts: omega_max = 4.4e4 rad/s for the reference 1 g cylinder,
 # 7.2e4 rad/s for the 0.3 g wedge) needs 290 / 480 steps per 1F period at 0.8 of the stability
-# limit; accuracy asks for 512 (MIN_STEPS_PER_PERIOD). Cost: ~20 / 36 us per step for the
-# 16-blade reference assembly (160 unknowns, 160 / 800 contact points) on the 2-core test box.
+# limit; accuracy asks for 512 (MIN_STEPS_PER_PERIOD). Cost per step: benchmarks/README.md,
+# 'Moved from the package's docstrings', timedomain.py.
 
 # Fewest steps per period by default (accuracy, not stability): the central differences shorten
 # the modal mass by (Omega dt)^2 / 12, which moves a resonance and, on the steep flank of the
-# lightly damped stuck 1F peak, changes the amplitude ~25x as much. Measured on the reference
-# 1 g cylinder at 95 Hz (stuck; HBM 0.226976 mm): 287 steps (the stability limit x 0.8)
-# 0.226339 mm (-0.28 %), 574 steps 0.226781 mm (-0.086 %): second order.
+# lightly damped stuck 1F peak, changes the amplitude ~25x as much; 512 keeps the reference
+# cylinder's stuck amplitude within ~0.1 % of the HBM's (benchmarks/README.md, 'Moved from the
+# package's docstrings', timedomain.py, 'MIN_STEPS_PER_PERIOD').
 MIN_STEPS_PER_PERIOD = 512
 
 
@@ -822,10 +822,10 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
     harmonics settle but a damper's mean keeps moving at an undiminished rate for
     ``drift_periods`` periods (a cylinder rolling along the platforms, a damper walking
     axially), the motion is not periodic: status "drifting", with the rate. First harmonics
-    that keep fluctuating from period to period (by more than ``tol``; measured 6e-5 on a
-    4-blade mistuned wedge disk, a period-2 pattern: most likely the undamped ringing of the
-    dampers on their contact springs, which the model does not damp; or the beat of a lightly
-    damped transient) are judged by their mean over 2 ``drift_periods`` periods: "periodic
+    that keep fluctuating from period to period (by more than ``tol``; for example a period-2
+    pattern, most likely the undamped ringing of the dampers on their contact springs, which
+    the model does not damp, or the beat of a lightly damped transient) are judged by their
+    mean over 2 ``drift_periods`` periods: "periodic
     within a fluctuation" when that mean settles (a trend <= tol per period) and the
     fluctuation is at most ``fluctuation_tol`` per period; the tip amplitudes are then that
     mean (a beat of the transient averages out of it).
@@ -1048,8 +1048,8 @@ def disk_time_response(disk, f_hz, tol: float = 1e-5, min_periods: int = 20, max
                               f"{q:.3g} per block)"))
         out["tip_harmonic"][i] = X
         # the works of the last period, or their mean over the same periods as a mean first harmonic
-        # (a fluctuating motion's last period stores or releases energy: measured 5.8e-3 of the
-        # excitation work for the 4-blade wedge disk at 97 Hz, 1.4e-4 as the mean over its 80 periods)
+        # (a fluctuating motion's last period stores or releases energy, which the mean over the
+        # periods averages out)
         works = np.mean(work_hist[-window:], axis=0) if window else work_hist[-1]
         out["dissipated_energy"][i] = works[2:].sum()
         out["damper_dissipation"][i] = works[2:]

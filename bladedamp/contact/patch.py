@@ -42,10 +42,10 @@ def rigid_point_map(xi: np.ndarray, eta: np.ndarray) -> np.ndarray:
 @functools.lru_cache(maxsize=64)
 def _dof_jacobian_path(b_shape, j_shape):
     """The einsum contraction order of :func:`dof_jacobian` for these operand shapes, found once
-    (numpy's optimiser searched it on every call: 9 % of a reference FRF's time, measured)."""
+    (numpy's optimiser would search it on every call, a noticeable share of an FRF's time)."""
     # m > 6 (a flexible platform's maps): numpy's optimiser would take one 8-loop einsum, 5 x slower
-    # than its own m = 6 path (B with B, then the point Jacobian), given here (measured, one BLAS
-    # thread, 2 x 25 points, 7 coefficients, m = 10: 6.3 against 1.3 ms)
+    # than its own m = 6 path (B with B, then the point Jacobian), given here (benchmarks/README.md,
+    # 'Moved from the package's docstrings', contact/patch.py)
     if b_shape[-1] != 6:
         return ["einsum_path", (0, 2), (0, 1)]
     return np.einsum_path("lpim,lpaikb,lpkn->lambn", np.empty(b_shape), np.empty(j_shape), np.empty(b_shape),
@@ -61,9 +61,8 @@ def dof_jacobian(point_map: np.ndarray, point_jacobian: np.ndarray) -> np.ndarra
     (..., P, C, 3, 3, C) is d f_coef[a, p, i] / d c_p[b, k] (force coefficient a of direction
     i by displacement coefficient b of direction k); returns (..., C, m, C, m). Leading axes
     (patches, dampers) are batched. One optimised einsum over
-    flattened leading axes (with one BLAS thread, measured on the 2-core box: 0.6 / 6.4 ms
-    for the 2 / 32 patches of a tuned sector / a 16-blade assembly at 7 coefficients, against
-    2.0 / 25 ms for two chained plain einsums)."""
+    flattened leading axes, several times faster than two chained plain einsums
+    (benchmarks/README.md, 'Moved from the package's docstrings', contact/patch.py)."""
     lead = point_map.shape[:-3]
     L = int(np.prod(lead, dtype=int))
     B = point_map.reshape((L,) + point_map.shape[-3:])

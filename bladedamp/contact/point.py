@@ -64,10 +64,10 @@ def slider_step(u0, u1, s0, s1, k_t, radius, in_contact):
 # the slider derivative over one period: the closed form is used when |det(I - Phi)| >=
 # SINGULAR_DET, else the derivative is iterated pass by pass as before (_iterate_passes).
 # det(I - Phi) = 1 - lambda, lambda the eigenvalue of the rank-1 Phi (|lambda| <= product of
-# g = mu N / |trial| over the slip samples). Measured on 7500 slipping points of the reference
-# disks (converged, random and FRF states; 3400 of random point motions) it is either
-# >= 1.9e-3 or <= 8e-16 (Phi = I, or a "slip" by rounding at the friction limit, g = 1 - 1e-16:
-# a stuck slider, whose periodic position is not unique); the threshold sits in that gap. The
+# g = mu N / |trial| over the slip samples). On slipping points it is either of order 1e-3 or
+# more, or of rounding size (Phi = I, or a "slip" by rounding at the friction limit: a stuck
+# slider, whose periodic position is not unique); the threshold sits in that gap
+# (benchmarks/README.md, 'Moved from the package's docstrings', contact/point.py). The
 # closed form loses about eps / det of relative accuracy (2e-10 at the threshold); below it the
 # previous iteration, which keeps the initial slider and its derivative convention, defines it.
 SINGULAR_DET = 1e-6
@@ -94,11 +94,9 @@ def touchdown_seats(approach, seat, seat_rate):
     A separated slider follows the displacement and is seated where the contact closes: at
     u_t + theta (u_{t+1} - u_t), not at the last separated sample u_t. Seating it at the
     sample makes an error of order (dt du/dt) k_T in the tangential force over the whole
-    following stick phase, and so of order dt in the forces' harmonics. Measured on random
-    oscillator 95 (inclined contact, separated 72 % of the period), the largest error of the
-    contact force's harmonics at 256 / 1024 / 4096 samples (against 65536), of the largest
-    one: 3.5e-3 / 1.0e-3 / 2.2e-4 seated at the sample (first order), 6.5e-4 / 4.0e-5 / 3.1e-6
-    seated here; and no spurious slip at touchdown. The closing instant is interpolated
+    following stick phase, and so of order dt in the forces' harmonics; seated here, the error
+    is of second order, with no spurious slip at touchdown (benchmarks/README.md, 'Moved from
+    the package's docstrings', contact/point.py). The closing instant is interpolated
     linearly in the approach, a smooth function of time, so the seat is exact to second order. With the static term
     (theta, the approach) depend on the normal coefficients: d theta / d a_t = -(1 - theta) /
     da, d theta / d a_{t+1} = -theta / da, da = a_{t+1} - a_t, and a = offset - u_zeta, so
@@ -719,8 +717,7 @@ def damper_contact_forces(B, local, synthesis, analysis, k_t, mu, weight, approa
     passes; False: the previous pass iteration, see :func:`_point_return_map`). No default: an
     omitted argument is a numba literal, and the kernels it reaches (``point_harmonics``,
     ``_point_return_map`` and what they inline) were compiled a second time for it, besides the
-    version ``point_contact_forces`` uses (measured: the reference FRF's first call on an empty
-    cache compiled ``_point_return_map`` twice).
+    version ``point_contact_forces`` uses.
     """
     nd, P = B.shape[0], B.shape[2]
     T, C = synthesis.shape[0], synthesis.shape[1]

@@ -10,9 +10,8 @@ So every answer is checked against an enriched harmonic set:
   points spread along it) the solution is lifted into the enriched set ``H+`` (the static term
   and the next two harmonics added) and solved again at the same frequency by Newton (and, where
   the plain Newton does not converge, by the damped Newton with a line search of the robust
-  start: measured on the reference 1 g cylinder with (0, ..., 7), whose peak point the plain
-  Newton could not solve with (0, ..., 9), so its estimate was "not verified"; damped it
-  converges there to 0.53 %; where neither converges, once more with
+  start, which converges at peak points the plain Newton cannot solve (benchmarks/README.md,
+  'Moved from the package's docstrings', accuracy.py); where neither converges, once more with
   :data:`ENRICHED_SAMPLES_GROWTH` x the AFT samples). The
   largest change of the first-harmonic output amplitudes (the blade tips, the oscillator's x),
   relative to the branch's peak amplitude, is the error estimate of ``H``. It is an
@@ -157,9 +156,8 @@ def harmonic_error(model, response, harmonics=None, n_points: int = 5, tol: floa
         for k, i in enumerate(idx):
             a = _enriched_amplitudes(model, response.coefficients[i], basis, system, float(w[i]), scales, tol)
             if a is None:
-                # Newton fails on the AFT's sampling of a contact event, not on the harmonics
-                # (random oscillator 154's (0..9) peak, 1024 samples: the lift-off instant between
-                # samples; it converges with 4096, 0.18 % off, as the time integration): once more
+                # Newton may fail on the AFT's sampling of a contact event (a lift-off instant
+                # between samples), not on the harmonics: once more
                 # with ENRICHED_SAMPLES_GROWTH x the samples (the change then includes the branch's
                 # own sampling error too)
                 if finer is None:
@@ -210,8 +208,9 @@ def converged_response(model, solve, harmonics="auto", tolerance: float = HARMON
     for a study that estimates it on a representative case instead (the Monte Carlo's first disk).
     ``guard_stalls``: a richer set's branches, once a poorer set's reached the end, are computed
     within :func:`~bladedamp.hbm.continuation.stall_guard` (a stalled branch ends early). Not for
-    the oscillator: measured on random oscillator 95 (damping ratio 1.7e-3), whose (0, ..., 7)
-    branch reaches the end only past a stretch the guard ends (benchmarks/README.md)."""
+    the oscillator: a lightly damped oscillator's richer branch may reach the end only past a
+    stretch the guard ends (benchmarks/README.md, 'Moved from the package's docstrings',
+    accuracy.py)."""
     if isinstance(harmonics, str):
         if harmonics != "auto":
             raise ValueError(f"harmonics must be 'auto' or a tuple of integers >= 0 (got {harmonics!r})")
@@ -249,8 +248,8 @@ def converged_response(model, solve, harmonics="auto", tolerance: float = HARMON
                 if best is not None and best[0].success and not response.reached_range_end:
                     # a richer set whose every branch (both ends, retry, finer samples) failed short
                     # of the end where a poorer set's reached it: the richer sets after it are not
-                    # tried (on the random EO >= 6 wedges they failed the same way, at the same
-                    # stall, for most of the analysis' time: benchmarks/README.md); the poorer
+                    # tried (they fail the same way, at the same stall, for most of the analysis'
+                    # time: benchmarks/README.md, 'Cost of the default FRF on random disks'); the poorer
                     # set's complete branch is the answer, its estimate saying how far it is
                     kept = annotate(best[0], best[1], tolerance)
                     where = (f"its branch got no further than {response.frequency_hz[response.furthest_index()]:.6g} Hz"

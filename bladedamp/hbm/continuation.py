@@ -65,11 +65,10 @@ def _bordered_pattern(n, indices, indptr):
 
 def bordered_matrix(J, column, row, column_scale, factor):
     """[[J diag(column_scale), column] factor; row] (J square, dense or sparse); in one pass
-    either way (sparse: CSC, each column's row entry last; tests/conftest.py's ``border`` of
-    ``scale_columns`` is the reference, tested equal; measured on a 321 x 321 CSC matrix of 10 % density: 0.073 against
-    0.10 ms). The sparse bordered matrix's indices are those of :func:`_bordered_pattern`, formed
-    once per pattern: measured on a Monte Carlo 16-blade disk's Jacobian (n = 320, medians of 15
-    alternating runs), 28 against 87 us a call."""
+    either way (sparse: CSC, each column's row entry last; equal to bordering
+    ``scale_columns``' result). The sparse bordered matrix's indices are those of
+    :func:`_bordered_pattern`, formed once per pattern (timings: benchmarks/README.md, 'Moved
+    from the package's docstrings', continuation.py)."""
     n = J.shape[0]
     if sp.issparse(J):
         J = J if sp.isspmatrix_csc(J) else sp.csc_matrix(J)
@@ -117,18 +116,16 @@ def _det_sign(A, solve=None) -> int:
 
 
 # returns of a branch to its own earlier points after which it is taken to be in a loop: a
-# corner may send the corrector back over a few points before it passes (measured: the 1 g
-# cylinder on the beam blade's own frequencies, (0, ..., 5), came back to a point 9 steps
-# earlier at 95.39 Hz and then reached the end), a loop returns at every step
+# corner may send the corrector back over a few points before it passes, a loop returns at
+# every step
 MAX_REVISITS = 200
 
 
 # The stall guard (:func:`stall_guard`): a branch whose furthest frequency has not grown by
-# STALL_PROGRESS of its range over its last STALL_POINTS points kept has stalled. Measured on the
-# random EO >= 6 wedges (benchmarks/README.md, issue 32 item 2): the richer harmonic sets' branches
-# stall near the first bending resonance with a fold every ~3 points, omega moving 5e-4 Hz a step
-# (2e-5 of the range) back and forth, for hundreds of points before the retrace guard or max_points
-# ends them.
+# STALL_PROGRESS of its range over its last STALL_POINTS points kept has stalled: a branch that
+# folds every few points with omega moving back and forth by a small fraction of the range would
+# otherwise run for hundreds of points before the retrace guard or max_points ends it
+# (benchmarks/README.md, 'Cost of the default FRF on random disks').
 STALL_POINTS = 100
 STALL_PROGRESS = 1e-4
 _STALL_GUARD = contextvars.ContextVar("stall_guard", default=False)
@@ -316,16 +313,14 @@ def _validate_options(step, max_step, min_step, max_points, tol, max_corrector, 
 
 
 # continuation(chord=True): a chord iteration whose update is larger than this fraction of the
-# previous one is followed by a fresh Jacobian. A chord iteration costs 0.24 ms against 1.1-1.35 ms
-# for a Newton iteration on the 16-blade assembly (residual and Jacobian 0.67 ms, bordering 0.2,
-# factorisation 0.2); measured on random 2 % Monte Carlo disks: see benchmarks/README.md
+# previous one is followed by a fresh Jacobian; a chord iteration costs a fraction of a Newton
+# iteration (benchmarks/README.md, 'Moved from the package's docstrings', continuation.py)
 CHORD_CONTRACTION = 0.25
 
 # The retry of continuation(retry_x_scale=...) gets this fraction of max_points. Where the
-# re-weighting is the cure, the branch it measures is shorter: random disks 16 and 102 reached the
-# end in 302 and 228 points after the first try had used its 2000 from either end; where it is
-# not (the reference cylinder's light masses at EO 7, which fail either way), a full retry doubled
-# the cost of each failed branch (robust_peak of 0.05 g: 42 s, 86 s with the retry).
+# re-weighting is the cure, the branch it follows is much shorter than the first try's; where
+# it is not, a full retry would double the cost of each failed branch (benchmarks/README.md,
+# 'Moved from the package's docstrings', continuation.py).
 RETRY_POINTS_FRACTION = 4
 
 
@@ -440,8 +435,7 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
                                    f"{first.message})"
                 return retried
         # both failed: the branch that got further into the range is the better account of where
-        # the solutions end (random disk 127: the first try retraced itself from a fold at 89.9 Hz
-        # back to the start, the second passed that fold and stopped at 94.1 Hz)
+        # the solutions end (the first try may retrace itself from a fold the second passes)
         if _reach(retried, omega_start, omega_end) > _reach(first, omega_start, omega_end):
             retried.message += f" (second try, with the arc length weighted by retry_x_scale, which got further " \
                                f"than the first; first try: {first.message})"
@@ -530,8 +524,7 @@ class ArcLengthContinuation:
         # Orientation of the branch (Allgower & Georg): the sense of the tangent t keeps the sign of
         # det [dR/dy; t^T], which changes at no fold and no corner of a piecewise-smooth branch.
         # "t . previous tangent > 0" picks the wrong sense once the branch turns by more than 90
-        # degrees (scaled) between two points: the branch then retraced itself (measured: random
-        # disk 12 ran up to 98.58 Hz and back down its own path to the start, 84.35 Hz), and a
+        # degrees (scaled) between two points: the branch then retraces itself, and a
         # corner the corrector cannot pass (below) may leave at any angle. With t solving
         # [dR/dy; r^T] t = e (r . t = 1), det [dR/dy; t^T] = det [dR/dy; r^T] |t|^2: the sign comes
         # from the bordered matrix already factorised (dense only; 0, not used, otherwise).
@@ -539,8 +532,8 @@ class ArcLengthContinuation:
         # where the mirror-odd damper DOFs are at zero with almost no stiffness, and their noise
         # flipped it at every step: the branch went back and forth between two points). So a
         # reversal the sign asks for on a tangent that has hardly turned (within 18 degrees of the
-        # previous one; measured there: 9 degrees, at the folds and corners of random disks 12 and
-        # 102 and oscillator 136: 75-90 degrees) is not taken, and the sign is re-recorded instead.
+        # previous one; the bifurcation's flips turn it by a few degrees, folds and corners by
+        # 75-90 degrees) is not taken, and the sign is re-recorded instead.
         self.orientation = 0
         self.stall_guard = _STALL_GUARD.get()
         self._scale = (None, None)      # (x_scale, scale()) of the last x_scale asked for
@@ -649,7 +642,7 @@ class ArcLengthContinuation:
                 continue
             if step_norm >= previous_norm:
                 # Newton updates that do not contract: the corrector diverges or cycles
-                # (measured: such runs go on to |omega| of hundreds of Hz); halve the step
+                # (such runs go on to |omega| of hundreds of Hz); halve the step
                 break
             fresh = not self.chord
         return ok, yc, it, bordered, A, previous_iterate
@@ -702,10 +695,9 @@ class ArcLengthContinuation:
         piece it leaves: its last iterates (a Newton 2-cycle) lie on the adjacent piece.
         Continue along that piece's tangent, oriented as the branch (det rule, see __init__):
         it may leave the corner at any angle, beyond 90 degrees at a non-smooth fold, where no
-        point exists on the hyperplane of the old tangent nor at a fixed omega beyond.
-        Measured on random disk 102 (a 0.042 g cylinder rolling into gross slip at 94.22 Hz):
-        the adjacent piece turns back by 154 degrees and its corrector converges quadratically
-        where the old one cycled at every step down to 1e-7."""
+        point exists on the hyperplane of the old tangent nor at a fixed omega beyond; the
+        corrector along the adjacent piece converges quadratically where the old one cycles at
+        every step."""
         for z in cycle:
             found = self.bordered_tangent(z, tangent)
             if found is None or found[1] == 0:
@@ -773,9 +765,7 @@ class ArcLengthContinuation:
 
         At a corner of a piecewise-smooth branch (a stick-slip transition, a contact opening)
         the corrector converges on the adjacent piece at a distance proportional to the step:
-        no step, however short, passes the 45-degree test. Measured on random disk 6 (a 0.094 g
-        wedge at slip onset, 94.996 Hz): the chord was 3.6 / 4.5 / 8.0 times the step at
-        h = 1e-2 / 1e-3 / 1e-4 and the branch turned by 75-83 degrees there. The point is
+        no step, however short, passes the 45-degree test. The point is
         accepted when the chord from ``y`` runs along the branch through ``yc`` (within 25
         degrees of its tangent, which excludes a jump to another branch crossing the
         hyperplane) and stays short (at most 10 steps and 2 max_step)."""
@@ -818,15 +808,15 @@ class ArcLengthContinuation:
 
         Where the branch turns by more than 90 degrees at a corner, the hyperplane corrector
         finds no point near its predictor at any step (the residual there is proportional to
-        the step: measured on random disk 51, a 7 g cylinder at 94.18 Hz, a Newton 2-cycle at
-        every step from 1e-2 to 1e-7), and the tangents of its 2-cycle iterates at the smallest
-        steps are those of the point itself. On a sphere of radius r around ``y`` the branch has
-        two points, the one it came from (direction -tangent) and the one it leaves by (there:
-        111 degrees off the tangent, omega turning back). Newton on the sphere from the
-        directions of the cycles' tangents (both senses, largest steps first) finds it; the
-        one leaving (not within 60 degrees of -tangent) and turning least is taken, and the
-        orientation is re-recorded on the new piece (the branch has one only where the
-        factorisation gives det signs: dense, or :class:`~bladedamp.hbm.linsolve.BlockRing`)."""
+        the step: a Newton 2-cycle at every step), and the tangents of its 2-cycle iterates at
+        the smallest steps are those of the point itself. On a sphere of radius r around ``y``
+        the branch has two points, the one it came from (direction -tangent) and the one it
+        leaves by (possibly more than 90 degrees off the tangent, omega turning back). Newton on
+        the sphere from the directions of the cycles' tangents (both senses, largest steps
+        first) finds it; the one leaving (not within 60 degrees of -tangent) and turning least
+        is taken, and the orientation is re-recorded on the new piece (the branch has one only
+        where the factorisation gives det signs: dense, or
+        :class:`~bladedamp.hbm.linsolve.BlockRing`)."""
         n = self.n
         directions = [tangent]
         for _, iterates in cycles[:4]:
@@ -876,10 +866,8 @@ class ArcLengthContinuation:
     def retraced(self, new, h):
         """Index of an earlier point (not among the last 5) that ``new`` comes back to, within
         1 % of the step ``h`` (scaled), or None. An FRF branch never passes through one of its
-        own points again: measured on random disk 51 (a 7 g cylinder, (0, 1, 2, 3)), past a
-        non-smooth fold at 94.18 Hz the branch went back and forth between 94.28 and 94.30 Hz
-        at full steps, coming back to within 1e-5..5e-7 of earlier points, until the 2000-point
-        cap. The caller stops after MAX_REVISITS returns (a corner may send a branch back over a
+        own points again; one that does is going back and forth past a non-smooth fold. The
+        caller stops after MAX_REVISITS returns (a corner may send a branch back over a
         few points before it passes)."""
         n, points = self.n, self.points
         if len(points) < 6:

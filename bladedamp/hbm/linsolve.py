@@ -35,8 +35,7 @@ def one_blas_thread(fn):
 
     The harmonic balance factorises many small dense matrices (70-300 unknowns per tuned
     sector): for these a threaded BLAS is slower, and far slower when the cores are shared
-    (measured on the 2-core box under load: LU of a 150 x 150 matrix 0.67 ms with one thread,
-    24 ms with two; the wedge's (0, ..., 7) FRF spent half its time in LU). The studies run
+    (benchmarks/README.md, 'Moved from the package's docstrings', hbm/linsolve.py). The studies run
     their own processes in parallel instead (:mod:`bladedamp.studies.parallel`).
     """
     @functools.wraps(fn)
@@ -346,9 +345,8 @@ class BlockRing:
     ``links[j]`` and ``links[j] + 1`` (mod n). The damper's equations hold only its own
     coordinates and those two blades'; a blade's only its own, its two dampers' and the
     border's. Dense LU of the damper-condensed system costs O(n^3), and sparse LU of the bordered
-    matrix is no better (the border and the ring's closing corners fill it in; measured on the
-    bordered Jacobian of 128 / 256 blades, one harmonic: splu 125-140 / 670-780 ms, this
-    1.5-2.2 / 4.1-4.6 ms); this is linear in n.
+    matrix is no better (the border and the ring's closing corners fill it in); this is linear
+    in n (timings: benchmarks/README.md, 'Moved from the package's docstrings', hbm/linsolve.py).
 
     Parameters
     ----------

@@ -22,8 +22,7 @@ over one period, hysteresis included:
   stick-slip switches are continuous in the state, so the difference is the derivative except
   when a switch falls within the step, which is of probability FD_STEP);
 * the Floquet multipliers mu: its eigenvalues; mu = exp(lambda T) with lambda the Floquet
-  exponents of Hill's method for a smooth system (tests/test_stability.py checks both on the
-  Duffing oscillator).
+  exponents of Hill's method for a smooth system.
 
 Stable when every multiplier satisfies log|mu| / (2 pi) < ``tolerance`` (the same threshold as
 Hill's Re lambda / Omega < tolerance, since |mu| = exp(2 pi Re lambda / Omega)). A slider that
@@ -64,13 +63,10 @@ are then off by (omega dt)^2 / 24 relative: ~6e-6 for 1F, but of order 1 for the
 modes near the stability limit (their multipliers are the discrete scheme's, with its own
 frequency; their moduli stay those of a lightly damped mode).
 
-Cost (``nice python benchmarks/bench_monodromy_disk.py 4 16``, one run on the 2-core test box
-with another job running; reference blade and 1 g cylinder, TunedDisk, harmonics (0, 1, 2, 3),
-512 steps per period, three points across 1F, compile excluded): 4 blades m = 160, 0.23 s per
-point (321 trajectories of one period: 1.4 us per trajectory step) against 2.0 ms per point of
-the HBM continuation (90-100 Hz, 112 points): 118 x the HBM solve; 16 blades m = 640, 3.8 s per
-point (1281 trajectories, 5.8 us per step) against 2.4 ms (681 points): ~1600 x. The cost
-grows as m^2 ~ n_blades^2 (m trajectories of a period costing ~ m each), so on a real disk the
+Cost: 2 m + 1 trajectories of one period per point, m the state's size; about 120 x the HBM
+solve per point for 4 blades and 1600 x for 16 (benchmarks/README.md, 'Moved from the package's
+docstrings', hbm/monodromy.py). The cost grows as m^2 ~ n_blades^2 (m trajectories of a period
+costing ~ m each), so on a real disk the
 monodromy is for chosen points (near a suspected bifurcation), not for every point of an FRF;
 a tuned disk does not get cheaper (the cyclic sector's solution is written out on the full
 assembly to see every nodal diameter).
@@ -98,9 +94,10 @@ from ..timedomain import (MIN_STEPS_PER_PERIOD, assembly_arrays, disk_period, hi
 STEPS_PER_PERIOD = 2048       # central-difference steps per period of the period map
 FD_STEP = 1e-6                # finite-difference step of the monodromy matrix, relative to the state's scale
 # A disk's periodicity error above this: the HBM solution is not a periodic orbit of the time
-# integration (AccuracyWarning naming the coordinate). Measured on HBM orbits that are: 0.3-1.9e-3
-# (4 and 16 blades, reference cylinder, stick and slip; most of it the HBM's static retention
-# spring, absent in the time domain); on the rolling 16-blade cylinder at 95.3 Hz: 0.67.
+# integration (AccuracyWarning naming the coordinate). It lies between the errors of HBM orbits
+# that are periodic orbits (a few 1e-3, most of it the HBM's static retention spring, absent in
+# the time domain) and those of one that is not (order 1): benchmarks/README.md, 'Moved from
+# the package's docstrings', hbm/monodromy.py.
 PERIODICITY_LIMIT = 1e-2
 
 

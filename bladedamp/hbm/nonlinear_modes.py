@@ -424,9 +424,9 @@ class NonlinearModeResponse(Saveable):
 # the peak tracked from a neighbouring design (tracked_forced_peaks): the offset of the secant's
 # second point in log a (its first step is a difference quotient of h; _resolve_peaks takes 1e-3
 # of its bracket, 3.4e-4 for the cylinder's 30 points over 4.2 decades, and h is smooth at that
-# scale: 1e-3 serves), and the secant steps before giving up (the full mode then): measured on the
-# reference cylinder's design (0.1-10 g, 0.05-0.2 N), 4-11 solves per peak over the 0.25-decade
-# steps of its grid, 4-6 in the refinements; 12 steps (14 solves) leave that margin
+# scale: 1e-3 serves), and the secant steps before giving up (the full mode then): 12 steps
+# (14 solves) leave a margin over the solves a peak takes (benchmarks/README.md, 'Moved from the
+# package's docstrings', hbm/nonlinear_modes.py)
 TRACK_FIRST_STEP = 1e-3
 TRACK_MAXITER = 12
 def _local_force_norm(system, x, omega) -> float:
@@ -762,7 +762,7 @@ def _synthesis_root(problem: EPMCProblem, force, solve, la_start: float, first_s
     if sec.converged and inside and found:
         # the secant's root is closer to the true one than its last solve (up to xtol away, where
         # h is up to ~1e-7 of |phi^H F|: the spline of forced_peak through that point can then
-        # cross zero up to 3e-6 away, measured on the cylinder at 4 g, 0.05 N): one more solve there
+        # cross zero up to a few 1e-6 away): one more solve there
         try:
             fun(sec.root)
             root = sec.root

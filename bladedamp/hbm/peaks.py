@@ -17,7 +17,7 @@ from .continuation import newton
 from .fourier import HarmonicBasis
 
 #: iterations of :meth:`PeakSolver.solve` (each a Newton solve at fixed Omega); it stops earlier
-#: once the frequency settles (measured on random 2 % mistuned disks: 1-3)
+#: once the frequency settles (usually after a few)
 PEAK_MAX_ITERATIONS = 12
 
 
@@ -92,7 +92,7 @@ class PeakSolver:
         ends is the next frequency (the bisection where the same end moved twice running), solved
         there by Newton from the Taylor predictor of the nearer end (tolerance ``tol``, scaled as
         the continuation's); the end it replaces keeps the invariant. It stops when the frequency
-        moves by less than 1e-9 relative (measured on smooth peaks: 2-3 iterations)."""
+        moves by less than 1e-9 relative (2-3 iterations on a smooth peak)."""
         omega, n = self.omega, len(self.omega)
         if not 0 < index < n - 1 or not (omega[index - 1] < omega[index] < omega[index + 1]):
             return None
@@ -116,8 +116,7 @@ class PeakSolver:
             if not r.converged:
                 return None
             # the tangent from the Newton's last factorisation (its iterate met the tolerance):
-            # one Jacobian less per iteration (measured on 8 Monte Carlo disks: 18.4 -> 3.5 tangent
-            # Jacobians per disk, the peaks' time 117 -> 73 ms on a loaded machine)
+            # one Jacobian less per iteration
             d = -r.solve(r.dR_domega)
             a, g = self._slope(output, r.x, d)
             best = max(best, (a, w))

@@ -52,13 +52,13 @@ in stick the force perturbation is k_T (dx(t) - dx(t_r)), with memory of the las
 t_r, so for a perturbation e^{lambda t} p(tau) the linearisation depends on lambda through
 e^{-lambda (t - t_r)}. The AFT Jacobian is its value at lambda = 0, and the Hill matrix built
 on it loses the copy structure of the exponents (the copies lambda +- i Omega, for which the
-memory factor is of order 1, get different real parts). Measured on the 1-DOF Jenkins
-oscillator (tests/test_stability.py): Hill's method on its AFT Jacobian gives -c / 2m =
--0.025 1/s, the viscous decay alone, where the monodromy matrix of the time integration
-(:mod:`bladedamp.hbm.monodromy`, memory included) gives down to -0.96 1/s (the friction damps
-the perturbation too); taking every distinct copy instead of the 2 n best-centred ones, Hill
-even showed real parts up to +1.8 1/s there, while a time integration started on the HBM
-solution returns to it. So
+memory factor is of order 1, get different real parts). On the 1-DOF Jenkins oscillator,
+Hill's method on its AFT Jacobian gives -c / 2m, the viscous decay alone, where the monodromy
+matrix of the time integration (:mod:`bladedamp.hbm.monodromy`, memory included) gives a
+decay many times faster (the friction damps the perturbation too); taking every distinct copy
+instead of the 2 n best-centred ones, Hill can even show positive real parts where a time
+integration started on the HBM solution returns to it (numbers: benchmarks/README.md, 'Moved
+from the package's docstrings', hbm/stability.py). So
 for systems with hysteretic elements, stability is decided by the one statement that holds
 exactly: at lambda = 0 the linearisation is the AFT Jacobian J, and the characteristic function
 P(lambda) = det(J(lambda) + lambda Delta_1 + lambda^2 Delta_2) is real on the real axis with
@@ -74,14 +74,13 @@ full-assembly MistunedDisk, by the time domain's integrator of the assembly; its
 ~100-1600 x the HBM solve per point, see that module).
 The result says which method was used (``method``: "hill", "determinant sign" or "monodromy").
 The default ("auto") stays Hill / determinant sign: the monodromy integrates 7 trajectories
-over one period per point, 4.3 times the cost (measured on the friction-fold branch of
-tests/test_stability.py, 2149 points, one run: 12.1 s against 2.8 s, both with the bordered
-determinant), and on this 1-DOF oscillator it puts the folds where det J does (within a point).
+over one period per point, several times the cost, and on the 1-DOF friction oscillator it
+puts the folds where det J does (within a point).
 
 For a tuned disk computed by cyclic symmetry the perturbations are those of the same
 travelling-wave family; the full assembly (:class:`~bladedamp.mistuned.MistunedDisk`) covers
 all nodal diameters. Its exponents hold the sector's, and can hold more: on a 4-blade ring of
-blades with cubic tip springs linked tip to tip (tests/test_stability_disk.py), the assembly
+blades with cubic tip springs linked tip to tip, the assembly
 loses stability one point before the sector's fold, to other nodal diameters, and a time
 integration of the assembly leaves the travelling wave there. Conversely, a fold of the
 travelling wave that every blade makes at once (uncoupled blades) is an even number of real
@@ -357,9 +356,8 @@ def _floquet_from_jacobian(system, J, omega, tolerance, n_near, method, x=None, 
     else:
         # half the spectrum or more (always so for one harmonic, C = 2: 4 n_dof = 2 N): ARPACK
         # cannot return all 2 N eigenvalues (at most 2 N - 2) and is not faster than the dense QZ
-        # there (measured, one run: 16 blades x 4 modes, harmonics (1, 3), 2 N = 512: 256
-        # eigenvalues by shift-invert 5.0 s, all by QZ 4.1 s; 4 blades, 2 N = 128: 0.78 s
-        # against 0.047 s; 24 of 512 by shift-invert 0.37 s)
+        # there (timings: benchmarks/README.md, 'Moved from the package's docstrings',
+        # hbm/stability.py)
         eigensolver = "dense"
         dense = (lambda A: A.toarray()) if sp.issparse(J) else np.asarray
         values, vectors = _dense_quadratic_eig(dense(J), dense(d1), dense(d2))
@@ -373,10 +371,9 @@ def _floquet_from_jacobian(system, J, omega, tolerance, n_near, method, x=None, 
     mu, lam = mu[kept], values[kept]
     resolved = np.abs(mu.imag) <= (max(system.basis.harmonics) + 0.5) * omega
     # at most 2 n resolved exponents, best-centred first: the further distinct ones are copies
-    # whose truncation error separated them from their exponent (measured on the Duffing
-    # oscillator with harmonics (0..5): 4-8 "distinct" resolved exponents, one with Re lambda
-    # > 0 twelve points before the fold, where the monodromy matrix and the best-centred
-    # copies agree on 0.992)
+    # whose truncation error separated them from their exponent (on a Duffing oscillator they
+    # can show Re lambda > 0 well before the fold, where the monodromy matrix and the
+    # best-centred copies agree on stability)
     decisive_index = np.flatnonzero(resolved)[:2 * n_dof]
     order = decisive_index[np.argsort(-mu[decisive_index].real)]
     decisive, multipliers = mu[order], np.exp(lam[order] * 2 * np.pi / omega)
@@ -443,8 +440,8 @@ class BranchStability:
     seconds: float
 
 
-@one_blas_thread       # many small determinants: measured on the 16-blade mistuned disk (2 %, seed 1,
-                       # (1,), 776 points, one run): 4.7 s with one thread, 18.6 s threaded (the solve: 11.4 s)
+@one_blas_thread       # many small determinants, which threads slow down (benchmarks/README.md,
+                       # 'Moved from the package's docstrings', hbm/stability.py)
 def branch_stability(system, coefficients: np.ndarray, omega: np.ndarray, x_scale=1.0,
                      tolerance: float = STABILITY_TOLERANCE, method: str = "auto", model=None) -> BranchStability:
     """Stability of every point of a branch (:func:`floquet_exponents`) and its branch points:

@@ -33,10 +33,9 @@ class StartResult:
     how: str
 
 
-#: damped Newton gives up once |R| has not halved over this many iterations. Measured on a light
-#: cylinder at EO 7 (0.05 g, 90 Hz) whose start does not converge: each failing damped Newton held
-#: |R| at 3e-5..8e-3 of the excitation for all 60 iterations (about 750 residual evaluations, 4 s
-#: of its 4.6 s response), while those that converge take at most 11
+#: damped Newton gives up once |R| has not halved over this many iterations: a failing damped
+#: Newton holds |R| for all its iterations, while those that converge need about as many as this
+#: in all (benchmarks/README.md, 'Moved from the package's docstrings', hbm/start.py)
 STAGNATION_WINDOW = 10
 STAGNATION_FACTOR = 0.5
 
@@ -55,11 +54,10 @@ def damped_newton(fun, x0, x_scale, residual_scale, tol=1e-10, max_iter=60, fact
     solution), is tried with the Jacobian (``fun(x, True)``): taken, its residual and Jacobian
     are the next iteration's, instead of one residual for the line search and both again at
     the same point. Other trials are residuals only (while the line search shortens the steps,
-    a Jacobian at the full step would mostly be thrown away). Measured on bench_pyharm's
-    fixed-frequency sweeps (13 and 11 points): chain 62 residuals + 47 with the Jacobian
-    before, 36 + 48 now; oscillator 32 + 42 before, 2 + 43 now; the same iterates (a
-    residual with the Jacobian differs from one without by rounding at most: the point
-    contacts' periodic-slider correction)."""
+    a Jacobian at the full step would mostly be thrown away). The iterates are those of
+    residual-only trials (a residual with the Jacobian differs from one without by rounding at
+    most: the point contacts' periodic-slider correction); evaluation counts:
+    benchmarks/README.md, 'Moved from the package's docstrings', hbm/start.py."""
     x = np.array(x0, dtype=float)
     shift = 0.0 if shift is None else shift
     rnorm = np.inf

@@ -37,8 +37,7 @@ class NonlinearElement(Protocol):
 
 # Coupling.support: the restricted map is used where it saves at least this many multiply-adds
 # in T^T (dF/dw) T; below, the two fancy-indexed copies (~9 us) cost more than they save
-# (measured: the 24 x 8 map of the friction oscillator, 3 us dense against 12.6 us restricted;
-# the 192 x 128 map of benchmarks/bench_pyharm.py's chain, 342 us against 69 us)
+# (timings: benchmarks/README.md, 'Moved from the package's docstrings', hbm/system.py)
 PRUNE_MIN_SAVING = 200_000
 
 

@@ -1,5 +1,5 @@
 """Damper design by nonlinear modes: the optimal damper mass at many excitation levels from
-EPMC backbones (issue 14, item 4).
+EPMC backbones.
 
 The resonance peak of a damper mass at an excitation level follows from its damped nonlinear
 mode (EPMC, :func:`bladedamp.nonlinear_mode`) by single-nonlinear-mode synthesis
@@ -22,8 +22,8 @@ full mode. Every evaluation is cached.
 
 The synthesis assumes one resonant mode, well separated (the 1F family of the tuned disk at one
 engine order), and a first-harmonic excitation; its peaks are within about 0.1 % of the
-one-harmonic FRF peaks of the reference disk (tests/test_backbone_design.py compares the
-optima with :func:`~bladedamp.studies.mass.optimal_mass`).
+one-harmonic FRF peaks of the reference disk (compared, with the optima of
+:func:`~bladedamp.studies.mass.optimal_mass`, in the test suite).
 """
 from __future__ import annotations
 
@@ -165,9 +165,8 @@ def optimal_mass_by_backbone(disk, excitation_levels, bracket=(1e-4, 1e-2), grid
     ``xatol`` : tolerance of the Brent search in log(mass) (5e-3: 0.5 % in mass);
     ``direction`` : tip DOF of the amplitude (0..2: u_x, u_y, u_z); ``harmonics``, ``n_points``,
     ``tol`` : of :func:`bladedamp.nonlinear_mode` and the tracking (30 points: the peaks are resolved by EPMC
-    solves at their roots, so they do not depend on the points; measured on the reference
-    cylinder at 0.9-1.1 g and 0.05-0.2 N: the same peaks to 7 digits with 30, 60 and 120 points,
-    while the interpolated ones move by up to 1e-3); ``f_range_hz`` : range of the undamped peak's FRF;
+    solves at their roots, so they do not depend on the points, while interpolated ones
+    would); ``f_range_hz`` : range of the undamped peak's FRF;
     ``track`` : a full mode for the first grid mass only; every other peak is tracked in mass
     from the nearest evaluated mass's EPMC solution at that level's peak
     (:func:`~bladedamp.hbm.nonlinear_modes.tracked_forced_peaks`: the same root of the synthesis

@@ -226,9 +226,10 @@ REDUCTION_TREND_TOLERANCE = 0.005   # 0.5 percentage points of reduction: the op
                                     # = 0.02 in log(mass) moves the optimum's peak by far less (a
                                     # parabola, ~ curvature * xatol^2), so a larger dip is physics
 MASS_TREND_TOLERANCE = 0.10         # 10 % of the optimal mass: at high EO the valley is flat;
-                                    # measured (cylinder, EO 7, optimum 11.43 g, 0.0354 mm): 0.9 and
-                                    # 1.1 times that mass give 0.0362 and 0.0358 mm, i.e. 0.05
-                                    # percentage points of reduction, so the mass is no better defined
+                                    # +-10 % of the optimal mass changes the reduction by a few
+                                    # hundredths of a percentage point there, so the mass is no
+                                    # better defined (benchmarks/README.md, 'Moved from the
+                                    # package's docstrings', studies/design.py)
 
 
 def eo_trend(values, tolerance: float, relative: bool = False) -> dict:

@@ -22,11 +22,10 @@ def with_mass(disk: TunedDisk, mass: float) -> TunedDisk:
 
 
 #: max_step of the peak searches' branches: the peak is solved on the branch by the peak condition
-#: (:meth:`TunedDisk.solve_peak`), which needs only points bracketing it. Measured on the reference
-#: cylinders 0.1-10 g and wedges 0.05-5 g (90-105 Hz, one harmonic), against the largest point
-#: of a branch at max_step 0.003 around the peak: solved at 0.1 within 8.3e-6, with 96-162
-#: points; the parabola at 0.05 (the searches' setting before) within 3.4e-5, with 185-317. At
-#: 0.2 (52-87 points) the solve is up to 2e-4 off: the one-harmonic curves are jagged at the
+#: (:meth:`TunedDisk.solve_peak`), which needs only points bracketing it: 0.1 is the largest step
+#: at which the solved peaks of the reference disks stay within 1e-5 of a dense branch's
+#: (benchmarks/README.md, 'Moved from the package's docstrings', studies/mass.py). At
+#: 0.2 the solve is up to 2e-4 off: the one-harmonic curves are jagged at the
 #: 1e-4 level near the peak (a contact point entering slip puts a kink in them), and a bracket
 #: that long can miss the highest of the humps.
 PEAK_SEARCH_MAX_STEP = 0.1
@@ -104,8 +103,8 @@ def _joinable(response) -> bool:
 
 # -- robust peak: the continuation settings tried, in order, when a frequency response fails --
 # Each run is capped at ROBUST_MAX_POINTS points: a complete branch at max_step 0.02 has about
-# 600-1100 points (measured on the reference disk), while a continuation trapped in a cycle
-# ran to the default 5000 points (72-124 s; cylinder 7.9 g at EO 7) before failing.
+# 600-1100 points on the reference disk, while a continuation trapped in a cycle runs to the
+# default 5000 points before failing.
 ROBUST_MAX_POINTS = 1500
 ROBUST_ATTEMPTS = ({"max_step": PEAK_SEARCH_MAX_STEP}, {"max_step": 0.05}, {"max_step": 0.02})
 
@@ -335,8 +334,8 @@ class MassOptimum(Saveable):
         return 1 - self.peak_amplitude / self.undamped_peak_amplitude
 
 
-GRID_PER_DECADE = 4   # bracketing grid density; the narrowest valley measured (cylinder, EO 7)
-                      # falls from 0.54 to 0.06 mm between 5 and 7.9 g, i.e. over 0.2 decade
+GRID_PER_DECADE = 4   # bracketing grid density: resolves a valley 0.2 decade wide, the narrowest
+                      # found (benchmarks/README.md, 'Moved from the package's docstrings', studies/mass.py)
 
 
 def log_mass_grid(bounds, grid_per_decade: float = GRID_PER_DECADE):

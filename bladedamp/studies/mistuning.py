@@ -173,8 +173,8 @@ def mistuned_response(disk: TunedDisk, kappa, f_range_hz=None, harmonics=(1,), m
 
     def sweep(lo, hi):
         # the upward sweep can leave the response curve at a branch point and follow another
-        # branch back out of the range (measured on 2 of 24 random 2 % disks: the cylinder's
-        # rolling branch, at max_step 0.05 or 0.1); the downward sweep, then both at half the
+        # branch back out of the range (as the cylinder's rolling branch can); the downward
+        # sweep, then both at half the
         # step, are tried before giving up
         failures = []
         for start, end, step in ((lo, hi, max_step), (hi, lo, max_step), (lo, hi, max_step / 2),
@@ -443,29 +443,26 @@ def plot_cases(cases: dict[str, MistuningCase], path=None):
 #: 0.4, tolerance 1e-6, chord corrector) and only brackets the peaks; the largest blade peaks are
 #: then solved on the response curve by the peak condition d|u|/dOmega = 0 (Newton at 1e-10,
 #: :meth:`bladedamp.MistunedDisk.solve_peaks`), every local maximum within
-#: MONTE_CARLO_PEAK_MARGIN of the largest. Measured against fine FRFs (max_step 0.05, tol 1e-10)
-#: on random 2 % reference disks (benchmarks/bench_mistuned.py, benchmarks/README.md): the largest
-#: blade peak within 6.7e-4 relative on 16 disks (2026-12-06; the code before the shared set-up
-#: and sparse Jacobian gave the same peaks to 4e-15) (parabola through the coarse branch alone:
-#: 5.8e-3, 1.4e-2 on one disk); above max_step 0.4 the points do not get fewer (57-81 per disk at 0.4 and at 1.0:
-#: the corrector's iterations limit the step); the other blades' peaks are parabola-refined on the
-#: coarse branch (weak blades on sharp local modes up to 1.9e-1 off on 16 disks).
+#: MONTE_CARLO_PEAK_MARGIN of the largest, which keeps the largest blade peak within 1e-3 of
+#: a fine FRF's; above max_step 0.4 the points do not get fewer (the corrector's iterations
+#: limit the step); the other blades' peaks are parabola-refined on the coarse branch, less
+#: accurate for weak blades on sharp local modes (benchmarks/README.md, 'Moved from the
+#: package's docstrings', studies/mistuning.py, 'MONTE_CARLO_MAX_STEP').
 MONTE_CARLO_MAX_STEP = 0.4
 MONTE_CARLO_TOL = 1e-6
 #: local maxima solved by the peak condition: within this fraction of the largest blade peak
-#: (parabola-refined). The parabola's error on the largest peak was at most 1.4e-2 on the coarse
-#: branch; at 2 % 3-4 maxima are solved per disk (25-35 ms), at 5 % 6-10 (40-120 ms)
+#: (parabola-refined): wider than the parabola's error on the largest peak on the coarse
+#: branch, narrow enough to solve only a few maxima per disk (benchmarks/README.md, 'Moved from
+#: the package's docstrings', studies/mistuning.py)
 MONTE_CARLO_PEAK_MARGIN = 0.02
 #: the chord corrector (continuation(chord=True)) and its step control: with chord steps a
-#: corrector takes more, cheaper iterations, so the step is kept up to 10 of them (measured on
-#: 8 random disks: 0.43-0.44 s per disk at 10, 0.45 at 12, and twice the points at the Newton
-#: corrector's 5)
+#: corrector takes more, cheaper iterations, so the step is kept up to 10 of them (the fastest
+#: of the counts tried: benchmarks/README.md, 'Moved from the package's docstrings',
+#: studies/mistuning.py)
 MONTE_CARLO_TARGET_ITERATIONS = 10
 #: :func:`auto_range`'s margin for the Monte Carlo's disks: 1 % (FRFs: 3 %). The peaks lie above
-#: f_01 min(kappa) (the damper stiffens the blades: 93-100 Hz for f_01 kappa in 90-99 Hz on
-#: random disks), so the wider range's first 3 Hz only cost points; a blade whose largest
-#: amplitude is at an end still widens the range. Measured on 16 random disks (seed 11): 0.37
-#: against 0.44 s per disk, the same largest peaks to 3e-4, none widened in vain or failed
+#: f_01 min(kappa) (the damper stiffens the blades), so the wider range's first 3 Hz only cost
+#: points; a blade whose largest amplitude is at an end still widens the range
 MONTE_CARLO_RANGE_MARGIN = 0.01
 
 
@@ -498,7 +495,7 @@ class MonteCarloResult(Saveable):
 
     kappa : (N, n) mistuning factors; peak_amplitude : (N, n) peak u_x of every blade [m] (with the
     default Monte Carlo settings, accurate for the largest blade of each disk; see
-    :data:`MONTE_CARLO_MAX_STEP` for the measured errors of the others);
+    :data:`MONTE_CARLO_MAX_STEP` for the accuracy of the others);
     peak_frequency_hz : (N, n); tuned_peak_amplitude [m]; errors : per disk, '' if it converged.
     meta : the settings, the executor, ``elapsed_s`` and ``harmonic_error_first_disk``: the harmonic
         error estimate of disk 0 (relative to its peak; None if it could not be estimated), the one
@@ -593,11 +590,11 @@ def local_worker_config():
     """Dask config context for local workers without Dask's MALLOC_TRIM_THRESHOLD_ (65536).
 
     With it glibc returns every freed large block to the system at once, so the dense Jacobians
-    (~0.8 MB each, several per residual) are mapped and zero-filled anew each time: measured
-    1.34x the time of a serial disk (0.94 of 4.4 s in the kernel), and more with two workers
-    faulting pages at once. The other settings (one BLAS thread per worker) are kept. And with
-    glibc's mmap threshold fixed at WORKER_MMAP_THRESHOLD those blocks always come from the heap
-    (measured serially: 0.40 s per disk against 0.45 s with glibc's default, the same 8 disks)."""
+    (~0.8 MB each, several per residual) are mapped and zero-filled anew each time, which
+    slows a worker against a serial disk, more with two workers faulting pages at once. The
+    other settings (one BLAS thread per worker) are kept. And with glibc's mmap threshold fixed
+    at WORKER_MMAP_THRESHOLD those blocks always come from the heap (timings:
+    benchmarks/README.md, 'Moved from the package's docstrings', studies/mistuning.py)."""
     import dask
 
     environ = dict(dask.config.get("distributed.nanny.pre-spawn-environ", default={}) or {})
@@ -647,7 +644,7 @@ def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f
     results = [None] * n_disks
     used = "serial"
     # the tuned full assembly, whose harmonic-balance set-up every disk shares (built once per
-    # process: measured 33 ms of a disk's ~0.4 s when each disk built its own)
+    # process, a noticeable share of a disk's time when each disk built its own)
     assembly = MistunedDisk.from_tuned(disk)
     if scheduler == "serial":
         for i, k in enumerate(kappas):

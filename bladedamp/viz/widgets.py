@@ -398,8 +398,8 @@ class DiskFRF:
 
 
 # half-width of the window of the contact state at resonance [Hz]: the coarse branch's peak is
-# within 0.01 Hz of the fine one; measured on the 1 g cylinder at gamma_R = 85 deg, contact_state
-# took 2.0 / 1.2 s on a +-1 / +-0.3 Hz window (loaded 2-core machine)
+# within 0.01 Hz of the fine one, and a narrower window is faster (benchmarks/README.md, 'Moved
+# from the package's docstrings', viz/widgets.py)
 CONTACT_STATE_WINDOW_HZ = 0.3
 
 
@@ -413,11 +413,9 @@ class DiskFRFCache:
     Parameters
     ----------
     f_range_hz : frequency window [Hz]
-    max_step : the continuation's largest step (scaled units, the window is 1). Measured against
-        the studies' step 0.05 on 0.1-10 g cylinders and wedges (10 disks, one loaded run): at
-        0.2 the peaks agree within 0.055 % in amplitude and 0.008 Hz, 43-87 points, 0.37-1.22 s
-        per response; 0.3 is 16 % faster (32-61 points) but 0.115 % off on the 1 g cylinder at
-        gamma_R = 45 deg (tests/test_widgets.py holds 0.1 % and 0.02 Hz)
+    max_step : the continuation's largest step (scaled units, the window is 1); at 0.2 the
+        peaks agree with the studies' step 0.05 within 0.1 % in amplitude and 0.02 Hz
+        (benchmarks/README.md, 'Moved from the package's docstrings', viz/widgets.py)
     max_entries : memoised responses kept (least recently used dropped)
     """
 
