@@ -82,3 +82,44 @@ def test_bad_input_raises_value_error_naming_the_parameter(case):
     make, name = CASES[case]
     with pytest.raises(ValueError, match=name):
         make()
+
+
+def _models_and_points():
+    """(name, system, x, omega [rad/s]) of the three model kinds, each built (and its start point
+    computed) before any residual is evaluated."""
+    import bladedamp as bd
+    disk = bd.reference_disk("cylinder", 1e-3)
+    omega = 2 * np.pi * 95.0
+    tuned = disk.hbm_system((0, 1, 2, 3))
+    kappa = 1.0 + 0.03 * np.random.default_rng(7).standard_normal(4)
+    ring = bd.MistunedDisk.from_tuned(disk, kappa, n_sector=4)
+    mistuned = ring.hbm_system((0, 1, 2, 3))
+    oscillator = bd.FrictionOscillator().hbm_system((1, 3))
+    x_osc = 0.1 * np.random.default_rng(8).standard_normal(oscillator.n_unknowns)
+    return [("tuned disk", tuned, disk.initial_guess(tuned, omega), omega),
+            ("mistuned disk", mistuned, ring.initial_guess(mistuned, omega), omega),
+            ("friction oscillator", oscillator, x_osc, 1.0)]
+
+
+def test_residuals_do_not_validate(monkeypatch):
+    """Validation at the boundary (issue 34 item 6): a model's inputs are checked when it is built,
+    so evaluating its residual, with or without the Jacobian, calls no function of
+    bladedamp.validation."""
+    from bladedamp import validation
+    cases = _models_and_points()
+    calls = []
+    for name in dir(validation):
+        f = getattr(validation, name)
+        if (not name.startswith("_") and callable(f) and not isinstance(f, type)
+                and getattr(f, "__module__", None) == validation.__name__):
+            def counted(*args, _f=f, _name=name, **kwargs):
+                calls.append(_name)
+                return _f(*args, **kwargs)
+            monkeypatch.setattr(validation, name, counted)
+    validation.positive("the counter itself", 1.0)
+    assert calls == ["positive"]
+    for name, system, x, omega in cases:
+        for jacobian in (True, False):
+            calls.clear()
+            system.residual(x, omega, jacobian=jacobian)
+            assert calls == [], f"{name} residual (jacobian={jacobian}) validated: {calls}"
