@@ -1,8 +1,12 @@
-"""Bad input is refused with a ValueError that names the parameter."""
+"""Bad input is refused with a ValueError that names the parameter; models validate when they are
+built, never inside their residuals (validation at the boundary)."""
+import warnings
+
 import numpy as np
 import pytest
 
-from bladedamp import ContactPatch, FrictionOscillator, HarmonicBasis, LinearNormalLaw, RoughnessNormalLaw
+from bladedamp import (ContactPatch, FrictionOscillator, HarmonicBasis, LinearNormalLaw, MistunedDisk,
+                       RoughnessNormalLaw, reference_disk, validation)
 from bladedamp.contact.point import PointContactElement
 from bladedamp.hbm.continuation import continuation
 
@@ -82,3 +86,67 @@ def test_bad_input_raises_value_error_naming_the_parameter(case):
     make, name = CASES[case]
     with pytest.raises(ValueError, match=name):
         make()
+
+
+def _models_and_points():
+    """(name, system, x, omega [rad/s]) of the three model kinds, each built (and its start point
+    computed) before any residual is evaluated."""
+    disk = reference_disk("cylinder", 1e-3)
+    omega = 2 * np.pi * 95.0
+    tuned = disk.hbm_system((0, 1, 2, 3))
+    kappa = 1.0 + 0.03 * np.random.default_rng(7).standard_normal(4)
+    ring = MistunedDisk.from_tuned(disk, kappa, n_sector=4)
+    mistuned = ring.hbm_system((0, 1, 2, 3))
+    oscillator = FrictionOscillator().hbm_system((1, 3))
+    x_osc = 0.1 * np.random.default_rng(8).standard_normal(oscillator.n_unknowns)
+    return [("tuned disk", tuned, disk.initial_guess(tuned, omega), omega),
+            ("mistuned disk", mistuned, ring.initial_guess(mistuned, omega), omega),
+            ("friction oscillator", oscillator, x_osc, 1.0)]
+
+
+def _count_validation_calls(monkeypatch) -> list:
+    """The list to which every call of a public function of bladedamp.validation appends its name."""
+    calls = []
+    for name in dir(validation):
+        f = getattr(validation, name)
+        if (not name.startswith("_") and callable(f) and not isinstance(f, type)
+                and getattr(f, "__module__", None) == validation.__name__):
+            def counted(*args, _f=f, _name=name, **kwargs):
+                calls.append(_name)
+                return _f(*args, **kwargs)
+            monkeypatch.setattr(validation, name, counted)
+    validation.positive("the counter itself", 1.0)
+    assert calls == ["positive"]
+    calls.clear()
+    return calls
+
+
+def test_residuals_do_not_validate(monkeypatch):
+    """Validation at the boundary (issue 34 item 6): a model's inputs are checked when it is built,
+    so evaluating its residual, with or without the Jacobian, calls no function of
+    bladedamp.validation."""
+    cases = _models_and_points()
+    calls = _count_validation_calls(monkeypatch)
+    for name, system, x, omega in cases:
+        for jacobian in (True, False):
+            calls.clear()
+            system.residual(x, omega, jacobian=jacobian)
+            assert calls == [], f"{name} residual (jacobian={jacobian}) validated: {calls}"
+
+
+def test_continuation_points_do_not_validate(monkeypatch):
+    """The continuation's per-point code (predictor, corrector, step control, the model's point
+    callbacks) validates nothing: a sweep's validation calls (its options and start, once) do not
+    grow with its number of points."""
+    oscillator = FrictionOscillator()
+    calls = _count_validation_calls(monkeypatch)
+    counts, points = [], []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for max_step in (0.05, 0.01):
+            calls.clear()
+            response = oscillator.frequency_response(0.5, 1.5, harmonics=(1, 3), max_step=max_step)
+            points.append(response.frequency_hz.size)
+            counts.append(len(calls))
+    assert points[1] > 3 * points[0]
+    assert counts[0] == counts[1], f"validation calls {counts} for {points} points"
