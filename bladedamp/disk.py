@@ -38,7 +38,7 @@ from .contact.patch import dof_jacobian
 from .contact.point import (MAX_PASSES, PERIODIC_TOL, PointContactSamples, damper_contact_forces, normal_law_parameters,
                             point_contact_forces)
 from .damper.geometry import CylinderDamper, DamperGeometry, WedgeDamper
-from .damper.kinetics import centrifugal_force, seat
+from .damper.kinetics import centrifugal_force, retention_stiffness, seat
 from .hbm.accuracy import HARMONIC_TOLERANCE, AccuracyWarning, converged_response
 from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_MAX_STEP, DEFAULT_POINT_BUDGET, Branch, Budget, continuation
 from .hbm.nonlinear_modes import linear_stuck_mode
@@ -523,7 +523,8 @@ class TunedDisk:
 
         ``static_retention``: with a static harmonic, frictionless seating leaves the damper's
         axial position (and the cylinder's roll angle) free; a spring of this fraction of the
-        normal contact stiffness on the static harmonic of the damper fixes them. It must not
+        normal contact stiffness on the static harmonic of the damper fixes them
+        (:func:`bladedamp.damper.retention_stiffness`). It must not
         be too weak: the mean tangential force left by slip onset (frictional shakedown) is
         independent of the mean position, so only this spring balances it; at 1e-6 the
         reference cylinder's (0, 1, 2, 3) continuation stalls at slip onset (~95.0 Hz, Newton
@@ -569,7 +570,7 @@ class TunedDisk:
             if basis.has_static:
                 k_n = sum(p.normal_law.stiffness for p in geometry.patches)
                 static_stiffness = np.zeros((n, n))
-                static_stiffness[nm:, nm:] = static_retention * k_n * np.diag([1, 1, 1, 1e-4, 1e-4, 1e-4])
+                static_stiffness[nm:, nm:] = retention_stiffness(static_retention, k_n)
 
         centrifugal = self._centrifugal_law() if self.has_damper and basis.has_static else None
 

@@ -58,7 +58,7 @@ from . import validation
 from .blade import PLATFORM_ANGLE, ModalBlade
 from .contact.laws import LinearNormalLaw
 from .contact.point import MAX_PASSES, PERIODIC_TOL
-from .damper.kinetics import seat
+from .damper.kinetics import retention_stiffness, seat
 from .disk import (AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION, DAMPER_DOFS, DEFAULT_DAMPER_RADIUS,
                    STOP_CHECK_OFFSET_HZ,
                    DamperContacts, TunedDisk, contact_point_maps, contact_rows, damper_weighted_scales,
@@ -944,7 +944,7 @@ class MistunedDisk:
                                            contact_point_maps(g, offsets, self.blades[k], self.blades[(k + 1) % s])))
             if static is not None:
                 k_n = sum(p.normal_law.stiffness for p in g.patches)
-                static[sl, sl] = static_retention * k_n * np.diag([1, 1, 1, 1e-4, 1e-4, 1e-4])
+                static[sl, sl] = retention_stiffness(static_retention, k_n)
         dphi = self.interblade_phase
 
         L = contacts[0].n_local if contacts else 12           # local coordinates per damper
