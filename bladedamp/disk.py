@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg
+from numba import njit
 
 from . import validation
 from .blade import PLATFORM_ANGLE, ModalBlade
@@ -38,7 +39,7 @@ from .contact.patch import dof_jacobian
 from .contact.point import (MAX_PASSES, PERIODIC_TOL, PointContactSamples, damper_contact_forces, normal_law_parameters,
                             point_contact_forces)
 from .damper.geometry import CylinderDamper, DamperGeometry, WedgeDamper
-from .damper.kinetics import centrifugal_force, seat
+from .damper.kinetics import centrifugal_force, retention_stiffness, seat
 from .hbm.accuracy import HARMONIC_TOLERANCE, AccuracyWarning, converged_response
 from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_MAX_STEP, DEFAULT_POINT_BUDGET, Branch, Budget, continuation
 from .hbm.nonlinear_modes import linear_stuck_mode
@@ -198,6 +199,61 @@ def contact_rows(contact_local: int, n_modes: int):
     return w, np.arange(6, m), np.arange(m + 6, 2 * m)
 
 
+#: Euler's identity needs the approach's omega-derivative to be kappa_d times the approach,
+#: damper by damper, to this fraction of its largest entry (the seating is homogeneous in F_CG)
+HOMOGENEOUS_TOL = 1e-12
+
+
+@njit(cache=True)
+def euler_rate(offsets, doffsets, blocks, local, force, domega):
+    """d force / d omega (C, n_d, L) [N s/rad] into ``domega`` by Euler's identity for linear
+    normal laws, when the static approach's omega-derivative is homogeneous: doffsets = kappa_d
+    offsets (n_d, 2, P) [m, m s/rad] for every damper d to :data:`HOMOGENEOUS_TOL` of its
+    largest entry (kappa_d = doffsets_d . offsets_d / |offsets_d|^2, 0 for a damper without
+    approach). The forces (C, n_d, L) [N] are then homogeneous of degree 1 in (local, offsets),
+    so d force / d omega = kappa_d (force - J local), J the Jacobian blocks (n_d, C, L, C, L)
+    [N/m] and local (C, n_d, L) [m]. Returns False (domega not written) if the approach is not
+    homogeneous.
+
+    The one implementation for both disk models: the mistuned ring's dampers side by side
+    (:meth:`~bladedamp.mistuned.AssemblyContacts.evaluate`, n_d dampers), and the tuned
+    sector's single damper (:meth:`DamperContacts.harmonic_forces`, n_d = 1: its (C, L) force
+    and local coordinates and its dense (C L, C L) Jacobian are the same memory viewed with a
+    damper axis of length one, so no copy is made)."""
+    nd = offsets.shape[0]
+    kappa = np.empty(nd)
+    for d in range(nd):
+        norm = 0.0
+        dot = 0.0
+        for q in range(offsets.shape[1]):
+            for p in range(offsets.shape[2]):
+                norm += offsets[d, q, p] * offsets[d, q, p]
+                dot += doffsets[d, q, p] * offsets[d, q, p]
+        kappa[d] = dot / norm if norm > 0 else 0.0
+    worst = 0.0
+    largest = 0.0
+    for d in range(nd):
+        for q in range(offsets.shape[1]):
+            for p in range(offsets.shape[2]):
+                off = abs(doffsets[d, q, p] - kappa[d] * offsets[d, q, p])
+                if not off <= worst:            # (a NaN stays)
+                    worst = off
+                largest = max(largest, abs(doffsets[d, q, p]))
+    if not worst <= HOMOGENEOUS_TOL * largest:
+        return False
+    C, L = force.shape[0], force.shape[2]
+    for a in range(C):
+        for d in range(nd):
+            for m in range(L):
+                jw = 0.0
+                for b in range(C):
+                    for n in range(L):
+                        jw += blocks[d, a, m, b, n] * local[b, d, n]
+                domega[a, d, m] = (force[a, d, m] - jw) * kappa[d]
+    return True
+
+
+
 @dataclass
 class DamperContacts:
     """Both contacts of one damper as a harmonic-balance element. Forces are those on the
@@ -342,13 +398,16 @@ class DamperContacts:
         domega = None
         if np.any(doffsets != 0):
             # the preload follows the rotor speed (one harmonic: the static approach scales with F_CG)
-            kappa = float(np.sum(doffsets * offsets) / np.sum(offsets * offsets))
+            C, L = basis.n_coeffs, self.n_local
             linear = all(isinstance(p.normal_law, LinearNormalLaw) for p in self.geometry.patches)
-            if linear and np.abs(doffsets - kappa * offsets).max() <= 1e-12 * np.abs(doffsets).max():
+            rate = np.empty((C, 1, L))
+            if linear and euler_rate(offsets[None], doffsets[None], jac.reshape(1, C, L, C, L),
+                                     np.asarray(local, dtype=float).reshape(C, 1, L), force.reshape(C, 1, L), rate):
                 # linear normal law: the forces are homogeneous of degree 1 in (w, approach) (springs
                 # and the Coulomb limit scale alike), so Euler's identity J w + (dF/da) a = F gives
-                # dF/dOmega = (F - J w) (da/dOmega) / a without another AFT pass
-                domega = (force.ravel() - jac @ local.ravel()) * kappa
+                # dF/dOmega = (F - J w) (da/dOmega) / a without another AFT pass (euler_rate, the
+                # mistuned ring's kernel with one damper)
+                domega = rate.ravel()
             else:
                 # central difference in omega, both ends without the Jacobian so that both take
                 # the same return-map passes (two extra AFT passes)
@@ -523,7 +582,8 @@ class TunedDisk:
 
         ``static_retention``: with a static harmonic, frictionless seating leaves the damper's
         axial position (and the cylinder's roll angle) free; a spring of this fraction of the
-        normal contact stiffness on the static harmonic of the damper fixes them. It must not
+        normal contact stiffness on the static harmonic of the damper fixes them
+        (:func:`bladedamp.damper.retention_stiffness`). It must not
         be too weak: the mean tangential force left by slip onset (frictional shakedown) is
         independent of the mean position, so only this spring balances it; at 1e-6 the
         reference cylinder's (0, 1, 2, 3) continuation stalls at slip onset (~95.0 Hz, Newton
@@ -569,7 +629,7 @@ class TunedDisk:
             if basis.has_static:
                 k_n = sum(p.normal_law.stiffness for p in geometry.patches)
                 static_stiffness = np.zeros((n, n))
-                static_stiffness[nm:, nm:] = static_retention * k_n * np.diag([1, 1, 1, 1e-4, 1e-4, 1e-4])
+                static_stiffness[nm:, nm:] = retention_stiffness(static_retention, k_n)
 
         centrifugal = self._centrifugal_law() if self.has_damper and basis.has_static else None
 

@@ -58,12 +58,12 @@ from . import validation
 from .blade import PLATFORM_ANGLE, ModalBlade
 from .contact.laws import LinearNormalLaw
 from .contact.point import MAX_PASSES, PERIODIC_TOL
-from .damper.kinetics import seat
+from .damper.kinetics import retention_stiffness, seat
 from .disk import (AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION, DAMPER_DOFS, DEFAULT_DAMPER_RADIUS,
                    STOP_CHECK_OFFSET_HZ,
                    DamperContacts, TunedDisk, contact_point_maps, contact_rows, damper_weighted_scales,
-                   fused_point_map_forces, interblade_phase, peak_checked_response, point_map_forces, rest_response,
-                   rotor_speed_in_hz, time_at_peak, time_check_beyond, with_stop_check)
+                   fused_point_map_forces, euler_rate, interblade_phase, peak_checked_response, point_map_forces,
+                   rest_response, rotor_speed_in_hz, time_at_peak, time_check_beyond, with_stop_check)
 from .hbm.accuracy import HARMONIC_TOLERANCE
 from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_MAX_STEP, DEFAULT_POINT_BUDGET, Branch, Budget, continuation
 from .hbm.start import robust_start
@@ -289,8 +289,8 @@ class AssemblyContacts:
             return force, None, None
         domega = None
         if doffsets.any():
-            # as DamperContacts.harmonic_forces: Euler's identity for linear normal laws, else
-            # a central difference in omega of all dampers at once
+            # as DamperContacts.harmonic_forces (the same kernel, disk.euler_rate): Euler's identity
+            # for linear normal laws, else a central difference in omega of all dampers at once
             domega = np.empty(force.shape)
             if not (self.linear_normal_laws and euler_rate(offsets, doffsets, blocks, local, force, domega)):
                 h = 1e-6 * omega
@@ -346,56 +346,6 @@ def _rotated_blocks(R, blocks):
                             for n in range(L):
                                 out[d, a, m, e, n] += w * blocks[d, b, m, c, n]
     return out
-
-
-#: Euler's identity needs the approach's omega-derivative to be kappa_d times the approach,
-#: damper by damper, to this fraction of its largest entry (the seating is homogeneous in F_CG)
-HOMOGENEOUS_TOL = 1e-12
-
-
-@njit(cache=True)
-def euler_rate(offsets, doffsets, blocks, local, force, domega):
-    """d force / d omega (C, n_d, L) [N s/rad] into ``domega`` by Euler's identity for linear
-    normal laws, when the static approach's omega-derivative is homogeneous: doffsets = kappa_d
-    offsets (n_d, 2, P) [m, m s/rad] for every damper d to :data:`HOMOGENEOUS_TOL` of its
-    largest entry (kappa_d = doffsets_d . offsets_d / |offsets_d|^2, 0 for a damper without
-    approach). The forces (C, n_d, L) [N] are then homogeneous of degree 1 in (local, offsets),
-    so d force / d omega = kappa_d (force - J local), J the Jacobian blocks (n_d, C, L, C, L)
-    [N/m] and local (C, n_d, L) [m]. Returns False (domega not written) if the approach is not
-    homogeneous. One call for what numpy did in eight calls: evaluate's own time with the
-    Jacobian (the contact kernel's left out) 20 against 43 us on the 16-blade disk; the same
-    numbers to rounding (sums in another order, tested to 1e-12)."""
-    nd = offsets.shape[0]
-    kappa = np.empty(nd)
-    for d in range(nd):
-        norm = 0.0
-        dot = 0.0
-        for q in range(offsets.shape[1]):
-            for p in range(offsets.shape[2]):
-                norm += offsets[d, q, p] * offsets[d, q, p]
-                dot += doffsets[d, q, p] * offsets[d, q, p]
-        kappa[d] = dot / norm if norm > 0 else 0.0
-    worst = 0.0
-    largest = 0.0
-    for d in range(nd):
-        for q in range(offsets.shape[1]):
-            for p in range(offsets.shape[2]):
-                off = abs(doffsets[d, q, p] - kappa[d] * offsets[d, q, p])
-                if not off <= worst:            # (a NaN stays)
-                    worst = off
-                largest = max(largest, abs(doffsets[d, q, p]))
-    if not worst <= HOMOGENEOUS_TOL * largest:
-        return False
-    C, L = force.shape[0], force.shape[2]
-    for a in range(C):
-        for d in range(nd):
-            for m in range(L):
-                jw = 0.0
-                for b in range(C):
-                    for n in range(L):
-                        jw += blocks[d, a, m, b, n] * local[b, d, n]
-                domega[a, d, m] = (force[a, d, m] - jw) * kappa[d]
-    return True
 
 
 @dataclass
@@ -944,7 +894,7 @@ class MistunedDisk:
                                            contact_point_maps(g, offsets, self.blades[k], self.blades[(k + 1) % s])))
             if static is not None:
                 k_n = sum(p.normal_law.stiffness for p in g.patches)
-                static[sl, sl] = static_retention * k_n * np.diag([1, 1, 1, 1e-4, 1e-4, 1e-4])
+                static[sl, sl] = retention_stiffness(static_retention, k_n)
         dphi = self.interblade_phase
 
         L = contacts[0].n_local if contacts else 12           # local coordinates per damper

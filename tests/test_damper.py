@@ -12,7 +12,8 @@ import dataclasses
 import numpy as np
 import pytest
 
-from bladedamp.damper import ContactProperties, CylinderDamper, WedgeDamper, centrifugal_force, seat
+from bladedamp.damper import (ContactProperties, CylinderDamper, WedgeDamper, centrifugal_force, retention_stiffness,
+                              seat)
 from bladedamp.reference import reference_damper, reference_disk
 
 # (gamma_L, gamma_R) [deg]: symmetric (the paper's reference), and asymmetric both ways
@@ -350,7 +351,29 @@ def test_seating_scales_with_the_preload():
     (lambda: centrifugal_force(-1e-3, 0.1, 95.0, 1), "damper mass"),
     (lambda: seat(CylinderDamper(1e-3).geometry(0.5, 0.5), -1.0), "radial_force"),
     (lambda: ContactProperties(friction_coefficient=-0.1), "friction_coefficient"),
+    (lambda: retention_stiffness(-1e-4, 1e6), "static_retention"),
+    (lambda: retention_stiffness(1e-4, -1e6), "normal_stiffness"),
 ])
 def test_bad_damper_input_raises_value_error_naming_the_parameter(call, match):
     with pytest.raises(ValueError, match=match):
         call()
+
+
+def test_retention_spring_holds_a_rotation_as_the_translation_at_10_mm():
+    """The retention spring's restoring force and moment on a rigid displacement u [m] and
+    rotation theta [rad] of the damper, written by hand: F = -r k_N u, M = -r k_N l^2 theta with
+    l = 10 mm (the same spring pulling on a point 10 mm from the centre, transverse to the
+    rotation axis), r the retention fraction and k_N the damper's normal contact stiffness."""
+    r, k_n, lever = 1e-4, 3.7e6, 0.01
+    u, theta = np.array([1e-6, -2e-6, 3e-6]), np.array([4e-4, -5e-4, 6e-4])
+    K = retention_stiffness(r, k_n)
+    restoring = -K @ np.concatenate([u, theta])
+    np.testing.assert_allclose(restoring[:3], -r * k_n * u, rtol=1e-15)
+    for axis in range(3):
+        # a point at `lever` from the centre, perpendicular to the axis, moves by theta x rho
+        rho = lever * np.eye(3)[(axis + 1) % 3]
+        rotation = np.zeros(3)
+        rotation[axis] = theta[axis]
+        moment = np.cross(rho, -r * k_n * np.cross(rotation, rho))
+        np.testing.assert_allclose(restoring[3 + axis], moment[axis], rtol=1e-12)
+    assert np.array_equal(K, K.T) and np.all(K == np.diag(np.diag(K)))

@@ -655,11 +655,11 @@ def test_residual_kernels_give_the_numbers_of_the_scipy_operations(harmonics):
 
 def test_euler_rate_is_the_numpy_formula_to_rounding():
     """AssemblyContacts.evaluate's d force / d omega by Euler's identity (one numba call,
-    mistuned.euler_rate) equals the numpy formula it replaced, kappa_d = doffsets_d . offsets_d
+    disk.euler_rate) equals the numpy formula it replaced, kappa_d = doffsets_d . offsets_d
     / |offsets_d|^2 and (force - J local) kappa, to 1e-12 of its largest entry at a stuck and a
     slipping state; an approach rate that is not homogeneous (one entry moved) is refused,
     domega left as it was, and evaluate takes the central difference there."""
-    from bladedamp.mistuned import euler_rate
+    from bladedamp.disk import euler_rate
 
     md = MistunedDisk.from_tuned(reference_disk("cylinder", 1e-3), mt.random_kappa(16, 0.02, seed=5))
     system = md.hbm_system((1,))

@@ -39,6 +39,36 @@ def centrifugal_force(mass: float, radius: float, f_hz: float | None = None, eng
     return mass * radius * omega_excitation ** 2 / engine_order ** 2, 2 * mass * radius * omega_excitation / engine_order ** 2
 
 
+#: The retention spring's rotational stiffness per unit translational stiffness [m^2]: l^2 with
+#: l = 10 mm, which turns N/m into N m/rad. The rotational spring is the translational one acting
+#: at 10 mm from the damper's centre (the order of a damper's dimensions: the reference cylinder
+#: is 2 mm in radius and 20 mm long), so a rotation theta is held as a displacement l theta is.
+RETENTION_LEVER_ARM_SQUARED = 1e-4
+
+
+def retention_stiffness(static_retention: float, normal_stiffness: float) -> np.ndarray:
+    """The static retention spring of one damper: the (6, 6) stiffness on the static harmonic of
+    its rigid-body coordinates (u_x, u_y, u_z [m], theta_x, theta_y, theta_z [rad]), diagonal,
+
+        K_ret = r k_N diag(1, 1, 1, l^2, l^2, l^2),
+
+    r = ``static_retention`` [-] (>= 0), k_N = ``normal_stiffness`` [N/m] (the sum of the normal
+    contact stiffnesses of the damper's patches), l^2 = :data:`RETENTION_LEVER_ARM_SQUARED`
+    [m^2]: N/m on the translations, N m/rad on the rotations.
+
+    Frictionless seating leaves the damper's axial position (and a cylinder's roll angle)
+    undetermined; this artificial spring fixes them. It must be weak against the contact (the
+    response should be the weak-spring limit) but not vanishing: after slip onset only this
+    spring balances the mean tangential force (frictional shakedown), which does not depend on
+    the mean position (see ``TunedDisk.hbm_system``). The one definition for the tuned disk's
+    sector and every damper of the mistuned assembly.
+    """
+    r = validation.nonnegative("static_retention (fraction of the normal contact stiffness)", static_retention)
+    k_n = validation.nonnegative("normal_stiffness [N/m]", normal_stiffness)
+    l2 = RETENTION_LEVER_ARM_SQUARED
+    return r * k_n * np.diag([1, 1, 1, l2, l2, l2])
+
+
 def seat(geometry: DamperGeometry, radial_force: float, tol: float = 1e-12, max_iter: int = 50):
     """Static seating of the damper under a radial force, frictionless, rigid platforms.
 
