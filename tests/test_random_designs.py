@@ -332,12 +332,15 @@ def all_designs():
     return [disk_design(i) for i in range(N_DISKS)] + [oscillator_design(i) for i in range(N_OSCILLATORS)]
 
 
-def run_all(designs, processes=None):
+def run_all(designs, processes=None, run=None):
+    """``run`` (default run_design; run_mistuned for the mistuned section) of every design, on
+    ``processes`` processes (default: up to 2)."""
+    run = run or run_design
     processes = processes or min(2, os.cpu_count() or 1)
     if processes <= 1:
-        return [run_design(d) for d in designs]
+        return [run(d) for d in designs]
     with ProcessPoolExecutor(processes) as pool:
-        return list(pool.map(run_design, designs, chunksize=1))
+        return list(pool.map(run, designs, chunksize=1))
 
 
 def summary(results) -> tuple[float, float, str]:
@@ -418,7 +421,7 @@ def test_random_mistuned_designs():
     """Issue 32 item 7: N_MISTUNED random mistuned disks; prints the shares of each status and
     fails on any complete-and-verified answer that the time integration at its peak contradicts
     (but those of KNOWN_MISTUNED_CONTRADICTIONS). CPU times are printed, not asserted."""
-    results = run_all_mistuned([mistuned_design(i) for i in range(N_MISTUNED)])
+    results = run_all([mistuned_design(i) for i in range(N_MISTUNED)], run=run_mistuned)
     text = mistuned_summary(results)
     print("\n" + text)
     contradicted = {r["kind"][1] for r in results if r["contradicted"]}
@@ -426,14 +429,6 @@ def test_random_mistuned_designs():
     # a known contradiction that no longer shows is printed, not failed: whether a design reaches the
     # end within its CPU budget (and so is checked at all) depends on the machine's speed
     print("known contradictions not seen in this run:", sorted(set(KNOWN_MISTUNED_CONTRADICTIONS) - contradicted))
-
-
-def run_all_mistuned(designs, processes=None):
-    processes = processes or min(2, os.cpu_count() or 1)
-    if processes <= 1:
-        return [run_mistuned(d) for d in designs]
-    with ProcessPoolExecutor(processes) as pool:
-        return list(pool.map(run_mistuned, designs, chunksize=1))
 
 
 def stopped_disk(i: int):
@@ -664,7 +659,7 @@ if __name__ == "__main__":
     t = time.perf_counter()
     if "--mistuned" in sys.argv:
         # python tests/test_random_designs.py [processes] --mistuned: the mistuned section's shares
-        print(mistuned_summary(run_all_mistuned([mistuned_design(i) for i in range(N_MISTUNED)], procs)))
+        print(mistuned_summary(run_all([mistuned_design(i) for i in range(N_MISTUNED)], procs, run=run_mistuned)))
     elif "--default" in sys.argv:
         indices = [int(i) for i in sys.argv[sys.argv.index("--default") + 1].split(",")]
         with ProcessPoolExecutor(procs or 2) as pool:
