@@ -1,7 +1,7 @@
 """Blade data from FE: modal data files (npz, CSV) and reduced FE matrices (ModalBlade.from_matrices)."""
 import dataclasses
-from pathlib import Path
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -423,3 +423,27 @@ def test_solid_blade_file_saved_before_the_blade_package_loads():
             points = fresh.contact_faces[side].points[::7]                 # (P, 3) samples on the face
             np.testing.assert_allclose(blade.platform_displacements(side, points),
                                        fresh.platform_displacements(side, points), rtol=1e-6, atol=1e-6 * scale)
+
+
+def test_a_blade_file_names_its_class_as_every_saved_result_and_untagged_files_still_read(tmp_path):
+    """One save/load for results and blades: ``blade.save`` writes the bladedamp entry naming the
+    class (read back by bladedamp.load and ModalBlade.from_file); a modal .npz without it and
+    without a format (written by hand) is a ModalBlade for from_file, not a result for load; a
+    saved result is not a blade (WrongKindError, a ValueError, naming the file)."""
+    import json
+
+    from bladedamp.io import META_KEY, WrongKindError
+
+    path = reference_blade().save(tmp_path / "blade.npz")
+    with np.load(path, allow_pickle=False) as data:
+        meta = json.loads(str(data[META_KEY]))
+        arrays = {k: data[k] for k in data.files if k not in (META_KEY, "format")}
+    assert meta["class"] == f"{ModalBlade.__module__}:ModalBlade" and meta["layout"] == "arrays"
+    hand = tmp_path / "hand.npz"
+    np.savez(hand, **arrays)
+    assert_same_blade(ModalBlade.from_file(hand), reference_blade())
+    with pytest.raises(ValueError, match="hand.npz is not a saved bladedamp result"):
+        bladedamp.load(hand)
+    result = BLADE_DATA.parent / "oscillator_response_v1.npz"
+    with pytest.raises(WrongKindError, match="oscillator_response_v1.npz: holds a FrequencyResponse, not a ModalBlade"):
+        ModalBlade.from_file(result)
