@@ -52,7 +52,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     print(f"bench_flexible_platform {datetime.date.today()}  {platform.machine()}, {os.cpu_count()} cores, "
           f"Python {platform.python_version()}, load average {os.getloadavg()[0]:.1f}")
-    blade = bd.ModalBlade.from_solid(element_size=args.element_size)
+    blade = bd.solid.solid_blade(element_size=args.element_size)
     print(f"solid blade: {blade.solid_info['n_dofs']} DOF, element size {1e3 * args.element_size:g} mm")
     print(f"{'damper':9s} {'platform':9s} {'n_local':>7s} {'residual+J [ms]':>16s} {'FRF H=(1,) [s]':>15s} "
           f"{'FRF H=(0..3) [s]':>17s} {'peak (0..3) [mm]':>17s}")

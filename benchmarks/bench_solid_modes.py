@@ -1,4 +1,4 @@
-"""Solid-blade benchmark: modal analysis of the reference solid blade (bladedamp.solid).
+"""Solid-blade benchmark: modal analysis of the reference solid blade (bladedamp.blade.solid).
 
 Run from the repository root (needs the fe extra, ``pip install -e '.[fe]'``)::
 
@@ -9,14 +9,14 @@ Run from the repository root (needs the fe extra, ``pip install -e '.[fe]'``)::
 
 Case: the reference blade (reference_blade_geometry with geometry.py's platform, 35 deg contact
 faces), quadratic tetrahedra, root clamped, the 10 lowest modes (the search set of
-``ModalBlade.from_solid``). Element size 7.5 mm gives about 22 100 DOF (4 300 tetrahedra of the
-mirrored quarter mesh; the default 6 mm of from_solid gives 28 800). Timed separately, each
+``bladedamp.blade.solid.solid_blade``). Element size 7.5 mm gives about 22 100 DOF (4 300 tetrahedra of the
+mirrored quarter mesh; the default 6 mm of solid_blade gives 28 800). Timed separately, each
 the best of ``--repeat`` runs after a warm-up (imports, gmsh start-up): meshing (gmsh, geometry
 and tetrahedra), assembly (scikit-fem K and M of the P2 elements), eigen-solution (clamping,
 SuperLU factorisation of K - sigma M, ARPACK shift-invert, Rayleigh-Ritz). Target: the whole
 modal analysis under 30 s on the 2-core machine.
 
-``--stl``: the same blade read as a user's geometry (bladedamp.solid.SurfaceBladeGeometry): the
+``--stl``: the same blade read as a user's geometry (bladedamp.blade.solid.SurfaceBladeGeometry): the
 parametric solid's boundary at 4.5 mm written to an STL in mm, read back with plane selectors for
 the root and the contact faces, and meshed by gmsh from that surface (classify, reparametrise,
 remesh, tetrahedra; no mirror symmetry, so about 10 % more DOF at the same element size).

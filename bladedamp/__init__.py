@@ -14,10 +14,10 @@ import cycle). From the top:
     disk models      mistuned > disk | oscillator
     analyses         hbm.stability > hbm.monodromy > timedomain | hbm.accuracy | hbm.nonlinear_modes
                      > response (the FRF result)
-    blade            solid | geometry (3D) > blade (modal blade, beam, files, the reference blade)
-                     > fe_formats | measurement (readers)
+    blade            geometry (3D) > blade: the package blade.solid > blade.reference > blade.modal
+                     (the modal blade and its files) > blade.beam > fe_formats | measurement (readers)
     contact, damper  damper > contact
-    results on disk  io (save / load by class name; blade file tags)
+    results on disk  io (save / load of results and blades by class name; old blade files by tag)
     engine           hbm.peaks > hbm.continuation | start | system | elements > hbm.fourier | linsolve
     utilities        plotting | progress > palette | validation | lazy | _numba_cache
 
@@ -26,8 +26,7 @@ reach a model through the protocols it implements
 (:class:`bladedamp.hbm.monodromy.PeriodMapModel`, :class:`~bladedamp.hbm.monodromy.AssemblyModel`),
 and the engine core (Fourier, residual, elements, Newton, continuation, linear solvers) imports
 nothing outside hbm but validation. This package (its public names below) sits above every
-layer. Two back arrows are left, listed in the contract's ``ignore_imports``:
-``blade -> solid`` (``ModalBlade.from_solid``, a SolidModalBlade read by ``from_file``) and
+layer. One back arrow is left, listed in the contract's ``ignore_imports``:
 ``disk -> mistuned`` (a TunedDisk's full assembly is ``MistunedDisk.from_tuned``).
 """
 from .lazy import lazy_attributes
@@ -42,6 +41,7 @@ __version__ = "0.1.0"
 # --help, worker start-up) and loads numpy, scipy and numba only with the first model.
 _LAZY = {
     "BeamBladeGeometry": "blade", "ModalBlade": "blade", "reference_blade": "blade",
+    "solid": "blade",            # the module bladedamp.blade.solid (``from bladedamp import solid``)
     "ContactPatch": "contact", "LinearNormalLaw": "contact", "RoughnessNormalLaw": "contact",
     "ContactProperties": "damper", "CylinderDamper": "damper", "WedgeDamper": "damper",
     "TunedDisk": "disk", "DiskResponse": "disk",

@@ -505,7 +505,7 @@ def _check_platform_angle_option(design, option: str, angles_deg) -> None:
     empty: not given) with a blade whose flexible platforms fix the angles: a solid FE blade
     ([blade] model = "solid", surface_file, or a solid blade's modal_file) has its contact faces
     at its geometry's platform angles, and its FE field at a contact point holds only for the
-    disk at those angles (:meth:`bladedamp.solid.SolidModalBlade.platform_displacements`), so
+    disk at those angles (:meth:`bladedamp.blade.solid.SolidModalBlade.platform_displacements`), so
     a study at other angles would stop at its first frequency response."""
     blade = design.disk.blade
     if not angles_deg or not getattr(blade, "flexible_platform", False):

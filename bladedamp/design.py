@@ -17,7 +17,7 @@ node tables ``[blade.test.OL]``, ``[blade.test.OR]``, ``[blade.test.tip]``, ``[b
 :meth:`bladedamp.blade.ModalBlade.from_test`) or a closed surface mesh meshed as a
 solid FE blade (``[blade] model = "solid"``, ``surface_file``, ``surface_units`` and the named
 regions ``[blade.regions.clamp]``, ``[blade.regions.OL]``, ``[blade.regions.OR]``, optionally
-``[blade.regions.tip]``, each a plane or its own surface file; :class:`bladedamp.solid.SurfaceBladeGeometry`);
+``[blade.regions.tip]``, each a plane or its own surface file; :class:`bladedamp.blade.solid.SurfaceBladeGeometry`);
 its OL / OR faces then set the disk's platform angles.
 
 Inside, everything is SI (m, kg, s, rad, N), as in the rest of the package.
@@ -230,7 +230,7 @@ REQUIRED_REGIONS = ("clamp", "OL", "OR")
 # [disk] gamma_left_deg / gamma_right_deg given with a surface_file blade may differ from its faces'
 # platform angles by this much [deg] (the faces' then count); a float32 STL in mm fixes them to ~1e-4 deg
 SURFACE_GAMMA_TOLERANCE_DEG = 0.01
-# [blade.regions.*] tolerance_mm when not given [mm] (bladedamp.solid.PlaneRegion's default, 1e-5 m)
+# [blade.regions.*] tolerance_mm when not given [mm] (bladedamp.blade.solid.PlaneRegion's default, 1e-5 m)
 REGION_TOLERANCE_MM = 0.01
 # [blade.beam] keys that apply to a surface_file blade (the others are the built-in blade's geometry)
 SURFACE_BEAM_KEYS = ("youngs_modulus_gpa", "poisson_ratio", "density_kg_m3", "tip_point_mm", "excitation_point_mm")
@@ -360,7 +360,7 @@ def _fields() -> list[Field]:
 
     g = ref.reference_blade_geometry()
     freqs, damping = ref.TABLE1_FREQUENCIES_HZ, ref.TABLE1_DAMPING_RATIOS
-    from .solid import DEFAULT_ELEMENT_SIZE as SOLID_ELEMENT_SIZE     # solid.py imports gmsh only when meshing
+    from .blade.solid import DEFAULT_ELEMENT_SIZE as SOLID_ELEMENT_SIZE     # solid.py imports gmsh only when meshing
     mm, pos = (lambda v: _tidy(v, 1e-3)), Number(0.0, 1e4, "right")
     beam = [
         ("shank_length_mm", mm(g.shank_length), pos, "mm", "root to platform (30 % of the 0.2 m span)"),
@@ -797,12 +797,12 @@ def reference_design() -> Design:
 
 
 def _solid_blade(path: Path, geometry, v: dict, n_modes: int, freqs, damping):
-    """The solid FE blade (:meth:`ModalBlade.from_solid`) of ``geometry``: a BeamBladeGeometry
+    """The solid FE blade (:func:`bladedamp.blade.solid.solid_blade`) of ``geometry``: a BeamBladeGeometry
     ([blade.beam]: the parametric solid with its platform faces at the disk's platform angles, which
     the contact kinematics need to agree) or a SurfaceBladeGeometry ([blade] surface_file, whose
     faces set the disk's angles: :func:`_surface_geometry`)."""
-    from .blade import BeamBladeGeometry, ModalBlade
-    from .solid import SolidBladeGeometry
+    from .blade import BeamBladeGeometry
+    from .blade.solid import SolidBladeGeometry, solid_blade
 
     d = v["disk"]
     parametric = isinstance(geometry, BeamBladeGeometry)
@@ -811,8 +811,8 @@ def _solid_blade(path: Path, geometry, v: dict, n_modes: int, freqs, damping):
         sg = (SolidBladeGeometry(beam=geometry, gamma_left=np.radians(d["gamma_left_deg"]),
                                  gamma_right=np.radians(d["gamma_right_deg"])) if parametric else geometry)
         options = {} if damping is None else {"damping_ratios": damping}
-        return ModalBlade.from_solid(sg, 1e-3 * v["blade"]["solid_element_size_mm"], n_modes,
-                                     natural_frequencies_hz=freqs, **options)
+        return solid_blade(sg, 1e-3 * v["blade"]["solid_element_size_mm"], n_modes,
+                           natural_frequencies_hz=freqs, **options)
     except (ImportError, ValueError, RuntimeError) as exc:     # ImportError: the fe extra's one-line hint
         raise DesignError(f"{path}: {where}: {exc}") from None
 
@@ -824,7 +824,7 @@ def _relative(path: Path, file: str) -> Path:
 
 
 def _surface_error_key(message: str, v: dict) -> str:
-    """The design key a :class:`~bladedamp.solid.SurfaceBladeGeometry` error ``message`` is about
+    """The design key a :class:`~bladedamp.blade.solid.SurfaceBladeGeometry` error ``message`` is about
     (its messages start with the parameter's name)."""
     import re
 
@@ -846,7 +846,7 @@ def _surface_error_key(message: str, v: dict) -> str:
 
 
 def _surface_geometry(path: Path, v: dict, given: set):
-    """The :class:`~bladedamp.solid.SurfaceBladeGeometry` of [blade] surface_file, surface_units, the
+    """The :class:`~bladedamp.blade.solid.SurfaceBladeGeometry` of [blade] surface_file, surface_units, the
     [blade.regions.*] tables and [blade.beam]'s material and points; DesignError naming the key."""
     b, beam = v["blade"], v["blade.beam"]
     if b["surface_units"] is None:
@@ -862,7 +862,7 @@ def _surface_geometry(path: Path, v: dict, given: set):
         raise DesignError(f"{path}: [blade] surface_file needs the tables {required} (missing: {', '.join(missing)}), "
                           "each with plane_point_mm and plane_normal, or file")
     try:
-        from .solid import PlaneRegion, SurfaceBladeGeometry, SurfacePatch
+        from .blade.solid import PlaneRegion, SurfaceBladeGeometry, SurfacePatch
     except ImportError as exc:
         raise DesignError(f"{path}: [blade] surface_file: {exc}") from None
     regions, points = {}, {}

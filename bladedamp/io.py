@@ -8,8 +8,11 @@ time-domain responses, the study results of :mod:`bladedamp.studies`) has ``.sav
     frf.save("results/frf")                 # writes results/frf.npz
     frf = bladedamp.load("results/frf.npz")
 
-:func:`load` also reads a blade's modal data file (``blade.save("blade.npz")``, see
-:mod:`bladedamp.blade`; a solid FE blade's comes back with its flexible platforms).
+Blades are saved the same way (``blade.save("blade.npz")``, :mod:`bladedamp.blade.modal`): their own
+arrays (the modal data file's documented keys) and the same ``__bladedamp__`` entry naming the class
+(``"layout": "arrays"``: the class reads its arrays back with its ``from_npz``), so :func:`load` gives
+a blade back (a solid FE blade's with its flexible platforms); blade files without that entry (saved
+before, or written by hand) are read by their ``format`` string (:data:`BLADE_FORMATS`).
 
 File layout (readable with ``np.load(path, allow_pickle=False)`` and any npz reader):
 
@@ -23,7 +26,7 @@ File layout (readable with ``np.load(path, allow_pickle=False)`` and any npz rea
   numbers as [re, im]; NaN as JSON's NaN), and the
   :class:`~bladedamp.hbm.fourier.HarmonicBasis` by its harmonics and n_samples: the typed
   JSON form of :func:`encode_value` / :func:`decode_value` (also used for a solid blade's
-  ``solid_info``, :meth:`bladedamp.solid.SolidModalBlade.npz_arrays`).
+  ``solid_info``, :meth:`bladedamp.blade.solid.SolidModalBlade.npz_arrays`).
 
 The model is not saved: a ``disk`` (TunedDisk or MistunedDisk) or ``system`` field is
 stored as absent, and a loaded result has ``disk=None`` (``system=None``). Rebuilding a disk
@@ -49,18 +52,21 @@ import numpy as np
 FORMAT_VERSION = 1
 META_KEY = "__bladedamp__"
 
-# Blade modal data files (bladedamp.blade.ModalBlade.save): no META_KEY entry, a ``format``
-# string naming the blade kind (format: bladedamp.blade's module docstring).
+# Blade modal data files (bladedamp.blade.modal.ModalBlade.save): the blade's own arrays (format:
+# bladedamp.blade.modal's docstring) with a ``format`` string naming the blade kind, and the
+# META_KEY entry of every saved object (``"layout": "arrays"``, :func:`write_npz`).
 MODAL_NPZ_FORMAT = "bladedamp.ModalBlade/1"
-# A solid FE blade's file (bladedamp.solid.SolidModalBlade.save): the ModalBlade keys plus its
+# A solid FE blade's file (bladedamp.blade.solid.SolidModalBlade.save): the ModalBlade keys plus its
 # flexible platforms' FE field, contact-face samples, surface and solid_info.
 SOLID_NPZ_FORMAT = "bladedamp.SolidModalBlade/2"
 # /2 writes solid_info with encode_value (typed); /1 files (solid_info in plain JSON, types
 # guessed on reading) are still read
 SOLID_NPZ_FORMATS_READ = ("bladedamp.SolidModalBlade/1", SOLID_NPZ_FORMAT)
-#: the reader of every blade file, resolved by name as every result class (this module imports
-#: no model or blade: it sits below them): ``ModalBlade.from_file`` (a SolidModalBlade for a solid's)
-BLADE_READER = "bladedamp.blade:ModalBlade"
+#: the class that reads a blade file without a META_KEY entry (one saved before blade files had
+#: it, or written by hand), by its ``format`` string; resolved by name as every saved class (this
+#: module imports no model or blade: it sits below them)
+BLADE_FORMATS = {MODAL_NPZ_FORMAT: "bladedamp.blade.modal:ModalBlade",
+                 **{tag: "bladedamp.blade.solid:SolidModalBlade" for tag in SOLID_NPZ_FORMATS_READ}}
 #: fields that hold a model, not data: stored as absent, loaded as None (see the module docstring)
 MODEL_FIELDS = ("disk", "system")
 
@@ -376,30 +382,53 @@ def _resolve(name: str):
 
 
 # ----- the public functions ---------------------------------------------------------------
+def write_npz(obj, path, arrays: dict, *, meta: dict | None = None, compressed: bool = False) -> Path:
+    """Write ``arrays`` (name -> array) to ``path`` (as given: no suffix is added; the folder is
+    created) with the :data:`META_KEY` entry that names ``obj``'s class, the one writer of every
+    saved object. ``meta``: the rest of that JSON (a result's fields, :func:`save`); None: an object
+    with its own layout (``"layout": "arrays"``: ``arrays`` are its ``npz_arrays()``, read back by
+    its classmethod ``from_npz(path, data)``, e.g. a blade). Returns ``path``."""
+    path = Path(path)
+    cls = type(obj)
+    meta = {"format": FORMAT_VERSION, "library": "bladedamp", "class": f"{cls.__module__}:{cls.__qualname__}",
+            **({"layout": "arrays"} if meta is None else meta)}
+    if META_KEY in arrays:
+        raise ValueError(f"cannot save {cls.__qualname__}: its arrays must not use the key {META_KEY!r}")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "wb") as fh:    # a file object: np.savez would append .npz to a suffix ".NPZ"
+        (np.savez_compressed if compressed else np.savez)(fh, **arrays, **{META_KEY: np.array(json.dumps(meta, allow_nan=True))})
+    return path
+
+
 def save(result, path) -> Path:
     """Write ``result`` (any response or study result) to ``path`` (``.npz`` appended if
     missing; the folder is created); returns the file's path. See the module docstring for
     the layout; the model (``disk``) is not saved."""
-    path = npz_path(path)
     arrays: dict[str, np.ndarray] = {}
     meta = _flatten(result, "", arrays)
-    meta = {"format": FORMAT_VERSION, "library": "bladedamp", **meta}
-    text = json.dumps(meta, allow_nan=True)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    np.savez(path, **arrays, **{META_KEY: np.array(text)})
-    return path
+    meta.pop("class")
+    return write_npz(result, npz_path(path), arrays, meta=meta)
 
 
 def load(path):
     """Read a result written by ``.save(path)`` / :func:`save` (``.npz``; ``path`` without the
     suffix works too); returns an object of the class stored in the file, with ``disk=None``.
-    A blade's modal data file (``ModalBlade.save``, a ``format`` entry naming a blade format) gives
-    the blade (:meth:`bladedamp.blade.ModalBlade.from_file`: a solid FE blade's a SolidModalBlade).
+    A blade's modal data file (``ModalBlade.save``, or a file with a ``format`` entry naming a blade
+    format) gives the blade (a solid FE blade's a :class:`~bladedamp.blade.solid.SolidModalBlade`).
     Raises :class:`FileReadError` (a ValueError) naming the file for a file that is missing
     (:class:`MissingFileError`, also a FileNotFoundError), empty, truncated or corrupted, not an
     ``.npz``, not a saved result, or with broken metadata or a missing array (:func:`reading`)."""
-    path = npz_path(path)
-    with reading(path, "saved bladedamp result"):
+    return load_npz(npz_path(path), "saved bladedamp result")
+
+
+def load_npz(path, what: str, untagged: type | None = None):
+    """The object saved in the ``.npz`` file ``path`` (:func:`load`; ``what`` names the kind of file
+    in the errors, :func:`reading`): the class named by its :data:`META_KEY` entry, rebuilt from its fields or, for an object with
+    its own layout, by its ``from_npz(path, data)`` (``data``: the open file, arrays by key). A file
+    without that entry: a blade file by its ``format`` (:data:`BLADE_FORMATS`), else read by
+    ``untagged.from_npz`` (e.g. a hand-written modal data file: ModalBlade), else ValueError."""
+    path = Path(path)
+    with reading(path, what):
         with open_npz(path) as z:
             files = set(z.files)
             if META_KEY in files:
@@ -409,11 +438,19 @@ def load(path):
                 if meta.get("format", 0) > FORMAT_VERSION:
                     raise ValueError(f"{path} has format {meta.get('format')}; this bladedamp reads up to "
                                      f"{FORMAT_VERSION}")
+                if meta.get("layout") == "arrays":
+                    return _resolve(meta["class"]).from_npz(path, z)
                 arrays = {k: z[k] for k in z.files if k != META_KEY}
-            blade = META_KEY not in files and "format" in files and z["format"].dtype.kind == "U"
-            tag = str(z["format"]) if blade else None
-        if META_KEY not in files:
-            if tag in (MODAL_NPZ_FORMAT, *SOLID_NPZ_FORMATS_READ):   # a blade's modal data file
-                return _resolve(BLADE_READER).from_file(path)
-            raise ValueError(f"{path} is not a saved bladedamp result (no {META_KEY} entry)")
+            else:
+                cls = untagged
+                if "format" in files:
+                    try:
+                        tag = z["format"]
+                    except ValueError:                     # an object array: the reader says which key
+                        tag = None
+                    if tag is not None and tag.dtype.kind == "U" and str(tag) in BLADE_FORMATS:
+                        cls = _resolve(BLADE_FORMATS[str(tag)])
+                if cls is None:
+                    raise ValueError(f"{path} is not a saved bladedamp result (no {META_KEY} entry)")
+                return cls.from_npz(path, z)
         return _rebuild(meta, "", arrays)

@@ -8,7 +8,7 @@ Given by the paper (Panning, Sextro, Popp; Table 1 and text):
 
 Calibrated, on these two results of the paper only:
   (1) the undamped 1F tip resonance amplitude 1.7 mm under F_x = 0.1 N -> blade chord
-      (in :func:`reference_blade_geometry`, :mod:`bladedamp.blade`; its thickness sets the FE 1F to Table 1's
+      (in :func:`reference_blade_geometry`, :mod:`bladedamp.blade.reference`; its thickness sets the FE 1F to Table 1's
       95 Hz): the calibrated model gives 1.6996 mm;
   (2) the cylinder's optimal mass ~1 g with ~71 % reduction at EO = 1 -> the tangential contact
       stiffness per length (sets the achievable reduction: a stiffer contact dissipates more
@@ -20,8 +20,8 @@ Everything else the paper reports is a prediction compared in the report.
 
 The reference blade: the beam model of :func:`reference_blade_geometry` gives the mode shapes,
 Table 1 the frequencies and damping (:func:`reference_blade`). They are defined in
-:mod:`bladedamp.blade` (with ``TABLE1_*`` and ``PLATFORM_ANGLE``; the blade layer lies below
-the disk models, which this module builds) and are the same objects here.
+:mod:`bladedamp.blade.reference` (with ``TABLE1_*`` and ``PLATFORM_ANGLE``; the blade layer lies
+below the disk models, which this module builds) and are the same objects here.
 """
 from __future__ import annotations
 

@@ -86,7 +86,7 @@ def test_blade_frequency_arguments_in_hz_are_eq5():
 
 
 def test_frequency_response_of_anything_else_is_a_type_error_naming_it():
-    with pytest.raises(TypeError, match="got bladedamp.blade.ModalBlade"):
+    with pytest.raises(TypeError, match="got bladedamp.blade.modal.ModalBlade"):
         bd.frequency_response(bd.reference_blade(), (90.0, 100.0))
     with pytest.raises(TypeError, match="got builtins.str"):
         bd.frequency_response("cylinder", (90.0, 100.0))

@@ -17,6 +17,7 @@ from bladedamp.blade import (
     rigid_offset_motion,
     torsion_constant_polygon,
     torsion_constant_rectangle,
+    warping_constant_rectangle,
 )
 
 # Clamped-free Euler-Bernoulli beam: beta_k L.
@@ -441,7 +442,7 @@ def test_timoshenko_without_shear_and_vlasov_without_warping_are_the_plain_beam(
     E, G, rho = g.youngs_modulus, g.shear_modulus, g.density
     J, Ip = torsion_constant_rectangle(a, a), a**4 / 6
     st_venant = 1 / (4 * L) * np.sqrt(G * J / (rho * Ip))
-    vlasov = solid.vlasov_cantilever_frequency_hz(L, G * J, E * solid.warping_constant_rectangle(a, a), rho * Ip)
+    vlasov = solid.vlasov_cantilever_frequency_hz(L, G * J, E * warping_constant_rectangle(a, a), rho * Ip)
     assert vlasov / st_venant - 1 == pytest.approx(1e-3, rel=0.01)
     coarse = by_name(beam_modes(bar(20, bending_theory="timoshenko", torsion_theory="vlasov")))
     fine = by_name(beam_modes(bar(160, torsion_theory="vlasov")))

@@ -1,6 +1,7 @@
 """Blade data from FE: modal data files (npz, CSV) and reduced FE matrices (ModalBlade.from_matrices)."""
 import dataclasses
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -381,3 +382,68 @@ def test_no_warning_for_six_dof_contact_points():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         ModalBlade.from_matrices(M, K, dof_map, points=points, n_modes=2, damping_ratios=0.01)
+
+
+# ---------------------------------------------------------------------------------------
+# blade files saved by earlier versions (tests/data/blades, README there) still load
+# ---------------------------------------------------------------------------------------
+BLADE_DATA = Path(__file__).parent / "data" / "blades"
+
+
+@pytest.mark.parametrize("name", ["reference_blade_v1.npz", "reference_blade_v1.csv"])
+def test_reference_blade_files_saved_before_the_blade_package_load(name):
+    """Files written by ``reference_blade().save`` before the blade package (format
+    bladedamp.ModalBlade/1, and the CSV) give today's reference blade (computed again by the beam
+    model: the same numbers to rounding), through ModalBlade.from_file and bladedamp.load."""
+    path = BLADE_DATA / name
+    readers = [ModalBlade.from_file] + ([bladedamp.load] if name.endswith(".npz") else [])
+    for read in readers:
+        blade = read(path)
+        assert type(blade) is ModalBlade
+        assert_same_blade(blade, reference_blade(), rtol=1e-9, atol=1e-9 * np.abs(blade.mode_shapes["tip"]).max())
+
+
+def test_solid_blade_file_saved_before_the_blade_package_loads():
+    """A solid FE blade saved before the blade package (format bladedamp.SolidModalBlade/2, the
+    reference solid at 12 mm, 4 modes) is read back as a solid blade with flexible platforms that
+    matches the same blade computed again: frequencies, rigid-point shapes and the FE field at
+    the contact faces."""
+    pytest.importorskip("gmsh")
+    pytest.importorskip("skfem")
+    from bladedamp import solid
+
+    path = BLADE_DATA / "solid_blade_v2.npz"
+    fresh = solid.solid_blade(None, 12e-3, 4)
+    for read in (ModalBlade.from_file, bladedamp.load):
+        blade = read(path)
+        assert isinstance(blade, solid.SolidModalBlade) and blade.flexible_platform
+        scale = np.abs(fresh.mode_shapes["tip"]).max()
+        assert_same_blade(blade, fresh, rtol=1e-6, atol=1e-6 * scale)
+        for side in ("OL", "OR"):
+            points = fresh.contact_faces[side].points[::7]                 # (P, 3) samples on the face
+            np.testing.assert_allclose(blade.platform_displacements(side, points),
+                                       fresh.platform_displacements(side, points), rtol=1e-6, atol=1e-6 * scale)
+
+
+def test_a_blade_file_names_its_class_as_every_saved_result_and_untagged_files_still_read(tmp_path):
+    """One save/load for results and blades: ``blade.save`` writes the bladedamp entry naming the
+    class (read back by bladedamp.load and ModalBlade.from_file); a modal .npz without it and
+    without a format (written by hand) is a ModalBlade for from_file, not a result for load; a
+    saved result is not a blade (WrongKindError, a ValueError, naming the file)."""
+    import json
+
+    from bladedamp.io import META_KEY, WrongKindError
+
+    path = reference_blade().save(tmp_path / "blade.npz")
+    with np.load(path, allow_pickle=False) as data:
+        meta = json.loads(str(data[META_KEY]))
+        arrays = {k: data[k] for k in data.files if k not in (META_KEY, "format")}
+    assert meta["class"] == f"{ModalBlade.__module__}:ModalBlade" and meta["layout"] == "arrays"
+    hand = tmp_path / "hand.npz"
+    np.savez(hand, **arrays)
+    assert_same_blade(ModalBlade.from_file(hand), reference_blade())
+    with pytest.raises(ValueError, match="hand.npz is not a saved bladedamp result"):
+        bladedamp.load(hand)
+    result = BLADE_DATA.parent / "oscillator_response_v1.npz"
+    with pytest.raises(WrongKindError, match="oscillator_response_v1.npz: holds a FrequencyResponse, not a ModalBlade"):
+        ModalBlade.from_file(result)

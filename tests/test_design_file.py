@@ -264,7 +264,7 @@ def stl_folder(reference_stl_mm, tmp_path):
     import shutil
 
     import trimesh
-    from bladedamp.solid import SurfaceBladeGeometry
+    from bladedamp.blade.solid import SurfaceBladeGeometry
     from conftest import reference_regions
 
     shutil.copy(reference_stl_mm, tmp_path / "blade.stl")
@@ -292,11 +292,11 @@ def _surface_text(regions=("clamp", "OL", "OR")) -> str:
 def test_surface_file_blade_is_the_direct_stl_blade(stl_folder):
     """The README's design-file example (section "Your own blade geometry (STL)"; its STL here the
     reference solid's surface in mm, its OR face as its own file, the mesh coarser) gives the blade of
-    ModalBlade.from_solid(SurfaceBladeGeometry(...)) at the same element size: the same frequencies
+    solid_blade(SurfaceBladeGeometry(...)) at the same element size: the same frequencies
     and shapes (the same mesh; rounding of the eigensolver only), flexible platforms, and the disk
     takes the platform angles of the STL's OL / OR faces (35 deg)."""
     from bladedamp.blade import ModalBlade
-    from bladedamp.solid import SolidModalBlade, SurfaceBladeGeometry
+    from bladedamp.blade.solid import SolidModalBlade, SurfaceBladeGeometry, solid_blade
     from conftest import reference_regions
 
     import pathlib
@@ -312,8 +312,8 @@ def test_surface_file_blade_is_the_direct_stl_blade(stl_folder):
     design = load_design(_write(stl_folder, example))
     blade = design.disk.blade
     assert isinstance(blade, SolidModalBlade) and blade.flexible_platform and design.blade_geometry is None
-    direct = ModalBlade.from_solid(SurfaceBladeGeometry(stl_folder / "blade.stl", reference_regions(), scale=1e-3),
-                                   1e-3 * SURFACE_ELEMENT_SIZE_MM)
+    direct = solid_blade(SurfaceBladeGeometry(stl_folder / "blade.stl", reference_regions(), scale=1e-3),
+                         1e-3 * SURFACE_ELEMENT_SIZE_MM)
     assert blade.solid_info["n_dofs"] == direct.solid_info["n_dofs"]
     np.testing.assert_allclose(blade.natural_frequencies_hz, direct.natural_frequencies_hz, rtol=1e-9)
     assert blade.mode_names == direct.mode_names == ("1F", "2F", "1T", "1E")
@@ -378,7 +378,7 @@ def test_surface_file_bad_input_one_line_naming_the_key(stl_folder, change, matc
 def test_modal_file_of_a_solid_blade_keeps_its_flexible_platforms(coarse_modes, tmp_path):
     """[blade] modal_file of a saved solid FE blade: the solid blade with its flexible platforms,
     its own frequencies, and the disk at its faces' platform angles (another angle is refused)."""
-    from bladedamp.solid import SolidModalBlade, solid_blade
+    from bladedamp.blade.solid import SolidModalBlade, solid_blade
 
     blade = solid_blade(modes=coarse_modes)
     blade.save(tmp_path / "solid.npz")
@@ -411,7 +411,7 @@ def test_platform_angle_option_with_a_solid_blade_exits_2_before_computing(blade
     import time
 
     from bladedamp.cli import main
-    from bladedamp.solid import solid_blade
+    from bladedamp.blade.solid import solid_blade
 
     if blade == "modal_file":
         solid_blade(modes=coarse_modes).save(stl_folder / "solid.npz")

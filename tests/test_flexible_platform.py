@@ -489,7 +489,7 @@ def test_design_file_solid_blade(tmp_path):
     """[blade] model = "solid": the solid FE blade of [blade.beam]'s geometry, its platform faces at
     the disk's platform angles (here 40 / 30 deg), flexible platforms in the disk's contacts."""
     from bladedamp.design import DesignError, load_design
-    from bladedamp.solid import SolidModalBlade
+    from bladedamp.blade.solid import SolidModalBlade
     path = tmp_path / "solid.toml"
     path.write_text('[blade]\nmodel = "solid"\nsolid_element_size_mm = 9.0\nnatural_frequencies_hz = "model"\n'
                     '[disk]\ngamma_left_deg = 40.0\ngamma_right_deg = 30.0\n')

@@ -1,4 +1,4 @@
-"""Validation of the solid finite-element blade (bladedamp.solid, ModalBlade.from_solid).
+"""Validation of the solid finite-element blade (bladedamp.blade.solid, solid_blade).
 
 Checks that could fail: the FE solution itself (mass normalisation, orthogonality, eigen
 residual, exact mass of the meshed volume), the plain cantilever plate against closed-form
@@ -7,7 +7,7 @@ geometry (frequencies within 3 % after mesh convergence, shapes at the named poi
 rigid-platform limit of the contact-face fit and of the beam, and a tuned-disk FRF with the
 solid blade.
 
-The beam model of the solid's geometry (bladedamp.blade.solid_platform_beam) is not the reference
+The beam model of the solid's geometry (bladedamp.blade.solid.solid_platform_beam) is not the reference
 beam (reference_blade_geometry(): a lumped rigid 30 x 50 x 4 mm plate on one node, Euler-Bernoulli,
 St. Venant; its mode shapes enter the paper replica, so it stays the reference's). It has the
 solid's platform prism as a stiff beam segment over its 5.43 mm height (its volume, 48.2 g over the
@@ -60,7 +60,7 @@ pytest.importorskip("skfem", reason="the solid blade needs the fe extra: pip ins
 
 import bladedamp as bd  # noqa: E402
 from bladedamp import solid  # noqa: E402
-from bladedamp.blade import REQUIRED_POINTS, beam_modes, solid_platform_beam  # noqa: E402
+from bladedamp.blade import REQUIRED_POINTS, beam_modes, solid_platform_beam, warping_constant_rectangle  # noqa: E402
 from bladedamp.reference import reference_blade_geometry  # noqa: E402
 from conftest import COARSE_SOLID, reference_regions as _reference_regions  # noqa: E402
 
@@ -78,7 +78,7 @@ def beam():
 @pytest.fixture(scope="module")
 def geometry_beam():
     """The beam model of the reference solid's geometry (its platform prism as a block, Timoshenko,
-    Vlasov; bladedamp.blade.solid_platform_beam), its own FE frequencies."""
+    Vlasov; bladedamp.blade.solid.solid_platform_beam), its own FE frequencies."""
     return bd.ModalBlade.from_beam(solid_platform_beam())
 
 
@@ -103,7 +103,7 @@ def _by_name(modes):
 def test_missing_fe_extra_gives_one_line_hint(monkeypatch):
     monkeypatch.setitem(sys.modules, "gmsh", None)      # import gmsh -> ImportError
     with pytest.raises(ImportError) as err:
-        bd.ModalBlade.from_solid()
+        solid.solid_blade()
     assert str(err.value) == "the solid blade needs the fe extra: pip install 'bladedamp[fe]'"
 
 
@@ -183,14 +183,14 @@ def test_warping_constant_of_a_solid_rectangle():
     finite-element warping analysis (Pilkey's method, quadratic triangles, 6 500 and 83 000 nodes):
     a square 1.34403e-4 a^6, the reference airfoil 4.57 x 45.5 mm 59 700.330 mm^6; and the thin
     limit t^3 c^3 / 144 (1 - 4.8 (t/c)^2): the series' own expansion."""
-    assert solid.warping_constant_rectangle(1.0, 1.0) == pytest.approx(1.3440262e-4, rel=1e-5)
-    ref = solid.warping_constant_rectangle(4.57e-3, 45.5e-3)
+    assert warping_constant_rectangle(1.0, 1.0) == pytest.approx(1.3440262e-4, rel=1e-5)
+    ref = warping_constant_rectangle(4.57e-3, 45.5e-3)
     assert ref == pytest.approx(59700.330e-18, rel=1e-7)
-    assert ref == solid.warping_constant_rectangle(45.5e-3, 4.57e-3)
+    assert ref == warping_constant_rectangle(45.5e-3, 4.57e-3)
     assert ref / (4.57e-3**3 * 45.5e-3**3 / 144) == pytest.approx(0.9562, abs=1e-4)
-    thin = solid.warping_constant_rectangle(1e-3, 1.0)
+    thin = warping_constant_rectangle(1e-3, 1.0)
     assert thin / (1e-9 / 144) == pytest.approx(1 - 4.8e-6, abs=1e-8)
-    assert solid.warping_constant_rectangle(2.0, 20.0) == pytest.approx(2.0**6 * solid.warping_constant_rectangle(1.0, 10.0),
+    assert warping_constant_rectangle(2.0, 20.0) == pytest.approx(2.0**6 * warping_constant_rectangle(1.0, 10.0),
                                                                         rel=1e-12)
 
 
@@ -237,7 +237,7 @@ def test_refined_closed_forms_reduce_to_the_classical_ones():
                           g.shear_modulus, g.density)
     sec = RectangularSection(t, c)
     refined = solid.cantilever_frequencies_hz(g, theory="refined")
-    GJ, ECw, rhoIp = G * sec.torsion_constant, E * solid.warping_constant_rectangle(t, c), rho * sec.polar_moment
+    GJ, ECw, rhoIp = G * sec.torsion_constant, E * warping_constant_rectangle(t, c), rho * sec.polar_moment
 
     def torsion(omega):                       # state (phi, phi', phi'', phi''')
         return np.array([[0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1], [rhoIp * omega**2 / ECw, 0, GJ / ECw, 0]])
@@ -518,7 +518,7 @@ def test_mirrored_mesh_gives_exactly_symmetric_modes(coarse_blade):
     rounding. OR is OL mirrored in x, and what the y-mirror forbids at OL in the bending and torsion
     modes (u_y, phi_x, phi_z in 1F / 2F; u_x, u_z, phi_y in 1T) vanishes. An unsymmetric mesh leaves
     about 1e-5 of them, on which the tuned disk's continuation with a static harmonic crawls
-    (see bladedamp.solid.mesh_blade)."""
+    (see bladedamp.blade.solid.mesh_blade)."""
     ol, or_ = coarse_blade.shape("OL"), coarse_blade.shape("OR")
     scale = np.abs(ol).max(axis=0)                      # (4,) per mode
     # x-mirror, 1F / 2F (u_x even in x): u_x and phi_y of OR are OL's, u_z the opposite
@@ -756,7 +756,7 @@ def test_tuned_disk_frf_with_the_solid_blade(beam, capsys):
     in 1F, so the damper works harder; rigid platforms: 0.4773 mm)."""
     from bladedamp.reference import TABLE1_DAMPING_RATIOS, TABLE1_FREQUENCIES_HZ
     ref = bd.reference_disk("cylinder", 1e-3)
-    solid_fe = bd.ModalBlade.from_solid(damping_ratios=TABLE1_DAMPING_RATIOS)
+    solid_fe = solid.solid_blade(damping_ratios=TABLE1_DAMPING_RATIOS)
     solid_t1 = solid.solid_blade(None, natural_frequencies_hz=TABLE1_FREQUENCIES_HZ,
                                  damping_ratios=TABLE1_DAMPING_RATIOS)
     beam_fe = dataclasses.replace(beam, damping_ratios=np.asarray(TABLE1_DAMPING_RATIOS))

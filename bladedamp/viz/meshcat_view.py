@@ -18,7 +18,7 @@ What is drawn (blade frame: x circumferential, y axial, z radial):
   and tip. This is a plausible cantilever-like shape matching the modal values at those points,
   not the FE shape between them. Each span segment moves rigidly with the interpolated motion
   at its middle, the platform with the platform node, the root not at all;
-* a solid FE blade (:class:`bladedamp.solid.SolidModalBlade`, which keeps its boundary surface
+* a solid FE blade (:class:`bladedamp.blade.solid.SolidModalBlade`, which keeps its boundary surface
   and the mode shapes at its vertices, ``blade.surface``) is drawn as that surface instead: sent
   once per blade as a mesh with the scaled mode shapes as relative morph targets
   (:class:`MorphMeshGeometry`), and the animation sets the morph weights to the modal
@@ -753,7 +753,7 @@ def ods_scene(result, index: int | None = None, frequency_hz: float | None = Non
     vis = scene.vis
     plain_stage(vis)
 
-    # a solid FE blade (bladedamp.solid.SolidModalBlade) brings its boundary surface and the
+    # a solid FE blade (bladedamp.blade.solid.SolidModalBlade) brings its boundary surface and the
     # mode shapes there: drawn deformed (exact superposition) instead of the beam's segments
     surface = getattr(blade, "surface", None)
     if blade_geometry is None:

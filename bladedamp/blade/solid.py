@@ -120,16 +120,18 @@ import scipy.linalg
 import scipy.sparse
 import scipy.sparse.linalg
 
-from . import validation as check
-from .blade import (PLATFORM_ANGLE, SHIFT_INVERT_SIGMA, SOLID_NPZ_FORMAT, BeamBladeGeometry, ModalBlade,
-                    PAPER_MODE_ORDER, platform_section, reference_blade_geometry)
-from .io import MissingFileError, decode_value, encode_value
+from bladedamp import validation as check
+from bladedamp.io import SOLID_NPZ_FORMAT, MissingFileError, decode_value, encode_value
+
+from .beam import BeamBladeGeometry, PlatformBlock, RectangularSection, platform_section, warping_constant_rectangle
+from .modal import PAPER_MODE_ORDER, SHIFT_INVERT_SIGMA, ModalBlade, modal_npz_fields
+from .reference import PLATFORM_ANGLE, reference_blade_geometry
 
 __all__ = ["FE_HINT", "SOLID_NPZ_FORMAT", "SolidBladeGeometry", "SurfaceBladeGeometry", "PlaneRegion", "SurfacePatch",
            "SolidMesh", "SolidModes", "ContactFaceModes", "ContactFaceField", "BladeSurface", "SolidModalBlade",
            "mesh_blade", "mesh_surface", "boundary_faces", "point_triangle_distances", "solid_modes", "solid_blade",
            "rigid_fit", "classify_tip_motion", "cantilever_frequencies_hz", "CANTILEVER_THEORIES",
-           "warping_constant_rectangle", "vlasov_cantilever_frequency_hz", "timoshenko_cantilever_frequency_hz"]
+           "solid_platform_beam", "vlasov_cantilever_frequency_hz", "timoshenko_cantilever_frequency_hz"]
 
 FE_HINT = "the solid blade needs the fe extra: pip install 'bladedamp[fe]'"
 
@@ -302,7 +304,7 @@ class SolidBladeGeometry:
         frame (3, 3) rows (xi, eta, zeta) as bladedamp.damper.geometry.contact_frame (zeta the
         face's outward normal, from the platform into the damper), xi_range (2,) and
         eta_range (2,) of the face rectangle in that frame, relative to the centre [m])."""
-        from .damper.geometry import contact_frame, contact_normal
+        from bladedamp.damper.geometry import contact_frame, contact_normal
         if side not in ("OL", "OR"):
             raise ValueError(f"side must be 'OL' or 'OR' (got {side!r})")
         poly = self.platform_polygon()
@@ -832,7 +834,7 @@ class SurfaceBladeGeometry:
 
     def _contact_face_geometry(self, side: str, given):
         """(centre, frame, xi_range, eta_range, gamma) of a contact face from its triangles."""
-        from .damper.geometry import contact_frame, contact_normal
+        from bladedamp.damper.geometry import contact_frame, contact_normal
         tri = self.vertices[self.faces[self.region_faces[side]]]
         normals = _triangle_normals(self.vertices, self.faces[self.region_faces[side]])
         area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
@@ -1036,6 +1038,30 @@ def classify_tip_motion(motion: np.ndarray, normal_matrix: np.ndarray, residual:
     return tuple(names), tuple(families), fractions
 
 
+def solid_platform_beam(solid_geometry=None, bending_theory: str = "timoshenko",
+                        torsion_theory: str = "vlasov", n_elements: int = 1) -> BeamBladeGeometry:
+    """The beam model of the parametric solid blade's geometry (:class:`SolidBladeGeometry`,
+    None: the reference's): its beam geometry with the solid's platform prism as the platform block
+    (:meth:`bladedamp.blade.beam.PlatformBlock.from_polygon` of ``platform_polygon()`` over ``platform_length``, with
+    ``n_elements`` elements on each side of the platform node), no lumped platform mass or
+    inertia (the block is the whole platform), and the given bending and torsion theories
+    (default the refined ones, which the solid has). Refused (ValueError): what the beam does not
+    represent, a twisted airfoil, a root block, a platform of another Young's modulus, no platform."""
+    if solid_geometry is None:
+        solid_geometry = SolidBladeGeometry()
+    sg = solid_geometry
+    unsupported = [name for name, bad in (("twist", sg.twist != 0.0), ("root_height", sg.root_height > 0.0),
+                                          ("platform", not sg.platform),
+                                          ("platform_youngs_modulus", sg.platform_youngs_modulus is not None
+                                           and sg.platform_youngs_modulus != sg.beam.youngs_modulus)) if bad]
+    if unsupported:
+        raise ValueError(f"solid_platform_beam: the beam model does not represent {unsupported} of the solid geometry")
+    block = PlatformBlock.from_polygon(sg.platform_polygon(), sg.platform_length, n_elements)
+    return dataclasses.replace(sg.beam, platform_block=block, platform_mass=0.0,
+                               platform_rotary_inertia=(0.0, 0.0, 0.0), bending_theory=bending_theory,
+                               torsion_theory=torsion_theory)
+
+
 CANTILEVER_THEORIES = ("euler-bernoulli", "refined")
 
 
@@ -1059,7 +1085,6 @@ def cantilever_frequencies_hz(geometry: BeamBladeGeometry | None = None, theory:
         that cannot curve anticlastically (the bound a wide section approaches; +4.8 % in frequency
         at nu = 0.3), with either theory; 1E and 1T keep E.
     """
-    from .blade import RectangularSection
     if theory not in CANTILEVER_THEORIES:
         raise ValueError(f"theory must be one of {CANTILEVER_THEORIES} (got {theory!r})")
     if geometry is None:
@@ -1088,42 +1113,6 @@ def cantilever_frequencies_hz(geometry: BeamBladeGeometry | None = None, theory:
             "2F": bending(4.694091, E_flat, sec.second_moment_flatwise),
             "1E": bending(1.875104, E, sec.second_moment_edgewise),
             "1T": 1.0 / (4 * L) * np.sqrt(g.shear_modulus * sec.torsion_constant / (rho * sec.polar_moment))}
-
-
-def warping_constant_rectangle(side_a: float, side_b: float, n_terms: int = 50) -> float:
-    """Warping constant C_w = int psi^2 dA [m^6] of a solid rectangle with sides ``side_a``,
-    ``side_b`` [m], psi the exact St. Venant warping function [m^2] about the centroid (the shear
-    centre of the doubly symmetric section).
-
-    With t <= c the short and long sides, x across t, y along c, h = t / 2 and k_n = n pi / t, the
-    series solution of the rectangle's torsion (Timoshenko & Goodier, Theory of Elasticity, torsion
-    of rectangular bars) is
-    psi = x y - sum_{n odd} C_n (-1)^((n-1)/2) sin(k_n x) sinh(k_n y) / cosh(k_n c / 2),
-    C_n = 32 h^2 / (pi^3 n^3). The sines are orthogonal on |x| <= h, so term by term
-    C_w = t^3 c^3 / 144 - 2 sum C_n X_n Y_n + h sum C_n^2 S_n with X_n = 2 / k_n^2,
-    Y_n = 2 (c / (2 k_n) - tanh(k_n c / 2) / k_n^2), S_n = tanh(k_n c / 2) / k_n - (c / 2) / cosh^2(k_n c / 2).
-
-    Thin rectangle: C_w -> t^3 c^3 / 144 (psi -> x y, the sectorial coordinate of a thin strip,
-    the thin-walled value), expanded C_w = t^3 c^3 / 144 (1 - 4.8 (t/c)^2 + 4.58 (t/c)^3 + ...);
-    the reference airfoil (4.57 x 45.5 mm, c / t = 9.96) has 0.956 of it, 5.9700e-14 m^6. Both that
-    and a square's 1.3440e-4 a^6 are the values of sectionproperties' finite-element warping analysis
-    (version 3.10, Pilkey's method: Pilkey, Analysis and Design of Elastic Beams, 2002) to 1e-8 and
-    2e-6. A solid rectangle is not thin-walled: Vlasov's torsion with this C_w is an approximation
-    (checked on the solid plain plate).
-    """
-    a = check.positive("side_a", side_a)
-    b = check.positive("side_b", side_b)
-    t, c = min(a, b), max(a, b)
-    h, half_c = t / 2.0, c / 2.0
-    n = np.arange(1, 2 * check.integer("n_terms", n_terms, minimum=1), 2, dtype=float)
-    k = n * np.pi / t
-    C = 32.0 * h**2 / (np.pi**3 * n**3)
-    X = 2.0 / k**2
-    th = np.tanh(k * half_c)
-    Y = 2.0 * (half_c / k - th / k**2)
-    sech2 = np.where(k * half_c < 350.0, 1.0 / np.cosh(np.minimum(k * half_c, 350.0))**2, 0.0)
-    S = th / k - half_c * sech2
-    return float(t**3 * c**3 / 144.0 - 2.0 * np.sum(C * X * Y) + h * np.sum(C**2 * S))
 
 
 def _nth_root_on_grid(determinant, frequencies_hz: np.ndarray, n: int):
@@ -1271,6 +1260,11 @@ class SolidModes:
     seconds : wall times [s] of "mesh", "assemble", "solve".
     rotor_speed_hz [Hz], hub_radius [m] : the centrifugal prestress (0: at rest; :func:`solid_modes`);
         with it, static_displacement (property) is the centrifugal static displacement (n_dofs,) [m].
+    fe_model : the scikit-fem model the modes were computed on, by name: "mesh" (skfem MeshTet),
+        "element" (the vector P2 element), "basis_k", "basis_m" (its bases), "facets" (face name ->
+        facet indices), "mu", "lam" (Lame constants [Pa]), "mass" [kg] and, with a prestress,
+        "static_displacement" (what :meth:`face_quadrature`, :meth:`displacements_at` and
+        :meth:`ContactFaceField.from_modes` evaluate).
     """
 
     geometry: SolidBladeGeometry
@@ -1287,25 +1281,25 @@ class SolidModes:
     mass_matrix: object = field(repr=False)
     free_dofs: np.ndarray = field(repr=False)
     seconds: dict = field(default_factory=dict)
-    _fe: dict = field(default_factory=dict, repr=False)   # skfem mesh and bases
+    fe_model: dict = field(default_factory=dict, repr=False)
     rotor_speed_hz: float = 0.0
     hub_radius: float = 0.0
 
     @property
     def mass(self) -> float:
         """Total blade mass [kg] (above the clamp)."""
-        return float(self._fe["mass"])
+        return float(self.fe_model["mass"])
 
     @property
     def static_displacement(self) -> np.ndarray | None:
         """(n_dofs,) displacement of the centrifugal static step [m] (None at rest)."""
-        return self._fe.get("static_displacement")
+        return self.fe_model.get("static_displacement")
 
     @property
     def vertex_dofs(self) -> np.ndarray:
         """(3, n_vertices) int: the index in :attr:`vectors`' rows and :attr:`static_displacement`
         of the x, y, z displacement of each mesh vertex (the P2 elements' vertex DOFs)."""
-        return self._fe["basis_k"].nodal_dofs
+        return self.fe_model["basis_k"].nodal_dofs
 
     # -- evaluation ----------------------------------------------------------------------
     def face_quadrature(self, name: str):
@@ -1313,7 +1307,7 @@ class SolidModes:
         "tip"; ValueError naming the faces otherwise): points (N, 3) [m], weights (N,) [m^2] and
         the n columns of :attr:`vectors` (mode shapes, in their units) at the points (N, 3, n)."""
         from skfem import FacetBasis
-        fe = self._fe
+        fe = self.fe_model
         if name not in fe["facets"]:
             raise ValueError(f"face must be one of {sorted(fe['facets'])} (got {name!r})")
         fb = FacetBasis(fe["mesh"], fe["element"], facets=fe["facets"][name], intorder=4)
@@ -1327,7 +1321,7 @@ class SolidModes:
         """Quadrature of the volume of ``elements`` (tetrahedron indices): points (N, 3), weights
         (N,) [m^3], values (N, 3, n)."""
         from skfem import Basis
-        fe = self._fe
+        fe = self.fe_model
         elements = np.asarray(elements, dtype=np.int64)
         if elements.size == 0:
             raise ValueError("no elements to fit over (this solid has no platform)")
@@ -1350,7 +1344,7 @@ class SolidModes:
         """(P, 3, n) FE displacements of every mode at points (P, 3) inside the solid [m/sqrt(kg)]
         (interpolated by the P2 shape functions; a point on the surface may need a nudge inward)."""
         x = np.atleast_2d(np.asarray(points, dtype=float))
-        probe = self._fe["basis_m"].probes(x.T)              # (3 P, n_dofs), rows component-major
+        probe = self.fe_model["basis_m"].probes(x.T)              # (3 P, n_dofs), rows component-major
         values = probe @ self.vectors                         # (3 P, n)
         return values.reshape(3, x.shape[0], -1).transpose(1, 0, 2)
 
@@ -1570,7 +1564,7 @@ def solid_modes(geometry: SolidBladeGeometry | BeamBladeGeometry | None = None,
                        frequencies_hz=np.sqrt(np.clip(lam, 0.0, None)) / (2 * np.pi), vectors=vectors,
                        mode_names=(), families=(), family_fractions=np.zeros((V.shape[1], 4)),
                        tip_residual=np.zeros(V.shape[1]), stiffness=K, mass_matrix=M, free_dofs=free,
-                       seconds={"mesh": mesh.seconds, "assemble": t1 - t0, "solve": t2 - t1}, _fe=fe,
+                       seconds={"mesh": mesh.seconds, "assemble": t1 - t0, "solve": t2 - t1}, fe_model=fe,
                        rotor_speed_hz=rotor_speed_hz, hub_radius=hub_radius)
     # names from the tip motion, signs: tip u_x > 0 (F), u_y > 0 (E), phi_z > 0 (T), u_z > 0 (A)
     x, w, u = modes.face_quadrature("tip")
@@ -1705,7 +1699,7 @@ class ContactFaceField:
     @classmethod
     def from_modes(cls, modes: "SolidModes", side: str, mode_indices) -> "ContactFaceField":
         """The field of ``modes`` (the columns ``mode_indices``) at its ``side`` contact face."""
-        fe = modes._fe
+        fe = modes.fe_model
         basis = fe["basis_k"]
         t = np.asarray(fe["mesh"].t)                                              # (4, n_e), = mesh.tets
         on_face = np.zeros(modes.mesh.vertices.shape[1], dtype=bool)
@@ -1937,9 +1931,18 @@ class SolidModalBlade(ModalBlade):
         return out
 
     @classmethod
+    def from_npz(cls, path, data) -> "SolidModalBlade":
+        """The blade of the open ``.npz`` file ``data`` of a solid FE blade (format
+        :data:`SOLID_NPZ_FORMAT` or its /1; ``path`` for the messages): the reader of
+        :func:`bladedamp.io.load_npz` for this class (use :meth:`~bladedamp.blade.modal.ModalBlade.from_file`
+        or :func:`bladedamp.load`)."""
+        fields, _, arrays = modal_npz_fields(path, data, SOLID_NPZ_FORMAT)
+        return cls.from_npz_arrays(path, fields, arrays)
+
+    @classmethod
     def from_npz_arrays(cls, path, fields: dict, arrays: dict) -> "SolidModalBlade":
         """The blade of a :data:`SOLID_NPZ_FORMAT` file ``path`` (for the messages) from its
-        ModalBlade ``fields`` and its other ``arrays`` (:func:`bladedamp.blade.read_modal_npz`);
+        ModalBlade ``fields`` and its other ``arrays`` (:func:`bladedamp.blade.modal.modal_npz_fields`);
         ValueError naming the file and the key for a missing or malformed entry."""
         def get(key):
             if key not in arrays:
