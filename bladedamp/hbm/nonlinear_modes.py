@@ -151,9 +151,11 @@ def _solve(problem: EPMCProblem, y0, a, y_scale, r_scale, tol=1e-10, max_iter=25
 
 # ----- the linear stuck mode ----------------------------------------------------------------
 def _static_equilibrium(model, system, omega, tol=1e-12):
-    """The static state (no dynamic motion): the model's (``static_state``), refined by Newton
-    on the static harmonic when the basis has one (the damper seated under F_CG with the
-    harmonic balance's own contact law and retention spring)."""
+    """The static state (no dynamic motion): the model's (``static_state``: the dampers seated on
+    rigid platforms), refined by :func:`bladedamp.hbm.newton.newton` on the static harmonic when
+    the basis has one (the damper seated under F_CG on the flexible blades, with the harmonic
+    balance's own contact law and retention spring), to the scaled residual ``tol`` (its scale:
+    the static load). The model's state if that Newton does not converge."""
     x = np.array(model.static_state(system, omega), dtype=float) if hasattr(model, "static_state") \
         else np.zeros(system.n_unknowns)
     basis = system.basis
@@ -162,19 +164,22 @@ def _static_equilibrium(model, system, omega, tol=1e-12):
     n = system.n_dof
     j0 = basis.cos_index(0)
     rows = slice(j0 * n, (j0 + 1) * n)
-    x0 = x.copy()
-    for _ in range(50):
-        R, J, _ = system.residual(x, omega)
+
+    def static_rows(x_static, w, jacobian=True):
+        y = x.copy()
+        y[rows] = x_static
+        R, J, _ = system.residual(y, w, jacobian)
+        if not jacobian:
+            return R[rows], None
         J = J.toarray() if hasattr(J, "toarray") else np.asarray(J)
-        r = R[rows]
-        try:
-            dx = -np.linalg.solve(J[rows, rows], r)
-        except np.linalg.LinAlgError:
-            return x0
-        x[rows] += dx
-        if np.linalg.norm(dx) <= tol * max(np.linalg.norm(x[rows]), 1e-300):
-            return x
-    return x0
+        return R[rows], J[rows, rows]
+
+    load = max(np.linalg.norm(system.excitation(omega)[0][rows]), 1e-300)
+    sol = newton(static_rows, x[rows], omega, max(np.abs(x[rows]).max(), 1e-300), load, tol=tol, max_iter=50,
+                 factorize=lambda J: lambda b: np.linalg.solve(J, b))
+    if sol.converged:
+        x[rows] = sol.x
+    return x
 
 
 def linear_stuck_mode(model, system, mode: int = 0, omega_guess: float | None = None, max_iter: int = 30):
