@@ -973,9 +973,10 @@ class TunedDisk:
     def static_state(self, system, omega):
         """The state without dynamic motion: rest, or with a static harmonic the damper seated
         frictionlessly under F_CG (``seat``)."""
-        seats = ((slice(self.blade.n_modes, None), self.damper_geometry(), self._centrifugal_force(omega)[0])
-                 for _ in range(self.has_damper))
-        return seated_state(system, seats)
+        def seats():
+            if self.has_damper:
+                yield slice(self.blade.n_modes, None), self.damper_geometry(), self._centrifugal_force(omega)[0]
+        return seated_state(system, seats())
 
     def initial_guess(self, system, omega):
         """Stuck linear solution (C * n_dof,) of ``system`` at ``omega`` [rad/s, the residual's
