@@ -63,3 +63,8 @@ def test_admissible_points_and_failures_are_reported():
     # a residual that is not finite
     r = newton(lambda x, p, jacobian=True: (x * np.nan, np.eye(1)), np.array([1.0]), None, 1.0, 1.0)
     assert not r.converged and r.residual_norm == np.inf
+
+
+def test_the_norm_is_checked():
+    with pytest.raises(ValueError, match="norm"):
+        newton(arctan, np.array([0.5]), 0.3, 1.0, 1.0, norm=1)

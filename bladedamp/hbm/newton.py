@@ -128,6 +128,8 @@ def newton(fun, x0, parameter, x_scale, residual_scale, tol=1e-10, max_iter=30, 
     Jacobian at the full step would mostly be thrown away); the iteration after a shortened
     step evaluates both at the point taken. Evaluation counts: benchmarks/README.md, 'Moved
     from the package's docstrings', hbm/start.py."""
+    if not (norm == 2 or norm == np.inf):
+        raise ValueError(f"norm must be 2 or np.inf (the norm of the convergence test), got {norm!r}")
     x = np.array(x0, dtype=float)
     rnorm = np.inf
     dx = None
