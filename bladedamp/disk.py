@@ -39,7 +39,7 @@ from .contact.patch import dof_jacobian
 from .contact.point import (MAX_PASSES, PERIODIC_TOL, PointContactSamples, damper_contact_forces, normal_law_parameters,
                             point_contact_forces)
 from .damper.geometry import CylinderDamper, DamperGeometry, WedgeDamper
-from .damper.kinetics import centrifugal_force, retention_stiffness, seat
+from .damper.kinetics import centrifugal_force, retention_stiffness, seat, seated_state
 from .hbm.accuracy import HARMONIC_TOLERANCE, AccuracyWarning, converged_response
 from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_MAX_STEP, DEFAULT_POINT_BUDGET, Branch, Budget, continuation
 from .hbm.nonlinear_modes import linear_stuck_mode
@@ -515,6 +515,11 @@ class TunedDisk:
         if self.engine_order == 0 and self.has_damper and self.rotor_speed_hz is None:
             raise ValueError("engine_order = 0 needs an explicit rotor_speed_hz (rotor revolutions per second, "
                              "> 0; rpm / 60)")
+        if self.initial_gaps is not None and self.damper is not None:
+            gaps = np.asarray(validation.finite("initial_gaps", self.initial_gaps), dtype=float)
+            P = self.damper.geometry(self.gamma_left, self.gamma_right).patches[0].n_points
+            if gaps.shape != (2, P):
+                raise ValueError(f"initial_gaps must have shape (2, {P}) (OL, OR points) in m")
 
     # ----- geometry --------------------------------------------------------------------
     @property
@@ -537,13 +542,12 @@ class TunedDisk:
         return tuple(f"q_{m}" for m in modes) + (DAMPER_DOFS if self.has_damper else ())
 
     def damper_geometry(self) -> DamperGeometry:
+        """The damper's :class:`DamperGeometry` at the disk's platform angles, with its
+        ``initial_gaps`` (validated when the disk is made)."""
         geometry = self.damper.geometry(self.gamma_left, self.gamma_right)
         if self.initial_gaps is not None:
-            gaps = np.asarray(validation.finite("initial_gaps", self.initial_gaps), dtype=float)
-            P = geometry.patches[0].n_points
-            if gaps.shape != (2, P):
-                raise ValueError(f"initial_gaps must have shape (2, {P}) (OL, OR points) in m")
-            geometry.patches = tuple(dataclasses.replace(p, initial_gap=g) for p, g in zip(geometry.patches, gaps))
+            geometry.patches = tuple(dataclasses.replace(p, initial_gap=g)
+                                     for p, g in zip(geometry.patches, np.asarray(self.initial_gaps, dtype=float)))
         return geometry
 
     def platform_offsets(self, geometry: DamperGeometry) -> np.ndarray:
@@ -969,12 +973,10 @@ class TunedDisk:
     def static_state(self, system, omega):
         """The state without dynamic motion: rest, or with a static harmonic the damper seated
         frictionlessly under F_CG (``seat``)."""
-        x = np.zeros(system.n_unknowns)
-        if self.has_damper and system.basis.has_static:
-            u_seat, _, _ = seat(self.damper_geometry(), self._centrifugal_force(omega)[0])
-            nm = self.blade.n_modes
-            x.reshape(system.basis.n_coeffs, system.n_dof)[system.basis.cos_index(0), nm:] = u_seat
-        return x
+        def seats():
+            if self.has_damper:
+                yield slice(self.blade.n_modes, None), self.damper_geometry(), self._centrifugal_force(omega)[0]
+        return seated_state(system, seats())
 
     def initial_guess(self, system, omega):
         """Stuck linear solution (C * n_dof,) of ``system`` at ``omega`` [rad/s, the residual's

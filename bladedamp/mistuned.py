@@ -58,7 +58,7 @@ from . import validation
 from .blade import PLATFORM_ANGLE, ModalBlade
 from .contact.laws import LinearNormalLaw
 from .contact.point import MAX_PASSES, PERIODIC_TOL
-from .damper.kinetics import retention_stiffness, seat
+from .damper.kinetics import retention_stiffness, seated_state
 from .disk import (AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION, DAMPER_DOFS, DEFAULT_DAMPER_RADIUS,
                    STOP_CHECK_OFFSET_HZ,
                    DamperContacts, TunedDisk, contact_point_maps, contact_rows, damper_weighted_scales,
@@ -959,14 +959,9 @@ class MistunedDisk:
 
     def static_state(self, system: HarmonicBalanceSystem, omega: float) -> np.ndarray:
         """Rest, or with a static harmonic every damper seated frictionlessly under F_CG."""
-        x = np.zeros(system.n_unknowns)
-        if system.basis.has_static:
-            X = x.reshape(system.basis.n_coeffs, system.n_dof)
-            for d, k in enumerate(self.active_dampers):
-                sector = self.sectors[k]
-                u_seat, _, _ = seat(sector.damper_geometry(), sector.centrifugal_force(omega / (2 * np.pi))[0])
-                X[system.basis.cos_index(0), self.damper_slice(d)] = u_seat
-        return x
+        seats = ((self.damper_slice(d), self.sectors[k].damper_geometry(),
+                  self.sectors[k].centrifugal_force(omega / (2 * np.pi))[0]) for d, k in enumerate(self.active_dampers))
+        return seated_state(system, seats)
 
     def initial_guess(self, system: HarmonicBalanceSystem, omega: float) -> np.ndarray:
         """Stuck linear solution (C * n_dof,) at ``omega`` [rad/s] (one Newton step from the static

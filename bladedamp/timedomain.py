@@ -25,6 +25,7 @@ from .contact.laws import normal_law_parameters
 from .contact.normal import normal_force, normal_forces
 from .contact.point import SEPARATED, PointContactElement, slider_step
 from .hbm.continuation import DEFAULT_MAX_STEP
+from .hbm.newton import newton
 from .io import Saveable
 
 
@@ -469,10 +470,11 @@ def point_normal_forces(arrays: AssemblyArrays, approach: np.ndarray):
 
 def frictionless_static_state(arrays: AssemblyArrays, f_static: np.ndarray, tol: float = 1e-12, max_iter: int = 60):
     """Static equilibrium under the centrifugal load F_CG (Eq. 26) with frictionless contacts:
-    K x - Z^T N(offset - Z x) = f_static, Z the normal displacement of every point. Newton
-    from every damper seated on rigid platforms (:func:`~bladedamp.damper.kinetics.seat`); the
-    directions no normal force fixes (axial position, the cylinder's roll) stay at zero
-    (minimum-norm steps). With friction this is the equilibrium with every slider at its
+    K x - Z^T N(offset - Z x) = f_static, Z the normal displacement of every point.
+    :func:`bladedamp.hbm.newton.newton` (max norm: residual below ``tol`` of max |f_static|,
+    update below sqrt(tol) of the seated displacement) from every damper seated on rigid
+    platforms (:func:`~bladedamp.damper.kinetics.seat`); the directions no normal force fixes
+    (axial position, the cylinder's roll) stay at zero (minimum-norm steps). With friction this is the equilibrium with every slider at its
     point's tangential displacement (zero tangential force). Returns x (N,)."""
     from .damper.kinetics import seat
 
@@ -484,7 +486,6 @@ def frictionless_static_state(arrays: AssemblyArrays, f_static: np.ndarray, tol:
     if not arrays.geometries:
         return np.asarray(np.linalg.lstsq(arrays.stiffness.toarray(), f_static, rcond=None)[0])
     import scipy.sparse as sp
-    from scipy.sparse.linalg import spsolve
 
     Z = arrays.point_map[2::3]                            # (P, N) sparse: u_zeta of every point
     K = arrays.stiffness
@@ -493,19 +494,18 @@ def frictionless_static_state(arrays: AssemblyArrays, f_static: np.ndarray, tol:
     # right-hand side is zero, so they stay at zero (to rounding), as minimum-norm steps would
     n_free = np.zeros(N)
     n_free[arrays.n_q:] = 1e-12 * (arrays.law_par[:, 0].max() + arrays.k_t.sum())
-    for _ in range(max_iter):
+    def residual(x, _, jacobian=True):
         normal, dn = point_normal_forces(arrays, arrays.offset - Z @ x)
         R = K @ x - Z.T @ normal - f_static
-        J = (K + Z.T @ sp.diags(dn) @ Z + sp.diags(n_free)).tocsc()
-        dx = -spsolve(J, R)
-        x = x + dx
-        if np.abs(R).max() <= tol * scale and np.linalg.norm(dx) <= 1e-9 * (np.linalg.norm(x) + 1e-300):
-            return x
-    normal, _ = point_normal_forces(arrays, arrays.offset - Z @ x)
-    R = K @ x - Z.T @ normal - f_static
+        return R, ((K + Z.T @ sp.diags(dn) @ Z + sp.diags(n_free)).tocsc() if jacobian else None)
+
+    sol = newton(residual, x, None, max(np.abs(x).max(), 1e-300), scale, tol=tol, max_iter=max_iter, norm=np.inf)
+    if sol.converged:
+        return sol.x
+    R = residual(sol.x, None, False)[0]
     if np.abs(R).max() > 1e-8 * scale:
         raise RuntimeError(f"static equilibrium under the centrifugal load did not converge (residual {np.abs(R).max():.3g} N)")
-    return x
+    return sol.x
 
 
 def highest_frequency(arrays: AssemblyArrays, x_static: np.ndarray) -> float:
@@ -1092,8 +1092,6 @@ def hbm_tip_at(disk, f_hz, harmonics=(0, 1, 2, 3), pad_hz: float = 1.0, max_step
                                     **kw, **continuation_options)
     if not r.success:
         raise RuntimeError(f"HBM continuation failed: {r.message}")
-    from .hbm.continuation import newton
-
     basis = r.basis
     system = disk.hbm_system(basis.harmonics, basis.n_samples)
     X = r.coefficients.reshape(len(r.omega), -1)

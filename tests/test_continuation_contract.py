@@ -327,28 +327,31 @@ def test_robust_start_finds_the_oscillator_solution_in_gross_slip():
 
 
 def test_damped_newton_gives_up_where_it_stagnates_and_not_where_it_converges_slowly():
-    """R(x) = x^2 + 1 has no real root: |R| cannot fall below 1, so damped Newton must stop as not
-    converged after about STAGNATION_WINDOW iterations, not max_iter. R(x) = x^3 (a triple root)
-    converges linearly, |R| falling by (2/3)^3 per iteration: it must converge, past that window."""
-    from bladedamp.hbm import start
+    """R(x) = x^2 + 1 has no real root: |R| cannot fall below 1, so Newton with the start's line
+    search must stop as not converged after about STAGNATION_WINDOW iterations, not max_iter.
+    R(x) = x^3 (a triple root) converges linearly, |R| falling by (2/3)^3 per iteration: it must
+    converge, past that window."""
+    from bladedamp.hbm.newton import STAGNATION_WINDOW, newton
+    from bladedamp.hbm.start import START_LINE_SEARCH
 
     calls = []
 
-    def no_root(x, jacobian):
+    def no_root(x, p, jacobian=True):
         calls.append(jacobian)
         return np.array([x[0] ** 2 + 1]), np.array([[2 * x[0]]])
-    x, converged, rnorm = start.damped_newton(no_root, np.array([0.3]), 1.0, 1.0, max_iter=60)
+    r = newton(no_root, np.array([0.3]), None, 1.0, 1.0, max_iter=60, line_search=START_LINE_SEARCH)
     newton_steps = sum(calls)
-    assert not converged and rnorm >= 1.0
-    assert start.STAGNATION_WINDOW < newton_steps <= start.STAGNATION_WINDOW + 2, newton_steps
+    assert not r.converged and r.residual_norm >= 1.0
+    assert STAGNATION_WINDOW < newton_steps <= STAGNATION_WINDOW + 2, newton_steps
+    assert STAGNATION_WINDOW < r.iterations <= STAGNATION_WINDOW + 1, r.iterations
 
     calls.clear()
 
-    def triple_root(x, jacobian):
+    def triple_root(x, p, jacobian=True):
         calls.append(jacobian)
         return np.array([x[0] ** 3]), np.array([[3 * x[0] ** 2]])
-    x, converged, rnorm = start.damped_newton(triple_root, np.array([1.0]), 1.0, 1.0, tol=1e-12, max_iter=200)
-    assert converged and abs(x[0]) < 1e-3 and sum(calls) > start.STAGNATION_WINDOW
+    r = newton(triple_root, np.array([1.0]), None, 1.0, 1.0, tol=1e-12, max_iter=200, line_search=START_LINE_SEARCH)
+    assert r.converged and abs(r.x[0]) < 1e-3 and sum(calls) > STAGNATION_WINDOW
 
 @pytest.mark.slow   # 8-26 s: kept out of the default run (under 10 min); CI runs it
 def test_a_branch_retracing_itself_is_stopped_and_says_so():

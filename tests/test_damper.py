@@ -377,3 +377,30 @@ def test_retention_spring_holds_a_rotation_as_the_translation_at_10_mm():
         moment = np.cross(rho, -r * k_n * np.cross(rotation, rho))
         np.testing.assert_allclose(restoring[3 + axis], moment[axis], rtol=1e-12)
     assert np.array_equal(K, K.T) and np.all(K == np.diag(np.diag(K)))
+
+
+def test_seated_state_is_the_rigid_seating_of_every_damper_in_the_static_harmonic():
+    """kinetics.seated_state serves the tuned sector and the mistuned assembly: each damper's
+    static harmonic is its frictionless rigid-platform seating under F_CG, whose normal loads
+    carry F_CG radially; everything else (and every harmonic without a static one) is at rest."""
+    from bladedamp.damper.kinetics import seat
+    from bladedamp.mistuned import MistunedDisk
+
+    # a numpy mass (as the studies pass): has_damper is a numpy bool
+    tuned = dataclasses.replace(reference_disk("wedge", np.float64(0.3e-3)), n_blades=3)
+    full = MistunedDisk.from_tuned(tuned)
+    w = 2 * np.pi * 97.0
+    F = tuned.centrifugal_force(97.0)[0]
+    geometry = tuned.damper_geometry()
+    u, _, loads = seat(geometry, F)
+    # the seating's normal loads balance F_CG along the radius (frictionless contacts)
+    assert np.dot(loads, geometry.frames[:, 2, 2]) == pytest.approx(-F, rel=1e-9)
+    for model, columns in ((tuned, [slice(tuned.blade.n_modes, None)]),
+                           (full, [full.damper_slice(d) for d in range(3)])):
+        system = model.hbm_system((0, 1))
+        X = model.static_state(system, w).reshape(system.basis.n_coeffs, system.n_dof)
+        expected = np.zeros_like(X)
+        for c in columns:
+            expected[system.basis.cos_index(0), c] = u
+        np.testing.assert_array_equal(X, expected)
+        assert not model.static_state(model.hbm_system((1,)), w).any()

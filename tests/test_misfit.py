@@ -69,6 +69,9 @@ def test_misfit_wedge_seats_on_one_edge_and_solves(wedge):
     assert abs(change) > 1e-3, "a partial contact must change the response"
 
 
-def test_bad_gap_shape_is_rejected(wedge):
+def test_bad_gaps_are_rejected_when_the_disk_is_made(wedge):
     with pytest.raises(ValueError, match="initial_gaps"):
-        dataclasses.replace(wedge, initial_gaps=np.zeros((2, 3))).damper_geometry()
+        dataclasses.replace(wedge, initial_gaps=np.zeros((2, 3)))
+    P = wedge.damper_geometry().patches[0].n_points
+    with pytest.raises(ValueError, match="initial_gaps"):
+        dataclasses.replace(wedge, initial_gaps=np.full((2, P), np.nan))

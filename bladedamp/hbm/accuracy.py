@@ -41,7 +41,7 @@ from ..response import BUDGET_PREFIX, harmonic_sentence
 from .continuation import newton, stall_guard
 from .fourier import HarmonicBasis, enriched
 from .linsolve import one_blas_thread
-from .start import damped_newton
+from .start import START_LINE_SEARCH
 
 #: default tolerance on the first-harmonic output amplitudes, relative to the peak amplitude
 HARMONIC_TOLERANCE = 0.01
@@ -128,8 +128,9 @@ def _enriched_amplitudes(model, coefficients, basis, system, omega, scales, tol)
     sol = newton(system.residual, x0, omega, scales, rs, tol=tol, max_iter=20, factorize=system.factorize)
     x, converged = sol.x, sol.converged
     if not converged:               # the plain Newton overshoots on a corner of the force map
-        x, converged, _ = damped_newton(lambda y, jacobian=True: system.residual(y, omega, jacobian)[:2],
-                                        x0, scales, rs, tol=tol, factorize=system.factorize)
+        sol = newton(system.residual, x0, omega, scales, rs, tol=tol, max_iter=60, factorize=system.factorize,
+                     line_search=START_LINE_SEARCH)
+        x, converged = sol.x, sol.converged
     if not converged:
         return None
     return model.output_amplitudes(x.reshape(1, system.basis.n_coeffs, -1), system.basis)[0]

@@ -26,6 +26,7 @@ import scipy.sparse as sp
 
 from .. import validation
 from .linsolve import factorize as lu_factorize
+from .newton import NewtonResult, euclidean, newton  # noqa: F401  (newton, NewtonResult: the names callers know)
 
 
 class _BorderedPattern:
@@ -87,12 +88,6 @@ def bordered_matrix(J, column, row, column_scale, factor):
     A[:n, n] = column * factor
     A[n] = row
     return A
-
-
-def _norm(v):
-    """The Euclidean norm of a real vector, the number np.linalg.norm gives (sqrt(v . v)), without
-    its dispatch (~5 us: several per corrector iteration)."""
-    return np.sqrt(v.dot(v))
 
 
 def _unit_last(n: int) -> np.ndarray:
@@ -201,45 +196,6 @@ class Budget:
 
 class ConvergenceWarning(UserWarning):
     """A Newton or continuation run stopped without converging."""
-
-
-@dataclass
-class NewtonResult:
-    """x (n,); ``solve`` and ``dR_domega`` (n,): the factorised dR/dx (``solve(b) = J^-1 b``) and
-    dR/dOmega of the last iterate evaluated, whose residual met the tolerance (one update before
-    ``x``), for a tangent dx/dOmega = -solve(dR_domega) without another Jacobian; None if the
-    solve did not converge."""
-
-    x: np.ndarray
-    converged: bool
-    iterations: int
-    residual_norm: float
-    solve: object = None
-    dR_domega: np.ndarray | None = None
-
-
-def newton(fun, x0, omega, x_scale, residual_scale, tol=1e-10, max_iter=30, factorize=lu_factorize):
-    """Solve R(x, omega) = 0 at fixed omega. Converged when the scaled residual is below ``tol``
-    and the Newton update computed there is below sqrt(tol) (scaled); that update is applied,
-    so the returned point is one step beyond the last residual evaluated (``residual_norm``).
-    ``factorize(J) -> solve``: the linear solver (default: dense or sparse LU,
-    :func:`bladedamp.hbm.linsolve.factorize`)."""
-    x = np.array(x0, dtype=float)
-    rnorm = np.inf
-    for it in range(1, max_iter + 1):
-        R, J, Rw = fun(x, omega)
-        rnorm = _norm(R) / residual_scale
-        if not np.all(np.isfinite(R)):
-            return NewtonResult(x, False, it, rnorm)
-        try:
-            solve = factorize(J)
-            dx = -solve(R)
-        except (np.linalg.LinAlgError, RuntimeError):   # singular (RuntimeError: splu)
-            return NewtonResult(x, False, it, rnorm)
-        x = x + dx
-        if rnorm < tol and _norm(dx / x_scale) < np.sqrt(tol):
-            return NewtonResult(x, True, it, rnorm, solve, Rw)
-    return NewtonResult(x, False, max_iter, rnorm)
 
 
 @dataclass
@@ -566,11 +522,11 @@ class ArcLengthContinuation:
         """t (solving [dR/dy; r^T] t = e_{n+1}, r = ``reference``) normalised, in the sense of
         the branch orientation (recorded from the start sense); ``corner``: at a corner the
         corrector could not pass, where the sign is taken whatever the angle."""
-        t = t / _norm(t)
+        t = t / euclidean(t)
         if sign == 0:
             return t
         if self.orientation == 0 or (sign != self.orientation and not corner
-                                     and t @ reference > 0.95 * _norm(reference)):
+                                     and t @ reference > 0.95 * euclidean(reference)):
             self.orientation = sign
             return t
         return t * sign * self.orientation
@@ -594,7 +550,7 @@ class ArcLengthContinuation:
             prev[n] = self.direction
         else:
             prev = prev / self.scale()
-            prev /= _norm(prev)
+            prev /= euclidean(prev)
         A = self.scaled_system(y, prev)[1]
         solve = self.factorize(A)        # a singular matrix raises here, as the callers expect
         return self.oriented(solve(self._e_last.copy()), _det_sign(A, solve), prev)
@@ -627,9 +583,9 @@ class ArcLengthContinuation:
                     break
             dy = -bordered(G)
             previous_iterate, yc = yc, yc + dy
-            previous_norm, step_norm = step_norm, _norm(dy)
+            previous_norm, step_norm = step_norm, euclidean(dy)
             # converged: residual at the noise level and the update computed there small
-            if _norm(R) < self.tol and step_norm < np.sqrt(self.tol):
+            if euclidean(R) < self.tol and step_norm < np.sqrt(self.tol):
                 ok = True
                 break
             if not fresh:
@@ -661,7 +617,7 @@ class ArcLengthContinuation:
                 # the predictor than the predictor is from the last point (more than 45 degrees off
                 # the tangent: another branch), or that step farther in omega than max_step allows
                 forward = ok and (yc - y) @ tangent > 0 and abs(yc[n] - y[n]) * self.w_scale <= self.max_dw
-                if forward and _norm(yc - (y + h * tangent)) <= h:
+                if forward and euclidean(yc - (y + h * tangent)) <= h:
                     attempt.accepted, attempt.point, attempt.iterations = True, yc, it
                     # the next tangent solves [J; tangent] t = e_{n+1}: the matrix just factorised
                     # at the converged point (to the last update), so it costs one back-substitution
@@ -979,7 +935,7 @@ class ArcLengthContinuation:
                 tangent = self.tangent_at(y, tangent_prev)
             else:
                 tangent = next_tangent / self.scale()      # unscaled -> scaled by the current x_scale
-                tangent /= _norm(tangent)
+                tangent /= euclidean(tangent)
             attempt = self.step_along(y, tangent, h)
             h, tangent, next_tangent = attempt.h, attempt.tangent, attempt.next_tangent
             if not attempt.accepted and h < self.step and hops < 5:

@@ -45,6 +45,7 @@ import scipy.linalg
 from .. import validation
 from ..io import Saveable
 from .fourier import HarmonicBasis
+from .newton import LineSearch, NewtonResult, equilibrated, newton
 
 
 # ----- the EPMC residual ------------------------------------------------------------------
@@ -125,57 +126,36 @@ class EPMCProblem:
         return out, Jfull
 
 
-def _newton(problem: EPMCProblem, y0, a, y_scale, r_scale, tol=1e-10, max_iter=25):
-    """Newton on the EPMC residual with a backtracking line search on the scaled residual norm
-    (the AFT's friction forces are piecewise smooth: a full step can 2-cycle across a kink, a
-    stick-slip switch of a time sample; halving the step breaks the cycle). Converged when the
-    scaled residual is below ``tol`` and the scaled update below sqrt(tol); that update is applied.
-    Returns (y, converged, iterations)."""
+#: the EPMC Newton's line search: the step fraction is halved down to 1/32 (the AFT's friction
+#: forces are piecewise smooth: a full step can 2-cycle across a kink, a stick-slip switch of a
+#: time sample; halving the step breaks the cycle), without a stagnation guard
+EPMC_LINE_SEARCH = LineSearch(min_step=1 / 32, stagnation_window=None)
+
+
+def _solve(problem: EPMCProblem, y0, a, y_scale, r_scale, tol=1e-10, max_iter=25) -> NewtonResult:
+    """The EPMC residual solved at modal amplitude ``a`` by :func:`bladedamp.hbm.newton.newton`:
+    the bordered Jacobian equilibrated by ``y_scale`` (N + 2,) and the residual scale
+    ``r_scale`` [N] of the N force rows (the two closing equations unscaled), the convergence
+    test in the max norm, a line search (EPMC_LINE_SEARCH) that keeps omega > 0 (a converged
+    point with omega <= 0 is not converged). Sets ``problem.last_worst`` (the unknown of the
+    largest scaled last update)."""
     N = problem.N
-
-    def scaled(y):
-        R, J = problem.residual(y, a)
-        if not (np.all(np.isfinite(R)) and np.all(np.isfinite(J))):
-            return None, None, np.inf
-        rs = R.copy()
-        rs[:N] /= r_scale
-        return rs, J, float(np.linalg.norm(rs))
-
-    y = np.array(y0, dtype=float)
-    rs, J, norm = scaled(y)
-    if rs is None:
-        return y, False, 0
-    for it in range(1, max_iter + 1):
-        Js = J * y_scale[None, :]
-        Js[:N] /= r_scale
-        try:
-            dz = -np.linalg.solve(Js, rs)
-        except np.linalg.LinAlgError:
-            return y, False, it
-        if not np.all(np.isfinite(dz)):
-            return y, False, it
-        problem.last_worst = int(np.argmax(np.abs(dz)))
-        if np.linalg.norm(rs, np.inf) < tol and np.linalg.norm(dz, np.inf) < np.sqrt(tol):
-            y = y + dz * y_scale
-            return y, bool(y[N] > 0), it
-        lam = 1.0
-        while True:
-            trial = y + lam * dz * y_scale
-            rs_t, J_t, norm_t = scaled(trial) if trial[N] > 0 else (None, None, np.inf)
-            if norm_t <= (1 - 1e-4 * lam) * norm or lam < 1 / 16:
-                break
-            lam /= 2
-        if rs_t is None:
-            return y, False, it
-        y, rs, J, norm = trial, rs_t, J_t, norm_t
-    return y, False, max_iter
+    residual_scale = np.concatenate([np.full(N, float(r_scale)), [1.0, 1.0]])
+    sol = newton(problem.residual, y0, a, y_scale, residual_scale, tol=tol, max_iter=max_iter,
+                 factorize=equilibrated(y_scale, residual_scale), line_search=EPMC_LINE_SEARCH, norm=np.inf,
+                 admissible=lambda y: y[N] > 0)
+    if sol.step is not None:
+        problem.last_worst = int(np.argmax(np.abs(sol.step / y_scale)))
+    return sol
 
 
 # ----- the linear stuck mode ----------------------------------------------------------------
 def _static_equilibrium(model, system, omega, tol=1e-12):
-    """The static state (no dynamic motion): the model's (``static_state``), refined by Newton
-    on the static harmonic when the basis has one (the damper seated under F_CG with the
-    harmonic balance's own contact law and retention spring)."""
+    """The static state (no dynamic motion): the model's (``static_state``: the dampers seated on
+    rigid platforms), refined by :func:`bladedamp.hbm.newton.newton` on the static harmonic when
+    the basis has one (the damper seated under F_CG on the flexible blades, with the harmonic
+    balance's own contact law and retention spring), to the scaled residual ``tol`` (its scale:
+    the static load). The model's state if that Newton does not converge."""
     x = np.array(model.static_state(system, omega), dtype=float) if hasattr(model, "static_state") \
         else np.zeros(system.n_unknowns)
     basis = system.basis
@@ -184,19 +164,22 @@ def _static_equilibrium(model, system, omega, tol=1e-12):
     n = system.n_dof
     j0 = basis.cos_index(0)
     rows = slice(j0 * n, (j0 + 1) * n)
-    x0 = x.copy()
-    for _ in range(50):
-        R, J, _ = system.residual(x, omega)
+
+    def static_rows(x_static, w, jacobian=True):
+        y = x.copy()
+        y[rows] = x_static
+        R, J, _ = system.residual(y, w, jacobian)
+        if not jacobian:
+            return R[rows], None
         J = J.toarray() if hasattr(J, "toarray") else np.asarray(J)
-        r = R[rows]
-        try:
-            dx = -np.linalg.solve(J[rows, rows], r)
-        except np.linalg.LinAlgError:
-            return x0
-        x[rows] += dx
-        if np.linalg.norm(dx) <= tol * max(np.linalg.norm(x[rows]), 1e-300):
-            return x
-    return x0
+        return R[rows], J[rows, rows]
+
+    load = max(np.linalg.norm(system.excitation(omega)[0][rows]), 1e-300)
+    sol = newton(static_rows, x[rows], omega, max(np.abs(x[rows]).max(), 1e-300), load, tol=tol, max_iter=50,
+                 factorize=lambda J: lambda b: np.linalg.solve(J, b))
+    if sol.converged:
+        x[rows] = sol.x
+    return x
 
 
 def linear_stuck_mode(model, system, mode: int = 0, omega_guess: float | None = None, max_iter: int = 30):
@@ -617,13 +600,15 @@ def nonlinear_mode(model, mode: int = 0, amplitudes=None, harmonics=(1,), n_samp
             a_start = min(amps[0], _default_amplitudes(problem, x_static, u0, omega_lin, 2)[0])
         except ValueError:        # nothing nonlinear along the mode: start where asked
             a_start = amps[0]
-    y, ok, it = _newton(problem, y_prev, a_start, *scales(a_start), tol=tol)
+    sol = _solve(problem, y_prev, a_start, *scales(a_start), tol=tol)
+    y, ok, it = sol.x, sol.converged, sol.iterations
     if not ok and a_start < amps[0]:
         # a start below the first amplitude asked for can lie under the rounding of the preload
         # forces (a vanishing friction coefficient: slip from the first micrometre, "onset" at
         # 1e-13, where Newton stalls at 5e-8 of the scaled residual); start there instead
         a_start = amps[0]
-        y, ok, it = _newton(problem, y_prev, a_start, *scales(a_start), tol=tol)
+        sol = _solve(problem, y_prev, a_start, *scales(a_start), tol=tol)
+        y, ok, it = sol.x, sol.converged, sol.iterations
     if not ok:
         return _result(model, system, problem, [], [], [], False,
                        f"no EPMC solution at the start amplitude {a_start:.4g} from the stuck linear mode "
@@ -651,9 +636,11 @@ def nonlinear_mode(model, mode: int = 0, amplitudes=None, harmonics=(1,), n_samp
             else:
                 guess = y_prev
             a_new = 10.0 ** la_new
-            y, ok, it = _newton(problem, guess, a_new, *scales(a_new), tol=tol)
+            sol = _solve(problem, guess, a_new, *scales(a_new), tol=tol)
+            y, ok, it = sol.x, sol.converged, sol.iterations
             if not ok and y_prev2 is not None:
-                y, ok, it = _newton(problem, y_prev, a_new, *scales(a_new), tol=tol)
+                sol = _solve(problem, y_prev, a_new, *scales(a_new), tol=tol)
+                y, ok, it = sol.x, sol.converged, sol.iterations
             if ok:
                 y_prev2, la_prev2 = y_prev, la_prev
                 y_prev, la_prev, it_prev = y, la_new, it
@@ -671,7 +658,8 @@ def nonlinear_mode(model, mode: int = 0, amplitudes=None, harmonics=(1,), n_samp
                         la_j = min(la_prev + jump, lt)
                         a_j = 10.0 ** la_j
                         for start in (guess, y_prev):
-                            y, ok, it = _newton(problem, start, a_j, *scales(a_j), tol=tol)
+                            sol = _solve(problem, start, a_j, *scales(a_j), tol=tol)
+                            y, ok, it = sol.x, sol.converged, sol.iterations
                             if ok:
                                 break
                         if ok:
@@ -799,7 +787,8 @@ def _resolve_peaks(problem, system, peak_scales, amps, ys, its, scales, tol):
         def solve(la, found):
             a = float(np.exp(la))
             guess = y0 + (y1 - y0) * (la - la0) / (la1 - la0)
-            y, ok, it = _newton(problem, guess, a, *scales(a), tol=tol)
+            sol = _solve(problem, guess, a, *scales(a), tol=tol)
+            y, ok, it = sol.x, sol.converged, sol.iterations
             if not ok:
                 raise _PeakNotResolved
             return a, y, it
@@ -916,7 +905,8 @@ def _tracked_peak(model, setup: _EPMCStart, start: NonlinearModeResponse, scale:
             guess = found[l0][1] + (found[l1][1] - found[l0][1]) * (la - l0) / (l1 - l0)
         else:
             guess = found[near[0]][1] if near else y_start
-        y, ok, it = _newton(problem, guess, a, *setup.scales(a), tol=tol)
+        sol = _solve(problem, guess, a, *setup.scales(a), tol=tol)
+        y, ok, it = sol.x, sol.converged, sol.iterations
         if not ok:
             raise _PeakNotResolved
         return a, y, it

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .linsolve import factorize as lu_factorize
+from .newton import LineSearch, newton
 
 
 @dataclass
@@ -33,73 +34,17 @@ class StartResult:
     how: str
 
 
-#: damped Newton gives up once |R| has not halved over this many iterations: a failing damped
-#: Newton holds |R| for all its iterations, while those that converge need about as many as this
-#: in all (benchmarks/README.md, 'Moved from the package's docstrings', hbm/start.py)
-STAGNATION_WINDOW = 10
-STAGNATION_FACTOR = 0.5
+#: the line search of the start (:class:`bladedamp.hbm.newton.LineSearch`'s defaults: halving
+#: down to 1e-4, the stagnation guard)
+START_LINE_SEARCH = LineSearch()
 
 
-def damped_newton(fun, x0, x_scale, residual_scale, tol=1e-10, max_iter=60, factorize=lu_factorize,
-                  shift=None):
-    """Newton with a backtracking (Armijo) line search on |R|, at fixed frequency.
-
-    ``fun(x) -> (R, J)``; ``shift``: a vector added to R (the homotopy's ``(1 - s) f``).
-    Converged when |R| / residual_scale < tol and the last full Newton update is below
-    sqrt(tol) (scaled by ``x_scale``), the test of :func:`bladedamp.hbm.continuation.newton`;
-    stopped as not converged when |R| has not fallen below STAGNATION_FACTOR of its value
-    STAGNATION_WINDOW iterations before. Returns (x, converged, scaled residual norm).
-
-    The first full Newton step, and each after a full step was taken (the rule near a
-    solution), is tried with the Jacobian (``fun(x, True)``): taken, its residual and Jacobian
-    are the next iteration's, instead of one residual for the line search and both again at
-    the same point. Other trials are residuals only (while the line search shortens the steps,
-    a Jacobian at the full step would mostly be thrown away). The iterates are those of
-    residual-only trials (a residual with the Jacobian differs from one without by rounding at
-    most: the point contacts' periodic-slider correction); evaluation counts:
-    benchmarks/README.md, 'Moved from the package's docstrings', hbm/start.py."""
-    x = np.array(x0, dtype=float)
-    shift = 0.0 if shift is None else shift
-    rnorm = np.inf
-    history = []
-    taken = None            # fun(x, True) of the full step just taken
-    full = True             # the last step was a full one (or none yet): try the next with the Jacobian
-    for _ in range(max_iter):
-        R, J = fun(x, True) if taken is None else taken
-        R = R + shift
-        r0 = np.linalg.norm(R)
-        rnorm = r0 / residual_scale
-        if not np.isfinite(r0):
-            return x, False, np.inf
-        history.append(rnorm)
-        if len(history) > STAGNATION_WINDOW and rnorm > STAGNATION_FACTOR * history[-1 - STAGNATION_WINDOW]:
-            return x, False, rnorm            # stagnated: no further progress to expect
-        try:
-            dx = -factorize(J)(R)
-        except (np.linalg.LinAlgError, RuntimeError):
-            return x, False, rnorm
-        if not np.all(np.isfinite(dx)):
-            return x, False, rnorm
-        step = np.linalg.norm(dx / x_scale)
-        if rnorm < tol and step < np.sqrt(tol):
-            return x + dx, True, rnorm
-        t = 1.0
-        while True:
-            x_new = x + t * dx
-            trial = fun(x_new, full and t == 1.0)
-            r_new = np.linalg.norm(trial[0] + shift)
-            if r_new < (1 - 1e-4 * t) * r0 or t <= 1e-4:
-                break
-            t /= 2
-        if not np.isfinite(r_new):
-            return x, False, rnorm
-        x = x_new
-        taken = trial if full and t == 1.0 else None
-        full = t == 1.0
-        if t * step < 1e-14:
-            break
-    R = fun(x, False)[0] + shift
-    return x, False, np.linalg.norm(R) / residual_scale
+def _shifted(residual, shift):
+    """``residual`` with ``shift`` added to R (the homotopy's ``(1 - s) f``)."""
+    def fun(x, omega, jacobian=True):
+        R, J = residual(x, omega, jacobian)[:2]
+        return R + shift, J
+    return fun
 
 
 def robust_start(residual, guesses, omega, x_scale, forcing, base=None, residual_scale=None, tol=1e-10,
@@ -128,19 +73,17 @@ def robust_start(residual, guesses, omega, x_scale, forcing, base=None, residual
     if residual_scale is None:
         residual_scale = max(np.linalg.norm(forcing), 1e-300)
 
-    def call(x, jacobian):
-        if jacobian:
-            R, J, _ = residual(x, omega)
-            return R, J
-        return residual(x, omega, False)[0], None
+    def damped_newton(x0, shift):
+        return newton(_shifted(residual, shift), x0, omega, x_scale, residual_scale, tol, max_iter=60,
+                      factorize=factorize, line_search=START_LINE_SEARCH)
 
     best = None
     for name, x0 in guesses.items():
-        x, ok, rn = damped_newton(call, x0, x_scale, residual_scale, tol, factorize=factorize)
-        if ok:
-            return StartResult(x, True, rn, name)
-        if best is None or rn < best.residual_norm:
-            best = StartResult(x, False, rn, name)
+        sol = damped_newton(x0, 0.0)
+        if sol.converged:
+            return StartResult(sol.x, True, sol.residual_norm, name)
+        if best is None or sol.residual_norm < best.residual_norm:
+            best = StartResult(sol.x, False, sol.residual_norm, name)
     # excitation homotopy: level s solves R(x) + (1 - s) f = 0, from the stuck state at small s
     base = np.zeros_like(forcing) if base is None else np.asarray(base, dtype=float)
     done, x_done = 0.0, None          # the last level solved and its solution
@@ -150,7 +93,7 @@ def robust_start(residual, guesses, omega, x_scale, forcing, base=None, residual
         trial = min(done + increment, 1.0)
         shift = (1.0 - trial) * forcing
         if x_done is None:
-            R, J = call(base, True)
+            R, J = residual(base, omega)[:2]
             try:
                 guess = base - factorize(J)(R + shift)
             except (np.linalg.LinAlgError, RuntimeError):
@@ -159,12 +102,13 @@ def robust_start(residual, guesses, omega, x_scale, forcing, base=None, residual
             guess = x_done
         else:
             guess = x_done + (x_done - previous[1]) * (trial - done) / (done - previous[0])
-        xs, ok, rn = damped_newton(call, guess, x_scale, residual_scale, tol, factorize=factorize, shift=shift)
-        if not ok and x_done is not None and previous is not None:
-            xs, ok, rn = damped_newton(call, x_done, x_scale, residual_scale, tol, factorize=factorize, shift=shift)
-        if ok:
+        sol = damped_newton(guess, shift)
+        if not sol.converged and x_done is not None and previous is not None:
+            sol = damped_newton(x_done, shift)
+        if sol.converged:
+            xs = sol.x
             if trial == 1.0:
-                return StartResult(xs, True, rn, "excitation homotopy")
+                return StartResult(xs, True, sol.residual_norm, "excitation homotopy")
             if x_done is not None:
                 previous = (done, x_done)
             done, x_done = trial, xs
