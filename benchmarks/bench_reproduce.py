@@ -7,7 +7,7 @@ Run from the repository root::
     python benchmarks/bench_reproduce.py --compare tests/data/reproduce_summary.json
     python benchmarks/bench_reproduce.py --summary OUT/summary.json --compare OLD/summary.json
 
-It runs :func:`bladedamp.cli.reproduce` once into ``--out`` (default a temporary folder) and
+It runs :func:`bladedamp.reproduce.reproduce` once into ``--out`` (default a temporary folder) and
 prints the time of each study (summary.json's ``timings_s``, wall-clock seconds) with its share
 of the total, and the load average before and after (the machine is shared: compare the times
 of one run with each other, not with another run's). ``--summary`` reads the timings of an
@@ -93,11 +93,12 @@ def main(argv=None) -> int:
         summary = json.loads(a.summary.read_text())
         wall = summary["timings_s"]["total_s"]
     else:
-        from bladedamp.cli import reproduce
+        from bladedamp.cli import Progress
+        from bladedamp.reproduce import reproduce
 
         out = a.out or Path(tempfile.mkdtemp(prefix="bench_reproduce_"))
         t0 = time.perf_counter()
-        summary = reproduce(out, processes=a.processes)
+        summary = reproduce(out, processes=a.processes, progress=Progress())
         wall = time.perf_counter() - t0
         print(f"output in {out}")
     load1 = os.getloadavg()
