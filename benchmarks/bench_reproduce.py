@@ -93,10 +93,11 @@ def main(argv=None) -> int:
         summary = json.loads(a.summary.read_text())
         wall = summary["timings_s"]["total_s"]
     else:
-        from bladedamp.cli import Progress
+        from bladedamp.cli import Progress, output_dir
         from bladedamp.reproduce import reproduce
 
-        out = a.out or Path(tempfile.mkdtemp(prefix="bench_reproduce_"))
+        # a non-empty --out is refused (UsageError), as by `bladedamp reproduce`: never replace results
+        out = output_dir(a.out) if a.out else Path(tempfile.mkdtemp(prefix="bench_reproduce_"))
         t0 = time.perf_counter()
         summary = reproduce(out, processes=a.processes, progress=Progress())
         wall = time.perf_counter() - t0
