@@ -93,11 +93,15 @@ def main(argv=None) -> int:
         summary = json.loads(a.summary.read_text())
         wall = summary["timings_s"]["total_s"]
     else:
-        from bladedamp.cli import Progress, output_dir
+        from bladedamp.cli import Progress, UsageError, output_dir
         from bladedamp.reproduce import reproduce
 
         # a non-empty --out is refused (UsageError), as by `bladedamp reproduce`: never replace results
-        out = output_dir(a.out) if a.out else Path(tempfile.mkdtemp(prefix="bench_reproduce_"))
+        try:
+            out = output_dir(a.out) if a.out else Path(tempfile.mkdtemp(prefix="bench_reproduce_"))
+        except UsageError as exc:
+            print(f"bench_reproduce: {exc}", file=sys.stderr)
+            return 2
         t0 = time.perf_counter()
         summary = reproduce(out, processes=a.processes, progress=Progress())
         wall = time.perf_counter() - t0
