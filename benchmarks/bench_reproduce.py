@@ -83,6 +83,7 @@ def compare(new: dict, old: dict, rtol: float) -> list[str]:
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--out", type=Path, help="output folder (default: a temporary one)")
+    p.add_argument("--overwrite", action="store_true", help="replace the files of the same names in a non-empty --out")
     p.add_argument("--processes", type=int, default=None, help="worker processes (default: every core)")
     p.add_argument("--summary", type=Path, help="report the timings of this summary.json instead of running")
     p.add_argument("--compare", type=Path, help="summary.json of another run to compare the numbers with")
@@ -98,7 +99,7 @@ def main(argv=None) -> int:
 
         # a non-empty --out is refused (UsageError), as by `bladedamp reproduce`: never replace results
         try:
-            out = output_dir(a.out) if a.out else Path(tempfile.mkdtemp(prefix="bench_reproduce_"))
+            out = output_dir(a.out, a.overwrite) if a.out else Path(tempfile.mkdtemp(prefix="bench_reproduce_"))
         except UsageError as exc:
             print(f"bench_reproduce: {exc}", file=sys.stderr)
             return 2
