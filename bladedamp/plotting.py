@@ -2,8 +2,9 @@
 
 :func:`place_legend` draws a legend that hides no data: where every location of the axes
 would cover a point (a resonance peak, a marker), it makes room above the data by raising the
-upper y limit until the legend is clear. :func:`legend_covers` counts the data points under a
-legend (the tests use it on every figure of the report).
+upper y limit until the legend is clear. :func:`legend_covers` counts the data points and the
+filled data areas (bars, histogram bins, colour-map cells, images) under a legend (the tests use it
+on every figure of the report and of the notebooks).
 
 :func:`save_figure` writes every figure the product saves, in the formats and resolution set by
 :func:`figure_output` (the command line's ``--format`` and ``--dpi``; PNG at 120 dpi otherwise).
@@ -115,9 +116,47 @@ def _densified(xy: np.ndarray, spacing: float = 2.0) -> np.ndarray:
     return np.vstack(pieces)
 
 
+def _data_areas(ax, renderer) -> np.ndarray:
+    """(k, 4) boxes [x0, y0, x1, y1] in display coordinates [px] of the filled data areas of
+    ``ax`` as drawn (clipped to the axes): bars and histogram bins (rectangles in data
+    coordinates; an ``axvspan`` is not one), every unmasked cell of a colour mesh
+    (``pcolormesh``) and every image (``imshow``)."""
+    from matplotlib.collections import QuadMesh
+    from matplotlib.image import AxesImage
+    from matplotlib.patches import Rectangle
+
+    boxes = []
+    for patch in ax.patches:
+        if isinstance(patch, Rectangle) and patch.get_visible() and patch.get_data_transform() is ax.transData:
+            b = patch.get_window_extent(renderer)
+            boxes.append([[b.x0, b.y0, b.x1, b.y1]])
+    for coll in ax.collections:
+        if isinstance(coll, QuadMesh) and coll.get_visible():
+            xy = np.asarray(coll.get_coordinates(), dtype=float)           # (rows + 1, columns + 1, 2)
+            xy = coll.get_transform().transform(xy.reshape(-1, 2)).reshape(xy.shape)
+            corners = np.stack([xy[:-1, :-1], xy[:-1, 1:], xy[1:, :-1], xy[1:, 1:]])   # (4, rows, columns, 2)
+            cells = np.concatenate([corners.min(axis=0), corners.max(axis=0)], axis=-1).reshape(-1, 4)
+            values = coll.get_array()
+            if values is not None and np.ma.getmaskarray(values).size == len(cells):
+                cells = cells[~np.ma.getmaskarray(values).ravel()]
+            boxes.append(cells)
+    for image in ax.images:
+        if isinstance(image, AxesImage) and image.get_visible():
+            b = image.get_window_extent(renderer)
+            boxes.append([[b.x0, b.y0, b.x1, b.y1]])
+    if not boxes:
+        return np.zeros((0, 4))
+    out = np.concatenate([np.asarray(b, dtype=float) for b in boxes])
+    a = ax.bbox
+    return np.column_stack([np.maximum(out[:, 0], a.x0), np.maximum(out[:, 1], a.y0),
+                            np.minimum(out[:, 2], a.x1), np.minimum(out[:, 3], a.y1)])
+
+
 def legend_covers(ax, legend=None) -> int:
     """Number of data points of ``ax`` (line vertices, markers, scatter points, with their
-    marker size) that lie under its legend (0: the legend hides nothing)."""
+    marker size) and of its filled data areas (bars, histogram bins, colour-map cells, images;
+    each one that the legend overlaps by more than a pixel both ways) that lie under its legend
+    (0: the legend hides nothing)."""
     legend = legend if legend is not None else ax.get_legend()
     if legend is None:
         return 0
@@ -127,6 +166,10 @@ def legend_covers(ax, legend=None) -> int:
     for xy, r in _data_points(ax):
         inside += int(np.sum((xy[:, 0] >= box.x0 - r) & (xy[:, 0] <= box.x1 + r)
                              & (xy[:, 1] >= box.y0 - r) & (xy[:, 1] <= box.y1 + r)))
+    areas = _data_areas(ax, renderer)
+    overlap_x = np.minimum(areas[:, 2], box.x1) - np.maximum(areas[:, 0], box.x0)
+    overlap_y = np.minimum(areas[:, 3], box.y1) - np.maximum(areas[:, 1], box.y0)
+    inside += int(np.sum((overlap_x > 1.0) & (overlap_y > 1.0)))
     return inside
 
 

@@ -16,7 +16,8 @@ rules (:func:`check_figure` asserts the list is empty):
   reference drawn with ``gid="reference"``, such as the damper-free level over engine order,
   may be flat) and no point whose x is within the limits lies above or
   below the y limits (not clipped);
-* legends: no legend hides a data point of an axes it lies over (twin axes included);
+* legends: no legend hides a data point or a filled data area (bar, histogram bin, colour-map cell,
+  image) of an axes it lies over (twin axes included);
 * title: the figure's titles (suptitle, every axes' titles) together name the design.
 
 The boxes are those of the texts actually drawn: :meth:`matplotlib.text.Text.draw` is watched
@@ -150,7 +151,7 @@ def series_problems(fig) -> list[str]:
 
 
 def legend_problems(fig) -> list[str]:
-    """Legends that hide data points of any axes they lie over (twin axes included), counted
+    """Legends that hide data points or areas of any axes they lie over (twin axes included), counted
     by :func:`bladedamp.plotting.legend_covers`."""
     from bladedamp.plotting import legend_covers
 
@@ -165,7 +166,7 @@ def legend_problems(fig) -> list[str]:
                 hidden = legend_covers(other, legend)
                 if hidden:
                     out.append(f"the legend ({', '.join(t.get_text() for t in legend.get_texts())}) hides "
-                               f"{hidden} data points of axes {other.get_title() or other.get_ylabel()!r}")
+                               f"{hidden} data points or areas of axes {other.get_title() or other.get_ylabel()!r}")
     return out
 
 

@@ -151,3 +151,36 @@ def test_a_legend_over_the_twin_axes_points_fails():
     twin.plot([90.5, 91.0], [95.0, 96.0], "s", label="under the legend")     # top left, where the legend is
     problems = figure_problems(fig, "rotor A")
     assert any("hides" in p for p in problems), problems
+
+
+def bar_and_map_figure(legend_outside: bool):
+    """Stacked bars filling the height (the shares of a period) beside a colour map, each with a
+    legend inside its axes or beside it."""
+    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(9, 3.5), constrained_layout=True)
+    x = np.arange(5)
+    ax.bar(x, np.full(5, 0.4), label="stick")
+    ax.bar(x, np.full(5, 0.6), bottom=0.4, label="slip")
+    ax.set(xlabel="point [-]", ylabel="share of the period [-]", title="rotor A: contact points")
+    ax2.pcolormesh(np.arange(9), np.arange(6), np.arange(40).reshape(5, 8) % 3, vmin=0, vmax=2)
+    ax2.plot([], [], "s", label="a key entry")        # a proxy of the map's key: no data of its own
+    ax2.set(xlabel="phase [deg]", ylabel="point [-]", title="rotor A: state map")
+    where = dict(loc="upper left", bbox_to_anchor=(1.02, 1.0)) if legend_outside else dict(loc="lower right")
+    ax.legend(**where)
+    ax2.legend(**where)
+    return fig
+
+
+def test_a_legend_over_bars_or_a_colour_map_fails_and_beside_them_passes():
+    problems = figure_problems(bar_and_map_figure(legend_outside=False), "rotor A")
+    assert any("(stick, slip) hides" in p and "contact points" in p for p in problems), problems
+    assert any("(a key entry) hides" in p and "state map" in p for p in problems), problems
+    assert figure_problems(bar_and_map_figure(legend_outside=True), "rotor A") == []
+
+
+def test_a_legend_over_an_image_fails():
+    fig, ax = plt.subplots(figsize=(5, 4))
+    ax.imshow(np.arange(16.0).reshape(4, 4), extent=(0, 4, 0, 4))
+    ax.plot([], [], "s", label="a key entry")
+    ax.set(xlabel="x [mm]", ylabel="y [mm]", title="rotor A: an image")
+    ax.legend(loc="center")
+    assert any("(a key entry) hides 1 data points or areas" in p for p in figure_problems(fig, "rotor A"))

@@ -306,30 +306,29 @@ def test_design_file_measured_modes_errors_are_one_line_naming_the_key(tmp_path,
     assert "\n" not in str(info.value)
 
 
-def test_design_file_measured_modes_bad_nodes_files_and_keys(tmp_path):
+@pytest.mark.parametrize("old, new, modes, modes_chars, expected", [
+    ("[blade.test.excitation]\nnode = 14\n", "", None, None,
+     r"\[blade\.test\.excitation\] is required with a measured mode file"),
+    ("node = 13", "node = 99", None, None,
+     r"modal_file = \"modes\.uff\": .*modes\.uff: no node 99 in the mode shapes .*\[blade\.test\.<point>\] position_mm"),
+    ("", "", "pyuff_uff55_translation_rotation.uff", None,
+     r"modes\.uff: no dataset 164 .*give units='SI'.*\(the design file's keys: \[blade\.test\] modal_mass_kg and units"),
+    ('modal_file = "modes.uff"', 'modal_file = "blade.npz"', None, None,
+     r"\[blade\.test\.OL\] node applies to a measured mode file as \[blade\] modal_file \(ending in \.uff, \.unv, \.uf\)"),
+    ("", "", None, 2000,
+     r"modal_file = \"modes\.uff\": .*modes\.uff: line \d+: dataset .* has no closing -1 line"),
+], ids=["no excitation node", "unknown node", "no dataset 164", "node without a mode file", "truncated mode file"])
+def test_design_file_measured_modes_bad_nodes_files_and_keys(tmp_path, old, new, modes, modes_chars, expected):
+    """The design file's text edited (``old`` -> ``new``), another mode file (``modes``, in
+    tests/data) or the mode file cut after ``modes_chars`` characters: one DesignError each."""
     from bladedamp.design import DesignError, load_design
-    path = write_test_design(tmp_path)
-    path.write_text(path.read_text().replace("[blade.test.excitation]\nnode = 14\n", ""))
-    with pytest.raises(DesignError, match=r"\[blade\.test\.excitation\] is required with a measured mode file"):
-        load_design(path)
-    path = write_test_design(tmp_path)
-    path.write_text(path.read_text().replace("node = 13", "node = 99"))
-    with pytest.raises(DesignError, match=r"modal_file = \"modes\.uff\": .*modes\.uff: no node 99 in the mode shapes "
-                                          r".*\[blade\.test\.<point>\] position_mm"):
-        load_design(path)
-    path = write_test_design(tmp_path, modes=DATA / "pyuff_uff55_translation_rotation.uff")
-    with pytest.raises(DesignError, match=r"modes\.uff: no dataset 164 .*give units='SI'.*\(the design file's keys: "
-                                          r"\[blade\.test\] modal_mass_kg and units"):
-        load_design(path)
-    path = write_test_design(tmp_path)
-    path.write_text(path.read_text().replace('modal_file = "modes.uff"', 'modal_file = "blade.npz"'))
-    with pytest.raises(DesignError, match=r"\[blade\.test\.OL\] node applies to a measured mode file as \[blade\] "
-                                          r"modal_file \(ending in \.uff, \.unv, \.uf\)"):
-        load_design(path)
-    path = write_test_design(tmp_path)
-    (tmp_path / "modes.uff").write_text((DATA / "reference_blade_modes.uff").read_text()[:2000])
-    with pytest.raises(DesignError, match=r"modal_file = \"modes\.uff\": .*modes\.uff: line \d+: dataset .* has no "
-                                          r"closing -1 line"):
+    path = write_test_design(tmp_path, modes=DATA / modes if modes else None)
+    if old:
+        assert old in path.read_text()
+        path.write_text(path.read_text().replace(old, new))
+    if modes_chars:
+        (tmp_path / "modes.uff").write_text((DATA / "reference_blade_modes.uff").read_text()[:modes_chars])
+    with pytest.raises(DesignError, match=expected):
         load_design(path)
 
 

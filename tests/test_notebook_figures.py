@@ -199,7 +199,8 @@ def test_mistuning_explorer_figure(explorer, pattern):
 
 
 # ---------------------------------------------------------------------------------------
-# every figure the notebooks show, their own cells' figures included (executed, slow)
+# every notebook executed, and every figure it shows checked, their own cells' figures
+# included (slow: the one run of each notebook in the tests)
 # ---------------------------------------------------------------------------------------
 #: what a notebook figure's title may name as its design: the contact point and the oscillator of
 #: notebook 01, the reference disk and its dampers, the blades of notebook 07
@@ -250,12 +251,14 @@ FIGURE_REPORT = 'import json as _json\nprint(_json.dumps({"count": _figure_watch
 
 def notebook_figure_problems(path, timeout=600) -> tuple[int, list[str]]:
     """Executes the notebook at ``path`` (its folder the kernel's working directory) with
-    :data:`FIGURE_WATCH` run first; returns (figures checked, problems)."""
+    :data:`FIGURE_WATCH` run first; returns (figures checked, problems). A cell that raises
+    (one of the notebook's own physics checks, say) or runs longer than ``timeout`` [s] raises
+    nbclient's CellExecutionError or a TimeoutError here, naming the cell."""
     import json
     import pathlib
 
-    nbformat = pytest.importorskip("nbformat")
-    pytest.importorskip("nbclient")
+    import nbformat        # test dependencies (the test extra): missing, the test fails rather than skips
+
     from notebook_client import execute_notebook
     nb = nbformat.read(path, as_version=4)
     tests = str(pathlib.Path(__file__).resolve().parent)
@@ -270,10 +273,17 @@ def notebook_figure_problems(path, timeout=600) -> tuple[int, list[str]]:
 NOTEBOOK_PATHS = sorted((__import__("pathlib").Path(__file__).resolve().parents[1] / "notebooks").glob("*.ipynb"))
 
 
+def test_the_slow_run_finds_the_notebooks():
+    """The parametrisation below is not empty (an empty one would execute nothing, unnoticed);
+    tests/test_notebook_files.py checks that notebooks/README.md lists exactly these."""
+    assert len(NOTEBOOK_PATHS) > 0
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("path", NOTEBOOK_PATHS, ids=lambda p: p.name[:2])
-def test_every_figure_a_notebook_shows(path):
-    """Every figure a notebook shows -- its helpers' and those its own cells draw -- keeps the
+def test_notebook_runs_and_every_figure_it_shows_keeps_the_rules(path):
+    """The notebook runs top to bottom without an error in any cell (its cells assert physical
+    facts) and every figure it shows -- its helpers' and those its own cells draw -- keeps the
     slide rules of tests/figure_checks.py, with a title naming the design shown."""
     count, problems = notebook_figure_problems(path)
     assert count > 0

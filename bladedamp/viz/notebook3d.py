@@ -220,7 +220,7 @@ def cycle_figure(data, title: str = ""):
     axes[0].set_ylabel("point [-]")
     axes[1].tick_params(labelleft=False)                  # the same points as OL's
     axes[1].legend(handles=[Patch(color=STATE_COLORS[k], label=STATE_NAMES[k]) for k in range(3)],
-                   fontsize=8, loc="upper right", framealpha=0.9)
+                   fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0))   # the maps' key, beside them
     for c in range(2):
         finite = np.isfinite(ratio[c])
         axes[2].plot(np.arange(1, P + 1)[finite], ratio[c][finite], "o", color=palette.series(c), ms=5,
