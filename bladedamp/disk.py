@@ -1293,7 +1293,9 @@ def peak_checked_response(model, system_model, solve, harmonics, tolerance: floa
     :func:`with_peak_check` (not run on an implausible amplitude). One accuracy warning per call: where the
     peak check runs, its verdict (which includes the estimate) replaces the estimate's
     AccuracyWarning, and an implausible amplitude (its status says so) has none; every other
-    warning raised on the way is raised again at the caller of ``frequency_response``."""
+    warning raised on the way is raised again at the caller of ``frequency_response``. A peak held
+    by the static retention spring (:func:`with_retention_check`, where the time integration models
+    the disk: ``can_check``) is not verified, and its warning replaces the estimate's."""
     with warnings.catch_warnings(record=True) as raised:
         response = converged_response(system_model, solve, harmonics, tolerance, max_harmonic, estimate=estimate,
                                       guard_stalls=True)
@@ -1302,6 +1304,10 @@ def peak_checked_response(model, system_model, solve, harmonics, tolerance: floa
         response = with_retention_check(model, response)
     response = with_peak_check(model, response, check_peak, tolerance, can_check)
     said = response.peak_check is not None or "amplitude" in response.failed_checks   # the verdict, or beyond the model
+    if response.peak_check is None and response.unverified_reason:       # no harmonic set verifies it
+        said = True
+        warnings.warn(f"{response.unverified_reason}: not a verified motion of the disk; check the peak by time "
+                      "integration (check_peak=True)", AccuracyWarning, stacklevel=3)
     for w in raised:
         if not said or not issubclass(w.category, AccuracyWarning):
             warnings.warn(w.message, w.category, stacklevel=3)     # this function, frequency_response, its caller

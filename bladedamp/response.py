@@ -398,7 +398,7 @@ def check_sentence(failed: dict) -> str:
     found = str(failed[first])
     if first == "peak_time_check":
         found = "the time integration at the peak finds no periodic motion" + (
-            ": the branch is unstable there" if "the branch is unstable at the peak" in found else "")
+            " (the branch is unstable there)" if "the branch is unstable at the peak" in found else "")
     elif first == "dissipation":      # the AFT's energy error at the solve's samples where stated, else the least
         error = re.search(r"AFT energy error (\S+ %)", found) or re.search(r"down to (\S+ %)", found)
         found = found.split(" (")[0] + (f", AFT energy error {error.group(1)}" if error else "")
