@@ -466,37 +466,6 @@ def point_normal_forces(arrays: AssemblyArrays, approach: np.ndarray):
     with the points' law kinds, parameters and weights."""
     return normal_forces(arrays.law_kind, arrays.law_par, arrays.weight, approach)
 
-def retention_shares(arrays: AssemblyArrays, static_coefficients: np.ndarray, omega: float) -> np.ndarray:
-    """(n_d,) the load that the HBM's static retention spring carries on each damper of the full
-    assembly (``arrays``: :func:`assembly_arrays`), relative to what the damper's own load could
-    balance, for the static harmonic ``static_coefficients`` (N,) of a harmonic solution at
-    ``omega`` [rad/s].
-
-    The spring (:func:`bladedamp.damper.retention_stiffness`, ``arrays.system.static_stiffness``)
-    acts on the static harmonic only, and the physical model and this time integration do not
-    have it: the load r = K_ret x_0 it carries (3 forces [N], 3 moments [N m] per damper) is the
-    residual of the physical model's static balance at that solution. Relative to the damper's
-    centrifugal load F_CG (the static excitation on its translations, Eq. 26) for the forces and
-    to F_CG l for the moments, l [m] the largest distance of its contact centres from its centre
-    of gravity (a cylinder's radius): the largest of the six ratios. Returns 0 for a damper
-    without centrifugal load (nothing to compare with) or where the model has no spring."""
-    n_q, nd = arrays.n_q, len(arrays.geometries)
-    K = arrays.system.static_stiffness
-    if K is None or not nd:
-        return np.zeros(nd)
-    x0 = np.asarray(static_coefficients, dtype=float)
-    load = np.asarray(K @ x0).reshape(-1)[n_q:n_q + 6 * nd].reshape(nd, 6)
-    C = arrays.system.basis.n_coeffs
-    f_static = arrays.system.excitation(omega)[0].reshape(C, -1)[0][n_q:n_q + 6 * nd].reshape(nd, 6)
-    f_cg = np.linalg.norm(f_static[:, :3], axis=1)
-    lever = np.array([np.linalg.norm(g.centres, axis=1).max() for g in arrays.geometries])
-    scale = np.concatenate([np.repeat(f_cg[:, None], 3, axis=1), np.repeat((f_cg * lever)[:, None], 3, axis=1)],
-                           axis=1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        share = np.where(scale > 0, np.abs(load) / scale, 0.0)
-    return share.max(axis=1)
-
-
 
 def frictionless_static_state(arrays: AssemblyArrays, f_static: np.ndarray, tol: float = 1e-12, max_iter: int = 60):
     """Static equilibrium under the centrifugal load F_CG (Eq. 26) with frictionless contacts:
