@@ -1458,8 +1458,8 @@ def peak_stability_note(model, response, k: int) -> str:
         mu, error = monodromy.monodromy_multipliers(model, response.coefficients[k], response.basis,
                                                     response.omega[k])
     if error > UNSTABLE_PERIODICITY_LIMIT:
-        return (f"; its Floquet multipliers do not apply there (the HBM orbit is {percent(error)} from periodic in the "
-                "time integration's one period: the model has no periodic motion near it)")
+        return (f"; its Floquet multipliers do not apply there (the HBM orbit is {percent(error)} from periodic over one "
+                "period of the time integration: not a periodic orbit of the model, whose stability they would tell)")
     lead = float(np.abs(mu[0]))
     if lead <= 1 + UNSTABLE_MARGIN:
         return ""
