@@ -436,6 +436,31 @@ def test_random_mistuned_designs():
     print("known contradictions not seen in this run:", sorted(set(KNOWN_MISTUNED_CONTRADICTIONS) - contradicted))
 
 
+@pytest.mark.slow
+def test_ring_27_held_by_the_retention_spring_shakes_down_to_the_stuck_motion():
+    """Random mistuned disk 27 (8.3 g cylinders at EO 1, 4 blades): its default answer (a CPU
+    budget of 150 s, so a loaded machine reaches (0, 1, 2, 3) too) is not verified, its peak held by
+    the static retention spring; the time integration at the peak, started on that branch, settles
+    with every contact point stuck: the stuck linear response (the model's own stuck linear
+    solution at that frequency, MistunedDisk.initial_guess with (0, 1), exact for a motion without
+    slip), which the checked answer names, 15 % from the branch."""
+    d = mistuned_design(27)
+    disk = make_mistuned(d)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = disk.frequency_response(d["f_start"], d["f_end"], max_step=d["max_step"], max_points=MAX_POINTS,
+                                    cpu_budget_s=150.0)
+        assert r.status is Status.COMPLETE_UNVERIFIED and "static retention spring" in r.status_message, r.message
+        checked = with_peak_check(disk, r, True, r.harmonic_tolerance)
+    assert "every contact point stuck the whole period" in checked.message, checked.message
+    assert checked.status is Status.COMPLETE_ABOVE_TOLERANCE and checked.harmonic_error > 0.1
+    system = disk.hbm_system((0, 1))
+    w = checked.peak_check.omega[0]
+    stuck = disk.output_amplitudes(disk.initial_guess(system, w).reshape(1, system.basis.n_coeffs, -1), system.basis)[0]
+    settled = disk.time_output_amplitudes(checked.peak_check)[0]
+    assert np.abs(settled - stuck).max() <= 5e-3 * stuck.max(), (settled, stuck)
+
+
 def stopped_disk(i: int):
     """(design, response, stop check) of random disk i: its branch as the suite runs it and
     the response's stop_check, the time integration just beyond where it got furthest."""
