@@ -106,7 +106,8 @@ MISTUNED_CPU_BUDGET_S = 30.0
 # 27's peak is held by the HBM's static retention spring (15 % of the cylinder's F_CG R in the
 # weak-spring limit, bladedamp.disk.retention_held), so its default answer is COMPLETE_UNVERIFIED
 # and says why; 17's direct estimate, 1.03 %, is within the tolerance plus the time integration's
-# own error bar (0.12 %, the same run with twice the steps: bladedamp.disk.peak_check_error). The
+# own error bar (0.12 %, the same run with twice the steps: bladedamp.disk.peak_check_error);
+# measured after (2026-12-07, branch trust): 9 of 40 complete-verified, contradicted 11 and 14. The
 # two left need a time integration or the monodromy at the peak to be seen, which the default
 # answer does not run (the monodromy costs 5-9 CPU s at 4 blades, about 13 times more at 16);
 # their checked answers now say why:
