@@ -1185,6 +1185,104 @@ def with_stop_check(model, response, f_start_hz: float, check_stop: bool):
     return with_stop_note(response, f_start_hz, check)
 
 
+# A harmonic solution whose static retention spring (hbm_system's static_retention) keeps carrying,
+# in the weak-spring limit, a load above this fraction of what the damper's own load can balance
+# (F_CG on a force, F_CG l on a moment: :func:`retention_held`) is held by that regularisation,
+# which the physical model does not have: no periodic motion of the model (the damper rolls or
+# slides, then drifts or shakes down). The fraction is the harmonic tolerance's (1 %): the held
+# load is a residual of the physical model's static balance at that solution. Measured at the
+# peaks of the random mistuned designs (benchmarks/README.md, 'Four contradictions, two cured'):
+# the 8 g cylinders of design 27, 7-15 % (its time integration shakes down to the stuck motion,
+# 15 % from the branch); the wedges of designs 11, 14, 17 below 0.2 % (and the spring's whole
+# load, held or not, on the reference 1 g cylinder in its slip range at most 0.13 %).
+RETENTION_HELD_LIMIT = 0.01
+
+
+def retention_held(model, coefficients, basis, omega: float) -> np.ndarray:
+    """(n_d,) the load that the static retention spring of ``model.hbm_system`` (a TunedDisk's
+    sector or a MistunedDisk; :func:`bladedamp.damper.retention_stiffness`, on the static harmonic
+    of each damper's six rigid-body coordinates) still carries in the weak-spring limit at the
+    harmonic solution ``coefficients`` (C, n) or (C * n,) of ``basis`` at ``omega`` [rad/s],
+    relative to the damper's own load: the largest of its three forces over F_CG and its three
+    moments over F_CG l (F_CG the damper's centrifugal load, the static excitation on its
+    translations, Eq. 26; l [m] the largest distance of its contact centres from its centre of
+    gravity, a cylinder's radius). 0 for every damper of a solution without the static harmonic.
+
+    With the spring s K_0 the load is L = s K_0 x_0 (x_0 the static harmonic). Where the contacts
+    hold the coordinate (a wedge's roll, pressed on two faces), x_0 does not grow as s falls and L
+    vanishes with s; where nothing else holds it (a cylinder's roll when friction leaves a net
+    mean moment, frictional shakedown) x_0 ~ 1 / s and L stays. To first order in s, from the
+    solution's Jacobian J (R(x) = 0 with the spring): d x / d ln s = -J^-1 L (L in the static
+    rows), so the load left at s -> 0 is L - d L / d ln s = -s K_0 (d x_0 / d ln s) =
+    s K_0 [J^-1 L]_0: equal to L for a coordinate the spring alone holds, near 0 for one the
+    contacts hold."""
+    system = model.hbm_system(tuple(basis.harmonics), basis.n_samples)
+    S = system.static_stiffness
+    element = system.couplings[0].element if system.couplings else None
+    contacts = getattr(element, "contacts", [element]) if element is not None else []
+    if S is None or not basis.has_static or not contacts:
+        return np.zeros(len(contacts))
+    S = np.asarray(S.toarray() if hasattr(S, "toarray") else S)
+    C, n = basis.n_coeffs, system.n_dof
+    j0 = basis.cos_index(0)
+    x = np.asarray(coefficients, dtype=float).reshape(C, n)
+    load = np.zeros((C, n))
+    load[j0] = S @ x[j0]
+    _, J, _ = system.residual(x.ravel(), omega, True)
+    dx = system.factorize(J)(load.ravel()).reshape(C, n)
+    held = S @ dx[j0]
+    f_static = system.excitation(omega)[0].reshape(C, n)[j0]
+    dofs = np.flatnonzero(np.diag(S) != 0).reshape(-1, 6)       # each damper's six coordinates
+    shares = np.zeros(len(dofs))
+    for d, (rows, contact) in enumerate(zip(dofs, contacts)):
+        f_cg = float(np.linalg.norm(f_static[rows[:3]]))
+        lever = float(np.linalg.norm(contact.geometry.centres, axis=1).max())
+        if f_cg > 0:
+            shares[d] = max(np.abs(held[rows[:3]]).max() / f_cg, np.abs(held[rows[3:]]).max() / (f_cg * lever))
+    return shares
+
+
+def retention_check(model, response, limit: float = RETENTION_HELD_LIMIT) -> tuple[str, str]:
+    """(what was found, the short reason) when, at ``response``'s peak (:func:`peak_index`), a
+    damper's load held by the static retention spring (:func:`retention_held`) exceeds ``limit``:
+    the peak is then a solution of the regularised harmonic balance only, not a periodic motion
+    of the physical model (no spring there: the damper rolls or slides on, drifting or shaking
+    down); ('', '') otherwise, and for an empty response or one without the static harmonic."""
+    if not len(response.omega) or not response.basis.has_static:
+        return "", ""
+    k = peak_index(model, response)
+    shares = retention_held(model, response.coefficients[k], response.basis, response.omega[k])
+    if not shares.size or not shares.max() > limit:
+        return "", ""
+    d = int(np.argmax(shares))
+    found = (f"at the peak, {response.frequency_hz[k]:.4f} Hz, the harmonic balance holds damper {d} with its static "
+             f"retention spring, which the physical model does not have: in the weak-spring limit it carries "
+             f"{percent(shares[d])} of the damper's load (F_CG on a force, F_CG times the contact lever on a moment; "
+             f"above {percent(limit)}), a mean friction load nothing else balances, so the damper rolls or slides on "
+             "and the peak need not be a motion of the disk")
+    reason = (f"the peak ({response.frequency_hz[k]:.2f} Hz) is held by the harmonic balance's static retention "
+              f"spring ({percent(shares[d])} of a damper's load), which the disk does not have")
+    return found, reason
+
+
+def with_retention_check(model, response, limit: float = RETENTION_HELD_LIMIT):
+    """``response`` (``success``) unverified where :func:`retention_check` finds its peak held by
+    the static retention spring: ``harmonic_error`` nan, ``harmonics_converged`` False (a richer
+    harmonic set solves the same regularised balance: no estimate of it verifies the curve),
+    ``unverified_reason`` the short reason (status COMPLETE_UNVERIFIED; the time integration of
+    ``check_peak`` decides then), the message what was found; else unchanged."""
+    if not response.success:
+        return response
+    found, reason = retention_check(model, response, limit)
+    if not found:
+        return response
+    error = response.harmonic_error
+    estimate = (f" (the enriched harmonic set's estimate, {percent(error)}, does not verify such a point)"
+                if np.isfinite(error) else "")
+    return dataclasses.replace(response, harmonic_error=float("nan"), harmonics_converged=False,
+                               unverified_reason=reason, message=f"{response.message}; not verified: {found}{estimate}")
+
+
 def peak_checked_response(model, system_model, solve, harmonics, tolerance: float, max_harmonic: int, estimate: bool,
                           check_peak: bool, can_check: bool):
     """The response of ``model.frequency_response`` (a :class:`TunedDisk` or
@@ -1195,13 +1293,21 @@ def peak_checked_response(model, system_model, solve, harmonics, tolerance: floa
     :func:`with_peak_check` (not run on an implausible amplitude). One accuracy warning per call: where the
     peak check runs, its verdict (which includes the estimate) replaces the estimate's
     AccuracyWarning, and an implausible amplitude (its status says so) has none; every other
-    warning raised on the way is raised again at the caller of ``frequency_response``."""
+    warning raised on the way is raised again at the caller of ``frequency_response``. A peak held
+    by the static retention spring (:func:`with_retention_check`, where the time integration models
+    the disk: ``can_check``) is not verified, and its warning replaces the estimate's."""
     with warnings.catch_warnings(record=True) as raised:
         response = converged_response(system_model, solve, harmonics, tolerance, max_harmonic, estimate=estimate,
                                       guard_stalls=True)
-    response = with_peak_check(model, with_amplitude_check(response, blade_span(model)), check_peak, tolerance,
-                               can_check)
+    response = with_amplitude_check(response, blade_span(model))
+    if can_check:
+        response = with_retention_check(model, response)
+    response = with_peak_check(model, response, check_peak, tolerance, can_check)
     said = response.peak_check is not None or "amplitude" in response.failed_checks   # the verdict, or beyond the model
+    if response.peak_check is None and response.unverified_reason:       # no harmonic set verifies it
+        said = True
+        warnings.warn(f"{response.unverified_reason}: not a verified motion of the disk; check the peak by time "
+                      "integration (check_peak=True)", AccuracyWarning, stacklevel=3)
     for w in raised:
         if not said or not issubclass(w.category, AccuracyWarning):
             warnings.warn(w.message, w.category, stacklevel=3)     # this function, frequency_response, its caller
@@ -1219,10 +1325,16 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
 
     * Periodic there: the largest difference of the first-harmonic tip amplitudes (every blade,
       x, y, z) relative to the branch's peak amplitude is a second harmonic error estimate, a
-      direct one (the time integration settles to about 5e-4 of the amplitude at its defaults).
-      ``harmonic_error`` becomes the larger of it and the enriched set's, or it alone where the
-      enriched set's Newton failed at the peak ("not verified"), held to ``tolerance``
-      (``harmonics_converged``). This is the estimate where the enriched set cannot solve the
+      direct one (the settle criterion leaves about 5e-4 of the amplitude at its defaults; the
+      time step more: about 0.1 % where it was measured, benchmarks/README.md). Where it exceeds
+      ``tolerance``, the same run with twice the steps a period gives its own error bar (the
+      difference of the two), and the message states it: ``harmonic_error`` becomes
+      :func:`peak_check_error`, the larger of it and the enriched set's, or it alone where the
+      enriched set's Newton failed at the peak ("not verified"), except that a direct estimate
+      above the tolerance by no more than its error bar does not contradict an enriched one
+      within it; held to ``tolerance`` (``harmonics_converged``). A settled motion with every
+      contact point stuck the whole period is named (the disk shakes down to the stuck motion),
+      with its largest tip amplitude. This is the estimate where the enriched set cannot solve the
       peak (as for light wedges whose damper is separated most of the period: brief impacts).
     * "Drifting" there (the first harmonics settle while a damper keeps rolling or walking, as the
       reference 1 g cylinder in its slip range, 95.1-96.1 Hz): compared as above, with the time
@@ -1235,7 +1347,12 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
     * Not settled or unstable there (the vibration does not settle): the branch's peak is not a
       motion the disk
       settles on, so the response is not ``success`` (its ``failed_checks`` has
-      ``peak_time_check``), whatever the harmonic set.
+      ``peak_time_check``), whatever the harmonic set; the finding names an unstable branch
+      where the peak's Floquet multipliers say so (:func:`peak_stability_note`).
+    * A peak held by the static retention spring (``unverified_reason``,
+      :func:`with_retention_check`): the time integration's estimate replaces the void one;
+      ``unverified_reason`` is cleared where it is within ``tolerance`` and kept otherwise (the
+      status sentence then says a richer set does not help).
 
     The result keeps the time integration as its ``peak_check``. Without ``check_peak``, a
     response whose estimate could not be verified says how to check it (where the time integration
@@ -1264,7 +1381,8 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
     status = check.status[0]
     if status not in ("periodic", "drifting"):
         found = (f"{where} finds no periodic motion ({check.message[0]}; the damper's contact points separated "
-                 f"{separated:.0f} % of the period): the branch's peak is not a motion the disk settles on")
+                 f"{separated:.0f} % of the period): the branch's peak is not a motion the disk settles on"
+                 + peak_stability_note(model, response, k))
         warnings.warn(f"at the peak, {f:.2f} Hz, the time integration finds no periodic motion: the curve's peak is "
                       "not a motion the disk keeps; the time integration is the answer there",
                       AccuracyWarning, stacklevel=4)   # with_peak_check, peak_checked_response, the model, the caller
@@ -1280,19 +1398,97 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
                           f"{percent(direct)} away: peak_check(result, start='static') gives the motion from rest",
                           AccuracyWarning, stacklevel=3)
             return dataclasses.replace(response, peak_check=check, message=response.message + "; " + note)
-    error = max(direct, enriched) if np.isfinite(enriched) else direct
+    spread, doubled = 0.0, ""
+    if direct > tolerance:           # a contradiction only beyond the check's own error bar: twice the steps
+        finer = model.peak_check(response, steps_per_period=2 * int(check.steps_per_period))
+        if str(finer.status[0]) == status:
+            spread = abs(float(np.abs(model.time_output_amplitudes(finer)[0] - at_peak).max() / peak) - direct)
+            doubled = (f", {100 * spread:.2g} % its own error bar (the same run with {2 * int(check.steps_per_period)} "
+                       f"instead of {int(check.steps_per_period)} steps a period)")
+        else:
+            doubled = f" (with twice the steps a period it is {finer.status[0]}: no error bar)"
+    error = peak_check_error(direct, spread, enriched, tolerance)
     met = error <= tolerance
     motion = ("settles on a periodic motion" if status == "periodic" else
               f"settles on a drifting vibration, a damper keeps rolling or walking ({check.message[0]}; its mean "
               "compared)")
-    note = (f"{where} {motion}, {100 * direct:.2g} % from the branch's tip amplitudes (contact points separated "
-            f"{separated:.0f} % of the period): harmonic error estimate {100 * error:.2g} %, "
-            + ("within" if met else "above") + f" the tolerance {100 * tolerance:.2g} %")
+    stuck = check.point_state[0][..., 0].min() >= 1.0 if check.point_state[0].size else False
+    if stuck:
+        motion += (f" with every contact point stuck the whole period, the stuck motion (largest tip amplitude "
+                   f"{1e3 * check.tip_amplitude[0].max():.4g} mm): the disk shakes down to it")
+    note = (f"{where} {motion}, {100 * direct:.3g} % from the branch's tip amplitudes{doubled} (contact points "
+            f"separated {separated:.0f} % of the period): harmonic error estimate {100 * error:.2g} %, "
+            + ("within" if met else "above") + f" the tolerance {100 * tolerance:.2g} %"
+            + (" given the time integration's own error bar" if met and direct > tolerance else ""))
     if not met:      # the sentence the result's status gives (bladedamp.response.status_message)
         warnings.warn(harmonic_sentence(response.basis.harmonics, error, tolerance, status == "drifting"),
                       AccuracyWarning, stacklevel=4)
     return dataclasses.replace(response, harmonic_error=error, harmonic_tolerance=tolerance, harmonics_converged=met,
-                               peak_check=check, message=response.message + "; " + note)
+                               peak_check=check, message=response.message + "; " + note,
+                               unverified_reason="" if met else response.unverified_reason)
+
+
+# The Floquet multipliers of a peak whose HBM orbit is within this periodicity error of a periodic
+# orbit of the time integration are read (:func:`peak_stability_note`): above the monodromy's warning
+# limit (1e-2, the HBM's own truncation error a few 1e-3), below the order-one errors of orbits the
+# time integration does not have (0.67-0.84 measured: a rolling cylinder, a hopping wedge)
+UNSTABLE_PERIODICITY_LIMIT = 0.1
+# a multiplier above 1 by more than this (a perturbation growing 1 % a period, e-fold in 100 of the
+# time integration's up to 4000 periods) counts as unstable: beyond the finite-difference and
+# discretisation scatter of the stuck sliders' multipliers 1 (1.004 measured where the motion is
+# periodic)
+UNSTABLE_MARGIN = 1e-2
+
+
+def peak_stability_note(model, response, k: int) -> str:
+    """What the monodromy matrix (:func:`bladedamp.hbm.monodromy.monodromy_multipliers`) of
+    ``response``'s point ``k`` (the peak) says of a peak whose time integration did not settle:
+    "; the branch is unstable at the peak (...)" with the largest Floquet multiplier's modulus and
+    its kind (a complex pair: Neimark-Sacker, the motion turns quasi-periodic; real above 1: a fold
+    or branch point; real below -1: period doubling) where it exceeds 1 + ``UNSTABLE_MARGIN`` on an
+    HBM orbit within ``UNSTABLE_PERIODICITY_LIMIT`` of a periodic orbit of the time integration;
+    a sentence saying the multipliers do not apply where the orbit is farther; '' where the
+    model has no period map, the harmonic set no static term, or every multiplier is within
+    the margin."""
+    from .hbm import monodromy
+    from .hbm.stability import multiplier_crossing
+
+    if not (response.basis.has_static and monodromy.supports(model)):
+        return ""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", AccuracyWarning)       # the periodicity error is judged here
+        mu, error = monodromy.monodromy_multipliers(model, response.coefficients[k], response.basis,
+                                                    response.omega[k])
+    if error > UNSTABLE_PERIODICITY_LIMIT:
+        return (f"; its Floquet multipliers do not apply there (the HBM orbit is {percent(error)} from periodic over one "
+                "period of the time integration: not a periodic orbit of the model, whose stability they would tell)")
+    lead = float(np.abs(mu[0]))
+    if lead <= 1 + UNSTABLE_MARGIN:
+        return ""
+    kind = {"fold": "a real multiplier above 1: a fold or branch point",
+            "period doubling": "a real multiplier below -1: period doubling",
+            "neimark-sacker": "a complex pair: Neimark-Sacker, the motion turns quasi-periodic"}[multiplier_crossing(mu)]
+    return (f"; the branch is unstable at the peak (monodromy: largest Floquet multiplier |mu| = {lead:.3g}, {kind}; "
+            f"the HBM orbit {percent(error)} from periodic)")
+
+
+def peak_check_error(direct: float, spread: float, enriched: float, tolerance: float) -> float:
+    """The harmonic error estimate of a peak checked by time integration (:func:`with_peak_check`):
+    ``direct``, the settled motion's largest first-harmonic tip difference from the branch's
+    (relative to the peak), ``spread`` >= 0 its own error bar (how much it moves when the run
+    takes twice the steps a period), ``enriched`` the enriched harmonic set's estimate (nan where
+    not verified), all fractions of the peak, held to ``tolerance``.
+
+    The larger of ``direct`` and ``enriched`` (``direct`` alone where ``enriched`` is nan), except
+    that a ``direct`` above the tolerance by no more than its own error bar does not contradict a
+    finite ``enriched``: then max(``enriched``, ``direct`` - ``spread``), which is within the
+    tolerance when ``enriched`` is. A contradiction is declared only where the difference exceeds
+    the tolerance plus the check's own error bar."""
+    if not np.isfinite(enriched):
+        return direct
+    if tolerance < direct <= tolerance + spread:
+        return max(enriched, direct - spread)
+    return max(direct, enriched)
 
 
 def orbit_departure(model, check, at_peak, peak: float, direct: float, tolerance: float) -> str | None:

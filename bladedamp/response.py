@@ -187,11 +187,13 @@ def only_sampling_failed(response) -> bool:
 
 
 def with_checks(response, failed: dict):
-    """``response`` with its failed checks recorded: not ``success``, the message says why."""
+    """``response`` with its failed checks recorded (added to those it had): not ``success``, the
+    message says why."""
     if not failed:
         return response
     message = response.message + "; failed checks: " + "; ".join(f"{k}: {v}" for k, v in failed.items())
-    return dataclasses.replace(response, success=False, message=message, failed_checks=dict(failed),
+    return dataclasses.replace(response, success=False, message=message,
+                               failed_checks={**(response.failed_checks or {}), **failed},
                                reached_end=response.reached_range_end)
 
 
@@ -395,7 +397,8 @@ def check_sentence(failed: dict) -> str:
     first = names[0]
     found = str(failed[first])
     if first == "peak_time_check":
-        found = "the time integration at the peak finds no periodic motion"
+        found = "the time integration at the peak finds no periodic motion" + (
+            " (the branch is unstable there)" if "the branch is unstable at the peak" in found else "")
     elif first == "dissipation":      # the AFT's energy error at the solve's samples where stated, else the least
         error = re.search(r"AFT energy error (\S+ %)", found) or re.search(r"down to (\S+ %)", found)
         found = found.split(" (")[0] + (f", AFT energy error {error.group(1)}" if error else "")
@@ -435,7 +438,14 @@ def status_message(response) -> str:
     H = tuple(response.basis.harmonics)
     check = getattr(response, "peak_check", None)
     drifting = check is not None and str(check.status[0]) == "drifting"
-    if status.complete:
+    reason = getattr(response, "unverified_reason", "")
+    if status is Status.COMPLETE_UNVERIFIED and reason:
+        detail = f"{reason}: not a verified motion of the disk; check the peak by time integration (check_peak=True)"
+    elif status is Status.COMPLETE_ABOVE_TOLERANCE and reason:
+        detail = (f"{reason}: the time integration at the peak settles {percent(error)} from the curve (tolerance "
+                  f"{percent(tolerance)}); a richer harmonic set does not change that, the time integration is the "
+                  "answer there")
+    elif status.complete:
         detail = harmonic_sentence(H, error if np.isfinite(tolerance) else float("nan"), tolerance, drifting,
                                    estimated=response.harmonics_converged is not None,
                                    checkable=hasattr(response, "peak_check"))
@@ -543,6 +553,10 @@ class FrequencyResponse(Saveable):
     linear_natural_frequencies_hz : (without the friction contacts, with them stuck): the natural
         frequencies [Hz] nearest the range of the model's two linear systems, given when the
         largest amplitude lies at an end of the range (:func:`with_range_end_estimate`), else ()
+    unverified_reason : what keeps a complete response from being verified whatever its harmonic
+        set (e.g. a disk's peak held by the harmonic balance's static retention spring,
+        :func:`bladedamp.disk.retention_check`), '' if nothing; with one, ``harmonic_error`` is
+        nan (status COMPLETE_UNVERIFIED) until a time integration of the peak gives an estimate
 
     Derived, for every response (saved ones too): :attr:`status` (a :class:`Status`),
     :attr:`status_message` and :attr:`peak_at_range_end`.
@@ -567,6 +581,7 @@ class FrequencyResponse(Saveable):
     stability_method: str = ""
     stopped_by: str = ""
     linear_natural_frequencies_hz: tuple = ()
+    unverified_reason: str = ""
 
     @property
     def status(self) -> Status:
