@@ -41,15 +41,16 @@ from .contact.point import (MAX_PASSES, PERIODIC_TOL, PointContactSamples, dampe
 from .damper.geometry import CylinderDamper, DamperGeometry, WedgeDamper
 from .damper.kinetics import centrifugal_force, retention_stiffness, seat
 from .hbm.accuracy import HARMONIC_TOLERANCE, AccuracyWarning, converged_response
-from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_MAX_STEP, DEFAULT_POINT_BUDGET, Branch, Budget, continuation
+from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_MAX_STEP, DEFAULT_POINT_BUDGET, Branch
 from .hbm.nonlinear_modes import linear_stuck_mode
 from .hbm.peaks import PeakSolver, first_harmonic_output
 from .hbm.start import robust_start
 from .hbm.fourier import HarmonicBasis
 from .hbm.monodromy import disk_monodromy
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, harmonic_sentence, nearest_to_range, percent,
-                       physical_checks, plot_branch, sampled_response, with_amplitude_check, with_checks,
+from .frf import checked_range, solve_frequency_response
+from .response import (FrequencyResponse, harmonic_sentence, nearest_to_range, percent,
+                       plot_branch, with_amplitude_check, with_checks,
                        with_range_end_estimate)
 
 DAMPER_DOFS = ("uD_x", "uD_y", "uD_z", "phiD_x", "phiD_y", "phiD_z")
@@ -464,8 +465,365 @@ def interblade_phase(engine_order, n_blades) -> float:
 DEFAULT_DAMPER_RADIUS = 0.1
 
 
+def check_blade_bounded(blade: ModalBlade, excitation, has_damper: bool, f_start_hz: float, f_end_hz: float) -> None:
+    """ValueError where no bounded periodic response exists in ``f_start_hz``..``f_end_hz``
+    [Hz] for ``blade`` under the tip load ``excitation`` (6,) [N, N m] with a damper on its
+    platforms (``has_damper``) or not: a blade mode j with zero modal damping, a modal force
+    phi_j^T F != 0, its natural frequency f_0j inside the range, and no damper acting on it (no
+    damper, or rigid platforms that do not move at OL and OR in that mode). Its modal equation is then
+    q_j'' + omega_0j^2 q_j = phi_j^T F cos(Omega t) alone, whose amplitude grows without
+    bound at Omega = omega_0j. (With a damper on that mode the bound of its friction forces
+    is no closed form: the normal loads vary with the motion.)"""
+    force = blade.shape("excitation").T @ np.asarray(excitation, dtype=float)          # (nm,) modal forces [N]
+    lo, hi = min(f_start_hz, f_end_hz), max(f_start_hz, f_end_hz)
+    if has_damper:
+        if blade.flexible_platform:
+            return
+        at_damper = np.abs(np.vstack([blade.shape("OL"), blade.shape("OR")])).max(axis=0) > 0
+    else:
+        at_damper = np.zeros(blade.n_modes, dtype=bool)
+    f0 = np.asarray(blade.natural_frequencies_hz, dtype=float)
+    free = (blade.damping_ratios == 0) & (force != 0) & ~at_damper & (f0 >= lo) & (f0 <= hi)
+    if np.any(free):
+        j = int(np.flatnonzero(free)[0])
+        name = blade.mode_names[j] if len(blade.mode_names) else str(j + 1)
+        why = "the disk has no damper" if not has_damper else "the damper's platforms do not move in it"
+        raise ValueError(
+            f"no bounded response: blade mode {name} has damping_ratios = 0, a modal force "
+            f"{force[j]:.6g} N and its natural frequency {f0[j]:.6g} Hz inside the range {f_start_hz:g}-"
+            f"{f_end_hz:g} Hz, and {why}: its amplitude grows without bound there; give the mode a damping "
+            f"ratio > 0 or a range without {f0[j]:.6g} Hz")
+
+
 @dataclass
-class TunedDisk:
+class DamperPosition:
+    """One damper position of a bladed disk, described once for both assemblies (the tuned
+    disk's cyclic sector has one, a ring one per blade): the damper between blade k's OL platform
+    and blade k+1's OR platform, its platform angles, the gaps of its contact points before
+    loading and its preload law, the centrifugal force F_CG = m R Omega_R^2 on the damper at the
+    radius R (Eq. 26; Omega_R = Omega_E / EO, or the given rotor speed). Its contacts as a
+    harmonic-balance element: :meth:`contacts`.
+
+    Parameters: as :class:`TunedDisk`'s of the same names (``damper``: CylinderDamper,
+    WedgeDamper or None; ``gamma_left``, ``gamma_right`` [rad]; ``initial_gaps`` (2, P) [m] or
+    None; ``damper_radius`` R [m]; ``engine_order``; ``rotor_speed_hz`` [Hz] or None). Frequencies
+    are the residual's angular excitation frequency omega [rad/s]. :meth:`validate` checks the
+    angles (the disk checks the rest).
+    """
+
+    damper: CylinderDamper | WedgeDamper | None
+    gamma_left: float = PLATFORM_ANGLE
+    gamma_right: float = PLATFORM_ANGLE
+    initial_gaps: np.ndarray | None = None
+    damper_radius: float = DEFAULT_DAMPER_RADIUS
+    engine_order: int = 1
+    rotor_speed_hz: float | None = None
+
+    def validate(self) -> "DamperPosition":
+        """ValueError unless both platform angles lie in (0, pi/2) [rad]; returns this position."""
+        validation.in_range("gamma_left (platform angle, rad)", self.gamma_left, 0.0, np.pi / 2, closed="neither")
+        validation.in_range("gamma_right (platform angle, rad)", self.gamma_right, 0.0, np.pi / 2, closed="neither")
+        return self
+
+    @property
+    def has_damper(self) -> bool:
+        """Whether a damper with a mass sits here."""
+        return self.damper is not None and self.damper.mass > 0
+
+    def damper_geometry(self) -> DamperGeometry:
+        """The damper's contact frames and patches at these platform angles, with the initial gaps."""
+        geometry = self.damper.geometry(self.gamma_left, self.gamma_right)
+        if self.initial_gaps is not None:
+            gaps = np.asarray(validation.finite("initial_gaps", self.initial_gaps), dtype=float)
+            P = geometry.patches[0].n_points
+            if gaps.shape != (2, P):
+                raise ValueError(f"initial_gaps must have shape (2, {P}) (OL, OR points) in m")
+            geometry.patches = tuple(dataclasses.replace(p, initial_gap=g) for p, g in zip(geometry.patches, gaps))
+        return geometry
+
+    def platform_offsets(self, geometry: DamperGeometry, points) -> np.ndarray:
+        """(2, 3) contact centres seen from the blades' OL / OR points ``points`` (a blade's
+        ``points``: every blade of a disk has the same; in each blade's frame).
+
+        The blade pitch at the platform (unrolled, neighbouring blade frames parallel) is chosen
+        so that the OL and OR contact centres lie above or below the OL point of blade i and
+        the OR point of blade i+1. For asymmetric platforms the two contact centres are at
+        different heights (radial mismatch dz); the damper is placed half-way, so each rigid
+        platform carries half of it (OL offset -dz/2, OR offset +dz/2, radially). This keeps
+        the model mirror-symmetric: exchanging gamma_L and gamma_R gives the mirror image of
+        the assembly (the paper: "the same results are obtained if the left and right platform
+        angle are exchanged"); carrying all of dz on one side breaks that.
+        """
+        p_ol, p_or = points["OL"], points["OR"]
+        cg = p_ol - geometry.centres[0]                      # damper CG in blade i's frame (OL centre on OL)
+        or_centre = cg + geometry.centres[1]                 # in blade i's frame
+        pitch = p_or[0] - or_centre[0]                       # blade i+1 frame = blade i frame - pitch x
+        mismatch = or_centre + np.array([pitch, 0.0, 0.0]) - p_or   # (0, dy, dz) with OL centre on OL
+        half = np.array([0.0, 0.0, mismatch[2] / 2])
+        return np.array([-half, mismatch - half])
+
+    def centrifugal_force(self, omega: float):
+        """(F_CG [N], dF_CG / dOmega_E [N s/rad]) at the angular excitation frequency ``omega``
+        [rad/s] (Eq. 26; the rotor speed omega / EO unless ``rotor_speed_hz`` is given)."""
+        return centrifugal_force(self.damper.mass, self.damper_radius, engine_order=self.engine_order,
+                                 f_hz=omega / (2 * np.pi), rotor_speed_hz=self.rotor_speed_hz)
+
+    def centrifugal_law(self):
+        """A function omega [rad/s, the excitation frequency] -> (F_CG [N], dF_CG / dOmega_E
+        [N s/rad]) of Eq. 26 whose parameters are validated once, here (the residual calls it
+        at every evaluation): F = c Omega_E^2, or constant at a given rotor speed."""
+        c, _ = self.centrifugal_force(1.0)
+        if self.rotor_speed_hz is not None:
+            return lambda omega: (c, 0.0)
+        return lambda omega: (c * omega ** 2, 2 * c * omega)
+
+    def seated(self, omega: float) -> np.ndarray:
+        """(6,) the damper seated frictionlessly under F_CG at ``omega`` [rad/s] (``seat``)."""
+        return seat(self.damper_geometry(), self.centrifugal_force(omega)[0])[0]
+
+    def approach_function(self, geometry: DamperGeometry, basis: HarmonicBasis):
+        """The static approach of ``geometry``'s contact points under this position's F_CG (Eq. 26):
+        a function omega [rad/s, the residual's excitation frequency] -> (per-point static
+        approach (2, P) [m], its omega-derivative (2, P) [m s/rad]). With a static harmonic in
+        ``basis`` the seating is part of the harmonic balance and the approach is the rest state
+        (minus the initial gaps); otherwise the frictionless seating under F_CG (``seat``).
+        The :attr:`DamperContacts.approach` of the damper here."""
+        gaps = np.array([p.initial_gap for p in geometry.patches])
+        if basis.has_static:
+            rest = -gaps  # the seating is part of the harmonic balance
+            zero = np.zeros_like(rest)
+            return lambda omega: (rest, zero)
+        if np.any(gaps != 0):
+            # a misfit: the seating is not homogeneous in F_CG; seat at each load, d/dF by central
+            # differences of the (smooth away from touch-down) seating
+            cache = {}
+
+            def approach(omega):
+                if omega not in cache:
+                    F, dF = self.centrifugal_force(omega)
+                    a = seat(geometry, F)[1]
+                    h = 1e-6 * max(F, 1e-12)
+                    da = (seat(geometry, F + h)[1] - seat(geometry, max(F - h, 0.0))[1]) / (F + h - max(F - h, 0.0))
+                    cache.clear()
+                    cache[omega] = (a, da * dF)
+                return cache[omega]
+
+            return approach
+        # perfect fit: seat once at a reference load; the laws are homogeneous, so the static
+        # approach scales as F_CG^(1/p) (p = 1 for the linear law)
+        exponent = getattr(geometry.patches[0].normal_law, "exponent", 1.0)
+        F_ref = 1.0
+        _, approach_ref, _ = seat(geometry, F_ref)
+        centrifugal = self.centrifugal_law()
+
+        def approach(omega):
+            F, dF = centrifugal(omega)
+            if F <= 0:
+                return np.zeros_like(approach_ref), np.zeros_like(approach_ref)
+            scale = (F / F_ref) ** (1 / exponent)
+            return approach_ref * scale, approach_ref * scale / (exponent * F) * dF
+
+        return approach
+
+
+class DiskModel:
+    """The behaviour of a bladed disk with underplatform dampers that does not depend on how it
+    is assembled: the tuned disk's cyclic sector (:class:`TunedDisk`, one blade and one damper,
+    the next blade by the interblade phase) and the ring of individual blades and dampers
+    (:class:`~bladedamp.mistuned.MistunedDisk`) are both one. It holds, once, the static state,
+    the stuck linear start, the robust start, the unknowns' scales and the retry scales of the
+    continuation, the FRF driver's sampling (:mod:`bladedamp.frf`), a blade point's map, the time
+    integration and its checks (:meth:`stop_check`, :meth:`peak_check`) and the monodromy matrix.
+
+    An assembly gives its layout (unknowns harmonic-major; per coefficient the blades' modal
+    coordinates first, then the six coordinates of each damper with a mass):
+
+    * ``engine_order``, ``n_blades``; :attr:`model_blades`: the blades written out (s);
+    * :attr:`active_positions`: the positions whose damper has a mass (the d-th of them owns the
+      unknowns :meth:`damper_unknowns` ``(d)``);
+    * :meth:`seated_damper` ``(k, omega)``: the frictionless seat of position k's damper under
+      F_CG at omega [rad/s] (Eq. 26);
+    * :meth:`full_assembly`, :meth:`blade_unknowns`.
+    """
+
+    def validate_parameters(self, has_damper: bool) -> None:
+        """The disk-wide parameters checked (ValueError naming the parameter) and normalised in
+        place: ``damper_radius`` > 0 (a PlausibilityWarning outside 1 mm..5 m), ``excitation`` a
+        finite 6-vector, and an explicit ``rotor_speed_hz`` where EO = 0 and a damper
+        (``has_damper``) needs the preload of Eq. 26."""
+        validation.positive("damper_radius R", self.damper_radius)
+        # R from a small test rig (the reference disk: 26 mm) to the largest fan and low-pressure
+        # turbine disks (~1.5 m): 1 mm..5 m; outside, most likely a unit slip (26 meant as 26 mm)
+        validation.plausible("damper_radius R", self.damper_radius, 1e-3, 5.0, "m",
+                            "the damper's distance to the rotor axis, 1 mm to 5 m")
+        self.excitation = np.asarray(validation.finite("excitation", self.excitation), dtype=float)
+        if self.excitation.shape != (6,):
+            raise ValueError("excitation must be a 6-vector (F_x, F_y, F_z, M_x, M_y, M_z) in N and N m")
+        if self.engine_order == 0 and has_damper and self.rotor_speed_hz is None:
+            raise ValueError("engine_order = 0 needs an explicit rotor_speed_hz (rotor revolutions per second, "
+                             "> 0; rpm / 60)")
+
+    @property
+    def interblade_phase(self) -> float:
+        """dphi [rad] in (-pi, pi], e^{i dphi} = e^{i 2 pi EO / n} (Eq. 25; :func:`interblade_phase`)."""
+        return interblade_phase(self.engine_order, self.n_blades)
+
+    @property
+    def n_modal_unknowns(self) -> int:
+        """The blades' modal coordinates per harmonic coefficient, s n_m (the dampers' follow)."""
+        return len(self.model_blades) * self.model_blades[0].n_modes
+
+    # ----- the start and the scales of a branch --------------------------------------------
+    def static_state(self, system: HarmonicBalanceSystem, omega: float) -> np.ndarray:
+        """The state (C * n_dof,) without dynamic motion: rest, or with a static harmonic every
+        damper seated frictionlessly under F_CG at ``omega`` [rad/s] (``seat``)."""
+        x = np.zeros(system.n_unknowns)
+        if system.basis.has_static:
+            X = x.reshape(system.basis.n_coeffs, system.n_dof)
+            for d, k in enumerate(self.active_positions):
+                X[system.basis.cos_index(0), self.damper_unknowns(d)] = self.seated_damper(k, omega)
+        return x
+
+    def initial_guess(self, system: HarmonicBalanceSystem, omega: float) -> np.ndarray:
+        """Stuck linear solution (C * n_dof,) of ``system`` at ``omega`` [rad/s, the residual's
+        excitation frequency]: one Newton step from the static state, where every contact point
+        sticks (without a damper: the linear solution itself).
+
+        With a static harmonic the contacts have no preload at x = 0 (zero approach: every
+        point is open and the Jacobian there has no contact stiffness at all), so the step
+        starts from the dampers seated frictionlessly under F_CG (``seat``) instead of from rest.
+        """
+        x = self.static_state(system, omega)
+        R, J, _ = system.residual(x, omega)
+        return x - system.factorize(J)(R)
+
+    def start_solution(self, system: HarmonicBalanceSystem, omega: float, scales, tol: float = 1e-10) -> np.ndarray:
+        """Solution (C * n_dof,) of ``system`` at the first frequency ``omega`` [rad/s], robust in
+        gross slip (:func:`bladedamp.hbm.start.robust_start`); ``scales`` (C * n_dof,) from
+        :meth:`unknown_scales`.
+
+        Damped Newton from the stuck linear solution; if that fails (a light damper sliding far
+        from its stuck state), an excitation homotopy on the dynamic excitation (the centrifugal
+        preload stays), from the seated dampers. Returns the best iterate (the continuation then
+        reports honestly if it is not a solution)."""
+        f = system.excitation(omega)[0].reshape(system.basis.n_coeffs, system.n_dof).copy()
+        if system.basis.has_static:
+            f[system.basis.cos_index(0)] = 0.0          # the preload is not ramped
+        base = self.static_state(system, omega)
+        residual_scale = max(np.linalg.norm(system.residual(np.zeros(system.n_unknowns), omega, False)[0]), 1e-300)
+        return robust_start(system.residual, {"stuck linear solution": self.initial_guess(system, omega)},
+                            omega, scales, f.ravel(), base=base, residual_scale=residual_scale, tol=tol,
+                            factorize=system.factorize).x
+
+    def unknown_scales(self, system: HarmonicBalanceSystem, omega_start: float, omega_end: float) -> np.ndarray:
+        """Scale (C * n_dof,) of each unknown of ``system`` over omega_start..omega_end [rad/s]
+        (the continuation's ``x_scale``): its largest value in the stuck linear responses across the
+        range (harmonic coefficients pooled per DOF, and over the blades for each mode and over
+        the dampers for each damper DOF, so that every blade is measured alike), floored at 1e-3
+        of the largest scale of its kind (modal / damper translation / damper rotation). A damper
+        group that the stuck response leaves at exactly zero (e.g. no damper rotation in the
+        symmetric EO = n/2 standing wave) is floored at 1e-3 of the platform motion of the same
+        kind instead (a 1e-300 floor turned round-off in the Newton step into an overflow).
+        Times sqrt(s) for s blades written out: the scaled norm of s blades equals that of one
+        sector, so the arc-length steps (and the number of points) are those of the tuned cyclic
+        model."""
+        C, N = system.basis.n_coeffs, system.n_dof
+        blades = self.model_blades
+        s, nm = len(blades), blades[0].n_modes
+        X = np.array([np.abs(self.initial_guess(system, w)).reshape(C, N).max(axis=0)
+                      for w in np.linspace(omega_start, omega_end, 7)]).max(axis=0)
+        q = X[:s * nm].reshape(s, nm).max(axis=0)
+        q = np.maximum(q, 1e-3 * q.max() + 1e-300)
+        out = [np.tile(q, s)]
+        nd = len(self.active_positions)
+        if nd:
+            u = X[s * nm:].reshape(nd, 6).max(axis=0)
+            phi = np.abs(np.stack([np.stack([b.shape("OL"), b.shape("OR")]) for b in blades]))
+            for g, platform in ((slice(0, 3), phi[:, :, :3].max()), (slice(3, 6), phi[:, :, 3:].max())):
+                u[g] = np.maximum(u[g], max(1e-3 * u[g].max(), 1e-3 * q.max() * platform) + 1e-300)
+            out.append(np.tile(u, nd))
+        return np.sqrt(s) * np.tile(np.concatenate(out), C)
+
+    def retry_scales(self, system: HarmonicBalanceSystem, scales: np.ndarray) -> np.ndarray | None:
+        """The continuation's ``retry_x_scale``: ``scales`` (from :meth:`unknown_scales`) with every
+        damper's unknowns weighing less in the arc length (:func:`damper_weighted_scales`); None
+        without a damper."""
+        if not self.active_positions:
+            return None
+        return damper_weighted_scales(scales, system.basis.n_coeffs, slice(self.n_modal_unknowns, None))
+
+    # ----- the protocol of bladedamp.frf (the FRF driver) ----------------------------------
+    def sample_plan(self, harmonics) -> tuple[int, int, int]:
+        """(first, most, most for a dissipation failure) AFT samples per period of the automatic
+        sampling (:func:`bladedamp.response.sampled_response`): the basis default (each damper
+        of a ring is sampled on its own grid, so no multiple of n / gcd(n, EO) is needed), then
+        ``AUTO_SAMPLES_GROWTH`` and ``AUTO_SAMPLES_GROWTH_DISSIPATION`` times it."""
+        first = HarmonicBasis(tuple(harmonics)).n_samples
+        return first, AUTO_SAMPLES_GROWTH * first, AUTO_SAMPLES_GROWTH_DISSIPATION * first
+
+    def judges_solution_samples(self, n_samples: int) -> bool:
+        """False: the dissipation is judged re-evaluated with more samples
+        (:func:`bladedamp.response.physical_checks`)."""
+        return False
+
+    # ----- outputs ---------------------------------------------------------------------------
+    def point_map(self, basis: HarmonicBasis, point: str = "tip", directions=(0,), blade: int = 0) -> np.ndarray:
+        """Real-form map (C*k, C*n_dof) from the unknowns of :meth:`hbm_system` (``basis``'s
+        harmonics) to the motion of blade ``blade``'s ``point`` (the tuned disk: its reference
+        blade, 0) in the k ``directions`` (0, 1, 2: x, y, z translation [m]; 3, 4, 5: rotations
+        [rad], blade frame), through the blade's mode shapes (the damper's DOFs do not enter).
+        The map of a :class:`~bladedamp.hbm.system.Coupling` from the model to an element at that
+        point; add one with ``system.add(element, map, name)``."""
+        blades = self.model_blades
+        blade = validation.integer("blade", blade, minimum=0, maximum=len(blades) - 1)
+        nm = blades[0].n_modes
+        n_dof = self.n_modal_unknowns + 6 * len(self.active_positions)
+        return blade_point_map(blades[blade], basis, point, directions, n_dof, slice(blade * nm, (blade + 1) * nm))
+
+    # ----- time integration ------------------------------------------------------------------
+    def time_response(self, f_hz, **options):
+        """Steady state of every blade at each excitation frequency ``f_hz`` [Hz] (scalar or
+        array) by time integration of the full assembly (:meth:`full_assembly`: every blade and
+        damper written out, no cyclic reduction), from the static equilibrium under F_CG (Eq. 26)
+        or a harmonic solution's state (``start_coefficients`` of the full assembly:
+        :func:`bladedamp.hbm.monodromy.full_assembly_coefficients`); see
+        :func:`bladedamp.timedomain.disk_time_response` for ``options``.
+        Returns a :class:`bladedamp.timedomain.DiskTimeResponse` (tip amplitudes of every blade)."""
+        from .timedomain import disk_time_response
+
+        return disk_time_response(self.full_assembly(), f_hz, **options)
+
+    def monodromy_matrix(self, coefficients, basis, omega: float, steps: int | None = None):
+        """(monodromy matrix, periodicity error) of the HBM solution ``coefficients`` at
+        ``omega`` [rad/s] on the full assembly (:func:`bladedamp.hbm.monodromy.disk_monodromy`)."""
+        result = disk_monodromy(self, coefficients, basis, omega, steps)
+        return result.matrix, result.periodicity_error
+
+    def stop_check(self, response, offset_hz: float = STOP_CHECK_OFFSET_HZ, f_start_hz: float | None = None,
+                   **options):
+        """Whether a periodic motion exists just beyond where ``response`` (a failed branch of
+        :meth:`frequency_response`) got furthest: :meth:`time_response` at that frequency plus
+        ``offset_hz`` [Hz] in the branch's direction (``options`` go to it); for a response that
+        kept no point, at ``f_start_hz`` [Hz], where its branch was to start. Its ``periodic``
+        and ``status`` answer for the motion reached from the static equilibrium: "not settled" or
+        "drifting" (the damper hops on the platforms or keeps rolling): not periodic, which no
+        harmonic-balance branch represents; "periodic": the branch did not reach a periodic motion
+        that exists (:func:`stop_verdict`).
+        Costs one time integration of the full assembly (30-210 s for the reference disk on 2
+        cores)."""
+        return time_check_beyond(self, response, offset_hz, f_start_hz, **options)
+
+    def peak_check(self, response, **options):
+        """:meth:`time_response` at the frequency of ``response``'s peak (the point of the
+        largest first-harmonic tip amplitude of any blade in any direction), started on the
+        branch's state there (``start="hbm"``, default) or from the static equilibrium
+        (``start="static"``; :func:`time_at_peak`), the other ``options`` going to it: what
+        ``frequency_response(..., check_peak=True)`` runs (:func:`with_peak_check`)."""
+        return time_at_peak(self, response, **options)
+
+
+@dataclass
+class TunedDisk(DiskModel):
     """Tuned bladed disk with one damper per blade pair (cyclic symmetry, Eq. 21-25).
 
     Parameters
@@ -502,29 +860,13 @@ class TunedDisk:
         self.rotor_speed_hz = rotor_speed_in_hz(self.rotor_speed_hz)
         validation.integer("n_blades", self.n_blades, minimum=2)
         self.engine_order = validation.integer("engine_order (EO)", self.engine_order, minimum=0)
-        validation.in_range("gamma_left (platform angle, rad)", self.gamma_left, 0.0, np.pi / 2, closed="neither")
-        validation.in_range("gamma_right (platform angle, rad)", self.gamma_right, 0.0, np.pi / 2, closed="neither")
-        validation.positive("damper_radius R", self.damper_radius)
-        # R from a small test rig (the reference disk: 26 mm) to the largest fan and low-pressure
-        # turbine disks (~1.5 m): 1 mm..5 m; outside, most likely a unit slip (26 meant as 26 mm)
-        validation.plausible("damper_radius R", self.damper_radius, 1e-3, 5.0, "m",
-                            "the damper's distance to the rotor axis, 1 mm to 5 m")
-        self.excitation = np.asarray(validation.finite("excitation", self.excitation), dtype=float)
-        if self.excitation.shape != (6,):
-            raise ValueError("excitation must be a 6-vector (F_x, F_y, F_z, M_x, M_y, M_z) in N and N m")
-        if self.engine_order == 0 and self.has_damper and self.rotor_speed_hz is None:
-            raise ValueError("engine_order = 0 needs an explicit rotor_speed_hz (rotor revolutions per second, "
-                             "> 0; rpm / 60)")
+        self.position.validate()
+        self.validate_parameters(self.has_damper)
 
     # ----- geometry --------------------------------------------------------------------
     @property
     def has_damper(self) -> bool:
         return self.damper is not None and self.damper.mass > 0
-
-    @property
-    def interblade_phase(self) -> float:
-        """dphi [rad] in (-pi, pi], e^{i dphi} = e^{i 2 pi EO / n} (Eq. 25; :func:`interblade_phase`)."""
-        return interblade_phase(self.engine_order, self.n_blades)
 
     @property
     def nodal_diameter(self) -> tuple[int, str]:
@@ -536,35 +878,42 @@ class TunedDisk:
         modes = self.blade.mode_names or tuple(f"q{j + 1}" for j in range(self.blade.n_modes))
         return tuple(f"q_{m}" for m in modes) + (DAMPER_DOFS if self.has_damper else ())
 
+    # ----- the layout of DiskModel: one blade, one damper ------------------------------
+    @property
+    def position(self) -> DamperPosition:
+        """The damper position of every sector (:class:`DamperPosition`; built from the fields on
+        each call, so that a field set after construction is seen)."""
+        return DamperPosition(self.damper, self.gamma_left, self.gamma_right, self.initial_gaps, self.damper_radius,
+                              self.engine_order, self.rotor_speed_hz)
+
+    @property
+    def model_blades(self) -> list[ModalBlade]:
+        """[blade]: the reference sector's blade, the one blade written out (:class:`DiskModel`)."""
+        return [self.blade]
+
+    @property
+    def active_positions(self) -> list[int]:
+        """[0] with a damper (it has a mass), else []."""
+        return [0] if self.has_damper else []
+
+    def damper_unknowns(self, d: int = 0) -> slice:
+        """The damper's six coordinates among the n_m + 6 unknowns per coefficient (after the
+        blade's modal coordinates)."""
+        nm = self.blade.n_modes
+        return slice(nm, nm + 6)
+
+    def seated_damper(self, k: int, omega: float) -> np.ndarray:
+        """(6,) the damper seated frictionlessly under F_CG at ``omega`` [rad/s] (``seat``; ``k``: 0)."""
+        return self.position.seated(omega)
+
     def damper_geometry(self) -> DamperGeometry:
-        geometry = self.damper.geometry(self.gamma_left, self.gamma_right)
-        if self.initial_gaps is not None:
-            gaps = np.asarray(validation.finite("initial_gaps", self.initial_gaps), dtype=float)
-            P = geometry.patches[0].n_points
-            if gaps.shape != (2, P):
-                raise ValueError(f"initial_gaps must have shape (2, {P}) (OL, OR points) in m")
-            geometry.patches = tuple(dataclasses.replace(p, initial_gap=g) for p, g in zip(geometry.patches, gaps))
-        return geometry
+        """The damper's contact frames and patches (:meth:`DamperPosition.damper_geometry`)."""
+        return self.position.damper_geometry()
 
     def platform_offsets(self, geometry: DamperGeometry) -> np.ndarray:
-        """(2, 3) contact centres seen from the blade's OL / OR points (in each blade's frame).
-
-        The blade pitch at the platform (unrolled, neighbouring blade frames parallel) is chosen
-        so that the OL and OR contact centres lie above or below the OL point of blade i and
-        the OR point of blade i+1. For asymmetric platforms the two contact centres are at
-        different heights (radial mismatch dz); the damper is placed half-way, so each rigid
-        platform carries half of it (OL offset -dz/2, OR offset +dz/2, radially). This keeps
-        the model mirror-symmetric: exchanging gamma_L and gamma_R gives the mirror image of
-        the assembly (the paper: "the same results are obtained if the left and right platform
-        angle are exchanged"); carrying all of dz on one side breaks that.
-        """
-        p_ol, p_or = self.blade.points["OL"], self.blade.points["OR"]
-        cg = p_ol - geometry.centres[0]                      # damper CG in blade i's frame (OL centre on OL)
-        or_centre = cg + geometry.centres[1]                 # in blade i's frame
-        pitch = p_or[0] - or_centre[0]                       # blade i+1 frame = blade i frame - pitch x
-        mismatch = or_centre + np.array([pitch, 0.0, 0.0]) - p_or   # (0, dy, dz) with OL centre on OL
-        half = np.array([0.0, 0.0, mismatch[2] / 2])
-        return np.array([-half, mismatch - half])
+        """(2, 3) contact centres seen from the blade's OL / OR points (in each blade's frame;
+        :meth:`DamperPosition.platform_offsets`)."""
+        return self.position.platform_offsets(geometry, self.blade.points)
 
     def centrifugal_force(self, f_hz: float):
         """(F_CG [N], dF_CG / dOmega_E [N s/rad]) at the excitation frequency ``f_hz`` [Hz] (Eq. 26;
@@ -573,8 +922,7 @@ class TunedDisk:
 
     def _centrifugal_force(self, omega: float):
         """:meth:`centrifugal_force` at the angular excitation frequency ``omega`` [rad/s] (the residual's)."""
-        return centrifugal_force(self.damper.mass, self.damper_radius, engine_order=self.engine_order,
-                                 f_hz=omega / (2 * np.pi), rotor_speed_hz=self.rotor_speed_hz)
+        return self.position.centrifugal_force(omega)
 
     # ----- harmonic balance --------------------------------------------------------------
     def hbm_system(self, harmonics=(1,), n_samples=None, static_retention: float = 1e-4) -> HarmonicBalanceSystem:
@@ -645,13 +993,8 @@ class TunedDisk:
         return HarmonicBalanceSystem(basis, M, D, K, excitation, couplings, static_stiffness)
 
     def _centrifugal_law(self):
-        """omega -> (F_CG [N], dF_CG / dOmega_E) of Eq. 26, its parameters validated once here
-        (the residual calls it at every evaluation): F = c Omega_E^2, or constant at a given
-        rotor speed."""
-        c, _ = self._centrifugal_force(1.0)
-        if self.rotor_speed_hz is not None:
-            return lambda omega: (c, 0.0)
-        return lambda omega: (c * omega ** 2, 2 * c * omega)
+        """:meth:`DamperPosition.centrifugal_law` of the damper."""
+        return self.position.centrifugal_law()
 
     def centrifugal_law(self):
         """A function omega [rad/s, the excitation frequency] -> (F_CG [N], dF_CG / dOmega_E
@@ -661,76 +1004,14 @@ class TunedDisk:
 
     def approach_function(self, geometry: DamperGeometry, basis: HarmonicBasis):
         """The static approach of ``geometry``'s contact points under this disk's F_CG (Eq. 26):
-        a function omega [rad/s, the residual's excitation frequency] -> (per-point static
-        approach (2, P) [m], its omega-derivative (2, P) [m s/rad]). With a static harmonic in
-        ``basis`` the seating is part of the harmonic balance and the approach is the rest state
-        (minus the initial gaps); otherwise the frictionless seating under F_CG (``seat``).
-        The :attr:`DamperContacts.approach` of this disk's and of a MistunedDisk's dampers."""
-        gaps = np.array([p.initial_gap for p in geometry.patches])
-        if basis.has_static:
-            rest = -gaps  # the seating is part of the harmonic balance
-            zero = np.zeros_like(rest)
-            return lambda omega: (rest, zero)
-        if np.any(gaps != 0):
-            # a misfit: the seating is not homogeneous in F_CG; seat at each load, d/dF by central
-            # differences of the (smooth away from touch-down) seating
-            cache = {}
-
-            def approach(omega):
-                if omega not in cache:
-                    F, dF = self._centrifugal_force(omega)
-                    a = seat(geometry, F)[1]
-                    h = 1e-6 * max(F, 1e-12)
-                    da = (seat(geometry, F + h)[1] - seat(geometry, max(F - h, 0.0))[1]) / (F + h - max(F - h, 0.0))
-                    cache.clear()
-                    cache[omega] = (a, da * dF)
-                return cache[omega]
-
-            return approach
-        # perfect fit: seat once at a reference load; the laws are homogeneous, so the static
-        # approach scales as F_CG^(1/p) (p = 1 for the linear law)
-        exponent = getattr(geometry.patches[0].normal_law, "exponent", 1.0)
-        F_ref = 1.0
-        _, approach_ref, _ = seat(geometry, F_ref)
-        centrifugal = self._centrifugal_law()
-
-        def approach(omega):
-            F, dF = centrifugal(omega)
-            if F <= 0:
-                return np.zeros_like(approach_ref), np.zeros_like(approach_ref)
-            scale = (F / F_ref) ** (1 / exponent)
-            return approach_ref * scale, approach_ref * scale / (exponent * F) * dF
-
-        return approach
+        :meth:`DamperPosition.approach_function` (omega [rad/s] -> (approach (2, P) [m], its
+        omega-derivative [m s/rad]))."""
+        return self.position.approach_function(geometry, basis)
 
     def check_bounded(self, f_start_hz: float, f_end_hz: float) -> None:
         """ValueError where no bounded periodic response exists in ``f_start_hz``..``f_end_hz``
-        [Hz]: a blade mode j with zero modal damping, a modal force phi_j^T F != 0, its natural
-        frequency f_0j inside the range, and no damper acting on it (no damper, or rigid
-        platforms that do not move at OL and OR in that mode). Its modal equation is then
-        q_j'' + omega_0j^2 q_j = phi_j^T F cos(Omega t) alone, whose amplitude grows without
-        bound at Omega = omega_0j. (With a damper on that mode the bound of its friction forces
-        is no closed form: the normal loads vary with the motion.)"""
-        blade = self.blade
-        force = blade.shape("excitation").T @ self.excitation                 # (nm,) modal forces [N]
-        lo, hi = min(f_start_hz, f_end_hz), max(f_start_hz, f_end_hz)
-        if self.has_damper:
-            if blade.flexible_platform:
-                return
-            at_damper = np.abs(np.vstack([blade.shape("OL"), blade.shape("OR")])).max(axis=0) > 0
-        else:
-            at_damper = np.zeros(blade.n_modes, dtype=bool)
-        f0 = np.asarray(blade.natural_frequencies_hz, dtype=float)
-        free = (blade.damping_ratios == 0) & (force != 0) & ~at_damper & (f0 >= lo) & (f0 <= hi)
-        if np.any(free):
-            j = int(np.flatnonzero(free)[0])
-            name = blade.mode_names[j] if len(blade.mode_names) else str(j + 1)
-            why = "the disk has no damper" if not self.has_damper else "the damper's platforms do not move in it"
-            raise ValueError(
-                f"no bounded response: blade mode {name} has damping_ratios = 0, a modal force "
-                f"{force[j]:.6g} N and its natural frequency {f0[j]:.6g} Hz inside the range {f_start_hz:g}-"
-                f"{f_end_hz:g} Hz, and {why}: its amplitude grows without bound there; give the mode a damping "
-                f"ratio > 0 or a range without {f0[j]:.6g} Hz")
+        [Hz] (:func:`check_blade_bounded` of the blade, with this disk's damper)."""
+        check_blade_bounded(self.blade, self.excitation, self.has_damper, f_start_hz, f_end_hz)
 
     def static_normal_loads(self, f_hz: float) -> np.ndarray:
         """Static normal loads (N_OL, N_OR) [N] from frictionless seating under F_CG at the
@@ -805,12 +1086,7 @@ class TunedDisk:
         ends there with every point it has, status ``OUT_OF_BUDGET`` (not ``success``), and
         ``stopped_by`` and the message say what ran out and at which frequency.
         """
-        validation.positive("f_start_hz", f_start_hz)
-        validation.positive("f_end_hz", f_end_hz)
-        if f_start_hz == f_end_hz:
-            raise ValueError("f_end_hz must differ from f_start_hz")
-        self.check_bounded(f_start_hz, f_end_hz)
-        w0, w1 = 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz
+        w0, w1 = checked_range(self, f_start_hz, f_end_hz)
         if stop_above is not None:
             validation.positive("stop_above", stop_above)
         validation.integer("stop_direction", stop_direction, minimum=0, maximum=2)
@@ -826,41 +1102,30 @@ class TunedDisk:
         if not np.any(self.excitation) and extra_couplings is None:
             return rest_response(self, w0, w1, max_step, harmonic_tolerance,
                                  lambda system, branch: DiskResponse.from_branch(self, system, branch))
-        budget = Budget(cpu_budget_s, point_budget)
-
-        def solve(H):
-            first = HarmonicBasis(tuple(H)).n_samples
-            return sampled_response(lambda n: solve_sampled(H, n), n_samples, first, AUTO_SAMPLES_GROWTH * first,
-                                    AUTO_SAMPLES_GROWTH_DISSIPATION * first)
-
-        def solve_sampled(H, n_samples):
-            system = model.hbm_system(H, n_samples)
-            scales = self.unknown_scales(system, w0, w1)
-            x0 = self.start_solution(system, w0, scales)
-            branch = continuation(system.residual, x0, w0, w1, x_scale=scales, max_step=max_step,
-                                  start_at_end=lambda: self.start_solution(system, w1, scales),
-                                  retry_x_scale=self.retry_scales(system, scales),
-                                  stop_when=self.amplitude_stop(system.basis, stop_above, stop_direction),
-                                  budget=budget, **continuation_options)
-            response = DiskResponse.from_branch(self, system, branch)
-            T = system.basis.n_samples
-
-            def points_dissipation(r, field="point_dissipation"):   # every contact point's, (n, 2 P)
-                return getattr(r, field).reshape(len(r.omega), -1) if self.has_damper and len(r.omega) \
-                    else np.zeros((len(r.omega), 0))
-
-            def refine(indices):
-                fine = model.hbm_system(system.basis.harmonics, REFINE_SAMPLES_FACTOR * T)
-                return points_dissipation(DiskResponse.from_branch(self, fine, branch.take(indices)))
-
-            return with_checks(response, physical_checks(branch.omega, (w0, w1), points_dissipation(response),
-                                                         response.excitation_work, max_step, T, refine,
-                                                         points_dissipation(response, "point_work_bound")))
-
         can_check = extra_couplings is None and not self.blade.flexible_platform
-        response = peak_checked_response(self, model, solve, harmonics, harmonic_tolerance, max_harmonic,
-                                         estimate_harmonic_error, check_peak, can_check)
+        response = solve_frequency_response(
+            model, f_start_hz, f_end_hz, harmonics, n_samples, max_step, harmonic_tolerance, max_harmonic,
+            converge=lambda solve: peak_checked_response(self, model, solve, harmonics, harmonic_tolerance,
+                                                         max_harmonic, estimate_harmonic_error, check_peak, can_check),
+            stop_when_for=None if stop_above is None else
+            lambda basis: self.amplitude_stop(basis, stop_above, stop_direction),
+            cpu_budget_s=cpu_budget_s, point_budget=point_budget, **continuation_options)
         return with_range_end_estimate(self, with_stop_check(self, response, f_start_hz, check_stop))
+
+    # ----- the protocol of bladedamp.frf (the FRF driver) ----------------------------------
+    def response_from_branch(self, system: HarmonicBalanceSystem, branch) -> "DiskResponse":
+        """:meth:`DiskResponse.from_branch` of this disk."""
+        return DiskResponse.from_branch(self, system, branch)
+
+    def branch_energies(self, system: HarmonicBalanceSystem, branch, response: "DiskResponse"):
+        """(excitation work (n,), every contact point's dissipation (n, 2 P), its work bound (n, 2 P))
+        per period [J] of ``response`` (no damper: (n, 0))."""
+        return (response.excitation_work, contact_point_field(self, response, "point_dissipation"),
+                contact_point_field(self, response, "point_work_bound"))
+
+    def refined_dissipation(self, system: HarmonicBalanceSystem, branch) -> np.ndarray:
+        """(k, 2 P) every contact point's dissipation per period [J] of ``branch`` on ``system``."""
+        return contact_point_field(self, DiskResponse.from_branch(self, system, branch), "point_dissipation")
 
     def linear_natural_frequencies_hz(self, f_low_hz: float, f_high_hz: float) -> tuple[float, float]:
         """(without dampers, dampers stuck): the natural frequency [Hz] of each linear sector
@@ -933,102 +1198,12 @@ class TunedDisk:
         solved = PeakSolver(system, response.omega, response.coefficients).solve(index, tip)
         return None if solved is None else (solved[0], solved[1] / (2 * np.pi))
 
-    def point_map(self, basis: HarmonicBasis, point: str = "tip", directions=(0,)) -> np.ndarray:
-        """Real-form map (C*k, C*n_dof) from the unknowns of :meth:`hbm_system` (``basis``'s
-        harmonics) to the motion of the reference blade's ``point`` in the k ``directions``
-        (0, 1, 2: x, y, z translation [m]; 3, 4, 5: rotations [rad], blade frame), through the
-        blade's mode shapes (the damper's DOFs do not enter). The map of a
-        :class:`~bladedamp.hbm.system.Coupling` from the sector to an element at that point."""
-        nm = self.blade.n_modes
-        return blade_point_map(self.blade, basis, point, directions, nm + (6 if self.has_damper else 0), slice(0, nm))
-
     # ----- the protocol of bladedamp.hbm.accuracy ----------------------------------------
     def output_amplitudes(self, coefficients: np.ndarray, basis: HarmonicBasis) -> np.ndarray:
         """(n, 3) first-harmonic tip amplitudes [m] of coefficients (n, C, n_dof)."""
         j1, nm = basis.cos_index(1), self.blade.n_modes
         q1 = coefficients[:, j1, :nm] - 1j * coefficients[:, j1 + 1, :nm]
         return np.abs(q1 @ self.blade.shape("tip")[:3].T)
-
-    def start_solution(self, system, omega, scales, tol=1e-10):
-        """Solution (C * n_dof,) of ``system`` at the first frequency ``omega`` [rad/s], robust in
-        gross slip (:func:`bladedamp.hbm.start.robust_start`); ``scales`` (C * n_dof,) from
-        :meth:`unknown_scales`.
-
-        Damped Newton from the stuck linear solution; if that fails (a light damper sliding far
-        from its stuck state), an excitation homotopy on the dynamic excitation (the centrifugal
-        preload stays), from the seated damper. Returns the best iterate (the continuation then
-        reports honestly if it is not a solution)."""
-        f = system.excitation(omega)[0].reshape(system.basis.n_coeffs, system.n_dof).copy()
-        if system.basis.has_static:
-            f[system.basis.cos_index(0)] = 0.0          # the preload is not ramped
-        base = self.static_state(system, omega)
-        residual_scale = max(np.linalg.norm(system.residual(np.zeros(system.n_unknowns), omega, False)[0]), 1e-300)
-        return robust_start(system.residual, {"stuck linear solution": self.initial_guess(system, omega)},
-                            omega, scales, f.ravel(), base=base, residual_scale=residual_scale, tol=tol).x
-
-    def static_state(self, system, omega):
-        """The state without dynamic motion: rest, or with a static harmonic the damper seated
-        frictionlessly under F_CG (``seat``)."""
-        x = np.zeros(system.n_unknowns)
-        if self.has_damper and system.basis.has_static:
-            u_seat, _, _ = seat(self.damper_geometry(), self._centrifugal_force(omega)[0])
-            nm = self.blade.n_modes
-            x.reshape(system.basis.n_coeffs, system.n_dof)[system.basis.cos_index(0), nm:] = u_seat
-        return x
-
-    def initial_guess(self, system, omega):
-        """Stuck linear solution (C * n_dof,) of ``system`` at ``omega`` [rad/s, the residual's
-        excitation frequency]: one Newton step from the static state, where every contact point
-        sticks (without a damper: the linear solution itself).
-
-        With a static harmonic the contacts have no preload at x = 0 (zero approach: every
-        point is open and the Jacobian there has no contact stiffness at all), so the step
-        starts from the damper seated frictionlessly under F_CG (``seat``) instead of from rest.
-        """
-        x = self.static_state(system, omega)
-        R, J, _ = system.residual(x, omega)
-        return x - np.linalg.solve(J, R)
-
-    def retry_scales(self, system: HarmonicBalanceSystem, scales: np.ndarray) -> np.ndarray | None:
-        """The continuation's ``retry_x_scale``: ``scales`` (from :meth:`unknown_scales`) with the
-        damper's unknowns weighing less in the arc length (:func:`damper_weighted_scales`); None
-        without a damper."""
-        if not self.has_damper:
-            return None
-        return damper_weighted_scales(scales, system.basis.n_coeffs, slice(self.blade.n_modes, None))
-
-    def unknown_scales(self, system: HarmonicBalanceSystem, omega_start: float, omega_end: float) -> np.ndarray:
-        """Scale (C * n_dof,) of each unknown of ``system`` over omega_start..omega_end [rad/s]
-        (the continuation's ``x_scale``): its largest value in the stuck linear responses across the
-        range (harmonic coefficients pooled per DOF), floored at 1e-3 of the largest scale of
-        its kind (modal / damper translation / damper rotation). A damper group that the stuck
-        response leaves at exactly zero (e.g. no damper rotation in the symmetric EO = n/2
-        standing wave) is floored at 1e-3 of the platform motion of the same kind instead
-        (a 1e-300 floor turned round-off in the Newton step into an overflow)."""
-        C, n = system.basis.n_coeffs, system.n_dof
-        nm = self.blade.n_modes
-        omegas = np.linspace(omega_start, omega_end, 7)
-        X = np.array([np.abs(self.initial_guess(system, w)).reshape(C, n).max(axis=0) for w in omegas]).max(axis=0)
-        groups = [(slice(0, nm), 0.0)]
-        if self.has_damper:
-            phi = np.abs(np.stack([self.blade.shape("OL"), self.blade.shape("OR")]))   # (2, 6, nm)
-            q = X[:nm].max()
-            groups += [(slice(nm, nm + 3), 1e-3 * q * phi[:, :3].max()), (slice(nm + 3, nm + 6), 1e-3 * q * phi[:, 3:].max())]
-        for g, platform_floor in groups:
-            X[g] = np.maximum(X[g], max(1e-3 * X[g].max(), platform_floor) + 1e-300)
-        return np.tile(X, C)
-
-    def time_response(self, f_hz, **options):
-        """Steady state at each excitation frequency ``f_hz`` [Hz] (scalar or array) by time
-        integration of the full assembly (``MistunedDisk.from_tuned(self)``: every blade and
-        damper written out, no cyclic reduction), from the static equilibrium under F_CG (Eq. 26)
-        or a harmonic solution's state (``start_coefficients`` of the full assembly:
-        :func:`bladedamp.hbm.monodromy.full_assembly_coefficients`); see
-        :func:`bladedamp.timedomain.disk_time_response` for ``options``.
-        Returns a :class:`bladedamp.timedomain.DiskTimeResponse` (tip amplitudes of every blade)."""
-        from .timedomain import disk_time_response
-
-        return disk_time_response(self.full_assembly(), f_hz, **options)
 
     def full_assembly(self):
         """The full assembly, every blade and damper written out, no cyclic reduction:
@@ -1064,34 +1239,6 @@ class TunedDisk:
         """True: the monodromy method has this model's period map, that of its full assembly
         (:class:`bladedamp.hbm.monodromy.PeriodMapModel`)."""
         return True
-
-    def monodromy_matrix(self, coefficients, basis, omega: float, steps: int | None = None):
-        """(monodromy matrix, periodicity error) of the HBM solution ``coefficients`` at
-        ``omega`` [rad/s] on the full assembly (:func:`bladedamp.hbm.monodromy.disk_monodromy`)."""
-        result = disk_monodromy(self, coefficients, basis, omega, steps)
-        return result.matrix, result.periodicity_error
-
-    def stop_check(self, response: "DiskResponse", offset_hz: float = STOP_CHECK_OFFSET_HZ,
-                   f_start_hz: float | None = None, **options):
-        """Whether a periodic motion exists just beyond where ``response`` (a failed branch of
-        :meth:`frequency_response`) got furthest: :meth:`time_response` at that frequency plus
-        ``offset_hz`` [Hz] in the branch's direction (``options`` go to it); for a response that
-        kept no point, at ``f_start_hz`` [Hz], where its branch was to start. Its ``periodic``
-        and ``status`` answer for the motion reached from the static equilibrium: "not settled" or
-        "drifting" (the damper hops on the platforms or keeps rolling): not periodic, which no
-        harmonic-balance branch represents; "periodic": the branch did not reach a periodic motion
-        that exists (:func:`stop_verdict`).
-        Costs one time integration of the full assembly (30-210 s for the reference disk on 2
-        cores)."""
-        return time_check_beyond(self, response, offset_hz, f_start_hz, **options)
-
-    def peak_check(self, response: "DiskResponse", **options):
-        """:meth:`time_response` at the frequency of ``response``'s peak (the point of the
-        largest first-harmonic tip amplitude in any direction), started on the branch's state
-        there (``start="hbm"``, default) or from the static equilibrium (``start="static"``;
-        :func:`time_at_peak`), the other ``options`` going to it: what
-        ``frequency_response(..., check_peak=True)`` runs (:func:`with_peak_check`)."""
-        return time_at_peak(self, response, **options)
 
     @staticmethod
     def time_output_amplitudes(check) -> np.ndarray:
@@ -1388,6 +1535,13 @@ def with_stop_note(response, f_start_hz: float | None = None, check=None):
     return dataclasses.replace(response, message=response.message + note)
 
 
+def contact_point_field(disk, response, field: str) -> np.ndarray:
+    """(n, 2 P) a per-point field (n, 2, P) of a :class:`DiskResponse` of ``disk`` flattened per
+    point ((n, 0) without a damper or a point)."""
+    n = len(response.omega)
+    return getattr(response, field).reshape(n, -1) if disk.has_damper and n else np.zeros((n, 0))
+
+
 def blade_point_map(blade, basis, point, directions, n_dof, modes):
     """Real-form map (C*k, C*n_dof) of ``basis`` to ``blade``'s ``point`` in ``directions`` (0..5), from
     its modal DOFs ``modes`` (a slice of the n_dof unknowns per coefficient)."""
@@ -1430,7 +1584,95 @@ class WithCouplings:
 
 
 @dataclass
-class DiskResponse(FrequencyResponse):
+class DiskModelResponse(FrequencyResponse):
+    """What the frequency responses of both disk models share (:class:`DiskResponse` of the tuned
+    disk's reference sector, :class:`~bladedamp.mistuned.MistunedResponse` of every blade of a
+    ring): the same names for the same quantities, per point of the branch (n points):
+
+    tip_amplitude : first-harmonic tip amplitude in x, y, z [m]: (n, 3) of the reference sector,
+        (n, s, 3) of the s blades of a ring
+    excitation_work, viscous_dissipation, dissipated_energy : (n,) per period, the whole model
+        (one sector, or the s blades) [J]: the work of the excitation, the blades' modal damping
+        dissipation and the friction dissipation of every damper
+    stop_check : for a branch that stopped before the end of its range, computed with
+        ``check_stop=True``: the time integration of the full assembly just beyond where it got
+        furthest (a one-frequency :class:`bladedamp.timedomain.DiskTimeResponse`; its ``periodic``
+        says whether a periodic motion exists there, :func:`stop_verdict`), else None
+    peak_check : for a branch that reached the end of its range, computed with
+        ``check_peak=True``: the time integration of the full assembly at its peak's frequency
+        (a one-frequency DiskTimeResponse, :func:`with_peak_check`), else None
+    disk : the model (None for a loaded result)
+
+    The peaks: :attr:`largest_peak_amplitude` (float [m]) and :attr:`largest_peak_frequency_hz`
+    (float [Hz]) are the largest tip amplitude u_x of any blade and its frequency, the same
+    quantity and type for both models; :attr:`blade_peak_amplitudes` and
+    :attr:`blade_peak_frequencies_hz` are (s,) arrays, one per blade written out ((1,) for the
+    tuned disk). ``peak_amplitude`` keeps its meaning per class: a float (the reference sector's
+    largest sample) on a :class:`DiskResponse`, the (s,) blade peaks (parabola-refined) on a
+    MistunedResponse.
+    """
+
+    tip_amplitude: np.ndarray = None
+    excitation_work: np.ndarray = None
+    viscous_dissipation: np.ndarray = None
+    dissipated_energy: np.ndarray = None
+    stop_check: object = None
+    peak_check: object = None
+    disk: DiskModel = None
+
+    @staticmethod
+    def linear_energies(system: HarmonicBalanceSystem, branch) -> tuple[np.ndarray, np.ndarray]:
+        """(excitation work (n,), viscous dissipation (n,)) per period [J] at the points of ``branch``."""
+        return (np.array([system.excitation_work(x, w) for x, w in zip(branch.x, branch.omega)]),
+                np.array([system.viscous_dissipation(x, w) for x, w in zip(branch.x, branch.omega)]))
+
+    def energy_balance_error(self) -> np.ndarray:
+        """|W_exc - W_visc - W_friction| / W_exc at every point (the whole model)."""
+        return np.abs(self.excitation_work - self.viscous_dissipation - self.dissipated_energy) / np.abs(self.excitation_work)
+
+    @property
+    def blade_peak_amplitudes(self) -> np.ndarray:
+        """(s,) peak first-harmonic tip amplitude u_x of each blade written out [m] ((1,) for the
+        tuned disk's reference sector)."""
+        return np.atleast_1d(np.asarray(self.peak_amplitude, dtype=float))
+
+    @property
+    def blade_peak_frequencies_hz(self) -> np.ndarray:
+        """(s,) frequency of each blade's peak [Hz], as :attr:`blade_peak_amplitudes`."""
+        return np.atleast_1d(np.asarray(self.peak_frequency_hz, dtype=float))
+
+    @property
+    def largest_peak_amplitude(self) -> float:
+        """The largest peak first-harmonic tip amplitude u_x of any blade [m] (nan for an empty branch)."""
+        peaks = self.blade_peak_amplitudes
+        return float(peaks.max()) if peaks.size and len(self.omega) else float("nan")
+
+    @property
+    def largest_peak_frequency_hz(self) -> float:
+        """The frequency of :attr:`largest_peak_amplitude` [Hz] (nan for an empty branch)."""
+        peaks = self.blade_peak_amplitudes
+        return float(self.blade_peak_frequencies_hz[np.argmax(peaks)]) if peaks.size and len(self.omega) \
+            else float("nan")
+
+    def finish_plot(self, ax, direction: int, measured=None, legend: dict | None = None):
+        """The axes of a disk response's :meth:`plot` completed: labels, grid, legend, the status
+        as the title of a failed response, and ``measured`` drawn beside it
+        (:func:`bladedamp.measurement.draw_measurement`)."""
+        ax.set_xlabel("excitation frequency [Hz]")
+        ax.set_ylabel(f"tip amplitude u_{'xyz'[direction]} [mm]")
+        ax.grid(True, alpha=0.3)
+        ax.legend(**(legend or {}))
+        if not self.success:
+            ax.set_title(textwrap.fill(self.status_message, 100), fontsize=8)   # what it means, not the log
+        if measured is not None:
+            from .measurement import draw_measurement
+
+            draw_measurement(ax, measured, model=self.disk)
+        return ax
+
+
+@dataclass
+class DiskResponse(DiskModelResponse):
     """Frequency response of a tuned disk (reference sector).
 
     Extra attributes (n points along the branch, C coefficients, P points per patch):
@@ -1459,7 +1701,6 @@ class DiskResponse(FrequencyResponse):
         (a one-frequency DiskTimeResponse, :func:`with_peak_check`), else None
     """
 
-    tip_amplitude: np.ndarray = None
     modal_amplitude: np.ndarray = None
     contact_force: np.ndarray = None
     relative_motion: np.ndarray = None
@@ -1467,13 +1708,7 @@ class DiskResponse(FrequencyResponse):
     point_state: np.ndarray = None
     point_dissipation: np.ndarray = None
     point_work_bound: np.ndarray = None
-    dissipated_energy: np.ndarray = None
-    excitation_work: np.ndarray = None
-    viscous_dissipation: np.ndarray = None
     normal_load: np.ndarray = None
-    stop_check: object = None
-    peak_check: object = None
-    disk: TunedDisk = None
 
     @classmethod
     def from_branch(cls, disk: TunedDisk, system: HarmonicBalanceSystem, branch) -> "DiskResponse":
@@ -1483,10 +1718,9 @@ class DiskResponse(FrequencyResponse):
         npts = len(branch.omega)
         j1 = basis.cos_index(1)
         q1 = X[:, j1, :nm] - 1j * X[:, j1 + 1, :nm]
-        out = dict(tip_amplitude=disk.output_amplitudes(X, basis), modal_amplitude=np.abs(q1),
-                   excitation_work=np.array([system.excitation_work(x.ravel(), w) for x, w in zip(X, branch.omega)]),
-                   viscous_dissipation=np.array([system.viscous_dissipation(x.ravel(), w)
-                                                 for x, w in zip(X, branch.omega)]))
+        work, viscous = cls.linear_energies(system, branch)
+        out = dict(tip_amplitude=disk.output_amplitudes(X, basis), modal_amplitude=np.abs(q1), excitation_work=work,
+                   viscous_dissipation=viscous)
         if disk.has_damper and npts:
             coupling = system.couplings[0]
             element = coupling.element
@@ -1527,10 +1761,6 @@ class DiskResponse(FrequencyResponse):
         """Frequency of the largest |u_x,tip| (the resonance) [Hz] (nan for an empty branch)."""
         return float(self.frequency_hz[np.argmax(self.tip_amplitude[:, 0])]) if len(self.omega) else float("nan")
 
-    def energy_balance_error(self) -> np.ndarray:
-        """|W_exc - W_visc - W_friction| / W_exc at every point."""
-        return np.abs(self.excitation_work - self.viscous_dissipation - self.dissipated_energy) / np.abs(self.excitation_work)
-
     def peak_curve(self) -> np.ndarray:
         """(n,) first-harmonic tip amplitude |u_x| at every point [m] (its largest is the peak)."""
         return self.tip_amplitude[:, 0]
@@ -1550,14 +1780,4 @@ class DiskResponse(FrequencyResponse):
             else:
                 label = f"{d.damper.kind} {1e3 * d.damper.mass:g} g" if d.has_damper else "no damper"
         plot_branch(ax, self.frequency_hz, 1e3 * self.tip_amplitude[:, direction], self.stable, label=label, **kwargs)
-        ax.set_xlabel("excitation frequency [Hz]")
-        ax.set_ylabel(f"tip amplitude u_{'xyz'[direction]} [mm]")
-        ax.grid(True, alpha=0.3)
-        ax.legend()
-        if not self.success:
-            ax.set_title(textwrap.fill(self.status_message, 100), fontsize=8)   # what it means, not the log
-        if measured is not None:
-            from .measurement import draw_measurement
-
-            draw_measurement(ax, measured, model=self.disk)
-        return ax
+        return self.finish_plot(ax, direction, measured)
