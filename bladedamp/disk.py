@@ -27,9 +27,11 @@ import textwrap
 import warnings
 
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 import scipy.linalg
+import scipy.sparse as sp
 from numba import njit
 
 from . import validation
@@ -255,6 +257,23 @@ def euler_rate(offsets, doffsets, blocks, local, force, domega):
 
 
 
+class PointBatch(NamedTuple):
+    """The contact points of one damper (both patches) or of n_d dampers side by side as one
+    batch of the point-contact kernel (what :meth:`DamperContacts.stacked_points` and
+    :meth:`AssemblyContacts.stacked_points` give; P points per patch)."""
+
+    #: point maps from the local coordinates, (2, P, 3, m) for one damper, (n_d, 2, P, 3, m) for n_d
+    maps: np.ndarray
+    #: (2 P,) or (2 n_d P,) tangential stiffness of each point: the patch's times the point's weight [N/m]
+    tangential_stiffness: np.ndarray
+    #: (2 P,) or (2 n_d P,) friction coefficient of each point [-]
+    friction_coefficient: np.ndarray
+    #: (2 P,) or (2 n_d P,) each point's weight [-]
+    weights: np.ndarray
+    #: the normal law every point shares
+    normal_law: object
+
+
 @dataclass
 class DamperContacts:
     """Both contacts of one damper as a harmonic-balance element. Forces are those on the
@@ -267,13 +286,15 @@ class DamperContacts:
 
     ``approach(omega)`` gives the per-point static approach (2, P) and its omega-derivative.
 
-    ``harmonic_forces`` evaluates the points of both patches in one call of a kernel when the
+    ``harmonic_forces`` is that of the one damper-contact element, :class:`AssemblyContacts`
+    with this damper alone (:attr:`element`; a ring's element holds every damper's
+    DamperContacts side by side): the points of both patches in one call of a kernel when the
     patches share their normal law and friction coefficient (always, for the dampers of
     :mod:`bladedamp.damper.geometry`): the fused kernel with rigid platforms
     (:func:`fused_point_map_forces`), else the point-contact kernel with numpy projections; the
     same numbers as two ``ContactPatch.evaluate`` calls to rounding (tested against ``evaluate``).
     With the one-harmonic preload and a linear normal law, d force / d omega comes from Euler's
-    identity instead of a second AFT pass (see ``harmonic_forces``).
+    identity instead of a second AFT pass (:func:`euler_rate`).
     """
 
     geometry: DamperGeometry
@@ -281,6 +302,7 @@ class DamperContacts:
     point_maps: np.ndarray | None = None
     n_local: int = field(default=12, init=False)
     _stacked: tuple | None = field(default=None, init=False, repr=False)
+    _element: object = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self):
         if self.point_maps is not None:
@@ -312,12 +334,12 @@ class DamperContacts:
         force is (C, 6 + n_m), its first 6 the forces and moments about the control point."""
         return self.evaluate_at(local, basis, self.approach(omega)[0], jacobian)
 
-    def stacked_points(self):
-        """The points of both patches as one batch: ``(True, point maps (2, P, 3, m), k_T (2P,)
-        [N/m per point: the patch's tangential stiffness times the point's weight], mu (2P,),
-        weights (2P,), normal law)``, or None if the patches differ in normal law, friction
+    def stacked_points(self) -> PointBatch | None:
+        """The points of both patches as one :class:`PointBatch` (point maps (2, P, 3, m), per
+        point (2P,): k_T [N/m, the patch's tangential stiffness times the point's weight], mu,
+        weights; the normal law), or None if the patches differ in normal law, friction
         coefficient or point count (then they are evaluated one by one). Cached; the batch of
-        :func:`point_map_forces` and of :class:`~bladedamp.mistuned.AssemblyContacts`."""
+        :func:`point_map_forces` and of :class:`AssemblyContacts`."""
         if self._stacked is None:
             pa, pb = self.geometry.patches
             same = (pa.normal_law == pb.normal_law and pa.friction_coefficient == pb.friction_coefficient
@@ -327,38 +349,26 @@ class DamperContacts:
             else:
                 ps = (pa, pb)
                 B = np.stack([p.point_map for p in ps]) if self.point_maps is None else self.point_maps
-                self._stacked = (True, B,
-                                 np.concatenate([p.tangential_stiffness * p.weights for p in ps]),
-                                 np.concatenate([np.full(p.n_points, p.friction_coefficient) for p in ps]),
-                                 np.concatenate([p.weights for p in ps]), pa.normal_law)
-        return self._stacked if self._stacked[0] else None
+                self._stacked = (True, PointBatch(B, np.concatenate([p.tangential_stiffness * p.weights for p in ps]),
+                                                  np.concatenate([np.full(p.n_points, p.friction_coefficient)
+                                                                  for p in ps]),
+                                                  np.concatenate([p.weights for p in ps]), pa.normal_law))
+        return self._stacked[1] if self._stacked[0] else None
 
     def forces_at(self, local, basis, offsets, jacobian):
         """Forces (C, n_local) [N, N m] and Jacobian (C*n_local, C*n_local) or None of both patches
         at ``local`` (C, n_local) with the per-point static approach ``offsets`` (2, P) [m] (no
-        omega: the approach is given; :meth:`harmonic_forces` takes it from :attr:`approach`)."""
+        omega: the approach is given), patch by patch (:meth:`evaluate_at`): the one element's
+        (:class:`AssemblyContacts`) evaluation of a damper whose patches do not stack
+        (:meth:`stacked_points` None); it evaluates stacked ones in one kernel call."""
         C, m = basis.n_coeffs, self.contact_local
-        stack = self.stacked_points()
-        if stack is None:
-            evs = self.evaluate_at(local, basis, offsets, jacobian)
-            force = np.hstack([ev.force for ev in evs])
-            blocks = [ev.jacobian.reshape(C, m, C, m) for ev in evs] if jacobian else None
-        else:
-            _, B, k_t, mu, weights, law = stack
-            fused = fused_point_map_forces(B[None], local.reshape(C, 1, 2 * m), basis, k_t, mu, law, weights,
-                                           offsets, jacobian)
-            if fused is not None:
-                force, blocks = fused
-                return force.reshape(C, 2 * m), None if blocks is None else blocks.reshape(C * 2 * m, C * 2 * m)
-            f, jb, _ = point_map_forces(B[None], local.reshape(C, 1, 2, m), basis, k_t, mu, law, weights, offsets,
-                                        jacobian)
-            force = f.reshape(C, 2 * m)
-            blocks = None if jb is None else jb[0]
+        evs = self.evaluate_at(local, basis, offsets, jacobian)
+        force = np.hstack([ev.force for ev in evs])
         if not jacobian:
             return force, None
         jac = np.zeros((C, 2 * m, C, 2 * m))
-        for c in range(2):
-            jac[:, m * c:m * c + m, :, m * c:m * c + m] = blocks[c]
+        for c, ev in enumerate(evs):
+            jac[:, m * c:m * c + m, :, m * c:m * c + m] = ev.jacobian.reshape(C, m, C, m)
         return force, jac.reshape(C * 2 * m, C * 2 * m)
 
     def evaluate_at(self, local, basis, offsets, jacobian=True):
@@ -379,7 +389,7 @@ class DamperContacts:
         offsets = np.stack([self.approach(w)[0] for w in omegas])                 # (n, 2, P)
         stack = self.stacked_points()
         if stack is not None:
-            _, B, k_t, mu, weights, law = stack
+            B, k_t, mu, weights, law = stack
             f, _, pts = point_map_forces(np.broadcast_to(B, (n,) + B.shape), np.moveaxis(local.reshape(n, C, 2, m), 0, 1),
                                          basis, np.tile(k_t, n), np.tile(mu, n), law, np.tile(weights, n), offsets,
                                          False)
@@ -391,32 +401,274 @@ class DamperContacts:
                                     for f in dataclasses.fields(PointContactSamples)))
         return force, pts
 
+    @property
+    def element(self) -> "AssemblyContacts":
+        """The one damper-contact element holding this damper alone, its Jacobian dense (built once)."""
+        if self._element is None:
+            self._element = AssemblyContacts([self], dense=True)
+        return self._element
+
     def harmonic_forces(self, local, basis, omega, jacobian=True):
+        """(force (C, n_local) [N, N m], dense Jacobian (C n_local, C n_local) or None, d force /
+        d omega (C n_local,) [N s/rad] or None) at ``local`` (C, n_local) and ``omega`` [rad/s]:
+        :meth:`AssemblyContacts.harmonic_forces` of :attr:`element`."""
+        return self.element.harmonic_forces(local, basis, omega, jacobian)
+
+
+@dataclass
+class AssemblyContacts:
+    """The contacts of all dampers of an assembly as one harmonic-balance element.
+
+    Local coordinates: those of each damper's :class:`DamperContacts` in turn (the 12 relative
+    motions of OL and OR, and with flexible platforms the platform blades' modal coordinates:
+    ``n_local = L * n_dampers``, L = :attr:`damper_local`, the same for every damper).
+    ``contacts[d]`` is damper d's :class:`DamperContacts` (built from its :class:`DamperPosition`
+    as the tuned disk's). The one damper-contact element of both disk models: a ring's dampers
+    side by side, and the tuned sector's damper alone (:attr:`DamperContacts.element`). Returns
+    a sparse block-diagonal local Jacobian, or with ``dense`` a dense one (one damper: its block).
+    """
+
+    contacts: list[DamperContacts]
+    n_local: int = 0
+    #: (n_d,) phase [rad] of each damper's motion in a tuned travelling wave (k dphi for the
+    #: damper on blade k), or None; damper d is sampled on a grid shifted by it (:meth:`grid_rotations`)
+    grid_phase: np.ndarray | None = None
+    #: return a dense local Jacobian (the tuned sector's one damper) instead of a sparse one
+    dense: bool = False
+    _batch: tuple | None = field(default=None, init=False, repr=False)
+    _index: dict = field(default_factory=dict, init=False, repr=False)
+    _rotations: dict = field(default_factory=dict, init=False, repr=False)
+    _last_approach: tuple | None = field(default=None, init=False, repr=False)
+
+    def __post_init__(self):
+        sizes = {c.n_local for c in self.contacts}
+        if len(sizes) > 1:
+            raise ValueError("the dampers' contacts must all have flexible platforms or all rigid ones "
+                             f"(local coordinates per damper: {sorted(sizes)})")
+        self.n_local = sum(c.n_local for c in self.contacts)
+
+    @property
+    def n_dampers(self) -> int:
+        return len(self.contacts)
+
+    @property
+    def damper_local(self) -> int:
+        """Local coordinates per damper L: 12 (rigid platforms) or 12 + 2 n_m (flexible)."""
+        return self.n_local // max(self.n_dampers, 1)
+
+    def stacked_points(self) -> PointBatch | None:
+        """The points of all dampers as one :class:`PointBatch` (point maps (n_d, 2, P, 3, m), per
+        point (2 n_d P,): k_T [N/m], mu, weights; the shared normal law): each damper's
+        :meth:`DamperContacts.stacked_points` stacked, or None if the dampers' batches differ in
+        normal law or point-map shape or one damper has none. Cached."""
+        if self._batch is None:
+            stacks = [c.stacked_points() for c in self.contacts]
+            ok = all(b is not None for b in stacks) and all(
+                b.normal_law == stacks[0].normal_law and b.maps.shape == stacks[0].maps.shape for b in stacks)
+            if not ok:
+                self._batch = (False,)
+            else:
+                self._batch = (True, PointBatch(np.stack([b.maps for b in stacks]),
+                                                *(np.concatenate([getattr(b, f) for b in stacks])
+                                                  for f in ("tangential_stiffness", "friction_coefficient", "weights")),
+                                                stacks[0].normal_law))
+        return self._batch[1] if self._batch[0] else None
+
+    def _block_index(self, C: int):
+        """COO indices of the (n_d, C, L, C, L) per-damper blocks in the local Jacobian."""
+        if C not in self._index:
+            nd, L = self.n_dampers, self.damper_local
+            d, a, m, b, k = np.meshgrid(np.arange(nd), np.arange(C), np.arange(L), np.arange(C), np.arange(L),
+                                        indexing="ij")
+            self._index[C] = ((a * L * nd + L * d + m).ravel(), (b * L * nd + L * d + k).ravel())
+        return self._index[C]
+
+    def grid_rotations(self, basis):
+        """(n_d, C, C) rotations R_d of the harmonic coefficients that sample damper d on the
+        grid omega t_j - grid_phase_d (coefficients R_d c on the common grid), or None when every
+        phase is a whole number of samples (the common grid then serves every damper exactly).
+
+        In a tuned travelling wave damper d's motion is the first damper's advanced by its phase
+        theta_d: c_h,d = c_h,0 e^{i h theta_d} (complex c_h = a_h - i b_h). Sampled on the shifted
+        grid, every damper of a tuned assembly sees the first's samples, so its discrete friction
+        law (history-dependent through the return map) gives the first's forces shifted, and the
+        tuned full assembly equals the cyclic sector to rounding at any sample count, not only
+        at multiples of n / gcd(n, EO). The forces come back by R_d^T (R_d is orthogonal) and
+        the Jacobian blocks as R_d^T J_d R_d. For a mistuned disk the shifted grids are an
+        equally good discretisation as the common one."""
+        if self.grid_phase is None:
+            return None
+        key = (basis.n_samples, basis.harmonics)
+        if key not in self._rotations:
+            phase = np.asarray(self.grid_phase)
+            shift = phase * basis.n_samples / (2 * np.pi)                   # in samples
+            R = None
+            if np.any(np.abs(shift - np.round(shift)) >= 1e-9):
+                R = np.zeros((len(phase), basis.n_coeffs, basis.n_coeffs))
+                for h in basis.harmonics:
+                    j = basis.cos_index(h)
+                    if h == 0:
+                        R[:, j, j] = 1.0
+                        continue
+                    c, sn = np.cos(-h * phase), np.sin(-h * phase)          # c~ = c e^{-i h phase}
+                    R[:, j, j], R[:, j, j + 1], R[:, j + 1, j], R[:, j + 1, j + 1] = c, sn, -sn, c
+            self._rotations[key] = R
+        return self._rotations[key]
+
+    def forces_at(self, local, basis, offsets, jacobian):
+        """Forces (C, n_d, L) [N, N m] and Jacobian blocks (n_d, C, L, C, L) or None at the local
+        coefficients ``local`` (C, n_d, L) with the static approach ``offsets`` (n_d, 2, P) [m]
+        (no omega: the approach is given, :meth:`approach` gives it), each damper sampled
+        on its own grid where the interblade shift is not a whole number of samples
+        (:meth:`grid_rotations`), else all on the common grid (:meth:`_forces_on_grid`)."""
+        R = self.grid_rotations(basis)
+        if R is None:
+            return self._forces_on_grid(local, basis, offsets, jacobian)
+        force, blocks = self._forces_on_grid(_rotated(R, np.ascontiguousarray(local, dtype=float), False), basis,
+                                             offsets, jacobian)
+        return _rotated(R, force, True), None if blocks is None else _rotated_blocks(R, blocks)
+
+    def _forces_on_grid(self, local, basis, offsets, jacobian):
+        """Forces (C, n_d, L) and Jacobian blocks (n_d, C, L, C, L) or None on the common grid.
+
+        Batched dampers with rigid platforms and a normal law the fused kernel knows go through
+        :func:`fused_point_map_forces` (one numba call: point motion, normal
+        law, return map, AFT and the projections); otherwise (flexible platforms too,
+        whose point maps the fused kernel does not take) :meth:`forces_at_numpy`."""
+        stack = self.stacked_points()
+        fused = None if stack is None else fused_point_map_forces(stack.maps, local, basis, stack.tangential_stiffness,
+                                                                  stack.friction_coefficient, stack.normal_law,
+                                                                  stack.weights, offsets, jacobian)
+        return self.forces_at_numpy(local, basis, offsets, jacobian) if fused is None else fused
+
+    def forces_at_numpy(self, local, basis, offsets, jacobian):
+        """:meth:`forces_at` through :func:`point_map_forces` (the point-contact
+        kernel and numpy projections; the reference of the fused kernel; any normal law and
+        flexible platforms)."""
+        C, nd, L = basis.n_coeffs, self.n_dampers, self.damper_local
+        stack = self.stacked_points()
+        if stack is None:
+            force = np.zeros((C, nd, L))
+            blocks = np.zeros((nd, C, L, C, L)) if jacobian else None
+            for d, c in enumerate(self.contacts):
+                f, j = c.forces_at(local[:, d], basis, offsets[d], jacobian)
+                force[:, d] = f
+                if jacobian:
+                    blocks[d] = j.reshape(C, L, C, L)
+            return force, blocks
+        B, k_t, mu, weights, law = stack                         # B (n_d, 2, P, 3, m)
+        m = B.shape[-1]
+        force, q_blocks, _ = point_map_forces(B, local.reshape(C, nd, 2, m), basis, k_t, mu, law, weights, offsets,
+                                              jacobian, max_passes=MAX_PASSES, tol=PERIODIC_TOL)
+        force = force.reshape(C, nd, L)
+        if not jacobian:
+            return force, None
+        blocks = np.zeros((nd, C, 2, m, C, 2, m))
+        for q in range(2):
+            blocks[:, :, q, :, :, q, :] = q_blocks[:, q]
+        return force, blocks.reshape(nd, C, L, C, L)
+
+    def approach(self, omega):
+        """Static approach (n_d, 2, P) [m] of every damper and its omega-derivative [m s/rad] at
+        ``omega`` [rad/s], as ``(offsets, doffsets)`` (last omega cached;
+        dampers that share their approach function, the same damper at every position, evaluate
+        it once: 16 calls were 0.05 of a residual's 0.9 ms)."""
+        last = self._last_approach            # one read: the element may be shared by threads
+        if last is None or last[0] != omega:
+            if "_approach_groups" not in self.__dict__:
+                functions = {}
+                index = [functions.setdefault(id(c.approach), (len(functions), c.approach))[0] for c in self.contacts]
+                self._approach_groups = ([f for _, f in functions.values()], np.array(index))
+            functions, index = self._approach_groups
+            out = [f(omega) for f in functions]
+            last = (omega, np.array([o[0] for o in out])[index], np.array([o[1] for o in out])[index])
+            self._last_approach = last
+        return last[1], last[2]
+
+    @property
+    def linear_normal_laws(self) -> bool:
+        """Whether every patch of every damper has a linear normal law (computed once)."""
+        if "_linear" not in self.__dict__:
+            self._linear = all(isinstance(p.normal_law, LinearNormalLaw) for c in self.contacts
+                               for p in c.geometry.patches)
+        return self._linear
+
+    def _sparse(self, blocks, C):
+        rows, cols = self._block_index(C)
+        n = C * self.n_local
+        return sp.csr_matrix((blocks.ravel(), (rows, cols)), shape=(n, n))
+
+    def evaluate(self, local, basis, omega, jacobian=True):
+        """``(force (C, n_d, L), Jacobian blocks (n_d, C*L, C*L) or None, d force / d omega
+        (C, n_d, L) or None)``; damper d's block in its own (coefficient, coordinate) order."""
+        C, nd, L = basis.n_coeffs, self.n_dampers, self.damper_local
+        local = np.asarray(local).reshape(C, nd, L)
         offsets, doffsets = self.approach(omega)
-        force, jac = self.forces_at(local, basis, offsets, jacobian)
+        force, blocks = self.forces_at(local, basis, offsets, jacobian)
         if not jacobian:
             return force, None, None
         domega = None
-        if np.any(doffsets != 0):
-            # the preload follows the rotor speed (one harmonic: the static approach scales with F_CG)
-            C, L = basis.n_coeffs, self.n_local
-            linear = all(isinstance(p.normal_law, LinearNormalLaw) for p in self.geometry.patches)
-            rate = np.empty((C, 1, L))
-            if linear and euler_rate(offsets[None], doffsets[None], jac.reshape(1, C, L, C, L),
-                                     np.asarray(local, dtype=float).reshape(C, 1, L), force.reshape(C, 1, L), rate):
-                # linear normal law: the forces are homogeneous of degree 1 in (w, approach) (springs
-                # and the Coulomb limit scale alike), so Euler's identity J w + (dF/da) a = F gives
-                # dF/dOmega = (F - J w) (da/dOmega) / a without another AFT pass (euler_rate, the
-                # mistuned ring's kernel with one damper)
-                domega = rate.ravel()
-            else:
-                # central difference in omega, both ends without the Jacobian so that both take
-                # the same return-map passes (two extra AFT passes)
+        if doffsets.any():
+            # as DamperContacts.harmonic_forces (the same kernel, disk.euler_rate): Euler's identity
+            # for linear normal laws, else a central difference in omega of all dampers at once
+            domega = np.empty(force.shape)
+            if not (self.linear_normal_laws and euler_rate(offsets, doffsets, blocks, local, force, domega)):
                 h = 1e-6 * omega
-                force_p, _ = self.forces_at(local, basis, offsets + h * doffsets, False)
-                force_m, _ = self.forces_at(local, basis, offsets - h * doffsets, False)
-                domega = ((force_p - force_m) / (2 * h)).ravel()
-        return force, jac, domega
+                fp, _ = self.forces_at(local, basis, offsets + h * doffsets, False)
+                fm, _ = self.forces_at(local, basis, offsets - h * doffsets, False)
+                domega = (fp - fm) / (2 * h)
+        return force, blocks.reshape(nd, C * L, C * L), domega
+
+    def harmonic_forces(self, local, basis, omega, jacobian=True):
+        C = basis.n_coeffs
+        force, blocks, domega = self.evaluate(local, basis, omega, jacobian)
+        if not jacobian:
+            return force.reshape(C, self.n_local), None, None
+        if not self.dense:
+            jac = self._sparse(blocks, C)
+        else:
+            jac = blocks[0] if self.n_dampers == 1 else self._sparse(blocks, C).toarray()
+        return force.reshape(C, self.n_local), jac, None if domega is None else domega.ravel()
+
+
+@njit(cache=True)
+def _rotated(R, values, transposed):
+    """(C, n_d, L) coefficients rotated damper by damper: R_d values_d, or R_d^T values_d
+    (``transposed``), R (n_d, C, C) (:meth:`AssemblyContacts.grid_rotations`)."""
+    C, nd, L = values.shape
+    out = np.zeros(values.shape)
+    for d in range(nd):
+        for a in range(C):
+            for b in range(C):
+                r = R[d, b, a] if transposed else R[d, a, b]
+                if r != 0.0:
+                    for m in range(L):
+                        out[a, d, m] += r * values[b, d, m]
+    return out
+
+
+@njit(cache=True)
+def _rotated_blocks(R, blocks):
+    """Jacobian blocks (n_d, C, L, C, L) rotated damper by damper: R_d^T J_d R_d (the forces
+    come back by R_d^T from coefficients that went in by R_d). As a numpy einsum it was 15 % of
+    a 128-blade FRF point; R_d has 2 x 2 blocks, so the loops skip its zeros."""
+    nd, C, L = blocks.shape[0], blocks.shape[1], blocks.shape[2]
+    out = np.zeros(blocks.shape)
+    for d in range(nd):
+        for a in range(C):
+            for b in range(C):
+                rba = R[d, b, a]
+                if rba == 0.0:
+                    continue
+                for c in range(C):
+                    for e in range(C):
+                        w = rba * R[d, c, e]
+                        if w == 0.0:
+                            continue
+                        for m in range(L):
+                            for n in range(L):
+                                out[d, a, m, e, n] += w * blocks[d, b, m, c, n]
+    return out
 
 
 def rotor_speed_in_hz(rotor_speed_hz):
@@ -643,7 +895,8 @@ class DiskModel:
       unknowns :meth:`damper_unknowns` ``(d)``);
     * :meth:`seated_damper` ``(k, omega)``: the frictionless seat of position k's damper under
       F_CG at omega [rad/s] (Eq. 26);
-    * :meth:`full_assembly`, :meth:`blade_unknowns`.
+    * ``hbm_system``, ``output_amplitudes`` (the protocol of :mod:`bladedamp.hbm.accuracy`) and
+      ``full_assembly`` (every blade and damper written out, what the time integration integrates).
     """
 
     def validate_parameters(self, has_damper: bool) -> None:
@@ -1673,11 +1926,11 @@ class DiskModelResponse(FrequencyResponse):
 
 @dataclass
 class DiskResponse(DiskModelResponse):
-    """Frequency response of a tuned disk (reference sector).
+    """Frequency response of a tuned disk (reference sector): the attributes of
+    :class:`DiskModelResponse` (``tip_amplitude`` (n, 3) [m]; ``dissipated_energy`` all contacts
+    of one sector [J]; ``stop_check``, ``peak_check``) and (n points along the branch, C
+    coefficients, P points per patch):
 
-    Extra attributes (n points along the branch, C coefficients, P points per patch):
-
-    tip_amplitude : (n, 3) first-harmonic tip amplitude in x, y, z [m]
     modal_amplitude : (n, n_m) first-harmonic modal amplitudes [sqrt(kg) m]
     contact_force : (n, C, 12) generalised contact forces on the platforms, OL then OR (Eq. 11;
         forces and moments of the point forces about the control points)
@@ -1688,17 +1941,10 @@ class DiskResponse(DiskModelResponse):
     point_dissipation : (n, 2, P) energy dissipated per period at each point [J]
     point_work_bound : (n, 2, P) each point's energy scale per period, the largest work its force
         and motion harmonics could do (HarmonicBasis.work_bound) [J]
-    dissipated_energy : (n,) friction dissipation per period, all contacts of one sector [J]
-    excitation_work : (n,) work of the excitation per period [J]
-    viscous_dissipation : (n,) blade modal damping dissipation per period [J]
     normal_load : (n, 2) mean normal load of OL, OR [N]
-    stop_check : for a branch that stopped before the end of its range, computed with
-        ``check_stop=True``: the time integration of the full assembly just beyond where it got
-        furthest (a one-frequency :class:`bladedamp.timedomain.DiskTimeResponse`; its ``periodic``
-        says whether a periodic motion exists there, :func:`stop_verdict`), else None
-    peak_check : for a branch that reached the end of its range, computed with
-        ``check_peak=True``: the time integration of the full assembly at its peak's frequency
-        (a one-frequency DiskTimeResponse, :func:`with_peak_check`), else None
+
+    ``peak_amplitude`` (float) is the largest sampled |u_x| of the reference blade, the same as
+    :attr:`~DiskModelResponse.largest_peak_amplitude`.
     """
 
     modal_amplitude: np.ndarray = None

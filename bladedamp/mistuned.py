@@ -26,7 +26,7 @@ Time sampling (AFT): the contact forces are evaluated at ``n_samples`` instants 
 in a tuned travelling wave blade k's motion is blade 0's shifted by k dphi; the discrete friction
 laws are shift-invariant only when that shift is a whole number of samples. Each damper is
 therefore sampled on its own grid, shifted by its phase k dphi (a rotation of its harmonic
-coefficients before the AFT and back after it, :meth:`AssemblyContacts.grid_rotations`;
+coefficients before the AFT and back after it, :meth:`~bladedamp.disk.AssemblyContacts.grid_rotations`;
 nothing to do where the shift is whole samples, n = 16 and EO = 1 at 64 samples): a tuned full
 assembly equals the cyclic solution to rounding at any ``n_samples``, and the default is the
 tuned disk's (64 for one harmonic at any n; before, it was rounded up to a multiple of
@@ -57,13 +57,10 @@ from numba import njit
 
 from . import validation
 from .blade import PLATFORM_ANGLE, ModalBlade
-from .contact.laws import LinearNormalLaw
-from .contact.point import MAX_PASSES, PERIODIC_TOL
 from .damper.kinetics import retention_stiffness
-from .disk import (DAMPER_DOFS, DEFAULT_DAMPER_RADIUS, DamperContacts, DamperPosition, DiskModel, DiskModelResponse,
-                   check_blade_bounded, TunedDisk, contact_point_maps,
-                   contact_rows, euler_rate, fused_point_map_forces, peak_checked_response, point_map_forces,
-                   rest_response, rotor_speed_in_hz, with_stop_check)
+from .disk import (DAMPER_DOFS, DEFAULT_DAMPER_RADIUS, AssemblyContacts, DamperContacts, DamperPosition, DiskModel,
+                   DiskModelResponse, TunedDisk, check_blade_bounded, contact_point_maps, contact_rows,
+                   peak_checked_response, rest_response, rotor_speed_in_hz, with_stop_check)
 from .frf import checked_range, solve_frequency_response
 from .hbm.accuracy import HARMONIC_TOLERANCE
 from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_MAX_STEP, DEFAULT_POINT_BUDGET, Branch, continuation
@@ -96,253 +93,6 @@ def sparse_real_form(basis: HarmonicBasis, per_harmonic) -> sp.csr_matrix:
     out = sp.coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                         shape=(C * n_out, C * n_in)).tocsr()
     out.eliminate_zeros()
-    return out
-
-
-@dataclass
-class AssemblyContacts:
-    """The contacts of all dampers of an assembly as one harmonic-balance element.
-
-    Local coordinates: those of each damper's :class:`DamperContacts` in turn (the 12 relative
-    motions of OL and OR, and with flexible platforms the platform blades' modal coordinates:
-    ``n_local = L * n_dampers``, L = :attr:`damper_local`, the same for every damper).
-    ``contacts[d]`` is damper d's :class:`DamperContacts` (built as the tuned disk's, from its DamperPosition). Returns a
-    sparse block-diagonal local Jacobian.
-    """
-
-    contacts: list[DamperContacts]
-    n_local: int = 0
-    #: (n_d,) phase [rad] of each damper's motion in a tuned travelling wave (k dphi for the
-    #: damper on blade k), or None; damper d is sampled on a grid shifted by it (:meth:`grid_rotations`)
-    grid_phase: np.ndarray | None = None
-    _batch: tuple | None = field(default=None, init=False, repr=False)
-    _index: dict = field(default_factory=dict, init=False, repr=False)
-    _rotations: dict = field(default_factory=dict, init=False, repr=False)
-    _last_approach: tuple | None = field(default=None, init=False, repr=False)
-
-    def __post_init__(self):
-        sizes = {c.n_local for c in self.contacts}
-        if len(sizes) > 1:
-            raise ValueError("the dampers' contacts must all have flexible platforms or all rigid ones "
-                             f"(local coordinates per damper: {sorted(sizes)})")
-        self.n_local = sum(c.n_local for c in self.contacts)
-
-    @property
-    def n_dampers(self) -> int:
-        return len(self.contacts)
-
-    @property
-    def damper_local(self) -> int:
-        """Local coordinates per damper L: 12 (rigid platforms) or 12 + 2 n_m (flexible)."""
-        return self.n_local // max(self.n_dampers, 1)
-
-    def stacked_points(self):
-        """The points of all dampers as one batch: ``(True, point maps (n_d, 2, P, 3, m), k_T
-        (2 n_d P,) [N/m per point], mu (2 n_d P,), weights (2 n_d P,), normal law)`` (each damper's
-        :meth:`DamperContacts.stacked_points` stacked), or None if the dampers' batches differ in
-        normal law or point-map shape or one damper has none. Cached."""
-        if self._batch is None:
-            stacks = [c.stacked_points() for c in self.contacts]
-            ok = all(s is not None for s in stacks) and all(
-                s[5] == stacks[0][5] and s[1].shape == stacks[0][1].shape for s in stacks)
-            if not ok:
-                self._batch = (False,)
-            else:
-                self._batch = (True, np.stack([s[1] for s in stacks]), np.concatenate([s[2] for s in stacks]),
-                               np.concatenate([s[3] for s in stacks]), np.concatenate([s[4] for s in stacks]),
-                               stacks[0][5])
-        return self._batch if self._batch[0] else None
-
-    def _block_index(self, C: int):
-        """COO indices of the (n_d, C, L, C, L) per-damper blocks in the local Jacobian."""
-        if C not in self._index:
-            nd, L = self.n_dampers, self.damper_local
-            d, a, m, b, k = np.meshgrid(np.arange(nd), np.arange(C), np.arange(L), np.arange(C), np.arange(L),
-                                        indexing="ij")
-            self._index[C] = ((a * L * nd + L * d + m).ravel(), (b * L * nd + L * d + k).ravel())
-        return self._index[C]
-
-    def grid_rotations(self, basis):
-        """(n_d, C, C) rotations R_d of the harmonic coefficients that sample damper d on the
-        grid omega t_j - grid_phase_d (coefficients R_d c on the common grid), or None when every
-        phase is a whole number of samples (the common grid then serves every damper exactly).
-
-        In a tuned travelling wave damper d's motion is the first damper's advanced by its phase
-        theta_d: c_h,d = c_h,0 e^{i h theta_d} (complex c_h = a_h - i b_h). Sampled on the shifted
-        grid, every damper of a tuned assembly sees the first's samples, so its discrete friction
-        law (history-dependent through the return map) gives the first's forces shifted, and the
-        tuned full assembly equals the cyclic sector to rounding at any sample count, not only
-        at multiples of n / gcd(n, EO). The forces come back by R_d^T (R_d is orthogonal) and
-        the Jacobian blocks as R_d^T J_d R_d. For a mistuned disk the shifted grids are an
-        equally good discretisation as the common one."""
-        if self.grid_phase is None:
-            return None
-        key = (basis.n_samples, basis.harmonics)
-        if key not in self._rotations:
-            phase = np.asarray(self.grid_phase)
-            shift = phase * basis.n_samples / (2 * np.pi)                   # in samples
-            R = None
-            if np.any(np.abs(shift - np.round(shift)) >= 1e-9):
-                R = np.zeros((len(phase), basis.n_coeffs, basis.n_coeffs))
-                for h in basis.harmonics:
-                    j = basis.cos_index(h)
-                    if h == 0:
-                        R[:, j, j] = 1.0
-                        continue
-                    c, sn = np.cos(-h * phase), np.sin(-h * phase)          # c~ = c e^{-i h phase}
-                    R[:, j, j], R[:, j, j + 1], R[:, j + 1, j], R[:, j + 1, j + 1] = c, sn, -sn, c
-            self._rotations[key] = R
-        return self._rotations[key]
-
-    def forces_at(self, local, basis, offsets, jacobian):
-        """Forces (C, n_d, L) [N, N m] and Jacobian blocks (n_d, C, L, C, L) or None at the local
-        coefficients ``local`` (C, n_d, L) with the static approach ``offsets`` (n_d, 2, P) [m]
-        (no omega: the approach is given, :meth:`approach` gives it), each damper sampled
-        on its own grid where the interblade shift is not a whole number of samples
-        (:meth:`grid_rotations`), else all on the common grid (:meth:`_forces_on_grid`)."""
-        R = self.grid_rotations(basis)
-        if R is None:
-            return self._forces_on_grid(local, basis, offsets, jacobian)
-        force, blocks = self._forces_on_grid(_rotated(R, np.ascontiguousarray(local, dtype=float), False), basis,
-                                             offsets, jacobian)
-        return _rotated(R, force, True), None if blocks is None else _rotated_blocks(R, blocks)
-
-    def _forces_on_grid(self, local, basis, offsets, jacobian):
-        """Forces (C, n_d, L) and Jacobian blocks (n_d, C, L, C, L) or None on the common grid.
-
-        Batched dampers with rigid platforms and a normal law the fused kernel knows go through
-        :func:`~bladedamp.disk.fused_point_map_forces` (one numba call: point motion, normal
-        law, return map, AFT and the projections); otherwise (flexible platforms too,
-        whose point maps the fused kernel does not take) :meth:`forces_at_numpy`."""
-        stack = self.stacked_points()
-        fused = None if stack is None else fused_point_map_forces(stack[1], local, basis, stack[2], stack[3], stack[5],
-                                                                  stack[4], offsets, jacobian)
-        return self.forces_at_numpy(local, basis, offsets, jacobian) if fused is None else fused
-
-    def forces_at_numpy(self, local, basis, offsets, jacobian):
-        """:meth:`forces_at` through :func:`~bladedamp.disk.point_map_forces` (the point-contact
-        kernel and numpy projections; the reference of the fused kernel; any normal law and
-        flexible platforms)."""
-        C, nd, L = basis.n_coeffs, self.n_dampers, self.damper_local
-        stack = self.stacked_points()
-        if stack is None:
-            force = np.zeros((C, nd, L))
-            blocks = np.zeros((nd, C, L, C, L)) if jacobian else None
-            for d, c in enumerate(self.contacts):
-                f, j = c.forces_at(local[:, d], basis, offsets[d], jacobian)
-                force[:, d] = f
-                if jacobian:
-                    blocks[d] = j.reshape(C, L, C, L)
-            return force, blocks
-        _, B, k_t, mu, weights, law = stack                      # B (n_d, 2, P, 3, m)
-        m = B.shape[-1]
-        force, q_blocks, _ = point_map_forces(B, local.reshape(C, nd, 2, m), basis, k_t, mu, law, weights, offsets,
-                                              jacobian, max_passes=MAX_PASSES, tol=PERIODIC_TOL)
-        force = force.reshape(C, nd, L)
-        if not jacobian:
-            return force, None
-        blocks = np.zeros((nd, C, 2, m, C, 2, m))
-        for q in range(2):
-            blocks[:, :, q, :, :, q, :] = q_blocks[:, q]
-        return force, blocks.reshape(nd, C, L, C, L)
-
-    def approach(self, omega):
-        """Static approach (n_d, 2, P) [m] of every damper and its omega-derivative [m s/rad] at
-        ``omega`` [rad/s], as ``(offsets, doffsets)`` (last omega cached;
-        dampers that share their approach function, the same damper at every position, evaluate
-        it once: 16 calls were 0.05 of a residual's 0.9 ms)."""
-        last = self._last_approach            # one read: the element may be shared by threads
-        if last is None or last[0] != omega:
-            if "_approach_groups" not in self.__dict__:
-                functions = {}
-                index = [functions.setdefault(id(c.approach), (len(functions), c.approach))[0] for c in self.contacts]
-                self._approach_groups = ([f for _, f in functions.values()], np.array(index))
-            functions, index = self._approach_groups
-            out = [f(omega) for f in functions]
-            last = (omega, np.array([o[0] for o in out])[index], np.array([o[1] for o in out])[index])
-            self._last_approach = last
-        return last[1], last[2]
-
-    @property
-    def linear_normal_laws(self) -> bool:
-        """Whether every patch of every damper has a linear normal law (computed once)."""
-        if "_linear" not in self.__dict__:
-            self._linear = all(isinstance(p.normal_law, LinearNormalLaw) for c in self.contacts
-                               for p in c.geometry.patches)
-        return self._linear
-
-    def _sparse(self, blocks, C):
-        rows, cols = self._block_index(C)
-        n = C * self.n_local
-        return sp.csr_matrix((blocks.ravel(), (rows, cols)), shape=(n, n))
-
-    def evaluate(self, local, basis, omega, jacobian=True):
-        """``(force (C, n_d, L), Jacobian blocks (n_d, C*L, C*L) or None, d force / d omega
-        (C, n_d, L) or None)``; damper d's block in its own (coefficient, coordinate) order."""
-        C, nd, L = basis.n_coeffs, self.n_dampers, self.damper_local
-        local = np.asarray(local).reshape(C, nd, L)
-        offsets, doffsets = self.approach(omega)
-        force, blocks = self.forces_at(local, basis, offsets, jacobian)
-        if not jacobian:
-            return force, None, None
-        domega = None
-        if doffsets.any():
-            # as DamperContacts.harmonic_forces (the same kernel, disk.euler_rate): Euler's identity
-            # for linear normal laws, else a central difference in omega of all dampers at once
-            domega = np.empty(force.shape)
-            if not (self.linear_normal_laws and euler_rate(offsets, doffsets, blocks, local, force, domega)):
-                h = 1e-6 * omega
-                fp, _ = self.forces_at(local, basis, offsets + h * doffsets, False)
-                fm, _ = self.forces_at(local, basis, offsets - h * doffsets, False)
-                domega = (fp - fm) / (2 * h)
-        return force, blocks.reshape(nd, C * L, C * L), domega
-
-    def harmonic_forces(self, local, basis, omega, jacobian=True):
-        C = basis.n_coeffs
-        force, blocks, domega = self.evaluate(local, basis, omega, jacobian)
-        if not jacobian:
-            return force.reshape(C, self.n_local), None, None
-        jac = self._sparse(blocks, C)
-        return force.reshape(C, self.n_local), jac, None if domega is None else domega.ravel()
-
-
-@njit(cache=True)
-def _rotated(R, values, transposed):
-    """(C, n_d, L) coefficients rotated damper by damper: R_d values_d, or R_d^T values_d
-    (``transposed``), R (n_d, C, C) (:meth:`AssemblyContacts.grid_rotations`)."""
-    C, nd, L = values.shape
-    out = np.zeros(values.shape)
-    for d in range(nd):
-        for a in range(C):
-            for b in range(C):
-                r = R[d, b, a] if transposed else R[d, a, b]
-                if r != 0.0:
-                    for m in range(L):
-                        out[a, d, m] += r * values[b, d, m]
-    return out
-
-
-@njit(cache=True)
-def _rotated_blocks(R, blocks):
-    """Jacobian blocks (n_d, C, L, C, L) rotated damper by damper: R_d^T J_d R_d (the forces
-    come back by R_d^T from coefficients that went in by R_d). As a numpy einsum it was 15 % of
-    a 128-blade FRF point; R_d has 2 x 2 blocks, so the loops skip its zeros."""
-    nd, C, L = blocks.shape[0], blocks.shape[1], blocks.shape[2]
-    out = np.zeros(blocks.shape)
-    for d in range(nd):
-        for a in range(C):
-            for b in range(C):
-                rba = R[d, b, a]
-                if rba == 0.0:
-                    continue
-                for c in range(C):
-                    for e in range(C):
-                        w = rba * R[d, c, e]
-                        if w == 0.0:
-                            continue
-                        for m in range(L):
-                            for n in range(L):
-                                out[d, a, m, e, n] += w * blocks[d, b, m, c, n]
     return out
 
 
@@ -844,7 +594,7 @@ class MistunedDisk(DiskModel):
     # ----- harmonic balance ------------------------------------------------------------
     def default_samples(self, harmonics) -> int:
         """HarmonicBasis' default sample count, as the tuned disk's: each damper is sampled on a
-        grid shifted by its interblade phase (:meth:`AssemblyContacts.grid_rotations`), so the
+        grid shifted by its interblade phase (:meth:`~bladedamp.disk.AssemblyContacts.grid_rotations`), so the
         count need not be a multiple of n / gcd(n, EO) (see the module notes)."""
         return HarmonicBasis(tuple(harmonics)).n_samples
 
@@ -1159,19 +909,18 @@ class MistunedDisk(DiskModel):
 
 @dataclass
 class MistunedResponse(DiskModelResponse):
-    """Frequency response of every blade of a :class:`MistunedDisk`.
+    """Frequency response of every blade of a :class:`MistunedDisk`: the attributes of
+    :class:`~bladedamp.disk.DiskModelResponse` (``tip_amplitude`` (n_points, s, 3) [m], each blade's;
+    the energies of the whole model; ``stop_check``, ``peak_check``) and
 
-    tip_amplitude : (n_points, s, 3) first-harmonic tip amplitude of each blade in x, y, z [m]
-    excitation_work, viscous_dissipation, dissipated_energy : (n_points,) per period, whole model [J]
     damper_dissipation : (n_points, n_active_dampers) friction dissipation of each damper [J]
     damper_work_bound : (n_points, n_active_dampers) each damper's energy scale per period, the
         largest work its force and motion harmonics could do (HarmonicBasis.work_bound) [J]
     tuned_peak_amplitude : the tuned disk's peak u_x [m] if given (amplification factors)
-    stop_check : for a branch that stopped before the end of its range, computed with
-        ``check_stop=True``: the time integration of the assembly just beyond where it got
-        furthest (a one-frequency :class:`bladedamp.timedomain.DiskTimeResponse`), else None
-    peak_check : for a branch that reached the end of its range, computed with
-        ``check_peak=True``: the time integration of the assembly at its peak's frequency, else None
+
+    ``peak_amplitude`` is the (s,) array of the blades' peaks (parabola-refined, :meth:`peaks`),
+    the same as :attr:`~bladedamp.disk.DiskModelResponse.blade_peak_amplitudes`; the largest of
+    them, a float as for the tuned disk, is ``largest_peak_amplitude``.
     """
 
     damper_dissipation: np.ndarray = None
