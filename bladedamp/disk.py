@@ -833,6 +833,23 @@ class DamperPosition:
         """(6,) the damper seated frictionlessly under F_CG at ``omega`` [rad/s] (``seat``)."""
         return seat(self.damper_geometry(), self.centrifugal_force(omega)[0])[0]
 
+    def contacts(self, geometry: DamperGeometry, approach, left: ModalBlade, right: ModalBlade):
+        """(DamperContacts, G_D (12, 6), G_P (12, 12)) of the damper here between blade ``left``
+        (its OL platform) and blade ``right`` (its OR platform), with ``geometry``
+        (:meth:`damper_geometry`) and the static ``approach`` (:meth:`approach_function`): the
+        contacts as a harmonic-balance element (flexible platforms' point maps where both blades
+        carry per-point data, :func:`contact_point_maps`) and the rigid kinematics of Eq. 6,
+        w = G_D u_D - G_P [Phi_OL; Phi_OR] q, at the contact centres :meth:`platform_offsets`."""
+        offsets = self.platform_offsets(geometry, left.points)
+        return (DamperContacts(geometry, approach, contact_point_maps(geometry, offsets, left, right)), geometry.G_D,
+                geometry.G_P(offsets))
+
+    @staticmethod
+    def retention(geometry: DamperGeometry, static_retention: float) -> np.ndarray:
+        """(6, 6) the static-harmonic retention spring of the damper [N/m, N m/rad]: the fraction
+        ``static_retention`` of its patches' summed normal stiffness (:func:`~bladedamp.damper.retention_stiffness`)."""
+        return retention_stiffness(static_retention, sum(p.normal_law.stiffness for p in geometry.patches))
+
     def approach_function(self, geometry: DamperGeometry, basis: HarmonicBasis):
         """The static approach of ``geometry``'s contact points under this position's F_CG (Eq. 26):
         a function omega [rad/s, the residual's excitation frequency] -> (per-point static
@@ -1207,12 +1224,10 @@ class TunedDisk(DiskModel):
             geometry = self.damper_geometry()
             if self.damper_inertia:
                 M[nm:, nm:] = geometry.inertia
-            offsets = self.platform_offsets(geometry)
-            G_D, G_P = geometry.G_D, geometry.G_P(offsets)
+            contacts, G_D, G_P = self.position.contacts(geometry, self.approach_function(geometry, basis), self.blade,
+                                                        self.blade)
             phi = np.vstack([self.blade.shape("OL"), self.blade.shape("OR")])  # (12, nm)
             dphi = self.interblade_phase
-            contacts = DamperContacts(geometry, self.approach_function(geometry, basis),
-                                      contact_point_maps(geometry, offsets, self.blade, self.blade))
             w_rows, left_rows, right_rows = contact_rows(contacts.contact_local, nm)
 
             def sector_map(h):
@@ -1228,9 +1243,8 @@ class TunedDisk(DiskModel):
 
             couplings.append(Coupling(contacts, basis.real_form(sector_map), "damper contacts"))
             if basis.has_static:
-                k_n = sum(p.normal_law.stiffness for p in geometry.patches)
                 static_stiffness = np.zeros((n, n))
-                static_stiffness[nm:, nm:] = retention_stiffness(static_retention, k_n)
+                static_stiffness[nm:, nm:] = DamperPosition.retention(geometry, static_retention)
 
         centrifugal = self._centrifugal_law() if self.has_damper and basis.has_static else None
 

@@ -57,10 +57,9 @@ from numba import njit
 
 from . import validation
 from .blade import PLATFORM_ANGLE, ModalBlade
-from .damper.kinetics import retention_stiffness
-from .disk import (DAMPER_DOFS, DEFAULT_DAMPER_RADIUS, AssemblyContacts, DamperContacts, DamperPosition, DiskModel,
-                   DiskModelResponse, TunedDisk, check_blade_bounded, contact_point_maps, contact_rows,
-                   peak_checked_response, rest_response, rotor_speed_in_hz, with_stop_check)
+from .disk import (DAMPER_DOFS, DEFAULT_DAMPER_RADIUS, AssemblyContacts, DamperPosition, DiskModel, DiskModelResponse,
+                   TunedDisk, check_blade_bounded, contact_rows, peak_checked_response, rest_response,
+                   rotor_speed_in_hz, with_stop_check)
 from .frf import checked_range, solve_frequency_response
 from .hbm.accuracy import HARMONIC_TOLERANCE
 from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_MAX_STEP, DEFAULT_POINT_BUDGET, Branch, continuation
@@ -646,7 +645,7 @@ class MistunedDisk(DiskModel):
             sl = self.blade_slice(k)
             mass[sl, sl] = np.eye(nm)
             forces.append(b.shape("excitation").T @ self.excitation)
-        geometries, contacts, maps, static = [], [], [], None
+        contacts, maps, static = [], [], None
         if basis.has_static and active:
             static = sp.lil_matrix((N, N))
         shared = {}       # positions with the same damper, angles and gaps share geometry and approach
@@ -657,18 +656,15 @@ class MistunedDisk(DiskModel):
                 g = position.damper_geometry()
                 shared[same] = (g, position.approach_function(g, basis))
             g, approach = shared[same]
-            geometries.append(g)
             sl = self.damper_slice(d)
             if self.damper_inertia:
                 mass[sl, sl] = g.inertia
-            offsets = position.platform_offsets(g, self.blades[k].points)
-            maps.append((g.G_D, g.G_P(offsets)))
             # damper k: blade k's OL platform, blade k+1's OR platform (that of the next sector's blade 0)
-            contacts.append(DamperContacts(g, approach,
-                                           contact_point_maps(g, offsets, self.blades[k], self.blades[(k + 1) % s])))
+            element, G_D, G_P = position.contacts(g, approach, self.blades[k], self.blades[(k + 1) % s])
+            contacts.append(element)
+            maps.append((G_D, G_P))
             if static is not None:
-                k_n = sum(p.normal_law.stiffness for p in g.patches)
-                static[sl, sl] = retention_stiffness(static_retention, k_n)
+                static[sl, sl] = DamperPosition.retention(g, static_retention)
         dphi = self.interblade_phase
 
         L = contacts[0].n_local if contacts else 12           # local coordinates per damper
