@@ -580,8 +580,12 @@ class AssemblyContacts:
                 index = [functions.setdefault(id(c.approach), (len(functions), c.approach))[0] for c in self.contacts]
                 self._approach_groups = ([f for _, f in functions.values()], np.array(index))
             functions, index = self._approach_groups
-            out = [f(omega) for f in functions]
-            last = (omega, np.array([o[0] for o in out])[index], np.array([o[1] for o in out])[index])
+            if len(index) == 1:                # one damper (the tuned sector's): its arrays viewed, not copied
+                offsets, doffsets = functions[0](omega)
+                last = (omega, offsets[None], doffsets[None])
+            else:
+                out = [f(omega) for f in functions]
+                last = (omega, np.array([o[0] for o in out])[index], np.array([o[1] for o in out])[index])
             self._last_approach = last
         return last[1], last[2]
 
@@ -601,7 +605,8 @@ class AssemblyContacts:
     def evaluate(self, local, basis, omega, jacobian=True):
         """``(force (C, n_d, L), Jacobian blocks (n_d, C*L, C*L) or None, d force / d omega
         (C, n_d, L) or None)``; damper d's block in its own (coefficient, coordinate) order."""
-        C, nd, L = basis.n_coeffs, self.n_dampers, self.damper_local
+        C, nd = basis.n_coeffs, len(self.contacts)
+        L = self.n_local // nd
         local = np.asarray(local).reshape(C, nd, L)
         offsets, doffsets = self.approach(omega)
         force, blocks = self.forces_at(local, basis, offsets, jacobian)
