@@ -50,7 +50,7 @@ from .hbm.start import robust_start
 from .hbm.fourier import HarmonicBasis
 from .hbm.monodromy import disk_monodromy
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .frf import checked_range, solve_frequency_response
+from .frf import branch_solver, checked_range
 from .response import (FrequencyResponse, harmonic_sentence, nearest_to_range, percent,
                        plot_branch, with_amplitude_check, with_checks,
                        with_range_end_estimate)
@@ -1375,13 +1375,11 @@ class TunedDisk(DiskModel):
             return rest_response(self, w0, w1, max_step, harmonic_tolerance,
                                  lambda system, branch: DiskResponse.from_branch(self, system, branch))
         can_check = extra_couplings is None and not self.blade.flexible_platform
-        response = solve_frequency_response(
-            model, f_start_hz, f_end_hz, harmonics, n_samples, max_step, harmonic_tolerance, max_harmonic,
-            converge=lambda solve: peak_checked_response(self, model, solve, harmonics, harmonic_tolerance,
-                                                         max_harmonic, estimate_harmonic_error, check_peak, can_check),
-            stop_when_for=None if stop_above is None else
-            lambda basis: self.amplitude_stop(basis, stop_above, stop_direction),
-            cpu_budget_s=cpu_budget_s, point_budget=point_budget, **continuation_options)
+        solve = branch_solver(model, f_start_hz, f_end_hz, n_samples, max_step, None if stop_above is None else
+                              lambda basis: self.amplitude_stop(basis, stop_above, stop_direction),
+                              cpu_budget_s, point_budget, **continuation_options)
+        response = peak_checked_response(self, model, solve, harmonics, harmonic_tolerance, max_harmonic,
+                                         estimate_harmonic_error, check_peak, can_check)
         return with_range_end_estimate(self, with_stop_check(self, response, f_start_hz, check_stop))
 
     # ----- the protocol of bladedamp.frf (the FRF driver) ----------------------------------

@@ -1,14 +1,14 @@
 """The one frequency-response driver of every model (issue 34 item 3): the friction oscillator,
 the tuned disk's cyclic sector and the mistuned ring solve their FRFs here.
 
-:func:`solve_frequency_response` validates the range, then, for each harmonic set the
-convergence asks for (``converge``: :func:`bladedamp.hbm.accuracy.converged_response` or a
-model's own wrapper of it) and each AFT sample count :func:`bladedamp.response.sampled_response`
-chooses, builds the model's harmonic balance, starts it robustly at the first frequency, follows
-it by pseudo-arclength continuation (:func:`bladedamp.hbm.continuation.continuation`) and holds
-the branch to :func:`bladedamp.response.physical_checks`. The models keep their public
-``frequency_response`` signatures (their own options, the rest response, the time checks) and
-call it.
+:func:`branch_solver` validates the range and gives ``solve(harmonics)``: for each harmonic
+set the convergence asks for (:func:`bladedamp.hbm.accuracy.converged_response` or the disks'
+wrapper of it, which the model's ``frequency_response`` calls) and each AFT sample count
+:func:`bladedamp.response.sampled_response` chooses, it builds the model's harmonic balance,
+starts it robustly at the first frequency, follows it by pseudo-arclength continuation
+(:func:`bladedamp.hbm.continuation.continuation`) and holds the branch to
+:func:`bladedamp.response.physical_checks`. The models keep their public ``frequency_response``
+signatures (their own options, the rest response, the time checks) and call it.
 
 The model protocol (:class:`FrequencyResponseModel`): the harmonic balance and its scales,
 the start, the response object and the energies the checks need. A model's methods take the
@@ -21,13 +21,12 @@ from typing import Callable, Protocol
 import numpy as np
 
 from . import validation
-from .hbm.accuracy import HARMONIC_TOLERANCE, converged_response
 from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_MAX_STEP, DEFAULT_POINT_BUDGET, Budget, continuation
 from .response import REFINE_SAMPLES_FACTOR, physical_checks, sampled_response, with_checks
 
 
 class FrequencyResponseModel(Protocol):
-    """What :func:`solve_frequency_response` asks of a model (``system``: its
+    """What :func:`branch_solver` asks of a model (``system``: its
     :class:`~bladedamp.hbm.system.HarmonicBalanceSystem`; omega in rad/s)."""
 
     def check_bounded(self, f_start_hz: float, f_end_hz: float) -> None:
@@ -73,28 +72,28 @@ def checked_range(model: FrequencyResponseModel, f_start_hz: float, f_end_hz: fl
     return 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz
 
 
-def solve_frequency_response(model: FrequencyResponseModel, f_start_hz: float, f_end_hz: float, harmonics="auto",
-                             n_samples: int | None = None, max_step: float | None = DEFAULT_MAX_STEP,
-                             harmonic_tolerance: float = HARMONIC_TOLERANCE, max_harmonic: int = 7,
-                             converge: Callable | None = None, stop_when_for: Callable | None = None,
-                             cpu_budget_s: float = DEFAULT_CPU_BUDGET_S, point_budget: int = DEFAULT_POINT_BUDGET,
-                             **continuation_options):
-    """The response of ``model`` from ``f_start_hz`` to ``f_end_hz`` [Hz] by harmonic balance and
-    continuation, the branch held to :func:`~bladedamp.response.physical_checks` (range, step,
-    every contact's dissipation >= 0 to the AFT's sampling floor, re-evaluated with
-    ``REFINE_SAMPLES_FACTOR`` times the samples where in doubt).
+def branch_solver(model: FrequencyResponseModel, f_start_hz: float, f_end_hz: float, n_samples: int | None = None,
+                  max_step: float | None = DEFAULT_MAX_STEP, stop_when_for: Callable | None = None,
+                  cpu_budget_s: float = DEFAULT_CPU_BUDGET_S, point_budget: int = DEFAULT_POINT_BUDGET,
+                  **continuation_options) -> Callable:
+    """``solve(harmonics) -> response``: the branch of ``model`` from ``f_start_hz`` to
+    ``f_end_hz`` [Hz] with ``harmonics`` by harmonic balance and continuation, its AFT samples
+    chosen by :func:`~bladedamp.response.sampled_response` and every branch held to
+    :func:`~bladedamp.response.physical_checks` (range, step, every contact's dissipation >= 0 to
+    the AFT's sampling floor, re-evaluated with ``REFINE_SAMPLES_FACTOR`` times the samples where
+    in doubt). A model's ``frequency_response`` gives it to its convergence in the harmonics
+    (:func:`~bladedamp.hbm.accuracy.converged_response`, or the disks' wrapper of it), called
+    from ``frequency_response`` itself so that the accuracy warnings point at its caller.
 
-    ``converge``: ``solve -> response`` with ``solve(harmonics) -> response`` (default
-    :func:`~bladedamp.hbm.accuracy.converged_response` of ``model`` with ``harmonics``,
-    ``harmonic_tolerance`` and ``max_harmonic``); ``n_samples``: given, or None for the model's
-    :meth:`~FrequencyResponseModel.sample_plan`; ``stop_when_for``: ``basis -> the continuation's
-    stop_when`` (or None; a ``stop_when`` of ``continuation_options`` is the same for every basis:
-    give one or the other); ``max_step`` (None: the continuation's default) and
-    ``continuation_options`` go to :func:`~bladedamp.hbm.continuation.continuation`;
-    ``cpu_budget_s`` [s] and ``point_budget`` are the whole analysis' (:class:`~bladedamp.hbm.continuation.Budget`).
-    The robust start is not begun once the budget has run out (the continuation then keeps no
-    point and says so), and the start at the end of the range is computed once for a branch
-    and its retry."""
+    ``n_samples``: given, or None for the model's :meth:`~FrequencyResponseModel.sample_plan`;
+    ``stop_when_for``: ``basis -> the continuation's stop_when`` (or None; a ``stop_when`` of
+    ``continuation_options`` is the same for every basis: give one or the other); ``max_step``
+    (None: the continuation's default) and ``continuation_options`` go to
+    :func:`~bladedamp.hbm.continuation.continuation`; ``cpu_budget_s`` [s] and ``point_budget``
+    are the whole analysis' (:class:`~bladedamp.hbm.continuation.Budget`, shared by every
+    ``solve``). The robust start is not begun once the budget has run out (the continuation then
+    keeps no point and says so), and the start at the end of the range is computed once for a
+    branch and its retry."""
     w0, w1 = checked_range(model, f_start_hz, f_end_hz)
     if stop_when_for is not None and continuation_options.get("stop_when") is not None:
         raise ValueError("give stop_when or the model's own stop (stop_above), not both")
@@ -137,6 +136,4 @@ def solve_frequency_response(model: FrequencyResponseModel, f_start_hz: float, f
         return with_checks(response, physical_checks(branch.omega, (w0, w1), dissipation, work, step, T, refine,
                                                      bound, judge_solution_samples=model.judges_solution_samples(T)))
 
-    if converge is None:
-        return converged_response(model, solve, harmonics, harmonic_tolerance, max_harmonic)
-    return converge(solve)
+    return solve

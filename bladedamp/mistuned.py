@@ -60,7 +60,7 @@ from .blade import PLATFORM_ANGLE, ModalBlade
 from .disk import (DAMPER_DOFS, DEFAULT_DAMPER_RADIUS, AssemblyContacts, DamperPosition, DiskModel, DiskModelResponse,
                    TunedDisk, check_blade_bounded, contact_rows, peak_checked_response, rest_response,
                    rotor_speed_in_hz, with_stop_check)
-from .frf import checked_range, solve_frequency_response
+from .frf import branch_solver, checked_range
 from .hbm.accuracy import HARMONIC_TOLERANCE
 from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_MAX_STEP, DEFAULT_POINT_BUDGET, Branch, continuation
 from .hbm.linsolve import BlockCondensation, BlockRing, one_blas_thread
@@ -775,11 +775,10 @@ class MistunedDisk(DiskModel):
             return rest_response(self, w0, w1, max_step, harmonic_tolerance, lambda system, branch:
                                  MistunedResponse.from_branch(self, system, branch, tuned_peak_amplitude))
         can_check = not any(b.flexible_platform for b in self.blades)
-        response = solve_frequency_response(
-            self, f_start_hz, f_end_hz, harmonics, n_samples, max_step, harmonic_tolerance, max_harmonic,
-            converge=lambda solve: peak_checked_response(self, self, solve, harmonics, harmonic_tolerance,
-                                                         max_harmonic, estimate_harmonic_error, check_peak, can_check),
-            cpu_budget_s=cpu_budget_s, point_budget=point_budget, **continuation_options)
+        solve = branch_solver(self, f_start_hz, f_end_hz, n_samples, max_step, None, cpu_budget_s, point_budget,
+                              **continuation_options)
+        response = peak_checked_response(self, self, solve, harmonics, harmonic_tolerance, max_harmonic,
+                                         estimate_harmonic_error, check_peak, can_check)
         if tuned_peak_amplitude is not None:       # kept for the amplification factors
             response = dataclasses.replace(response, tuned_peak_amplitude=tuned_peak_amplitude)
         return with_stop_check(self, response, f_start_hz, check_stop)

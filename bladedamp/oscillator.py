@@ -18,8 +18,8 @@ import numpy as np
 from . import validation
 from .contact.laws import LinearNormalLaw
 from .contact.point import PointContactElement
-from .frf import solve_frequency_response
-from .hbm.accuracy import HARMONIC_TOLERANCE
+from .frf import branch_solver
+from .hbm.accuracy import HARMONIC_TOLERANCE, converged_response
 from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_MAX_STEP, DEFAULT_POINT_BUDGET
 from .hbm.start import robust_start
 from .hbm.elements import CubicSpring
@@ -196,10 +196,10 @@ class FrictionOscillator:
         ends there with every point it has, status ``OUT_OF_BUDGET`` (not ``success``), and
         ``stopped_by`` and the message say what ran out and at which frequency.
         """
-        return with_range_end_estimate(self, solve_frequency_response(
-            self, f_start_hz, f_end_hz, harmonics, n_samples, continuation_options.pop("max_step", DEFAULT_MAX_STEP),
-            harmonic_tolerance, max_harmonic, cpu_budget_s=cpu_budget_s, point_budget=point_budget,
-            **continuation_options))
+        solve = branch_solver(self, f_start_hz, f_end_hz, n_samples, continuation_options.pop("max_step", DEFAULT_MAX_STEP),
+                              None, cpu_budget_s, point_budget, **continuation_options)
+        return with_range_end_estimate(self, converged_response(self, solve, harmonics, harmonic_tolerance,
+                                                                max_harmonic))
 
     # ----- the protocol of bladedamp.frf (the FRF driver) ----------------------------------
     def sample_plan(self, harmonics) -> tuple[int, int, None]:
