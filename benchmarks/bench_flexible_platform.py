@@ -1,5 +1,5 @@
 """Flexible-platform benchmark: the cost of the solid blade's per-point platform kinematics
-(bladedamp.disk.contact_point_maps) against rigid platforms at OL / OR, same modes.
+(bladedamp.diskmodel.contact_point_maps) against rigid platforms at OL / OR, same modes.
 
 Run from the repository root (needs the fe extra, ``pip install -e '.[fe]'``)::
 

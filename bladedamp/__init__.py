@@ -8,10 +8,12 @@ siblings), never from one above; import-linter checks it against the contracts i
 pyproject.toml (``[tool.importlinter]``, run by the test suite, which also finds no
 import cycle). From the top:
 
-    front ends       cli > app > viz | compare > report | design (files) | compilation
+    front ends       cli > app > viz | compare | reproduce (the paper's pipeline) > report | design (files)
+                     | compilation
     studies          studies (mass, engine orders, platform angles, Monte Carlo, backbone)
     reference        reference (the paper's disk: reference_disk)
-    disk models      mistuned > disk | oscillator
+    disk models      disk (the tuned sector) | oscillator > mistuned (the full ring) > diskmodel (what
+                     both disks share: damper position, contact element, DiskModel, checks)
     FRF driver       frf (one frequency-response driver of every model)
     analyses         hbm.stability > hbm.monodromy > timedomain | hbm.accuracy | hbm.nonlinear_modes
                      > response (the FRF result)
@@ -19,7 +21,8 @@ import cycle). From the top:
                      (the modal blade and its files) > blade.beam > fe_formats | measurement (readers)
     contact, damper  damper > contact
     results on disk  io (save / load of results and blades by class name; old blade files by tag)
-    engine           hbm.peaks > hbm.continuation | start | system | elements > hbm.fourier | linsolve
+    engine           hbm.peaks > hbm.continuation | start | system | elements > hbm.newton (the one
+                     Newton) > hbm.fourier | linsolve
     utilities        plotting | progress > palette | validation | lazy | _numba_cache
 
 The engine and its analyses (``bladedamp.hbm``) import no model: stability and the monodromy
@@ -27,8 +30,7 @@ reach a model through the protocols it implements
 (:class:`bladedamp.hbm.monodromy.PeriodMapModel`, :class:`~bladedamp.hbm.monodromy.AssemblyModel`),
 and the engine core (Fourier, residual, elements, Newton, continuation, linear solvers) imports
 nothing outside hbm but validation. This package (its public names below) sits above every
-layer. One back arrow is left, listed in the contract's ``ignore_imports``:
-``disk -> mistuned`` (a TunedDisk's full assembly is ``MistunedDisk.from_tuned``).
+layer. No back arrow is left.
 """
 from .lazy import lazy_attributes
 
@@ -96,7 +98,7 @@ def frequency_response(model, f_range_hz, harmonics="auto", stability: bool = Fa
 
         extra = options.get("extra_couplings")
         if extra is not None:
-            from .disk import WithCouplings
+            from .diskmodel import WithCouplings
 
             model = WithCouplings(model, extra)
         response = with_stability(model, response)

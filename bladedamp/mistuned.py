@@ -6,10 +6,10 @@ geometry (the paper's "contact mistuning"). Unknowns, harmonic-major as everywhe
 :mod:`bladedamp.hbm`: the modal coordinates of blade 0, 1, ..., n-1, then the six rigid-body
 coordinates of each damper that has a mass. Damper k sits between blade k (its OL platform)
 and blade k+1 (that blade's OR platform), exactly as in :class:`~bladedamp.disk.TunedDisk`;
-each position is described by its :class:`~bladedamp.disk.DamperPosition` (damper, platform
+each position is described by its :class:`~bladedamp.diskmodel.DamperPosition` (damper, platform
 angles, gaps, the preload law: geometry, ``platform_offsets``, ``G_P``, ``G_D``, seating / static
 approach, centrifugal force), the same description as the tuned disk's one position, and the
-shared behaviour is :class:`~bladedamp.disk.DiskModel`'s, so a tuned MistunedDisk is the
+shared behaviour is :class:`~bladedamp.diskmodel.DiskModel`'s, so a tuned MistunedDisk is the
 TunedDisk written out blade by blade.
 
 Engine-order excitation: blade k's first-harmonic force is f e^{i k dphi}, dphi = 2 pi EO / n,
@@ -26,7 +26,7 @@ Time sampling (AFT): the contact forces are evaluated at ``n_samples`` instants 
 in a tuned travelling wave blade k's motion is blade 0's shifted by k dphi; the discrete friction
 laws are shift-invariant only when that shift is a whole number of samples. Each damper is
 therefore sampled on its own grid, shifted by its phase k dphi (a rotation of its harmonic
-coefficients before the AFT and back after it, :meth:`~bladedamp.disk.AssemblyContacts.grid_rotations`;
+coefficients before the AFT and back after it, :meth:`~bladedamp.diskmodel.AssemblyContacts.grid_rotations`;
 nothing to do where the shift is whole samples, n = 16 and EO = 1 at 64 samples): a tuned full
 assembly equals the cyclic solution to rounding at any ``n_samples``, and the default is the
 tuned disk's (64 for one harmonic at any n; before, it was rounded up to a multiple of
@@ -57,9 +57,9 @@ from numba import njit
 
 from . import validation
 from .blade import PLATFORM_ANGLE, ModalBlade
-from .disk import (DAMPER_DOFS, DEFAULT_DAMPER_RADIUS, AssemblyContacts, DamperPosition, DiskModel, DiskModelResponse,
-                   TunedDisk, check_blade_bounded, contact_rows, peak_checked_response, rest_response,
-                   rotor_speed_in_hz, with_stop_check)
+from .diskmodel import (DAMPER_DOFS, DEFAULT_DAMPER_RADIUS, AssemblyContacts, DamperPosition, DiskModel,
+                        DiskModelResponse, check_blade_bounded, contact_rows, peak_checked_response, rest_response,
+                        rotor_speed_in_hz, with_stop_check)
 from .frf import branch_solver, checked_range
 from .hbm.accuracy import HARMONIC_TOLERANCE
 from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_MAX_STEP, DEFAULT_POINT_BUDGET, Branch, continuation
@@ -477,14 +477,6 @@ class MistunedDisk(DiskModel):
         self.validate_parameters(any(p.has_damper for p in self.positions))
         self._systems = {}
 
-    @property
-    def sectors(self) -> list[TunedDisk]:
-        """The former description of each position: a TunedDisk of blade k and damper k (built on
-        each call; the model is built from :attr:`positions` and :attr:`blades`)."""
-        return [TunedDisk(b, p.damper, self.n_blades, self.engine_order, p.gamma_left, p.gamma_right,
-                          self.damper_radius, self.excitation, self.rotor_speed_hz, self.damper_inertia, p.initial_gaps)
-                for b, p in zip(self.blades, self.positions)]
-
     def __getstate__(self):
         # the cached systems hold closures (their excitation) and are rebuilt on demand; a
         # mistuned copy unpickled builds its own (its source's set-up is not carried along)
@@ -514,7 +506,7 @@ class MistunedDisk(DiskModel):
         return out
 
     @classmethod
-    def from_tuned(cls, disk: TunedDisk, kappa=None, dampers="same", n_sector: int | None = None) -> "MistunedDisk":
+    def from_tuned(cls, disk: DiskModel, kappa=None, dampers="same", n_sector: int | None = None) -> "MistunedDisk":
         """The disk of ``disk`` with blade k's frequencies times ``kappa[k]`` (the paper's
         mistuning factor, all modes alike) and optionally its own ``dampers``.
 
@@ -563,7 +555,7 @@ class MistunedDisk(DiskModel):
     # ----- the layout of DiskModel: s blades, a damper at each position with a mass ----------
     @property
     def model_blades(self) -> list[ModalBlade]:
-        """The s blades written out (:class:`~bladedamp.disk.DiskModel`)."""
+        """The s blades written out (:class:`~bladedamp.diskmodel.DiskModel`)."""
         return self.blades
 
     @property
@@ -593,7 +585,7 @@ class MistunedDisk(DiskModel):
     # ----- harmonic balance ------------------------------------------------------------
     def default_samples(self, harmonics) -> int:
         """HarmonicBasis' default sample count, as the tuned disk's: each damper is sampled on a
-        grid shifted by its interblade phase (:meth:`~bladedamp.disk.AssemblyContacts.grid_rotations`), so the
+        grid shifted by its interblade phase (:meth:`~bladedamp.diskmodel.AssemblyContacts.grid_rotations`), so the
         count need not be a multiple of n / gcd(n, EO) (see the module notes)."""
         return HarmonicBasis(tuple(harmonics)).n_samples
 
@@ -754,9 +746,9 @@ class MistunedDisk(DiskModel):
         A failed branch without it says how to tell. ``check_peak``: for a branch that reached the
         end, the time integration at the peak's frequency gives a direct harmonic error estimate,
         or fails the response where the vibration there does not settle, as
-        :meth:`TunedDisk.frequency_response` (:meth:`peak_check`, :func:`~bladedamp.disk.with_peak_check`).
+        :meth:`TunedDisk.frequency_response` (:meth:`peak_check`, :func:`~bladedamp.diskmodel.with_peak_check`).
         Without dynamic excitation (``excitation`` zero) the response is rest, exactly
-        (:func:`~bladedamp.disk.rest_response`). Without dampers, a range holding the natural
+        (:func:`~bladedamp.diskmodel.rest_response`). Without dampers, a range holding the natural
         frequency of an excited blade mode without modal damping has no bounded response and is
         refused with a ValueError (:meth:`check_bounded`).
         ``cpu_budget_s`` [s] and ``point_budget``: the CPU time (``time.process_time``) and the
@@ -787,7 +779,7 @@ class MistunedDisk(DiskModel):
     def check_bounded(self, f_start_hz: float, f_end_hz: float) -> None:
         """ValueError where no bounded periodic response exists in ``f_start_hz``..``f_end_hz``
         [Hz]: without dampers every blade is on its own, as a tuned disk without damper
-        (:func:`~bladedamp.disk.check_blade_bounded` of each blade); with dampers nothing is refused."""
+        (:func:`~bladedamp.diskmodel.check_blade_bounded` of each blade); with dampers nothing is refused."""
         if not self.active_dampers:
             for blade in self.blades:
                 check_blade_bounded(blade, self.excitation, False, f_start_hz, f_end_hz)
@@ -905,7 +897,7 @@ class MistunedDisk(DiskModel):
 @dataclass
 class MistunedResponse(DiskModelResponse):
     """Frequency response of every blade of a :class:`MistunedDisk`: the attributes of
-    :class:`~bladedamp.disk.DiskModelResponse` (``tip_amplitude`` (n_points, s, 3) [m], each blade's;
+    :class:`~bladedamp.diskmodel.DiskModelResponse` (``tip_amplitude`` (n_points, s, 3) [m], each blade's;
     the energies of the whole model; ``stop_check``, ``peak_check``) and
 
     damper_dissipation : (n_points, n_active_dampers) friction dissipation of each damper [J]
@@ -914,7 +906,7 @@ class MistunedResponse(DiskModelResponse):
     tuned_peak_amplitude : the tuned disk's peak u_x [m] if given (amplification factors)
 
     ``peak_amplitude`` is the (s,) array of the blades' peaks (parabola-refined, :meth:`peaks`),
-    the same as :attr:`~bladedamp.disk.DiskModelResponse.blade_peak_amplitudes`; the largest of
+    the same as :attr:`~bladedamp.diskmodel.DiskModelResponse.blade_peak_amplitudes`; the largest of
     them, a float as for the tuned disk, is ``largest_peak_amplitude``.
     """
 

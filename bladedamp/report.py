@@ -1069,7 +1069,7 @@ def zzenf_outputs(out: Path, design, diagram) -> dict:
     :class:`~bladedamp.studies.interference.InterferenceDiagram`). Returns the JSON summary."""
     import matplotlib.pyplot as plt
 
-    from .disk import nodal_diameter
+    from .diskmodel import nodal_diameter
 
     fig, ax = plt.subplots(figsize=(9.5, 5))
     diagram.plot(ax=ax)

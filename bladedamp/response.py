@@ -555,7 +555,7 @@ class FrequencyResponse(Saveable):
         largest amplitude lies at an end of the range (:func:`with_range_end_estimate`), else ()
     unverified_reason : what keeps a complete response from being verified whatever its harmonic
         set (e.g. a disk's peak held by the harmonic balance's static retention spring,
-        :func:`bladedamp.disk.retention_check`), '' if nothing; with one, ``harmonic_error`` is
+        :func:`bladedamp.diskmodel.retention_check`), '' if nothing; with one, ``harmonic_error`` is
         nan (status COMPLETE_UNVERIFIED) until a time integration of the peak gives an estimate
 
     Derived, for every response (saved ones too): :attr:`status` (a :class:`Status`),

@@ -234,7 +234,7 @@ def test_random_disks_with_a_free_rolling_light_damper_reach_the_end(i):
     gross slip near the undamped 1F) crawled to the 2000-point cap from both ends of the range,
     1 rad/s apart: one damper rotation coefficient, held by the damper's inertia alone, took
     95-97 % of the arc length. The retry with the damper's unknowns weighing less in the arc
-    length (``bladedamp.disk.DAMPER_ARC_SCALE``; set it to 1 and this fails) reaches the end."""
+    length (``bladedamp.diskmodel.DAMPER_ARC_SCALE``; set it to 1 and this fails) reaches the end."""
     from test_random_designs import disk_design, run_design
 
     r = run_design(disk_design(i))

@@ -16,7 +16,8 @@ import numpy as np
 import pytest
 from conftest import central_difference, relative_matrix_error
 
-from bladedamp.disk import DamperContacts, DiskResponse, TunedDisk
+from bladedamp.disk import DiskResponse, TunedDisk
+from bladedamp.diskmodel import DamperContacts
 from bladedamp.hbm.continuation import Branch, newton
 from bladedamp.reference import reference_disk
 
@@ -680,7 +681,7 @@ def test_check_stop_keeps_the_time_integration_beyond_a_failed_branch_and_says_w
     that frequency (independent: the HBM's own answer, interpolated, within 1 %). It survives
     save / load. A branch that reaches the end, or is stopped by stop_above, runs no check."""
     from bladedamp import load
-    from bladedamp.disk import STOP_CHECK_OFFSET_HZ
+    from bladedamp.diskmodel import STOP_CHECK_OFFSET_HZ
 
     disk = dataclasses.replace(reference_disk("cylinder", 1e-3), n_blades=4)
     with warnings.catch_warnings():
@@ -768,7 +769,8 @@ def test_check_peak_starts_on_the_hbm_solution(monkeypatch):
     The integration from the static equilibrium reaches the same motion. A motion farther than
     that bound (the settled amplitudes replaced by half the branch's) is reported as a coexisting
     motion, a note that leaves the harmonic error estimate the enriched set's."""
-    from bladedamp.disk import TunedDisk, orbit_departure
+    from bladedamp.disk import TunedDisk
+    from bladedamp.diskmodel import orbit_departure
 
     disk = dataclasses.replace(reference_disk("cylinder", 1e-3), n_blades=4)
     with warnings.catch_warnings():
@@ -868,7 +870,7 @@ def test_a_response_without_the_harmonic_error_estimate_is_the_same_branch_and_s
 def test_nodal_diameter_of_any_engine_order(eo, n, expected):
     """k = EO mod n, folded to n - k (backward) above n / 2; the interblade phase has
     e^{i dphi} = e^{i 2 pi EO / n} and lies in (-pi, pi], negative for a backward wave."""
-    from bladedamp.disk import interblade_phase, nodal_diameter
+    from bladedamp.diskmodel import interblade_phase, nodal_diameter
     assert nodal_diameter(eo, n) == expected
     dphi = interblade_phase(eo, n)
     assert -np.pi < dphi <= np.pi

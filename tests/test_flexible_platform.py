@@ -27,7 +27,7 @@ import pytest
 from conftest import central_difference, relative_matrix_error
 
 import bladedamp as bd
-from bladedamp.disk import DamperContacts, contact_point_maps
+from bladedamp.diskmodel import DamperContacts, contact_point_maps
 from bladedamp.hbm.continuation import newton
 from bladedamp.mistuned import MistunedDisk
 from bladedamp.reference import reference_disk

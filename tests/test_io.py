@@ -20,7 +20,7 @@ import pytest  # noqa: E402
 
 import bladedamp as bd  # noqa: E402
 from bladedamp import io  # noqa: E402
-from bladedamp.disk import DiskModelResponse  # noqa: E402
+from bladedamp.diskmodel import DiskModelResponse  # noqa: E402
 from bladedamp.mistuned import MistunedDisk, MistunedResponse  # noqa: E402
 from bladedamp.studies import design as sd  # noqa: E402
 from bladedamp.studies import mass as sm  # noqa: E402

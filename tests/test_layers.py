@@ -112,7 +112,7 @@ def test_the_monodromy_reaches_a_model_through_its_protocol():
     (not every blade) and a model with extra couplings (the time integration has not got them)
     have no period map, as when the method dispatched on the model's class."""
     import bladedamp as bd
-    from bladedamp.disk import WithCouplings
+    from bladedamp.diskmodel import WithCouplings
     from bladedamp.hbm.monodromy import AssemblyModel, PeriodMapModel, supports
     from bladedamp.mistuned import MistunedDisk
 

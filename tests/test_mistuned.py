@@ -492,7 +492,7 @@ def test_automatic_aft_sampling_goes_through_sampled_response(monkeypatch):
     times; a given n_samples is used as given. The growth itself on a failing branch:
     test_automatic_aft_sampling_rescues_a_retracing_branch (slow)."""
     import bladedamp.frf as frf_module
-    from bladedamp.disk import AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION
+    from bladedamp.diskmodel import AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION
     from bladedamp.response import sampled_response
 
     calls = []
@@ -659,7 +659,7 @@ def test_euler_rate_is_the_numpy_formula_to_rounding():
     / |offsets_d|^2 and (force - J local) kappa, to 1e-12 of its largest entry at a stuck and a
     slipping state; an approach rate that is not homogeneous (one entry moved) is refused,
     domega left as it was, and evaluate takes the central difference there."""
-    from bladedamp.disk import euler_rate
+    from bladedamp.diskmodel import euler_rate
 
     md = MistunedDisk.from_tuned(reference_disk("cylinder", 1e-3), mt.random_kappa(16, 0.02, seed=5))
     system = md.hbm_system((1,))
@@ -736,7 +736,7 @@ def test_check_stop_of_the_mistuned_assembly_says_what_the_time_integration_foun
     methods share only the model). It survives save / load. A complete branch runs no check;
     without check_stop a cut branch says how to tell (MistunedDisk.stop_check)."""
     from bladedamp import load
-    from bladedamp.disk import STOP_CHECK_OFFSET_HZ
+    from bladedamp.diskmodel import STOP_CHECK_OFFSET_HZ
 
     disk = MistunedDisk.from_tuned(tuned(5), [1.0, 1.01, 0.99, 1.005, 0.995])
     with warnings.catch_warnings():

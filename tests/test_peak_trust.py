@@ -1,7 +1,7 @@
 """What keeps a peak from reading "verified" (issue 32 item 1): the peak check's own error bar
-(:func:`bladedamp.disk.peak_check_error`) and the Floquet multipliers of a peak whose time
-integration does not settle (:func:`bladedamp.disk.peak_stability_note`). The retention spring's
-held load (:func:`bladedamp.disk.retention_held`) is tested on random disks in
+(:func:`bladedamp.diskmodel.peak_check_error`) and the Floquet multipliers of a peak whose time
+integration does not settle (:func:`bladedamp.diskmodel.peak_stability_note`). The retention spring's
+held load (:func:`bladedamp.diskmodel.retention_held`) is tested on random disks in
 tests/test_random_designs.py."""
 import warnings
 
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from bladedamp import FrictionOscillator
-from bladedamp.disk import UNSTABLE_MARGIN, peak_check_error, peak_stability_note
+from bladedamp.diskmodel import UNSTABLE_MARGIN, peak_check_error, peak_stability_note
 
 W0 = 2 * np.pi          # natural frequency 1 Hz
 DAMPING = 0.2           # c [N s/m], zeta = 0.016

@@ -28,7 +28,8 @@ from bladedamp import FrictionOscillator
 from bladedamp.blade import reference_blade
 from bladedamp.damper.geometry import ContactProperties, CylinderDamper, WedgeDamper
 from bladedamp.damper.kinetics import centrifugal_force
-from bladedamp.disk import RETENTION_HELD_LIMIT, DiskResponse, TunedDisk, retention_held, with_peak_check
+from bladedamp.disk import DiskResponse, TunedDisk
+from bladedamp.diskmodel import RETENTION_HELD_LIMIT, retention_held, with_peak_check
 from bladedamp.mistuned import MistunedDisk
 from bladedamp.hbm.continuation import Branch, newton
 from bladedamp.hbm.monodromy import full_assembly_coefficients
@@ -49,7 +50,7 @@ N_OSCILLATORS = 160
 # or turn back near 94-95 Hz where the damper hops or rolls, 1 turns back at 90 Hz, 1 does not
 # start, 1 misses the harmonic tolerance); 301 of 320 = 0.941 on 2026-12-02, sixth session (disks 143 of
 # 160 with the retry of a failed branch with the damper's unknowns weighing less in the arc length,
-# bladedamp.disk.DAMPER_ARC_SCALE: random disks 16, 102 and 124; oscillators 158 of 160; the floor
+# bladedamp.diskmodel.DAMPER_ARC_SCALE: random disks 16, 102 and 124; oscillators 158 of 160; the floor
 # leaves 3 designs for rounding: disk 55 failed in the fifth session's venv and passes in this
 # one); 296 of 320 = 0.925 on 2026-12-01, fourth session (disks
 # 138 of 160, oscillators 158 of 160: the interpolated touchdown seat, the automatic AFT sampling
@@ -89,7 +90,7 @@ N_TIME_CHECKS = 10
 # benchmarks/README.md has the numbers), blade mistuning 1-5 % std, each run by default
 # (harmonics 'auto') with a CPU budget of MISTUNED_CPU_BUDGET_S; every answer that reads as
 # complete and verified is cross-checked by the library's own time integration at its peak
-# (bladedamp.disk.with_peak_check, started on the HBM state).
+# (bladedamp.diskmodel.with_peak_check, started on the HBM state).
 # Budget 30 CPU s, not the issue's 60: measured on the 40 designs at 4 blades with 60 s, each
 # finished within 28 CPU s or ran past 60, so the shares are the same and the section's CPU time
 # falls from 1236 to about 800 CPU s (about 7 min of wall time on 2 cores; benchmarks/README.md).
@@ -104,9 +105,9 @@ MISTUNED_CPU_BUDGET_S = 30.0
 # (benchmarks/README.md, "Why the time integration contradicts four complete-and-verified
 # answers"); branch trust cured two (benchmarks/README.md, "Four contradictions, two cured"):
 # 27's peak is held by the HBM's static retention spring (15 % of the cylinder's F_CG R in the
-# weak-spring limit, bladedamp.disk.retention_held), so its default answer is COMPLETE_UNVERIFIED
+# weak-spring limit, bladedamp.diskmodel.retention_held), so its default answer is COMPLETE_UNVERIFIED
 # and says why; 17's direct estimate, 1.03 %, is within the tolerance plus the time integration's
-# own error bar (0.12 %, the same run with twice the steps: bladedamp.disk.peak_check_error);
+# own error bar (0.12 %, the same run with twice the steps: bladedamp.diskmodel.peak_check_error);
 # measured after (2026-12-07, branch trust): 9 of 40 complete-verified, contradicted 11 and 14. The
 # two left need a time integration or the monodromy at the peak to be seen, which the default
 # answer does not run (the monodromy costs 5-9 CPU s at 4 blades, about 13 times more at 16);
@@ -293,7 +294,7 @@ def run_mistuned(d: dict, time_check: bool = True) -> dict:
     """The default frequency response of random mistuned disk ``d`` (:func:`mistuned_design`)
     within MISTUNED_CPU_BUDGET_S, its status and CPU seconds; an answer whose status is
     COMPLETE_VERIFIED is checked by the time integration at its peak (``time_check``:
-    :func:`bladedamp.disk.with_peak_check`, the library's check_peak): ``contradicted`` holds the
+    :func:`bladedamp.diskmodel.with_peak_check`, the library's check_peak): ``contradicted`` holds the
     message where that check no longer finds the answer complete and verified (a periodic motion
     farther from the branch's peak than the harmonic tolerance, or none)."""
     disk = make_mistuned(d)
@@ -479,7 +480,7 @@ def test_a_failing_disk_has_no_periodic_motion_beyond_its_stop():
     (time integration of the full assembly 0.05 Hz beyond) finds no periodic motion: measured
     "not settled" after 4000 periods, separated 69 % of the period, the first harmonics still
     changing by 0.33 % per period. So no harmonic-balance branch can go on there (13 of the 17
-    failing random disks are like this one: bladedamp.disk.with_stop_note), and the result, with
+    failing random disks are like this one: bladedamp.diskmodel.with_stop_note), and the result, with
     check_stop, says so: the suite counts it as answered rightly (``run_design``)."""
     d, r, check = stopped_disk(51)
     assert not r.success and "stop_check(result) tells" not in r.message, r.message     # the verdict, not the hint

@@ -344,7 +344,7 @@ def test_an_amplitude_beyond_small_deformations_is_no_success(undamped_light_cyl
 
 
 def test_the_span_is_the_blades_root_to_tip():
-    from bladedamp.disk import blade_span
+    from bladedamp.diskmodel import blade_span
 
     td = dataclasses.replace(bd.reference_disk("cylinder", 1e-3), n_blades=4)
     assert blade_span(td) == pytest.approx(0.2, rel=1e-12)                    # Table 1's 60 + 140 mm

@@ -226,7 +226,7 @@ class ModalBlade:
         6-DOF shape per control point, so the platform moves rigidly with it (Eq. 6). A blade
         with its own surface data (the solid FE blade, :class:`bladedamp.blade.solid.SolidModalBlade`)
         overrides this, and the contact kinematics then use those shapes at every contact point
-        (:func:`bladedamp.disk.contact_point_maps`)."""
+        (:func:`bladedamp.diskmodel.contact_point_maps`)."""
         if side not in ("OL", "OR"):
             raise ValueError(f"side must be 'OL' or 'OR' (got {side!r})")
         return None

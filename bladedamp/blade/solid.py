@@ -85,7 +85,7 @@ over a region, with the point P as reference (so u_P is the fitted translation a
   is, and the raw FE displacements of the face at a grid of points are kept in
   :attr:`SolidModalBlade.contact_faces`. The contact kinematics of the disks do not use a rigid
   platform: :meth:`SolidModalBlade.platform_displacements` gives the FE field at every contact
-  point of the damper's patches (:func:`bladedamp.disk.contact_point_maps`, flexible
+  point of the damper's patches (:func:`bladedamp.diskmodel.contact_point_maps`, flexible
   platforms; :meth:`SolidModalBlade.rigid_platform_blade` for the rigid ones).
 * platform: over the platform prism's volume.
 * tip (and excitation, and any point at the tip height): over the tip face; another height:
@@ -1781,7 +1781,7 @@ class SolidModalBlade(ModalBlade):
     With ``face_fields``, :meth:`platform_displacements` gives the FE displacement of the
     platform's contact faces at any point of them, and the disks (:class:`~bladedamp.disk.TunedDisk`,
     :class:`~bladedamp.mistuned.MistunedDisk`) use it at every contact point: a flexible
-    platform (:func:`bladedamp.disk.contact_point_maps`). :meth:`rigid_platform_blade` is the
+    platform (:func:`bladedamp.diskmodel.contact_point_maps`). :meth:`rigid_platform_blade` is the
     same blade with rigid platforms at OL / OR (the beam model's contact kinematics).
 
     Saved files (:meth:`save`, ``.npz`` only, format :data:`SOLID_NPZ_FORMAT`) hold everything but

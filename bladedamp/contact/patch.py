@@ -185,7 +185,7 @@ class ContactPatch:
             :meth:`approach_for_load`)
         point_map : (P, 3, m) map from ``w`` to the point displacements (xi, eta, zeta) [m]
             instead of the rigid :attr:`point_map` (e.g. a flexible platform's,
-            :func:`bladedamp.disk.contact_point_maps`); the forces are then conjugate to ``w``
+            :func:`bladedamp.diskmodel.contact_point_maps`); the forces are then conjugate to ``w``
         """
         w = np.asarray(w, dtype=float)
         C = basis.n_coeffs

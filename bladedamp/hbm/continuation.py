@@ -321,7 +321,7 @@ def continuation(fun, x0, omega_start, omega_end, x_scale=None, residual_scale=N
     retry_x_scale : scale of the unknowns (as ``x_scale``) for a second try where the first
         (from the start, then from the end) fails, or None: the same continuation with the arc
         length measured by these scales (e.g. a disk's with the damper's unknowns weighing less,
-        :func:`bladedamp.disk.damper_weighted_scales`), and with 1 / RETRY_POINTS_FRACTION of
+        :func:`bladedamp.diskmodel.damper_weighted_scales`), and with 1 / RETRY_POINTS_FRACTION of
         ``max_points``. Its branch is returned if it succeeds, its message saying so; otherwise
         the one of the two failed branches that got further into the range (the first on a tie),
         with its warnings. A branch that succeeds at the first try is never recomputed, so the

@@ -146,7 +146,7 @@ def engine_order_sweep(disk: TunedDisk, engine_orders=range(0, 9), mass_bounds=(
     Parameters
     ----------
     disk : TunedDisk with a damper (its mass is the one thing not used: it is optimised)
-    engine_orders : EOs >= 0 (non-empty; above n/2 the backward waves, :func:`bladedamp.disk.nodal_diameter`)
+    engine_orders : EOs >= 0 (non-empty; above n/2 the backward waves, :func:`bladedamp.diskmodel.nodal_diameter`)
     mass_bounds : (low, high) [kg], 0 < low < high
     rotor_speed_eo0_hz : rotor speed at EO = 0 [Hz] (> 0) if the disk has none; otherwise
         Omega_R = Omega_E / EO (or the disk's fixed rotor speed)

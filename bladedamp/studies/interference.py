@@ -3,7 +3,7 @@
 * :func:`interference_diagram` -- the natural frequencies of the linear sector models per nodal
   diameter 0..n/2 (without dampers; dampers stuck, at the ends of a rotor-speed range), with the
   engine-order excitation f = EO Omega_R over that range at each engine order's nodal diameter
-  (:func:`bladedamp.disk.nodal_diameter`: EO mod n, folded to n - (EO mod n) above n / 2).
+  (:func:`bladedamp.diskmodel.nodal_diameter`: EO mod n, folded to n - (EO mod n) above n / 2).
 * :func:`campbell_diagram` -- the same natural frequencies over rotor speed at the nodal diameter
   of each named engine order, the lines f = EO Omega_R, and at each engine order the damped
   resonance: the peak of the frequency response of the disk at that engine order, whose rotor
@@ -23,7 +23,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import palette, validation
-from ..disk import TunedDisk, nodal_diameter
+from ..disk import TunedDisk
+from ..diskmodel import nodal_diameter
 
 #: rotor speeds at which a Campbell diagram's stuck natural frequencies are computed (the preload
 #: m R Omega_R^2 changes them smoothly: a line through this many speeds)
