@@ -73,8 +73,8 @@ from .hbm.peaks import PEAK_MAX_ITERATIONS, PeakSolver, first_harmonic_output
 from .hbm.fourier import HarmonicBasis
 from .hbm.monodromy import disk_monodromy
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, physical_checks, refined_peak, sampled_response,
-                       with_checks)
+from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, continuation_note, physical_checks, refined_peak,
+                       sampled_response, with_checks)
 
 
 def sparse_real_form(basis: HarmonicBasis, per_harmonic) -> sp.csr_matrix:
@@ -1191,8 +1191,8 @@ class MistunedDisk:
             iterations = np.concatenate([piece.iterations[:0:-1], response.iterations])
             turning = np.concatenate([k - piece.turning_points, response.turning_points + k])
         success = bool(response.success and piece.success)
-        message = piece.message if not piece.success else response.message
-        branch = Branch(omega, x, iterations, success, message, np.sort(turning).astype(int))
+        message, ran_out = (piece.message, piece.out_of_points) if not piece.success else (response.message, 0)
+        branch = Branch(omega, x, iterations, success, message, np.sort(turning).astype(int), out_of_points=ran_out)
         return MistunedResponse.from_branch(self, system, branch, response.tuned_peak_amplitude)
 
     @one_blas_thread
@@ -1295,8 +1295,8 @@ class MistunedResponse(FrequencyResponse):
                 force, _, _ = c.element.harmonic_forces(local, basis, w, False)
                 diss[i] = basis.work_per_cycle(force, local).reshape(nd, -1).sum(axis=1)
                 bound[i] = basis.work_bound(force, local).reshape(nd, -1).sum(axis=1)
-        return cls(branch.omega, X, basis, disk.dof_names, branch.success, branch.message, branch.iterations,
-                   branch.turning_points, tip_amplitude=tip, excitation_work=np.array(exc),
+        return cls(branch.omega, X, basis, disk.dof_names, branch.success, "", branch.iterations,
+                   branch.turning_points, notes=(continuation_note(branch),), tip_amplitude=tip, excitation_work=np.array(exc),
                    viscous_dissipation=np.array(visc), dissipated_energy=diss.sum(axis=1), damper_dissipation=diss,
                    damper_work_bound=bound,
                    tuned_peak_amplitude=tuned_peak_amplitude, disk=disk, stopped_by=branch.stopped_by)

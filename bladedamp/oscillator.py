@@ -25,8 +25,8 @@ from .hbm.elements import CubicSpring
 from .hbm.fourier import HarmonicBasis
 from .hbm.monodromy import STEPS_PER_PERIOD, oscillator_monodromy
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, physical_checks, sampled_response, with_checks,
-                       with_range_end_estimate)
+from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, continuation_note, physical_checks, sampled_response,
+                       with_checks, with_range_end_estimate)
 from .timedomain import TimeResponse, oscillator_steady_state
 
 # most AFT samples per period the automatic sampling may choose (sampled_response; one DOF:
@@ -219,8 +219,8 @@ class FrictionOscillator:
                                   budget=budget, **continuation_options)
             C = system.basis.n_coeffs
             response = FrequencyResponse(branch.omega, branch.x.reshape(-1, C, 1), system.basis, ("x",),
-                                         branch.success, branch.message, branch.iterations, branch.turning_points,
-                                         stopped_by=branch.stopped_by)
+                                         branch.success, "", branch.iterations, branch.turning_points,
+                                         stopped_by=branch.stopped_by, notes=(continuation_note(branch),))
             # per point: the excitation work, and the contact's dissipation and energy scale (one AFT)
             work = np.array([system.excitation_work(x, w) for x, w in zip(branch.x, branch.omega)])
             energies = np.array([[sum(e) for e in system.element_energies(x, w)]
