@@ -12,6 +12,7 @@ import cycle). From the top:
     studies          studies (mass, engine orders, platform angles, Monte Carlo, backbone)
     reference        reference (the paper's disk: reference_disk)
     disk models      mistuned > disk | oscillator
+    FRF driver       frf (one frequency-response driver of every model)
     analyses         hbm.stability > hbm.monodromy > timedomain | hbm.accuracy | hbm.nonlinear_modes
                      > response (the FRF result)
     blade            geometry (3D) > blade: the package blade.solid > blade.reference > blade.modal

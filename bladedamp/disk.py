@@ -27,9 +27,11 @@ import textwrap
 import warnings
 
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 import scipy.linalg
+import scipy.sparse as sp
 from numba import njit
 
 from . import validation
@@ -39,18 +41,18 @@ from .contact.patch import dof_jacobian
 from .contact.point import (MAX_PASSES, PERIODIC_TOL, PointContactSamples, damper_contact_forces, normal_law_parameters,
                             point_contact_forces)
 from .damper.geometry import CylinderDamper, DamperGeometry, WedgeDamper
-from .damper.kinetics import centrifugal_force, retention_stiffness, seat, seated_state
+from .damper.kinetics import centrifugal_force, retention_stiffness, seat
 from .hbm.accuracy import HARMONIC_TOLERANCE, AccuracyWarning, converged_response
-from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_MAX_STEP, DEFAULT_POINT_BUDGET, Branch, Budget, continuation
+from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_MAX_STEP, DEFAULT_POINT_BUDGET, Branch
 from .hbm.nonlinear_modes import linear_stuck_mode
 from .hbm.peaks import PeakSolver, first_harmonic_output
 from .hbm.start import robust_start
 from .hbm.fourier import HarmonicBasis
 from .hbm.monodromy import disk_monodromy
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, Note, NoteKind, continuation_note, harmonic_sentence,
-                       nearest_to_range, percent, physical_checks, plot_branch, sampled_response, with_amplitude_check,
-                       with_checks, with_note, with_range_end_estimate)
+from .frf import branch_solver, checked_range
+from .response import (FrequencyResponse, Note, NoteKind, continuation_note, harmonic_sentence, nearest_to_range,
+                       percent, plot_branch, with_amplitude_check, with_checks, with_note, with_range_end_estimate)
 
 DAMPER_DOFS = ("uD_x", "uD_y", "uD_z", "phiD_x", "phiD_y", "phiD_z")
 # the automatic AFT sampling of a disk's branch (TunedDisk and MistunedDisk) may grow the samples
@@ -254,6 +256,23 @@ def euler_rate(offsets, doffsets, blocks, local, force, domega):
 
 
 
+class PointBatch(NamedTuple):
+    """The contact points of one damper (both patches) or of n_d dampers side by side as one
+    batch of the point-contact kernel (what :meth:`DamperContacts.stacked_points` and
+    :meth:`AssemblyContacts.stacked_points` give; P points per patch)."""
+
+    #: point maps from the local coordinates, (2, P, 3, m) for one damper, (n_d, 2, P, 3, m) for n_d
+    maps: np.ndarray
+    #: (2 P,) or (2 n_d P,) tangential stiffness of each point: the patch's times the point's weight [N/m]
+    tangential_stiffness: np.ndarray
+    #: (2 P,) or (2 n_d P,) friction coefficient of each point [-]
+    friction_coefficient: np.ndarray
+    #: (2 P,) or (2 n_d P,) each point's weight [-]
+    weights: np.ndarray
+    #: the normal law every point shares
+    normal_law: object
+
+
 @dataclass
 class DamperContacts:
     """Both contacts of one damper as a harmonic-balance element. Forces are those on the
@@ -266,13 +285,15 @@ class DamperContacts:
 
     ``approach(omega)`` gives the per-point static approach (2, P) and its omega-derivative.
 
-    ``harmonic_forces`` evaluates the points of both patches in one call of a kernel when the
+    ``harmonic_forces`` is that of the one damper-contact element, :class:`AssemblyContacts`
+    with this damper alone (:attr:`element`; a ring's element holds every damper's
+    DamperContacts side by side): the points of both patches in one call of a kernel when the
     patches share their normal law and friction coefficient (always, for the dampers of
     :mod:`bladedamp.damper.geometry`): the fused kernel with rigid platforms
     (:func:`fused_point_map_forces`), else the point-contact kernel with numpy projections; the
     same numbers as two ``ContactPatch.evaluate`` calls to rounding (tested against ``evaluate``).
     With the one-harmonic preload and a linear normal law, d force / d omega comes from Euler's
-    identity instead of a second AFT pass (see ``harmonic_forces``).
+    identity instead of a second AFT pass (:func:`euler_rate`).
     """
 
     geometry: DamperGeometry
@@ -280,6 +301,7 @@ class DamperContacts:
     point_maps: np.ndarray | None = None
     n_local: int = field(default=12, init=False)
     _stacked: tuple | None = field(default=None, init=False, repr=False)
+    _element: object = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self):
         if self.point_maps is not None:
@@ -311,12 +333,12 @@ class DamperContacts:
         force is (C, 6 + n_m), its first 6 the forces and moments about the control point."""
         return self.evaluate_at(local, basis, self.approach(omega)[0], jacobian)
 
-    def stacked_points(self):
-        """The points of both patches as one batch: ``(True, point maps (2, P, 3, m), k_T (2P,)
-        [N/m per point: the patch's tangential stiffness times the point's weight], mu (2P,),
-        weights (2P,), normal law)``, or None if the patches differ in normal law, friction
+    def stacked_points(self) -> PointBatch | None:
+        """The points of both patches as one :class:`PointBatch` (point maps (2, P, 3, m), per
+        point (2P,): k_T [N/m, the patch's tangential stiffness times the point's weight], mu,
+        weights; the normal law), or None if the patches differ in normal law, friction
         coefficient or point count (then they are evaluated one by one). Cached; the batch of
-        :func:`point_map_forces` and of :class:`~bladedamp.mistuned.AssemblyContacts`."""
+        :func:`point_map_forces` and of :class:`AssemblyContacts`."""
         if self._stacked is None:
             pa, pb = self.geometry.patches
             same = (pa.normal_law == pb.normal_law and pa.friction_coefficient == pb.friction_coefficient
@@ -326,38 +348,26 @@ class DamperContacts:
             else:
                 ps = (pa, pb)
                 B = np.stack([p.point_map for p in ps]) if self.point_maps is None else self.point_maps
-                self._stacked = (True, B,
-                                 np.concatenate([p.tangential_stiffness * p.weights for p in ps]),
-                                 np.concatenate([np.full(p.n_points, p.friction_coefficient) for p in ps]),
-                                 np.concatenate([p.weights for p in ps]), pa.normal_law)
-        return self._stacked if self._stacked[0] else None
+                self._stacked = (True, PointBatch(B, np.concatenate([p.tangential_stiffness * p.weights for p in ps]),
+                                                  np.concatenate([np.full(p.n_points, p.friction_coefficient)
+                                                                  for p in ps]),
+                                                  np.concatenate([p.weights for p in ps]), pa.normal_law))
+        return self._stacked[1] if self._stacked[0] else None
 
     def forces_at(self, local, basis, offsets, jacobian):
         """Forces (C, n_local) [N, N m] and Jacobian (C*n_local, C*n_local) or None of both patches
         at ``local`` (C, n_local) with the per-point static approach ``offsets`` (2, P) [m] (no
-        omega: the approach is given; :meth:`harmonic_forces` takes it from :attr:`approach`)."""
+        omega: the approach is given), patch by patch (:meth:`evaluate_at`): the one element's
+        (:class:`AssemblyContacts`) evaluation of a damper whose patches do not stack
+        (:meth:`stacked_points` None); it evaluates stacked ones in one kernel call."""
         C, m = basis.n_coeffs, self.contact_local
-        stack = self.stacked_points()
-        if stack is None:
-            evs = self.evaluate_at(local, basis, offsets, jacobian)
-            force = np.hstack([ev.force for ev in evs])
-            blocks = [ev.jacobian.reshape(C, m, C, m) for ev in evs] if jacobian else None
-        else:
-            _, B, k_t, mu, weights, law = stack
-            fused = fused_point_map_forces(B[None], local.reshape(C, 1, 2 * m), basis, k_t, mu, law, weights,
-                                           offsets, jacobian)
-            if fused is not None:
-                force, blocks = fused
-                return force.reshape(C, 2 * m), None if blocks is None else blocks.reshape(C * 2 * m, C * 2 * m)
-            f, jb, _ = point_map_forces(B[None], local.reshape(C, 1, 2, m), basis, k_t, mu, law, weights, offsets,
-                                        jacobian)
-            force = f.reshape(C, 2 * m)
-            blocks = None if jb is None else jb[0]
+        evs = self.evaluate_at(local, basis, offsets, jacobian)
+        force = np.hstack([ev.force for ev in evs])
         if not jacobian:
             return force, None
         jac = np.zeros((C, 2 * m, C, 2 * m))
-        for c in range(2):
-            jac[:, m * c:m * c + m, :, m * c:m * c + m] = blocks[c]
+        for c, ev in enumerate(evs):
+            jac[:, m * c:m * c + m, :, m * c:m * c + m] = ev.jacobian.reshape(C, m, C, m)
         return force, jac.reshape(C * 2 * m, C * 2 * m)
 
     def evaluate_at(self, local, basis, offsets, jacobian=True):
@@ -378,7 +388,7 @@ class DamperContacts:
         offsets = np.stack([self.approach(w)[0] for w in omegas])                 # (n, 2, P)
         stack = self.stacked_points()
         if stack is not None:
-            _, B, k_t, mu, weights, law = stack
+            B, k_t, mu, weights, law = stack
             f, _, pts = point_map_forces(np.broadcast_to(B, (n,) + B.shape), np.moveaxis(local.reshape(n, C, 2, m), 0, 1),
                                          basis, np.tile(k_t, n), np.tile(mu, n), law, np.tile(weights, n), offsets,
                                          False)
@@ -390,32 +400,279 @@ class DamperContacts:
                                     for f in dataclasses.fields(PointContactSamples)))
         return force, pts
 
+    @property
+    def element(self) -> "AssemblyContacts":
+        """The one damper-contact element holding this damper alone, its Jacobian dense (built once)."""
+        if self._element is None:
+            self._element = AssemblyContacts([self], dense=True)
+        return self._element
+
     def harmonic_forces(self, local, basis, omega, jacobian=True):
+        """(force (C, n_local) [N, N m], dense Jacobian (C n_local, C n_local) or None, d force /
+        d omega (C n_local,) [N s/rad] or None) at ``local`` (C, n_local) and ``omega`` [rad/s]:
+        :meth:`AssemblyContacts.harmonic_forces` of :attr:`element`."""
+        return self.element.harmonic_forces(local, basis, omega, jacobian)
+
+
+@dataclass
+class AssemblyContacts:
+    """The contacts of all dampers of an assembly as one harmonic-balance element.
+
+    Local coordinates: those of each damper's :class:`DamperContacts` in turn (the 12 relative
+    motions of OL and OR, and with flexible platforms the platform blades' modal coordinates:
+    ``n_local = L * n_dampers``, L = :attr:`damper_local`, the same for every damper).
+    ``contacts[d]`` is damper d's :class:`DamperContacts` (built from its :class:`DamperPosition`
+    as the tuned disk's). The one damper-contact element of both disk models: a ring's dampers
+    side by side, and the tuned sector's damper alone (:attr:`DamperContacts.element`). Returns
+    a sparse block-diagonal local Jacobian, or with ``dense`` a dense one (one damper: its block).
+    """
+
+    contacts: list[DamperContacts]
+    n_local: int = 0
+    #: (n_d,) phase [rad] of each damper's motion in a tuned travelling wave (k dphi for the
+    #: damper on blade k), or None; damper d is sampled on a grid shifted by it (:meth:`grid_rotations`)
+    grid_phase: np.ndarray | None = None
+    #: return a dense local Jacobian (the tuned sector's one damper) instead of a sparse one
+    dense: bool = False
+    _batch: tuple | None = field(default=None, init=False, repr=False)
+    _index: dict = field(default_factory=dict, init=False, repr=False)
+    _rotations: dict = field(default_factory=dict, init=False, repr=False)
+    _last_approach: tuple | None = field(default=None, init=False, repr=False)
+
+    def __post_init__(self):
+        sizes = {c.n_local for c in self.contacts}
+        if len(sizes) > 1:
+            raise ValueError("the dampers' contacts must all have flexible platforms or all rigid ones "
+                             f"(local coordinates per damper: {sorted(sizes)})")
+        self.n_local = sum(c.n_local for c in self.contacts)
+
+    @property
+    def n_dampers(self) -> int:
+        return len(self.contacts)
+
+    @property
+    def damper_local(self) -> int:
+        """Local coordinates per damper L: 12 (rigid platforms) or 12 + 2 n_m (flexible)."""
+        return self.n_local // max(self.n_dampers, 1)
+
+    def stacked_points(self) -> PointBatch | None:
+        """The points of all dampers as one :class:`PointBatch` (point maps (n_d, 2, P, 3, m), per
+        point (2 n_d P,): k_T [N/m], mu, weights; the shared normal law): each damper's
+        :meth:`DamperContacts.stacked_points` stacked, or None if the dampers' batches differ in
+        normal law or point-map shape or one damper has none. Cached."""
+        if self._batch is None:
+            stacks = [c.stacked_points() for c in self.contacts]
+            ok = all(b is not None for b in stacks) and all(
+                b.normal_law == stacks[0].normal_law and b.maps.shape == stacks[0].maps.shape for b in stacks)
+            if not ok:
+                self._batch = (False,)
+            else:
+                self._batch = (True, PointBatch(np.stack([b.maps for b in stacks]),
+                                                *(np.concatenate([getattr(b, f) for b in stacks])
+                                                  for f in ("tangential_stiffness", "friction_coefficient", "weights")),
+                                                stacks[0].normal_law))
+        return self._batch[1] if self._batch[0] else None
+
+    def _block_index(self, C: int):
+        """COO indices of the (n_d, C, L, C, L) per-damper blocks in the local Jacobian."""
+        if C not in self._index:
+            nd, L = self.n_dampers, self.damper_local
+            d, a, m, b, k = np.meshgrid(np.arange(nd), np.arange(C), np.arange(L), np.arange(C), np.arange(L),
+                                        indexing="ij")
+            self._index[C] = ((a * L * nd + L * d + m).ravel(), (b * L * nd + L * d + k).ravel())
+        return self._index[C]
+
+    def grid_rotations(self, basis):
+        """(n_d, C, C) rotations R_d of the harmonic coefficients that sample damper d on the
+        grid omega t_j - grid_phase_d (coefficients R_d c on the common grid), or None when every
+        phase is a whole number of samples (the common grid then serves every damper exactly).
+
+        In a tuned travelling wave damper d's motion is the first damper's advanced by its phase
+        theta_d: c_h,d = c_h,0 e^{i h theta_d} (complex c_h = a_h - i b_h). Sampled on the shifted
+        grid, every damper of a tuned assembly sees the first's samples, so its discrete friction
+        law (history-dependent through the return map) gives the first's forces shifted, and the
+        tuned full assembly equals the cyclic sector to rounding at any sample count, not only
+        at multiples of n / gcd(n, EO). The forces come back by R_d^T (R_d is orthogonal) and
+        the Jacobian blocks as R_d^T J_d R_d. For a mistuned disk the shifted grids are an
+        equally good discretisation as the common one."""
+        if self.grid_phase is None:
+            return None
+        key = (basis.n_samples, basis.harmonics)
+        if key not in self._rotations:
+            phase = np.asarray(self.grid_phase)
+            shift = phase * basis.n_samples / (2 * np.pi)                   # in samples
+            R = None
+            if np.any(np.abs(shift - np.round(shift)) >= 1e-9):
+                R = np.zeros((len(phase), basis.n_coeffs, basis.n_coeffs))
+                for h in basis.harmonics:
+                    j = basis.cos_index(h)
+                    if h == 0:
+                        R[:, j, j] = 1.0
+                        continue
+                    c, sn = np.cos(-h * phase), np.sin(-h * phase)          # c~ = c e^{-i h phase}
+                    R[:, j, j], R[:, j, j + 1], R[:, j + 1, j], R[:, j + 1, j + 1] = c, sn, -sn, c
+            self._rotations[key] = R
+        return self._rotations[key]
+
+    def forces_at(self, local, basis, offsets, jacobian):
+        """Forces (C, n_d, L) [N, N m] and Jacobian blocks (n_d, C, L, C, L) or None at the local
+        coefficients ``local`` (C, n_d, L) with the static approach ``offsets`` (n_d, 2, P) [m]
+        (no omega: the approach is given, :meth:`approach` gives it), each damper sampled
+        on its own grid where the interblade shift is not a whole number of samples
+        (:meth:`grid_rotations`), else all on the common grid (:meth:`_forces_on_grid`)."""
+        R = self.grid_rotations(basis)
+        if R is None:
+            return self._forces_on_grid(local, basis, offsets, jacobian)
+        force, blocks = self._forces_on_grid(_rotated(R, np.ascontiguousarray(local, dtype=float), False), basis,
+                                             offsets, jacobian)
+        return _rotated(R, force, True), None if blocks is None else _rotated_blocks(R, blocks)
+
+    def _forces_on_grid(self, local, basis, offsets, jacobian):
+        """Forces (C, n_d, L) and Jacobian blocks (n_d, C, L, C, L) or None on the common grid.
+
+        Batched dampers with rigid platforms and a normal law the fused kernel knows go through
+        :func:`fused_point_map_forces` (one numba call: point motion, normal
+        law, return map, AFT and the projections); otherwise (flexible platforms too,
+        whose point maps the fused kernel does not take) :meth:`forces_at_numpy`."""
+        stack = self.stacked_points()
+        fused = None if stack is None else fused_point_map_forces(stack.maps, local, basis, stack.tangential_stiffness,
+                                                                  stack.friction_coefficient, stack.normal_law,
+                                                                  stack.weights, offsets, jacobian)
+        return self.forces_at_numpy(local, basis, offsets, jacobian) if fused is None else fused
+
+    def forces_at_numpy(self, local, basis, offsets, jacobian):
+        """:meth:`forces_at` through :func:`point_map_forces` (the point-contact
+        kernel and numpy projections; the reference of the fused kernel; any normal law and
+        flexible platforms)."""
+        C, nd, L = basis.n_coeffs, self.n_dampers, self.damper_local
+        stack = self.stacked_points()
+        if stack is None:
+            force = np.zeros((C, nd, L))
+            blocks = np.zeros((nd, C, L, C, L)) if jacobian else None
+            for d, c in enumerate(self.contacts):
+                f, j = c.forces_at(local[:, d], basis, offsets[d], jacobian)
+                force[:, d] = f
+                if jacobian:
+                    blocks[d] = j.reshape(C, L, C, L)
+            return force, blocks
+        B, k_t, mu, weights, law = stack                         # B (n_d, 2, P, 3, m)
+        m = B.shape[-1]
+        force, q_blocks, _ = point_map_forces(B, local.reshape(C, nd, 2, m), basis, k_t, mu, law, weights, offsets,
+                                              jacobian, max_passes=MAX_PASSES, tol=PERIODIC_TOL)
+        force = force.reshape(C, nd, L)
+        if not jacobian:
+            return force, None
+        blocks = np.zeros((nd, C, 2, m, C, 2, m))
+        for q in range(2):
+            blocks[:, :, q, :, :, q, :] = q_blocks[:, q]
+        return force, blocks.reshape(nd, C, L, C, L)
+
+    def approach(self, omega):
+        """Static approach (n_d, 2, P) [m] of every damper and its omega-derivative [m s/rad] at
+        ``omega`` [rad/s], as ``(offsets, doffsets)`` (last omega cached;
+        dampers that share their approach function, the same damper at every position, evaluate
+        it once: 16 calls were 0.05 of a residual's 0.9 ms)."""
+        last = self._last_approach            # one read: the element may be shared by threads
+        if last is None or last[0] != omega:
+            if "_approach_groups" not in self.__dict__:
+                functions = {}
+                index = [functions.setdefault(id(c.approach), (len(functions), c.approach))[0] for c in self.contacts]
+                self._approach_groups = ([f for _, f in functions.values()], np.array(index))
+            functions, index = self._approach_groups
+            if len(index) == 1:                # one damper (the tuned sector's): its arrays viewed, not copied
+                offsets, doffsets = functions[0](omega)
+                last = (omega, offsets[None], doffsets[None])
+            else:
+                out = [f(omega) for f in functions]
+                last = (omega, np.array([o[0] for o in out])[index], np.array([o[1] for o in out])[index])
+            self._last_approach = last
+        return last[1], last[2]
+
+    @property
+    def linear_normal_laws(self) -> bool:
+        """Whether every patch of every damper has a linear normal law (computed once)."""
+        if "_linear" not in self.__dict__:
+            self._linear = all(isinstance(p.normal_law, LinearNormalLaw) for c in self.contacts
+                               for p in c.geometry.patches)
+        return self._linear
+
+    def _sparse(self, blocks, C):
+        rows, cols = self._block_index(C)
+        n = C * self.n_local
+        return sp.csr_matrix((blocks.ravel(), (rows, cols)), shape=(n, n))
+
+    def evaluate(self, local, basis, omega, jacobian=True):
+        """``(force (C, n_d, L), Jacobian blocks (n_d, C*L, C*L) or None, d force / d omega
+        (C, n_d, L) or None)``; damper d's block in its own (coefficient, coordinate) order."""
+        C, nd = basis.n_coeffs, len(self.contacts)
+        L = self.n_local // nd
+        local = np.asarray(local).reshape(C, nd, L)
         offsets, doffsets = self.approach(omega)
-        force, jac = self.forces_at(local, basis, offsets, jacobian)
+        force, blocks = self.forces_at(local, basis, offsets, jacobian)
         if not jacobian:
             return force, None, None
         domega = None
-        if np.any(doffsets != 0):
-            # the preload follows the rotor speed (one harmonic: the static approach scales with F_CG)
-            C, L = basis.n_coeffs, self.n_local
-            linear = all(isinstance(p.normal_law, LinearNormalLaw) for p in self.geometry.patches)
-            rate = np.empty((C, 1, L))
-            if linear and euler_rate(offsets[None], doffsets[None], jac.reshape(1, C, L, C, L),
-                                     np.asarray(local, dtype=float).reshape(C, 1, L), force.reshape(C, 1, L), rate):
-                # linear normal law: the forces are homogeneous of degree 1 in (w, approach) (springs
-                # and the Coulomb limit scale alike), so Euler's identity J w + (dF/da) a = F gives
-                # dF/dOmega = (F - J w) (da/dOmega) / a without another AFT pass (euler_rate, the
-                # mistuned ring's kernel with one damper)
-                domega = rate.ravel()
-            else:
-                # central difference in omega, both ends without the Jacobian so that both take
-                # the same return-map passes (two extra AFT passes)
+        if doffsets.any():
+            # as DamperContacts.harmonic_forces (the same kernel, disk.euler_rate): Euler's identity
+            # for linear normal laws, else a central difference in omega of all dampers at once
+            domega = np.empty(force.shape)
+            if not (self.linear_normal_laws and euler_rate(offsets, doffsets, blocks, local, force, domega)):
                 h = 1e-6 * omega
-                force_p, _ = self.forces_at(local, basis, offsets + h * doffsets, False)
-                force_m, _ = self.forces_at(local, basis, offsets - h * doffsets, False)
-                domega = ((force_p - force_m) / (2 * h)).ravel()
-        return force, jac, domega
+                fp, _ = self.forces_at(local, basis, offsets + h * doffsets, False)
+                fm, _ = self.forces_at(local, basis, offsets - h * doffsets, False)
+                domega = (fp - fm) / (2 * h)
+        return force, blocks.reshape(nd, C * L, C * L), domega
+
+    def harmonic_forces(self, local, basis, omega, jacobian=True):
+        C = basis.n_coeffs
+        force, blocks, domega = self.evaluate(local, basis, omega, jacobian)
+        if not jacobian:
+            return force.reshape(C, self.n_local), None, None
+        if not self.dense:
+            jac = self._sparse(blocks, C)
+        else:
+            jac = blocks[0] if self.n_dampers == 1 else self._sparse(blocks, C).toarray()
+        return force.reshape(C, self.n_local), jac, None if domega is None else domega.ravel()
+
+
+@njit(cache=True)
+def _rotated(R, values, transposed):
+    """(C, n_d, L) coefficients rotated damper by damper: R_d values_d, or R_d^T values_d
+    (``transposed``), R (n_d, C, C) (:meth:`AssemblyContacts.grid_rotations`)."""
+    C, nd, L = values.shape
+    out = np.zeros(values.shape)
+    for d in range(nd):
+        for a in range(C):
+            for b in range(C):
+                r = R[d, b, a] if transposed else R[d, a, b]
+                if r != 0.0:
+                    for m in range(L):
+                        out[a, d, m] += r * values[b, d, m]
+    return out
+
+
+@njit(cache=True)
+def _rotated_blocks(R, blocks):
+    """Jacobian blocks (n_d, C, L, C, L) rotated damper by damper: R_d^T J_d R_d (the forces
+    come back by R_d^T from coefficients that went in by R_d). As a numpy einsum it was 15 % of
+    a 128-blade FRF point; R_d has 2 x 2 blocks, so the loops skip its zeros."""
+    nd, C, L = blocks.shape[0], blocks.shape[1], blocks.shape[2]
+    out = np.zeros(blocks.shape)
+    for d in range(nd):
+        for a in range(C):
+            for b in range(C):
+                rba = R[d, b, a]
+                if rba == 0.0:
+                    continue
+                for c in range(C):
+                    for e in range(C):
+                        w = rba * R[d, c, e]
+                        if w == 0.0:
+                            continue
+                        for m in range(L):
+                            for n in range(L):
+                                out[d, a, m, e, n] += w * blocks[d, b, m, c, n]
+    return out
 
 
 def rotor_speed_in_hz(rotor_speed_hz):
@@ -464,8 +721,387 @@ def interblade_phase(engine_order, n_blades) -> float:
 DEFAULT_DAMPER_RADIUS = 0.1
 
 
+def check_blade_bounded(blade: ModalBlade, excitation, has_damper: bool, f_start_hz: float, f_end_hz: float) -> None:
+    """ValueError where no bounded periodic response exists in ``f_start_hz``..``f_end_hz``
+    [Hz] for ``blade`` under the tip load ``excitation`` (6,) [N, N m] with a damper on its
+    platforms (``has_damper``) or not: a blade mode j with zero modal damping, a modal force
+    phi_j^T F != 0, its natural frequency f_0j inside the range, and no damper acting on it (no
+    damper, or rigid platforms that do not move at OL and OR in that mode). Its modal equation is then
+    q_j'' + omega_0j^2 q_j = phi_j^T F cos(Omega t) alone, whose amplitude grows without
+    bound at Omega = omega_0j. (With a damper on that mode the bound of its friction forces
+    is no closed form: the normal loads vary with the motion.)"""
+    force = blade.shape("excitation").T @ np.asarray(excitation, dtype=float)          # (nm,) modal forces [N]
+    lo, hi = min(f_start_hz, f_end_hz), max(f_start_hz, f_end_hz)
+    if has_damper:
+        if blade.flexible_platform:
+            return
+        at_damper = np.abs(np.vstack([blade.shape("OL"), blade.shape("OR")])).max(axis=0) > 0
+    else:
+        at_damper = np.zeros(blade.n_modes, dtype=bool)
+    f0 = np.asarray(blade.natural_frequencies_hz, dtype=float)
+    free = (blade.damping_ratios == 0) & (force != 0) & ~at_damper & (f0 >= lo) & (f0 <= hi)
+    if np.any(free):
+        j = int(np.flatnonzero(free)[0])
+        name = blade.mode_names[j] if len(blade.mode_names) else str(j + 1)
+        why = "the disk has no damper" if not has_damper else "the damper's platforms do not move in it"
+        raise ValueError(
+            f"no bounded response: blade mode {name} has damping_ratios = 0, a modal force "
+            f"{force[j]:.6g} N and its natural frequency {f0[j]:.6g} Hz inside the range {f_start_hz:g}-"
+            f"{f_end_hz:g} Hz, and {why}: its amplitude grows without bound there; give the mode a damping "
+            f"ratio > 0 or a range without {f0[j]:.6g} Hz")
+
+
 @dataclass
-class TunedDisk:
+class DamperPosition:
+    """One damper position of a bladed disk, described once for both assemblies (the tuned
+    disk's cyclic sector has one, a ring one per blade): the damper between blade k's OL platform
+    and blade k+1's OR platform, its platform angles, the gaps of its contact points before
+    loading and its preload law, the centrifugal force F_CG = m R Omega_R^2 on the damper at the
+    radius R (Eq. 26; Omega_R = Omega_E / EO, or the given rotor speed). Its contacts as a
+    harmonic-balance element: :meth:`contacts`.
+
+    Parameters: as :class:`TunedDisk`'s of the same names (``damper``: CylinderDamper,
+    WedgeDamper or None; ``gamma_left``, ``gamma_right`` [rad]; ``initial_gaps`` (2, P) [m] or
+    None; ``damper_radius`` R [m]; ``engine_order``; ``rotor_speed_hz`` [Hz] or None). Frequencies
+    are the residual's angular excitation frequency omega [rad/s]. :meth:`validate` checks the
+    angles (the disk checks the rest).
+    """
+
+    damper: CylinderDamper | WedgeDamper | None
+    gamma_left: float = PLATFORM_ANGLE
+    gamma_right: float = PLATFORM_ANGLE
+    initial_gaps: np.ndarray | None = None
+    damper_radius: float = DEFAULT_DAMPER_RADIUS
+    engine_order: int = 1
+    rotor_speed_hz: float | None = None
+
+    def validate(self) -> "DamperPosition":
+        """ValueError unless both platform angles lie in (0, pi/2) [rad] and ``initial_gaps`` (if
+        given, with a damper) is a finite (2, P) array [m] (OL, OR points); returns this position.
+        Run when a disk is made (issue 34 item 6), not at each :meth:`damper_geometry`."""
+        validation.in_range("gamma_left (platform angle, rad)", self.gamma_left, 0.0, np.pi / 2, closed="neither")
+        validation.in_range("gamma_right (platform angle, rad)", self.gamma_right, 0.0, np.pi / 2, closed="neither")
+        if self.initial_gaps is not None and self.damper is not None:
+            gaps = np.asarray(validation.finite("initial_gaps", self.initial_gaps), dtype=float)
+            P = self.damper.geometry(self.gamma_left, self.gamma_right).patches[0].n_points
+            if gaps.shape != (2, P):
+                raise ValueError(f"initial_gaps must have shape (2, {P}) (OL, OR points) in m")
+        return self
+
+    @property
+    def has_damper(self) -> bool:
+        """Whether a damper with a mass sits here."""
+        return self.damper is not None and self.damper.mass > 0
+
+    def damper_geometry(self) -> DamperGeometry:
+        """The damper's contact frames and patches at these platform angles, with the initial gaps."""
+        geometry = self.damper.geometry(self.gamma_left, self.gamma_right)
+        if self.initial_gaps is not None:    # validated when the disk was made (validate)
+            gaps = np.asarray(self.initial_gaps, dtype=float)
+            geometry.patches = tuple(dataclasses.replace(p, initial_gap=g) for p, g in zip(geometry.patches, gaps))
+        return geometry
+
+    def platform_offsets(self, geometry: DamperGeometry, points) -> np.ndarray:
+        """(2, 3) contact centres seen from the blades' OL / OR points ``points`` (a blade's
+        ``points``: every blade of a disk has the same; in each blade's frame).
+
+        The blade pitch at the platform (unrolled, neighbouring blade frames parallel) is chosen
+        so that the OL and OR contact centres lie above or below the OL point of blade i and
+        the OR point of blade i+1. For asymmetric platforms the two contact centres are at
+        different heights (radial mismatch dz); the damper is placed half-way, so each rigid
+        platform carries half of it (OL offset -dz/2, OR offset +dz/2, radially). This keeps
+        the model mirror-symmetric: exchanging gamma_L and gamma_R gives the mirror image of
+        the assembly (the paper: "the same results are obtained if the left and right platform
+        angle are exchanged"); carrying all of dz on one side breaks that.
+        """
+        p_ol, p_or = points["OL"], points["OR"]
+        cg = p_ol - geometry.centres[0]                      # damper CG in blade i's frame (OL centre on OL)
+        or_centre = cg + geometry.centres[1]                 # in blade i's frame
+        pitch = p_or[0] - or_centre[0]                       # blade i+1 frame = blade i frame - pitch x
+        mismatch = or_centre + np.array([pitch, 0.0, 0.0]) - p_or   # (0, dy, dz) with OL centre on OL
+        half = np.array([0.0, 0.0, mismatch[2] / 2])
+        return np.array([-half, mismatch - half])
+
+    def centrifugal_force(self, omega: float):
+        """(F_CG [N], dF_CG / dOmega_E [N s/rad]) at the angular excitation frequency ``omega``
+        [rad/s] (Eq. 26; the rotor speed omega / EO unless ``rotor_speed_hz`` is given)."""
+        return centrifugal_force(self.damper.mass, self.damper_radius, engine_order=self.engine_order,
+                                 f_hz=omega / (2 * np.pi), rotor_speed_hz=self.rotor_speed_hz)
+
+    def centrifugal_law(self):
+        """A function omega [rad/s, the excitation frequency] -> (F_CG [N], dF_CG / dOmega_E
+        [N s/rad]) of Eq. 26 whose parameters are validated once, here (the residual calls it
+        at every evaluation): F = c Omega_E^2, or constant at a given rotor speed."""
+        c, _ = self.centrifugal_force(1.0)
+        if self.rotor_speed_hz is not None:
+            return lambda omega: (c, 0.0)
+        return lambda omega: (c * omega ** 2, 2 * c * omega)
+
+    def seated(self, omega: float) -> np.ndarray:
+        """(6,) the damper seated frictionlessly under F_CG at ``omega`` [rad/s] (``seat``)."""
+        return seat(self.damper_geometry(), self.centrifugal_force(omega)[0])[0]
+
+    def contacts(self, geometry: DamperGeometry, approach, left: ModalBlade, right: ModalBlade):
+        """(DamperContacts, G_D (12, 6), G_P (12, 12)) of the damper here between blade ``left``
+        (its OL platform) and blade ``right`` (its OR platform), with ``geometry``
+        (:meth:`damper_geometry`) and the static ``approach`` (:meth:`approach_function`): the
+        contacts as a harmonic-balance element (flexible platforms' point maps where both blades
+        carry per-point data, :func:`contact_point_maps`) and the rigid kinematics of Eq. 6,
+        w = G_D u_D - G_P [Phi_OL; Phi_OR] q, at the contact centres :meth:`platform_offsets`."""
+        offsets = self.platform_offsets(geometry, left.points)
+        return (DamperContacts(geometry, approach, contact_point_maps(geometry, offsets, left, right)), geometry.G_D,
+                geometry.G_P(offsets))
+
+    @staticmethod
+    def retention(geometry: DamperGeometry, static_retention: float) -> np.ndarray:
+        """(6, 6) the static-harmonic retention spring of the damper [N/m, N m/rad]: the fraction
+        ``static_retention`` of its patches' summed normal stiffness (:func:`~bladedamp.damper.retention_stiffness`)."""
+        return retention_stiffness(static_retention, sum(p.normal_law.stiffness for p in geometry.patches))
+
+    def approach_function(self, geometry: DamperGeometry, basis: HarmonicBasis):
+        """The static approach of ``geometry``'s contact points under this position's F_CG (Eq. 26):
+        a function omega [rad/s, the residual's excitation frequency] -> (per-point static
+        approach (2, P) [m], its omega-derivative (2, P) [m s/rad]). With a static harmonic in
+        ``basis`` the seating is part of the harmonic balance and the approach is the rest state
+        (minus the initial gaps); otherwise the frictionless seating under F_CG (``seat``).
+        The :attr:`DamperContacts.approach` of the damper here."""
+        gaps = np.array([p.initial_gap for p in geometry.patches])
+        if basis.has_static:
+            rest = -gaps  # the seating is part of the harmonic balance
+            zero = np.zeros_like(rest)
+            return lambda omega: (rest, zero)
+        if np.any(gaps != 0):
+            # a misfit: the seating is not homogeneous in F_CG; seat at each load, d/dF by central
+            # differences of the (smooth away from touch-down) seating
+            cache = {}
+
+            def approach(omega):
+                if omega not in cache:
+                    F, dF = self.centrifugal_force(omega)
+                    a = seat(geometry, F)[1]
+                    h = 1e-6 * max(F, 1e-12)
+                    da = (seat(geometry, F + h)[1] - seat(geometry, max(F - h, 0.0))[1]) / (F + h - max(F - h, 0.0))
+                    cache.clear()
+                    cache[omega] = (a, da * dF)
+                return cache[omega]
+
+            return approach
+        # perfect fit: seat once at a reference load; the laws are homogeneous, so the static
+        # approach scales as F_CG^(1/p) (p = 1 for the linear law)
+        exponent = getattr(geometry.patches[0].normal_law, "exponent", 1.0)
+        F_ref = 1.0
+        _, approach_ref, _ = seat(geometry, F_ref)
+        centrifugal = self.centrifugal_law()
+
+        def approach(omega):
+            F, dF = centrifugal(omega)
+            if F <= 0:
+                return np.zeros_like(approach_ref), np.zeros_like(approach_ref)
+            scale = (F / F_ref) ** (1 / exponent)
+            return approach_ref * scale, approach_ref * scale / (exponent * F) * dF
+
+        return approach
+
+
+class DiskModel:
+    """The behaviour of a bladed disk with underplatform dampers that does not depend on how it
+    is assembled: the tuned disk's cyclic sector (:class:`TunedDisk`, one blade and one damper,
+    the next blade by the interblade phase) and the ring of individual blades and dampers
+    (:class:`~bladedamp.mistuned.MistunedDisk`) are both one. It holds, once, the static state,
+    the stuck linear start, the robust start, the unknowns' scales and the retry scales of the
+    continuation, the FRF driver's sampling (:mod:`bladedamp.frf`), a blade point's map, the time
+    integration and its checks (:meth:`stop_check`, :meth:`peak_check`) and the monodromy matrix.
+
+    An assembly gives its layout (unknowns harmonic-major; per coefficient the blades' modal
+    coordinates first, then the six coordinates of each damper with a mass):
+
+    * ``engine_order``, ``n_blades``; :attr:`model_blades`: the blades written out (s);
+    * :attr:`active_positions`: the positions whose damper has a mass (the d-th of them owns the
+      unknowns :meth:`damper_unknowns` ``(d)``);
+    * :meth:`seated_damper` ``(k, omega)``: the frictionless seat of position k's damper under
+      F_CG at omega [rad/s] (Eq. 26);
+    * ``hbm_system``, ``output_amplitudes`` (the protocol of :mod:`bladedamp.hbm.accuracy`) and
+      ``full_assembly`` (every blade and damper written out, what the time integration integrates).
+    """
+
+    def validate_parameters(self, has_damper: bool) -> None:
+        """The disk-wide parameters checked (ValueError naming the parameter) and normalised in
+        place: ``damper_radius`` > 0 (a PlausibilityWarning outside 1 mm..5 m), ``excitation`` a
+        finite 6-vector, and an explicit ``rotor_speed_hz`` where EO = 0 and a damper
+        (``has_damper``) needs the preload of Eq. 26."""
+        validation.positive("damper_radius R", self.damper_radius)
+        # R from a small test rig (the reference disk: 26 mm) to the largest fan and low-pressure
+        # turbine disks (~1.5 m): 1 mm..5 m; outside, most likely a unit slip (26 meant as 26 mm)
+        validation.plausible("damper_radius R", self.damper_radius, 1e-3, 5.0, "m",
+                            "the damper's distance to the rotor axis, 1 mm to 5 m")
+        self.excitation = np.asarray(validation.finite("excitation", self.excitation), dtype=float)
+        if self.excitation.shape != (6,):
+            raise ValueError("excitation must be a 6-vector (F_x, F_y, F_z, M_x, M_y, M_z) in N and N m")
+        if self.engine_order == 0 and has_damper and self.rotor_speed_hz is None:
+            raise ValueError("engine_order = 0 needs an explicit rotor_speed_hz (rotor revolutions per second, "
+                             "> 0; rpm / 60)")
+
+    @property
+    def interblade_phase(self) -> float:
+        """dphi [rad] in (-pi, pi], e^{i dphi} = e^{i 2 pi EO / n} (Eq. 25; :func:`interblade_phase`)."""
+        return interblade_phase(self.engine_order, self.n_blades)
+
+    @property
+    def n_modal_unknowns(self) -> int:
+        """The blades' modal coordinates per harmonic coefficient, s n_m (the dampers' follow)."""
+        return len(self.model_blades) * self.model_blades[0].n_modes
+
+    # ----- the start and the scales of a branch --------------------------------------------
+    def static_state(self, system: HarmonicBalanceSystem, omega: float) -> np.ndarray:
+        """The state (C * n_dof,) without dynamic motion: rest, or with a static harmonic every
+        damper seated frictionlessly under F_CG at ``omega`` [rad/s] (``seat``)."""
+        x = np.zeros(system.n_unknowns)
+        if system.basis.has_static:
+            X = x.reshape(system.basis.n_coeffs, system.n_dof)
+            for d, k in enumerate(self.active_positions):
+                X[system.basis.cos_index(0), self.damper_unknowns(d)] = self.seated_damper(k, omega)
+        return x
+
+    def initial_guess(self, system: HarmonicBalanceSystem, omega: float) -> np.ndarray:
+        """Stuck linear solution (C * n_dof,) of ``system`` at ``omega`` [rad/s, the residual's
+        excitation frequency]: one Newton step from the static state, where every contact point
+        sticks (without a damper: the linear solution itself).
+
+        With a static harmonic the contacts have no preload at x = 0 (zero approach: every
+        point is open and the Jacobian there has no contact stiffness at all), so the step
+        starts from the dampers seated frictionlessly under F_CG (``seat``) instead of from rest.
+        """
+        x = self.static_state(system, omega)
+        R, J, _ = system.residual(x, omega)
+        return x - system.factorize(J)(R)
+
+    def start_solution(self, system: HarmonicBalanceSystem, omega: float, scales, tol: float = 1e-10) -> np.ndarray:
+        """Solution (C * n_dof,) of ``system`` at the first frequency ``omega`` [rad/s], robust in
+        gross slip (:func:`bladedamp.hbm.start.robust_start`); ``scales`` (C * n_dof,) from
+        :meth:`unknown_scales`.
+
+        Damped Newton from the stuck linear solution; if that fails (a light damper sliding far
+        from its stuck state), an excitation homotopy on the dynamic excitation (the centrifugal
+        preload stays), from the seated dampers. Returns the best iterate (the continuation then
+        reports honestly if it is not a solution)."""
+        f = system.excitation(omega)[0].reshape(system.basis.n_coeffs, system.n_dof).copy()
+        if system.basis.has_static:
+            f[system.basis.cos_index(0)] = 0.0          # the preload is not ramped
+        base = self.static_state(system, omega)
+        residual_scale = max(np.linalg.norm(system.residual(np.zeros(system.n_unknowns), omega, False)[0]), 1e-300)
+        return robust_start(system.residual, {"stuck linear solution": self.initial_guess(system, omega)},
+                            omega, scales, f.ravel(), base=base, residual_scale=residual_scale, tol=tol,
+                            factorize=system.factorize).x
+
+    def unknown_scales(self, system: HarmonicBalanceSystem, omega_start: float, omega_end: float) -> np.ndarray:
+        """Scale (C * n_dof,) of each unknown of ``system`` over omega_start..omega_end [rad/s]
+        (the continuation's ``x_scale``): its largest value in the stuck linear responses across the
+        range (harmonic coefficients pooled per DOF, and over the blades for each mode and over
+        the dampers for each damper DOF, so that every blade is measured alike), floored at 1e-3
+        of the largest scale of its kind (modal / damper translation / damper rotation). A damper
+        group that the stuck response leaves at exactly zero (e.g. no damper rotation in the
+        symmetric EO = n/2 standing wave) is floored at 1e-3 of the platform motion of the same
+        kind instead (a 1e-300 floor turned round-off in the Newton step into an overflow).
+        Times sqrt(s) for s blades written out: the scaled norm of s blades equals that of one
+        sector, so the arc-length steps (and the number of points) are those of the tuned cyclic
+        model."""
+        C, N = system.basis.n_coeffs, system.n_dof
+        blades = self.model_blades
+        s, nm = len(blades), blades[0].n_modes
+        X = np.array([np.abs(self.initial_guess(system, w)).reshape(C, N).max(axis=0)
+                      for w in np.linspace(omega_start, omega_end, 7)]).max(axis=0)
+        q = X[:s * nm].reshape(s, nm).max(axis=0)
+        q = np.maximum(q, 1e-3 * q.max() + 1e-300)
+        out = [np.tile(q, s)]
+        nd = len(self.active_positions)
+        if nd:
+            u = X[s * nm:].reshape(nd, 6).max(axis=0)
+            phi = np.abs(np.stack([np.stack([b.shape("OL"), b.shape("OR")]) for b in blades]))
+            for g, platform in ((slice(0, 3), phi[:, :, :3].max()), (slice(3, 6), phi[:, :, 3:].max())):
+                u[g] = np.maximum(u[g], max(1e-3 * u[g].max(), 1e-3 * q.max() * platform) + 1e-300)
+            out.append(np.tile(u, nd))
+        return np.sqrt(s) * np.tile(np.concatenate(out), C)
+
+    def retry_scales(self, system: HarmonicBalanceSystem, scales: np.ndarray) -> np.ndarray | None:
+        """The continuation's ``retry_x_scale``: ``scales`` (from :meth:`unknown_scales`) with every
+        damper's unknowns weighing less in the arc length (:func:`damper_weighted_scales`); None
+        without a damper."""
+        if not self.active_positions:
+            return None
+        return damper_weighted_scales(scales, system.basis.n_coeffs, slice(self.n_modal_unknowns, None))
+
+    # ----- the protocol of bladedamp.frf (the FRF driver) ----------------------------------
+    def sample_plan(self, harmonics) -> tuple[int, int, int]:
+        """(first, most, most for a dissipation failure) AFT samples per period of the automatic
+        sampling (:func:`bladedamp.response.sampled_response`): the basis default (each damper
+        of a ring is sampled on its own grid, so no multiple of n / gcd(n, EO) is needed), then
+        ``AUTO_SAMPLES_GROWTH`` and ``AUTO_SAMPLES_GROWTH_DISSIPATION`` times it."""
+        first = HarmonicBasis(tuple(harmonics)).n_samples
+        return first, AUTO_SAMPLES_GROWTH * first, AUTO_SAMPLES_GROWTH_DISSIPATION * first
+
+    def judges_solution_samples(self, n_samples: int) -> bool:
+        """False: the dissipation is judged re-evaluated with more samples
+        (:func:`bladedamp.response.physical_checks`)."""
+        return False
+
+    # ----- outputs ---------------------------------------------------------------------------
+    def point_map(self, basis: HarmonicBasis, point: str = "tip", directions=(0,), blade: int = 0) -> np.ndarray:
+        """Real-form map (C*k, C*n_dof) from the unknowns of :meth:`hbm_system` (``basis``'s
+        harmonics) to the motion of blade ``blade``'s ``point`` (the tuned disk: its reference
+        blade, 0) in the k ``directions`` (0, 1, 2: x, y, z translation [m]; 3, 4, 5: rotations
+        [rad], blade frame), through the blade's mode shapes (the damper's DOFs do not enter).
+        The map of a :class:`~bladedamp.hbm.system.Coupling` from the model to an element at that
+        point; add one with ``system.add(element, map, name)``."""
+        blades = self.model_blades
+        blade = validation.integer("blade", blade, minimum=0, maximum=len(blades) - 1)
+        nm = blades[0].n_modes
+        n_dof = self.n_modal_unknowns + 6 * len(self.active_positions)
+        return blade_point_map(blades[blade], basis, point, directions, n_dof, slice(blade * nm, (blade + 1) * nm))
+
+    # ----- time integration ------------------------------------------------------------------
+    def time_response(self, f_hz, **options):
+        """Steady state of every blade at each excitation frequency ``f_hz`` [Hz] (scalar or
+        array) by time integration of the full assembly (:meth:`full_assembly`: every blade and
+        damper written out, no cyclic reduction), from the static equilibrium under F_CG (Eq. 26)
+        or a harmonic solution's state (``start_coefficients`` of the full assembly:
+        :func:`bladedamp.hbm.monodromy.full_assembly_coefficients`); see
+        :func:`bladedamp.timedomain.disk_time_response` for ``options``.
+        Returns a :class:`bladedamp.timedomain.DiskTimeResponse` (tip amplitudes of every blade)."""
+        from .timedomain import disk_time_response
+
+        return disk_time_response(self.full_assembly(), f_hz, **options)
+
+    def monodromy_matrix(self, coefficients, basis, omega: float, steps: int | None = None):
+        """(monodromy matrix, periodicity error) of the HBM solution ``coefficients`` at
+        ``omega`` [rad/s] on the full assembly (:func:`bladedamp.hbm.monodromy.disk_monodromy`)."""
+        result = disk_monodromy(self, coefficients, basis, omega, steps)
+        return result.matrix, result.periodicity_error
+
+    def stop_check(self, response, offset_hz: float = STOP_CHECK_OFFSET_HZ, f_start_hz: float | None = None,
+                   **options):
+        """Whether a periodic motion exists just beyond where ``response`` (a failed branch of
+        :meth:`frequency_response`) got furthest: :meth:`time_response` at that frequency plus
+        ``offset_hz`` [Hz] in the branch's direction (``options`` go to it); for a response that
+        kept no point, at ``f_start_hz`` [Hz], where its branch was to start. Its ``periodic``
+        and ``status`` answer for the motion reached from the static equilibrium: "not settled" or
+        "drifting" (the damper hops on the platforms or keeps rolling): not periodic, which no
+        harmonic-balance branch represents; "periodic": the branch did not reach a periodic motion
+        that exists (:func:`stop_verdict`).
+        Costs one time integration of the full assembly (30-210 s for the reference disk on 2
+        cores)."""
+        return time_check_beyond(self, response, offset_hz, f_start_hz, **options)
+
+    def peak_check(self, response, **options):
+        """:meth:`time_response` at the frequency of ``response``'s peak (the point of the
+        largest first-harmonic tip amplitude of any blade in any direction), started on the
+        branch's state there (``start="hbm"``, default) or from the static equilibrium
+        (``start="static"``; :func:`time_at_peak`), the other ``options`` going to it: what
+        ``frequency_response(..., check_peak=True)`` runs (:func:`with_peak_check`)."""
+        return time_at_peak(self, response, **options)
+
+
+@dataclass
+class TunedDisk(DiskModel):
     """Tuned bladed disk with one damper per blade pair (cyclic symmetry, Eq. 21-25).
 
     Parameters
@@ -502,34 +1138,13 @@ class TunedDisk:
         self.rotor_speed_hz = rotor_speed_in_hz(self.rotor_speed_hz)
         validation.integer("n_blades", self.n_blades, minimum=2)
         self.engine_order = validation.integer("engine_order (EO)", self.engine_order, minimum=0)
-        validation.in_range("gamma_left (platform angle, rad)", self.gamma_left, 0.0, np.pi / 2, closed="neither")
-        validation.in_range("gamma_right (platform angle, rad)", self.gamma_right, 0.0, np.pi / 2, closed="neither")
-        validation.positive("damper_radius R", self.damper_radius)
-        # R from a small test rig (the reference disk: 26 mm) to the largest fan and low-pressure
-        # turbine disks (~1.5 m): 1 mm..5 m; outside, most likely a unit slip (26 meant as 26 mm)
-        validation.plausible("damper_radius R", self.damper_radius, 1e-3, 5.0, "m",
-                            "the damper's distance to the rotor axis, 1 mm to 5 m")
-        self.excitation = np.asarray(validation.finite("excitation", self.excitation), dtype=float)
-        if self.excitation.shape != (6,):
-            raise ValueError("excitation must be a 6-vector (F_x, F_y, F_z, M_x, M_y, M_z) in N and N m")
-        if self.engine_order == 0 and self.has_damper and self.rotor_speed_hz is None:
-            raise ValueError("engine_order = 0 needs an explicit rotor_speed_hz (rotor revolutions per second, "
-                             "> 0; rpm / 60)")
-        if self.initial_gaps is not None and self.damper is not None:
-            gaps = np.asarray(validation.finite("initial_gaps", self.initial_gaps), dtype=float)
-            P = self.damper.geometry(self.gamma_left, self.gamma_right).patches[0].n_points
-            if gaps.shape != (2, P):
-                raise ValueError(f"initial_gaps must have shape (2, {P}) (OL, OR points) in m")
+        self.position.validate()
+        self.validate_parameters(self.has_damper)
 
     # ----- geometry --------------------------------------------------------------------
     @property
     def has_damper(self) -> bool:
         return self.damper is not None and self.damper.mass > 0
-
-    @property
-    def interblade_phase(self) -> float:
-        """dphi [rad] in (-pi, pi], e^{i dphi} = e^{i 2 pi EO / n} (Eq. 25; :func:`interblade_phase`)."""
-        return interblade_phase(self.engine_order, self.n_blades)
 
     @property
     def nodal_diameter(self) -> tuple[int, str]:
@@ -541,34 +1156,42 @@ class TunedDisk:
         modes = self.blade.mode_names or tuple(f"q{j + 1}" for j in range(self.blade.n_modes))
         return tuple(f"q_{m}" for m in modes) + (DAMPER_DOFS if self.has_damper else ())
 
+    # ----- the layout of DiskModel: one blade, one damper ------------------------------
+    @property
+    def position(self) -> DamperPosition:
+        """The damper position of every sector (:class:`DamperPosition`; built from the fields on
+        each call, so that a field set after construction is seen)."""
+        return DamperPosition(self.damper, self.gamma_left, self.gamma_right, self.initial_gaps, self.damper_radius,
+                              self.engine_order, self.rotor_speed_hz)
+
+    @property
+    def model_blades(self) -> list[ModalBlade]:
+        """[blade]: the reference sector's blade, the one blade written out (:class:`DiskModel`)."""
+        return [self.blade]
+
+    @property
+    def active_positions(self) -> list[int]:
+        """[0] with a damper (it has a mass), else []."""
+        return [0] if self.has_damper else []
+
+    def damper_unknowns(self, d: int = 0) -> slice:
+        """The damper's six coordinates among the n_m + 6 unknowns per coefficient (after the
+        blade's modal coordinates)."""
+        nm = self.blade.n_modes
+        return slice(nm, nm + 6)
+
+    def seated_damper(self, k: int, omega: float) -> np.ndarray:
+        """(6,) the damper seated frictionlessly under F_CG at ``omega`` [rad/s] (``seat``; ``k``: 0)."""
+        return self.position.seated(omega)
+
     def damper_geometry(self) -> DamperGeometry:
-        """The damper's :class:`DamperGeometry` at the disk's platform angles, with its
-        ``initial_gaps`` (validated when the disk is made)."""
-        geometry = self.damper.geometry(self.gamma_left, self.gamma_right)
-        if self.initial_gaps is not None:
-            geometry.patches = tuple(dataclasses.replace(p, initial_gap=g)
-                                     for p, g in zip(geometry.patches, np.asarray(self.initial_gaps, dtype=float)))
-        return geometry
+        """The damper's contact frames and patches (:meth:`DamperPosition.damper_geometry`)."""
+        return self.position.damper_geometry()
 
     def platform_offsets(self, geometry: DamperGeometry) -> np.ndarray:
-        """(2, 3) contact centres seen from the blade's OL / OR points (in each blade's frame).
-
-        The blade pitch at the platform (unrolled, neighbouring blade frames parallel) is chosen
-        so that the OL and OR contact centres lie above or below the OL point of blade i and
-        the OR point of blade i+1. For asymmetric platforms the two contact centres are at
-        different heights (radial mismatch dz); the damper is placed half-way, so each rigid
-        platform carries half of it (OL offset -dz/2, OR offset +dz/2, radially). This keeps
-        the model mirror-symmetric: exchanging gamma_L and gamma_R gives the mirror image of
-        the assembly (the paper: "the same results are obtained if the left and right platform
-        angle are exchanged"); carrying all of dz on one side breaks that.
-        """
-        p_ol, p_or = self.blade.points["OL"], self.blade.points["OR"]
-        cg = p_ol - geometry.centres[0]                      # damper CG in blade i's frame (OL centre on OL)
-        or_centre = cg + geometry.centres[1]                 # in blade i's frame
-        pitch = p_or[0] - or_centre[0]                       # blade i+1 frame = blade i frame - pitch x
-        mismatch = or_centre + np.array([pitch, 0.0, 0.0]) - p_or   # (0, dy, dz) with OL centre on OL
-        half = np.array([0.0, 0.0, mismatch[2] / 2])
-        return np.array([-half, mismatch - half])
+        """(2, 3) contact centres seen from the blade's OL / OR points (in each blade's frame;
+        :meth:`DamperPosition.platform_offsets`)."""
+        return self.position.platform_offsets(geometry, self.blade.points)
 
     def centrifugal_force(self, f_hz: float):
         """(F_CG [N], dF_CG / dOmega_E [N s/rad]) at the excitation frequency ``f_hz`` [Hz] (Eq. 26;
@@ -577,8 +1200,7 @@ class TunedDisk:
 
     def _centrifugal_force(self, omega: float):
         """:meth:`centrifugal_force` at the angular excitation frequency ``omega`` [rad/s] (the residual's)."""
-        return centrifugal_force(self.damper.mass, self.damper_radius, engine_order=self.engine_order,
-                                 f_hz=omega / (2 * np.pi), rotor_speed_hz=self.rotor_speed_hz)
+        return self.position.centrifugal_force(omega)
 
     # ----- harmonic balance --------------------------------------------------------------
     def hbm_system(self, harmonics=(1,), n_samples=None, static_retention: float = 1e-4) -> HarmonicBalanceSystem:
@@ -610,12 +1232,10 @@ class TunedDisk:
             geometry = self.damper_geometry()
             if self.damper_inertia:
                 M[nm:, nm:] = geometry.inertia
-            offsets = self.platform_offsets(geometry)
-            G_D, G_P = geometry.G_D, geometry.G_P(offsets)
+            contacts, G_D, G_P = self.position.contacts(geometry, self.approach_function(geometry, basis), self.blade,
+                                                        self.blade)
             phi = np.vstack([self.blade.shape("OL"), self.blade.shape("OR")])  # (12, nm)
             dphi = self.interblade_phase
-            contacts = DamperContacts(geometry, self.approach_function(geometry, basis),
-                                      contact_point_maps(geometry, offsets, self.blade, self.blade))
             w_rows, left_rows, right_rows = contact_rows(contacts.contact_local, nm)
 
             def sector_map(h):
@@ -631,9 +1251,8 @@ class TunedDisk:
 
             couplings.append(Coupling(contacts, basis.real_form(sector_map), "damper contacts"))
             if basis.has_static:
-                k_n = sum(p.normal_law.stiffness for p in geometry.patches)
                 static_stiffness = np.zeros((n, n))
-                static_stiffness[nm:, nm:] = retention_stiffness(static_retention, k_n)
+                static_stiffness[nm:, nm:] = DamperPosition.retention(geometry, static_retention)
 
         centrifugal = self._centrifugal_law() if self.has_damper and basis.has_static else None
 
@@ -649,13 +1268,8 @@ class TunedDisk:
         return HarmonicBalanceSystem(basis, M, D, K, excitation, couplings, static_stiffness)
 
     def _centrifugal_law(self):
-        """omega -> (F_CG [N], dF_CG / dOmega_E) of Eq. 26, its parameters validated once here
-        (the residual calls it at every evaluation): F = c Omega_E^2, or constant at a given
-        rotor speed."""
-        c, _ = self._centrifugal_force(1.0)
-        if self.rotor_speed_hz is not None:
-            return lambda omega: (c, 0.0)
-        return lambda omega: (c * omega ** 2, 2 * c * omega)
+        """:meth:`DamperPosition.centrifugal_law` of the damper."""
+        return self.position.centrifugal_law()
 
     def centrifugal_law(self):
         """A function omega [rad/s, the excitation frequency] -> (F_CG [N], dF_CG / dOmega_E
@@ -665,76 +1279,14 @@ class TunedDisk:
 
     def approach_function(self, geometry: DamperGeometry, basis: HarmonicBasis):
         """The static approach of ``geometry``'s contact points under this disk's F_CG (Eq. 26):
-        a function omega [rad/s, the residual's excitation frequency] -> (per-point static
-        approach (2, P) [m], its omega-derivative (2, P) [m s/rad]). With a static harmonic in
-        ``basis`` the seating is part of the harmonic balance and the approach is the rest state
-        (minus the initial gaps); otherwise the frictionless seating under F_CG (``seat``).
-        The :attr:`DamperContacts.approach` of this disk's and of a MistunedDisk's dampers."""
-        gaps = np.array([p.initial_gap for p in geometry.patches])
-        if basis.has_static:
-            rest = -gaps  # the seating is part of the harmonic balance
-            zero = np.zeros_like(rest)
-            return lambda omega: (rest, zero)
-        if np.any(gaps != 0):
-            # a misfit: the seating is not homogeneous in F_CG; seat at each load, d/dF by central
-            # differences of the (smooth away from touch-down) seating
-            cache = {}
-
-            def approach(omega):
-                if omega not in cache:
-                    F, dF = self._centrifugal_force(omega)
-                    a = seat(geometry, F)[1]
-                    h = 1e-6 * max(F, 1e-12)
-                    da = (seat(geometry, F + h)[1] - seat(geometry, max(F - h, 0.0))[1]) / (F + h - max(F - h, 0.0))
-                    cache.clear()
-                    cache[omega] = (a, da * dF)
-                return cache[omega]
-
-            return approach
-        # perfect fit: seat once at a reference load; the laws are homogeneous, so the static
-        # approach scales as F_CG^(1/p) (p = 1 for the linear law)
-        exponent = getattr(geometry.patches[0].normal_law, "exponent", 1.0)
-        F_ref = 1.0
-        _, approach_ref, _ = seat(geometry, F_ref)
-        centrifugal = self._centrifugal_law()
-
-        def approach(omega):
-            F, dF = centrifugal(omega)
-            if F <= 0:
-                return np.zeros_like(approach_ref), np.zeros_like(approach_ref)
-            scale = (F / F_ref) ** (1 / exponent)
-            return approach_ref * scale, approach_ref * scale / (exponent * F) * dF
-
-        return approach
+        :meth:`DamperPosition.approach_function` (omega [rad/s] -> (approach (2, P) [m], its
+        omega-derivative [m s/rad]))."""
+        return self.position.approach_function(geometry, basis)
 
     def check_bounded(self, f_start_hz: float, f_end_hz: float) -> None:
         """ValueError where no bounded periodic response exists in ``f_start_hz``..``f_end_hz``
-        [Hz]: a blade mode j with zero modal damping, a modal force phi_j^T F != 0, its natural
-        frequency f_0j inside the range, and no damper acting on it (no damper, or rigid
-        platforms that do not move at OL and OR in that mode). Its modal equation is then
-        q_j'' + omega_0j^2 q_j = phi_j^T F cos(Omega t) alone, whose amplitude grows without
-        bound at Omega = omega_0j. (With a damper on that mode the bound of its friction forces
-        is no closed form: the normal loads vary with the motion.)"""
-        blade = self.blade
-        force = blade.shape("excitation").T @ self.excitation                 # (nm,) modal forces [N]
-        lo, hi = min(f_start_hz, f_end_hz), max(f_start_hz, f_end_hz)
-        if self.has_damper:
-            if blade.flexible_platform:
-                return
-            at_damper = np.abs(np.vstack([blade.shape("OL"), blade.shape("OR")])).max(axis=0) > 0
-        else:
-            at_damper = np.zeros(blade.n_modes, dtype=bool)
-        f0 = np.asarray(blade.natural_frequencies_hz, dtype=float)
-        free = (blade.damping_ratios == 0) & (force != 0) & ~at_damper & (f0 >= lo) & (f0 <= hi)
-        if np.any(free):
-            j = int(np.flatnonzero(free)[0])
-            name = blade.mode_names[j] if len(blade.mode_names) else str(j + 1)
-            why = "the disk has no damper" if not self.has_damper else "the damper's platforms do not move in it"
-            raise ValueError(
-                f"no bounded response: blade mode {name} has damping_ratios = 0, a modal force "
-                f"{force[j]:.6g} N and its natural frequency {f0[j]:.6g} Hz inside the range {f_start_hz:g}-"
-                f"{f_end_hz:g} Hz, and {why}: its amplitude grows without bound there; give the mode a damping "
-                f"ratio > 0 or a range without {f0[j]:.6g} Hz")
+        [Hz] (:func:`check_blade_bounded` of the blade, with this disk's damper)."""
+        check_blade_bounded(self.blade, self.excitation, self.has_damper, f_start_hz, f_end_hz)
 
     def static_normal_loads(self, f_hz: float) -> np.ndarray:
         """Static normal loads (N_OL, N_OR) [N] from frictionless seating under F_CG at the
@@ -809,12 +1361,7 @@ class TunedDisk:
         ends there with every point it has, status ``OUT_OF_BUDGET`` (not ``success``), and
         ``stopped_by`` and the message say what ran out and at which frequency.
         """
-        validation.positive("f_start_hz", f_start_hz)
-        validation.positive("f_end_hz", f_end_hz)
-        if f_start_hz == f_end_hz:
-            raise ValueError("f_end_hz must differ from f_start_hz")
-        self.check_bounded(f_start_hz, f_end_hz)
-        w0, w1 = 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz
+        w0, w1 = checked_range(self, f_start_hz, f_end_hz)
         if stop_above is not None:
             validation.positive("stop_above", stop_above)
         validation.integer("stop_direction", stop_direction, minimum=0, maximum=2)
@@ -830,41 +1377,28 @@ class TunedDisk:
         if not np.any(self.excitation) and extra_couplings is None:
             return rest_response(self, w0, w1, max_step, harmonic_tolerance,
                                  lambda system, branch: DiskResponse.from_branch(self, system, branch))
-        budget = Budget(cpu_budget_s, point_budget)
-
-        def solve(H):
-            first = HarmonicBasis(tuple(H)).n_samples
-            return sampled_response(lambda n: solve_sampled(H, n), n_samples, first, AUTO_SAMPLES_GROWTH * first,
-                                    AUTO_SAMPLES_GROWTH_DISSIPATION * first)
-
-        def solve_sampled(H, n_samples):
-            system = model.hbm_system(H, n_samples)
-            scales = self.unknown_scales(system, w0, w1)
-            x0 = self.start_solution(system, w0, scales)
-            branch = continuation(system.residual, x0, w0, w1, x_scale=scales, max_step=max_step,
-                                  start_at_end=lambda: self.start_solution(system, w1, scales),
-                                  retry_x_scale=self.retry_scales(system, scales),
-                                  stop_when=self.amplitude_stop(system.basis, stop_above, stop_direction),
-                                  budget=budget, **continuation_options)
-            response = DiskResponse.from_branch(self, system, branch)
-            T = system.basis.n_samples
-
-            def points_dissipation(r, field="point_dissipation"):   # every contact point's, (n, 2 P)
-                return getattr(r, field).reshape(len(r.omega), -1) if self.has_damper and len(r.omega) \
-                    else np.zeros((len(r.omega), 0))
-
-            def refine(indices):
-                fine = model.hbm_system(system.basis.harmonics, REFINE_SAMPLES_FACTOR * T)
-                return points_dissipation(DiskResponse.from_branch(self, fine, branch.take(indices)))
-
-            return with_checks(response, physical_checks(branch.omega, (w0, w1), points_dissipation(response),
-                                                         response.excitation_work, max_step, T, refine,
-                                                         points_dissipation(response, "point_work_bound")))
-
         can_check = extra_couplings is None and not self.blade.flexible_platform
+        solve = branch_solver(model, f_start_hz, f_end_hz, n_samples, max_step, None if stop_above is None else
+                              lambda basis: self.amplitude_stop(basis, stop_above, stop_direction),
+                              cpu_budget_s, point_budget, **continuation_options)
         response = peak_checked_response(self, model, solve, harmonics, harmonic_tolerance, max_harmonic,
                                          estimate_harmonic_error, check_peak, can_check)
         return with_range_end_estimate(self, with_stop_check(self, response, f_start_hz, check_stop))
+
+    # ----- the protocol of bladedamp.frf (the FRF driver) ----------------------------------
+    def response_from_branch(self, system: HarmonicBalanceSystem, branch) -> "DiskResponse":
+        """:meth:`DiskResponse.from_branch` of this disk."""
+        return DiskResponse.from_branch(self, system, branch)
+
+    def branch_energies(self, system: HarmonicBalanceSystem, branch, response: "DiskResponse"):
+        """(excitation work (n,), every contact point's dissipation (n, 2 P), its work bound (n, 2 P))
+        per period [J] of ``response`` (no damper: (n, 0))."""
+        return (response.excitation_work, contact_point_field(self, response, "point_dissipation"),
+                contact_point_field(self, response, "point_work_bound"))
+
+    def refined_dissipation(self, system: HarmonicBalanceSystem, branch) -> np.ndarray:
+        """(k, 2 P) every contact point's dissipation per period [J] of ``branch`` on ``system``."""
+        return contact_point_field(self, DiskResponse.from_branch(self, system, branch), "point_dissipation")
 
     def linear_natural_frequencies_hz(self, f_low_hz: float, f_high_hz: float) -> tuple[float, float]:
         """(without dampers, dampers stuck): the natural frequency [Hz] of each linear sector
@@ -937,100 +1471,12 @@ class TunedDisk:
         solved = PeakSolver(system, response.omega, response.coefficients).solve(index, tip)
         return None if solved is None else (solved[0], solved[1] / (2 * np.pi))
 
-    def point_map(self, basis: HarmonicBasis, point: str = "tip", directions=(0,)) -> np.ndarray:
-        """Real-form map (C*k, C*n_dof) from the unknowns of :meth:`hbm_system` (``basis``'s
-        harmonics) to the motion of the reference blade's ``point`` in the k ``directions``
-        (0, 1, 2: x, y, z translation [m]; 3, 4, 5: rotations [rad], blade frame), through the
-        blade's mode shapes (the damper's DOFs do not enter). The map of a
-        :class:`~bladedamp.hbm.system.Coupling` from the sector to an element at that point."""
-        nm = self.blade.n_modes
-        return blade_point_map(self.blade, basis, point, directions, nm + (6 if self.has_damper else 0), slice(0, nm))
-
     # ----- the protocol of bladedamp.hbm.accuracy ----------------------------------------
     def output_amplitudes(self, coefficients: np.ndarray, basis: HarmonicBasis) -> np.ndarray:
         """(n, 3) first-harmonic tip amplitudes [m] of coefficients (n, C, n_dof)."""
         j1, nm = basis.cos_index(1), self.blade.n_modes
         q1 = coefficients[:, j1, :nm] - 1j * coefficients[:, j1 + 1, :nm]
         return np.abs(q1 @ self.blade.shape("tip")[:3].T)
-
-    def start_solution(self, system, omega, scales, tol=1e-10):
-        """Solution (C * n_dof,) of ``system`` at the first frequency ``omega`` [rad/s], robust in
-        gross slip (:func:`bladedamp.hbm.start.robust_start`); ``scales`` (C * n_dof,) from
-        :meth:`unknown_scales`.
-
-        Damped Newton from the stuck linear solution; if that fails (a light damper sliding far
-        from its stuck state), an excitation homotopy on the dynamic excitation (the centrifugal
-        preload stays), from the seated damper. Returns the best iterate (the continuation then
-        reports honestly if it is not a solution)."""
-        f = system.excitation(omega)[0].reshape(system.basis.n_coeffs, system.n_dof).copy()
-        if system.basis.has_static:
-            f[system.basis.cos_index(0)] = 0.0          # the preload is not ramped
-        base = self.static_state(system, omega)
-        residual_scale = max(np.linalg.norm(system.residual(np.zeros(system.n_unknowns), omega, False)[0]), 1e-300)
-        return robust_start(system.residual, {"stuck linear solution": self.initial_guess(system, omega)},
-                            omega, scales, f.ravel(), base=base, residual_scale=residual_scale, tol=tol).x
-
-    def static_state(self, system, omega):
-        """The state without dynamic motion: rest, or with a static harmonic the damper seated
-        frictionlessly under F_CG (``seat``)."""
-        def seats():
-            if self.has_damper:
-                yield slice(self.blade.n_modes, None), self.damper_geometry(), self._centrifugal_force(omega)[0]
-        return seated_state(system, seats())
-
-    def initial_guess(self, system, omega):
-        """Stuck linear solution (C * n_dof,) of ``system`` at ``omega`` [rad/s, the residual's
-        excitation frequency]: one Newton step from the static state, where every contact point
-        sticks (without a damper: the linear solution itself).
-
-        With a static harmonic the contacts have no preload at x = 0 (zero approach: every
-        point is open and the Jacobian there has no contact stiffness at all), so the step
-        starts from the damper seated frictionlessly under F_CG (``seat``) instead of from rest.
-        """
-        x = self.static_state(system, omega)
-        R, J, _ = system.residual(x, omega)
-        return x - np.linalg.solve(J, R)
-
-    def retry_scales(self, system: HarmonicBalanceSystem, scales: np.ndarray) -> np.ndarray | None:
-        """The continuation's ``retry_x_scale``: ``scales`` (from :meth:`unknown_scales`) with the
-        damper's unknowns weighing less in the arc length (:func:`damper_weighted_scales`); None
-        without a damper."""
-        if not self.has_damper:
-            return None
-        return damper_weighted_scales(scales, system.basis.n_coeffs, slice(self.blade.n_modes, None))
-
-    def unknown_scales(self, system: HarmonicBalanceSystem, omega_start: float, omega_end: float) -> np.ndarray:
-        """Scale (C * n_dof,) of each unknown of ``system`` over omega_start..omega_end [rad/s]
-        (the continuation's ``x_scale``): its largest value in the stuck linear responses across the
-        range (harmonic coefficients pooled per DOF), floored at 1e-3 of the largest scale of
-        its kind (modal / damper translation / damper rotation). A damper group that the stuck
-        response leaves at exactly zero (e.g. no damper rotation in the symmetric EO = n/2
-        standing wave) is floored at 1e-3 of the platform motion of the same kind instead
-        (a 1e-300 floor turned round-off in the Newton step into an overflow)."""
-        C, n = system.basis.n_coeffs, system.n_dof
-        nm = self.blade.n_modes
-        omegas = np.linspace(omega_start, omega_end, 7)
-        X = np.array([np.abs(self.initial_guess(system, w)).reshape(C, n).max(axis=0) for w in omegas]).max(axis=0)
-        groups = [(slice(0, nm), 0.0)]
-        if self.has_damper:
-            phi = np.abs(np.stack([self.blade.shape("OL"), self.blade.shape("OR")]))   # (2, 6, nm)
-            q = X[:nm].max()
-            groups += [(slice(nm, nm + 3), 1e-3 * q * phi[:, :3].max()), (slice(nm + 3, nm + 6), 1e-3 * q * phi[:, 3:].max())]
-        for g, platform_floor in groups:
-            X[g] = np.maximum(X[g], max(1e-3 * X[g].max(), platform_floor) + 1e-300)
-        return np.tile(X, C)
-
-    def time_response(self, f_hz, **options):
-        """Steady state at each excitation frequency ``f_hz`` [Hz] (scalar or array) by time
-        integration of the full assembly (``MistunedDisk.from_tuned(self)``: every blade and
-        damper written out, no cyclic reduction), from the static equilibrium under F_CG (Eq. 26)
-        or a harmonic solution's state (``start_coefficients`` of the full assembly:
-        :func:`bladedamp.hbm.monodromy.full_assembly_coefficients`); see
-        :func:`bladedamp.timedomain.disk_time_response` for ``options``.
-        Returns a :class:`bladedamp.timedomain.DiskTimeResponse` (tip amplitudes of every blade)."""
-        from .timedomain import disk_time_response
-
-        return disk_time_response(self.full_assembly(), f_hz, **options)
 
     def full_assembly(self):
         """The full assembly, every blade and damper written out, no cyclic reduction:
@@ -1066,34 +1512,6 @@ class TunedDisk:
         """True: the monodromy method has this model's period map, that of its full assembly
         (:class:`bladedamp.hbm.monodromy.PeriodMapModel`)."""
         return True
-
-    def monodromy_matrix(self, coefficients, basis, omega: float, steps: int | None = None):
-        """(monodromy matrix, periodicity error) of the HBM solution ``coefficients`` at
-        ``omega`` [rad/s] on the full assembly (:func:`bladedamp.hbm.monodromy.disk_monodromy`)."""
-        result = disk_monodromy(self, coefficients, basis, omega, steps)
-        return result.matrix, result.periodicity_error
-
-    def stop_check(self, response: "DiskResponse", offset_hz: float = STOP_CHECK_OFFSET_HZ,
-                   f_start_hz: float | None = None, **options):
-        """Whether a periodic motion exists just beyond where ``response`` (a failed branch of
-        :meth:`frequency_response`) got furthest: :meth:`time_response` at that frequency plus
-        ``offset_hz`` [Hz] in the branch's direction (``options`` go to it); for a response that
-        kept no point, at ``f_start_hz`` [Hz], where its branch was to start. Its ``periodic``
-        and ``status`` answer for the motion reached from the static equilibrium: "not settled" or
-        "drifting" (the damper hops on the platforms or keeps rolling): not periodic, which no
-        harmonic-balance branch represents; "periodic": the branch did not reach a periodic motion
-        that exists (:func:`stop_verdict`).
-        Costs one time integration of the full assembly (30-210 s for the reference disk on 2
-        cores)."""
-        return time_check_beyond(self, response, offset_hz, f_start_hz, **options)
-
-    def peak_check(self, response: "DiskResponse", **options):
-        """:meth:`time_response` at the frequency of ``response``'s peak (the point of the
-        largest first-harmonic tip amplitude in any direction), started on the branch's state
-        there (``start="hbm"``, default) or from the static equilibrium (``start="static"``;
-        :func:`time_at_peak`), the other ``options`` going to it: what
-        ``frequency_response(..., check_peak=True)`` runs (:func:`with_peak_check`)."""
-        return time_at_peak(self, response, **options)
 
     @staticmethod
     def time_output_amplitudes(check) -> np.ndarray:
@@ -1586,6 +2004,13 @@ def with_stop_note(response, f_start_hz: float | None = None, check=None):
     return with_note(response, Note(NoteKind.STOP_CHECK, note))
 
 
+def contact_point_field(disk, response, field: str) -> np.ndarray:
+    """(n, 2 P) a per-point field (n, 2, P) of a :class:`DiskResponse` of ``disk`` flattened per
+    point ((n, 0) without a damper or a point)."""
+    n = len(response.omega)
+    return getattr(response, field).reshape(n, -1) if disk.has_damper and n else np.zeros((n, 0))
+
+
 def blade_point_map(blade, basis, point, directions, n_dof, modes):
     """Real-form map (C*k, C*n_dof) of ``basis`` to ``blade``'s ``point`` in ``directions`` (0..5), from
     its modal DOFs ``modes`` (a slice of the n_dof unknowns per coefficient)."""
@@ -1628,12 +2053,100 @@ class WithCouplings:
 
 
 @dataclass
-class DiskResponse(FrequencyResponse):
-    """Frequency response of a tuned disk (reference sector).
+class DiskModelResponse(FrequencyResponse):
+    """What the frequency responses of both disk models share (:class:`DiskResponse` of the tuned
+    disk's reference sector, :class:`~bladedamp.mistuned.MistunedResponse` of every blade of a
+    ring): the same names for the same quantities, per point of the branch (n points):
 
-    Extra attributes (n points along the branch, C coefficients, P points per patch):
+    tip_amplitude : first-harmonic tip amplitude in x, y, z [m]: (n, 3) of the reference sector,
+        (n, s, 3) of the s blades of a ring
+    excitation_work, viscous_dissipation, dissipated_energy : (n,) per period, the whole model
+        (one sector, or the s blades) [J]: the work of the excitation, the blades' modal damping
+        dissipation and the friction dissipation of every damper
+    stop_check : for a branch that stopped before the end of its range, computed with
+        ``check_stop=True``: the time integration of the full assembly just beyond where it got
+        furthest (a one-frequency :class:`bladedamp.timedomain.DiskTimeResponse`; its ``periodic``
+        says whether a periodic motion exists there, :func:`stop_verdict`), else None
+    peak_check : for a branch that reached the end of its range, computed with
+        ``check_peak=True``: the time integration of the full assembly at its peak's frequency
+        (a one-frequency DiskTimeResponse, :func:`with_peak_check`), else None
+    disk : the model (None for a loaded result)
 
-    tip_amplitude : (n, 3) first-harmonic tip amplitude in x, y, z [m]
+    The peaks: :attr:`largest_peak_amplitude` (float [m]) and :attr:`largest_peak_frequency_hz`
+    (float [Hz]) are the largest tip amplitude u_x of any blade and its frequency, the same
+    quantity and type for both models; :attr:`blade_peak_amplitudes` and
+    :attr:`blade_peak_frequencies_hz` are (s,) arrays, one per blade written out ((1,) for the
+    tuned disk). ``peak_amplitude`` keeps its meaning per class: a float (the reference sector's
+    largest sample) on a :class:`DiskResponse`, the (s,) blade peaks (parabola-refined) on a
+    MistunedResponse.
+    """
+
+    tip_amplitude: np.ndarray = None
+    excitation_work: np.ndarray = None
+    viscous_dissipation: np.ndarray = None
+    dissipated_energy: np.ndarray = None
+    stop_check: object = None
+    peak_check: object = None
+    disk: DiskModel = None
+
+    @staticmethod
+    def linear_energies(system: HarmonicBalanceSystem, branch) -> tuple[np.ndarray, np.ndarray]:
+        """(excitation work (n,), viscous dissipation (n,)) per period [J] at the points of ``branch``."""
+        return (np.array([system.excitation_work(x, w) for x, w in zip(branch.x, branch.omega)]),
+                np.array([system.viscous_dissipation(x, w) for x, w in zip(branch.x, branch.omega)]))
+
+    def energy_balance_error(self) -> np.ndarray:
+        """|W_exc - W_visc - W_friction| / W_exc at every point (the whole model)."""
+        return np.abs(self.excitation_work - self.viscous_dissipation - self.dissipated_energy) / np.abs(self.excitation_work)
+
+    @property
+    def blade_peak_amplitudes(self) -> np.ndarray:
+        """(s,) peak first-harmonic tip amplitude u_x of each blade written out [m] ((1,) for the
+        tuned disk's reference sector)."""
+        return np.atleast_1d(np.asarray(self.peak_amplitude, dtype=float))
+
+    @property
+    def blade_peak_frequencies_hz(self) -> np.ndarray:
+        """(s,) frequency of each blade's peak [Hz], as :attr:`blade_peak_amplitudes`."""
+        return np.atleast_1d(np.asarray(self.peak_frequency_hz, dtype=float))
+
+    @property
+    def largest_peak_amplitude(self) -> float:
+        """The largest peak first-harmonic tip amplitude u_x of any blade [m] (nan for an empty branch)."""
+        peaks = self.blade_peak_amplitudes
+        return float(peaks.max()) if peaks.size and len(self.omega) else float("nan")
+
+    @property
+    def largest_peak_frequency_hz(self) -> float:
+        """The frequency of :attr:`largest_peak_amplitude` [Hz] (nan for an empty branch)."""
+        peaks = self.blade_peak_amplitudes
+        return float(self.blade_peak_frequencies_hz[np.argmax(peaks)]) if peaks.size and len(self.omega) \
+            else float("nan")
+
+    def finish_plot(self, ax, direction: int, measured=None, legend: dict | None = None):
+        """The axes of a disk response's :meth:`plot` completed: labels, grid, legend, the status
+        as the title of a failed response, and ``measured`` drawn beside it
+        (:func:`bladedamp.measurement.draw_measurement`)."""
+        ax.set_xlabel("excitation frequency [Hz]")
+        ax.set_ylabel(f"tip amplitude u_{'xyz'[direction]} [mm]")
+        ax.grid(True, alpha=0.3)
+        ax.legend(**(legend or {}))
+        if not self.success:
+            ax.set_title(textwrap.fill(self.status_message, 100), fontsize=8)   # what it means, not the log
+        if measured is not None:
+            from .measurement import draw_measurement
+
+            draw_measurement(ax, measured, model=self.disk)
+        return ax
+
+
+@dataclass
+class DiskResponse(DiskModelResponse):
+    """Frequency response of a tuned disk (reference sector): the attributes of
+    :class:`DiskModelResponse` (``tip_amplitude`` (n, 3) [m]; ``dissipated_energy`` all contacts
+    of one sector [J]; ``stop_check``, ``peak_check``) and (n points along the branch, C
+    coefficients, P points per patch):
+
     modal_amplitude : (n, n_m) first-harmonic modal amplitudes [sqrt(kg) m]
     contact_force : (n, C, 12) generalised contact forces on the platforms, OL then OR (Eq. 11;
         forces and moments of the point forces about the control points)
@@ -1644,20 +2157,12 @@ class DiskResponse(FrequencyResponse):
     point_dissipation : (n, 2, P) energy dissipated per period at each point [J]
     point_work_bound : (n, 2, P) each point's energy scale per period, the largest work its force
         and motion harmonics could do (HarmonicBasis.work_bound) [J]
-    dissipated_energy : (n,) friction dissipation per period, all contacts of one sector [J]
-    excitation_work : (n,) work of the excitation per period [J]
-    viscous_dissipation : (n,) blade modal damping dissipation per period [J]
     normal_load : (n, 2) mean normal load of OL, OR [N]
-    stop_check : for a branch that stopped before the end of its range, computed with
-        ``check_stop=True``: the time integration of the full assembly just beyond where it got
-        furthest (a one-frequency :class:`bladedamp.timedomain.DiskTimeResponse`; its ``periodic``
-        says whether a periodic motion exists there, :func:`stop_verdict`), else None
-    peak_check : for a branch that reached the end of its range, computed with
-        ``check_peak=True``: the time integration of the full assembly at its peak's frequency
-        (a one-frequency DiskTimeResponse, :func:`with_peak_check`), else None
+
+    ``peak_amplitude`` (float) is the largest sampled |u_x| of the reference blade, the same as
+    :attr:`~DiskModelResponse.largest_peak_amplitude`.
     """
 
-    tip_amplitude: np.ndarray = None
     modal_amplitude: np.ndarray = None
     contact_force: np.ndarray = None
     relative_motion: np.ndarray = None
@@ -1665,13 +2170,7 @@ class DiskResponse(FrequencyResponse):
     point_state: np.ndarray = None
     point_dissipation: np.ndarray = None
     point_work_bound: np.ndarray = None
-    dissipated_energy: np.ndarray = None
-    excitation_work: np.ndarray = None
-    viscous_dissipation: np.ndarray = None
     normal_load: np.ndarray = None
-    stop_check: object = None
-    peak_check: object = None
-    disk: TunedDisk = None
 
     @classmethod
     def from_branch(cls, disk: TunedDisk, system: HarmonicBalanceSystem, branch) -> "DiskResponse":
@@ -1681,10 +2180,9 @@ class DiskResponse(FrequencyResponse):
         npts = len(branch.omega)
         j1 = basis.cos_index(1)
         q1 = X[:, j1, :nm] - 1j * X[:, j1 + 1, :nm]
-        out = dict(tip_amplitude=disk.output_amplitudes(X, basis), modal_amplitude=np.abs(q1),
-                   excitation_work=np.array([system.excitation_work(x.ravel(), w) for x, w in zip(X, branch.omega)]),
-                   viscous_dissipation=np.array([system.viscous_dissipation(x.ravel(), w)
-                                                 for x, w in zip(X, branch.omega)]))
+        work, viscous = cls.linear_energies(system, branch)
+        out = dict(tip_amplitude=disk.output_amplitudes(X, basis), modal_amplitude=np.abs(q1), excitation_work=work,
+                   viscous_dissipation=viscous)
         if disk.has_damper and npts:
             coupling = system.couplings[0]
             element = coupling.element
@@ -1726,10 +2224,6 @@ class DiskResponse(FrequencyResponse):
         """Frequency of the largest |u_x,tip| (the resonance) [Hz] (nan for an empty branch)."""
         return float(self.frequency_hz[np.argmax(self.tip_amplitude[:, 0])]) if len(self.omega) else float("nan")
 
-    def energy_balance_error(self) -> np.ndarray:
-        """|W_exc - W_visc - W_friction| / W_exc at every point."""
-        return np.abs(self.excitation_work - self.viscous_dissipation - self.dissipated_energy) / np.abs(self.excitation_work)
-
     def peak_curve(self) -> np.ndarray:
         """(n,) first-harmonic tip amplitude |u_x| at every point [m] (its largest is the peak)."""
         return self.tip_amplitude[:, 0]
@@ -1749,14 +2243,4 @@ class DiskResponse(FrequencyResponse):
             else:
                 label = f"{d.damper.kind} {1e3 * d.damper.mass:g} g" if d.has_damper else "no damper"
         plot_branch(ax, self.frequency_hz, 1e3 * self.tip_amplitude[:, direction], self.stable, label=label, **kwargs)
-        ax.set_xlabel("excitation frequency [Hz]")
-        ax.set_ylabel(f"tip amplitude u_{'xyz'[direction]} [mm]")
-        ax.grid(True, alpha=0.3)
-        ax.legend()
-        if not self.success:
-            ax.set_title(textwrap.fill(self.status_message, 100), fontsize=8)   # what it means, not the log
-        if measured is not None:
-            from .measurement import draw_measurement
-
-            draw_measurement(ax, measured, model=self.disk)
-        return ax
+        return self.finish_plot(ax, direction, measured)

@@ -6,9 +6,11 @@ geometry (the paper's "contact mistuning"). Unknowns, harmonic-major as everywhe
 :mod:`bladedamp.hbm`: the modal coordinates of blade 0, 1, ..., n-1, then the six rigid-body
 coordinates of each damper that has a mass. Damper k sits between blade k (its OL platform)
 and blade k+1 (that blade's OR platform), exactly as in :class:`~bladedamp.disk.TunedDisk`;
-each damper's coupling is built by the TunedDisk of its own blade and damper (geometry,
-``platform_offsets``, ``G_P``, ``G_D``, seating / static approach, centrifugal force), so a
-tuned MistunedDisk is the TunedDisk written out blade by blade.
+each position is described by its :class:`~bladedamp.disk.DamperPosition` (damper, platform
+angles, gaps, the preload law: geometry, ``platform_offsets``, ``G_P``, ``G_D``, seating / static
+approach, centrifugal force), the same description as the tuned disk's one position, and the
+shared behaviour is :class:`~bladedamp.disk.DiskModel`'s, so a tuned MistunedDisk is the
+TunedDisk written out blade by blade.
 
 Engine-order excitation: blade k's first-harmonic force is f e^{i k dphi}, dphi = 2 pi EO / n,
 so that the tuned solution is blade 0's cyclic solution with harmonic h of blade k turned by
@@ -24,7 +26,7 @@ Time sampling (AFT): the contact forces are evaluated at ``n_samples`` instants 
 in a tuned travelling wave blade k's motion is blade 0's shifted by k dphi; the discrete friction
 laws are shift-invariant only when that shift is a whole number of samples. Each damper is
 therefore sampled on its own grid, shifted by its phase k dphi (a rotation of its harmonic
-coefficients before the AFT and back after it, :meth:`AssemblyContacts.grid_rotations`;
+coefficients before the AFT and back after it, :meth:`~bladedamp.disk.AssemblyContacts.grid_rotations`;
 nothing to do where the shift is whole samples, n = 16 and EO = 1 at 64 samples): a tuned full
 assembly equals the cyclic solution to rounding at any ``n_samples``, and the default is the
 tuned disk's (64 for one harmonic at any n; before, it was rounded up to a multiple of
@@ -46,7 +48,6 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import textwrap
 from dataclasses import dataclass, field
 from typing import ClassVar, Sequence
 
@@ -56,25 +57,18 @@ from numba import njit
 
 from . import validation
 from .blade import PLATFORM_ANGLE, ModalBlade
-from .contact.laws import LinearNormalLaw
-from .contact.point import MAX_PASSES, PERIODIC_TOL
-from .damper.kinetics import retention_stiffness, seated_state
-from .disk import (AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION, DAMPER_DOFS, DEFAULT_DAMPER_RADIUS,
-                   STOP_CHECK_OFFSET_HZ,
-                   DamperContacts, TunedDisk, contact_point_maps, contact_rows, damper_weighted_scales,
-                   fused_point_map_forces, euler_rate, interblade_phase, peak_checked_response, point_map_forces,
-                   rest_response, rotor_speed_in_hz, time_at_peak, time_check_beyond, with_stop_check)
+from .disk import (DAMPER_DOFS, DEFAULT_DAMPER_RADIUS, AssemblyContacts, DamperPosition, DiskModel, DiskModelResponse,
+                   TunedDisk, check_blade_bounded, contact_rows, peak_checked_response, rest_response,
+                   rotor_speed_in_hz, with_stop_check)
+from .frf import branch_solver, checked_range
 from .hbm.accuracy import HARMONIC_TOLERANCE
-from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_MAX_STEP, DEFAULT_POINT_BUDGET, Branch, Budget, continuation
-from .hbm.start import robust_start
+from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_MAX_STEP, DEFAULT_POINT_BUDGET, Branch, continuation
 from .hbm.linsolve import BlockCondensation, BlockRing, one_blas_thread
 from .hbm.linsolve import factorize as lu_factorize
 from .hbm.peaks import PEAK_MAX_ITERATIONS, PeakSolver, first_harmonic_output
 from .hbm.fourier import HarmonicBasis
-from .hbm.monodromy import disk_monodromy
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, continuation_note, physical_checks, refined_peak,
-                       sampled_response, with_checks)
+from .response import continuation_note, refined_peak
 
 
 def sparse_real_form(basis: HarmonicBasis, per_harmonic) -> sp.csr_matrix:
@@ -98,253 +92,6 @@ def sparse_real_form(basis: HarmonicBasis, per_harmonic) -> sp.csr_matrix:
     out = sp.coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                         shape=(C * n_out, C * n_in)).tocsr()
     out.eliminate_zeros()
-    return out
-
-
-@dataclass
-class AssemblyContacts:
-    """The contacts of all dampers of an assembly as one harmonic-balance element.
-
-    Local coordinates: those of each damper's :class:`DamperContacts` in turn (the 12 relative
-    motions of OL and OR, and with flexible platforms the platform blades' modal coordinates:
-    ``n_local = L * n_dampers``, L = :attr:`damper_local`, the same for every damper).
-    ``contacts[d]`` is damper d's :class:`DamperContacts` (built as its TunedDisk's). Returns a
-    sparse block-diagonal local Jacobian.
-    """
-
-    contacts: list[DamperContacts]
-    n_local: int = 0
-    #: (n_d,) phase [rad] of each damper's motion in a tuned travelling wave (k dphi for the
-    #: damper on blade k), or None; damper d is sampled on a grid shifted by it (:meth:`grid_rotations`)
-    grid_phase: np.ndarray | None = None
-    _batch: tuple | None = field(default=None, init=False, repr=False)
-    _index: dict = field(default_factory=dict, init=False, repr=False)
-    _rotations: dict = field(default_factory=dict, init=False, repr=False)
-    _last_approach: tuple | None = field(default=None, init=False, repr=False)
-
-    def __post_init__(self):
-        sizes = {c.n_local for c in self.contacts}
-        if len(sizes) > 1:
-            raise ValueError("the dampers' contacts must all have flexible platforms or all rigid ones "
-                             f"(local coordinates per damper: {sorted(sizes)})")
-        self.n_local = sum(c.n_local for c in self.contacts)
-
-    @property
-    def n_dampers(self) -> int:
-        return len(self.contacts)
-
-    @property
-    def damper_local(self) -> int:
-        """Local coordinates per damper L: 12 (rigid platforms) or 12 + 2 n_m (flexible)."""
-        return self.n_local // max(self.n_dampers, 1)
-
-    def stacked_points(self):
-        """The points of all dampers as one batch: ``(True, point maps (n_d, 2, P, 3, m), k_T
-        (2 n_d P,) [N/m per point], mu (2 n_d P,), weights (2 n_d P,), normal law)`` (each damper's
-        :meth:`DamperContacts.stacked_points` stacked), or None if the dampers' batches differ in
-        normal law or point-map shape or one damper has none. Cached."""
-        if self._batch is None:
-            stacks = [c.stacked_points() for c in self.contacts]
-            ok = all(s is not None for s in stacks) and all(
-                s[5] == stacks[0][5] and s[1].shape == stacks[0][1].shape for s in stacks)
-            if not ok:
-                self._batch = (False,)
-            else:
-                self._batch = (True, np.stack([s[1] for s in stacks]), np.concatenate([s[2] for s in stacks]),
-                               np.concatenate([s[3] for s in stacks]), np.concatenate([s[4] for s in stacks]),
-                               stacks[0][5])
-        return self._batch if self._batch[0] else None
-
-    def _block_index(self, C: int):
-        """COO indices of the (n_d, C, L, C, L) per-damper blocks in the local Jacobian."""
-        if C not in self._index:
-            nd, L = self.n_dampers, self.damper_local
-            d, a, m, b, k = np.meshgrid(np.arange(nd), np.arange(C), np.arange(L), np.arange(C), np.arange(L),
-                                        indexing="ij")
-            self._index[C] = ((a * L * nd + L * d + m).ravel(), (b * L * nd + L * d + k).ravel())
-        return self._index[C]
-
-    def grid_rotations(self, basis):
-        """(n_d, C, C) rotations R_d of the harmonic coefficients that sample damper d on the
-        grid omega t_j - grid_phase_d (coefficients R_d c on the common grid), or None when every
-        phase is a whole number of samples (the common grid then serves every damper exactly).
-
-        In a tuned travelling wave damper d's motion is the first damper's advanced by its phase
-        theta_d: c_h,d = c_h,0 e^{i h theta_d} (complex c_h = a_h - i b_h). Sampled on the shifted
-        grid, every damper of a tuned assembly sees the first's samples, so its discrete friction
-        law (history-dependent through the return map) gives the first's forces shifted, and the
-        tuned full assembly equals the cyclic sector to rounding at any sample count, not only
-        at multiples of n / gcd(n, EO). The forces come back by R_d^T (R_d is orthogonal) and
-        the Jacobian blocks as R_d^T J_d R_d. For a mistuned disk the shifted grids are an
-        equally good discretisation as the common one."""
-        if self.grid_phase is None:
-            return None
-        key = (basis.n_samples, basis.harmonics)
-        if key not in self._rotations:
-            phase = np.asarray(self.grid_phase)
-            shift = phase * basis.n_samples / (2 * np.pi)                   # in samples
-            R = None
-            if np.any(np.abs(shift - np.round(shift)) >= 1e-9):
-                R = np.zeros((len(phase), basis.n_coeffs, basis.n_coeffs))
-                for h in basis.harmonics:
-                    j = basis.cos_index(h)
-                    if h == 0:
-                        R[:, j, j] = 1.0
-                        continue
-                    c, sn = np.cos(-h * phase), np.sin(-h * phase)          # c~ = c e^{-i h phase}
-                    R[:, j, j], R[:, j, j + 1], R[:, j + 1, j], R[:, j + 1, j + 1] = c, sn, -sn, c
-            self._rotations[key] = R
-        return self._rotations[key]
-
-    def forces_at(self, local, basis, offsets, jacobian):
-        """Forces (C, n_d, L) [N, N m] and Jacobian blocks (n_d, C, L, C, L) or None at the local
-        coefficients ``local`` (C, n_d, L) with the static approach ``offsets`` (n_d, 2, P) [m]
-        (no omega: the approach is given, :meth:`approach` gives it), each damper sampled
-        on its own grid where the interblade shift is not a whole number of samples
-        (:meth:`grid_rotations`), else all on the common grid (:meth:`_forces_on_grid`)."""
-        R = self.grid_rotations(basis)
-        if R is None:
-            return self._forces_on_grid(local, basis, offsets, jacobian)
-        force, blocks = self._forces_on_grid(_rotated(R, np.ascontiguousarray(local, dtype=float), False), basis,
-                                             offsets, jacobian)
-        return _rotated(R, force, True), None if blocks is None else _rotated_blocks(R, blocks)
-
-    def _forces_on_grid(self, local, basis, offsets, jacobian):
-        """Forces (C, n_d, L) and Jacobian blocks (n_d, C, L, C, L) or None on the common grid.
-
-        Batched dampers with rigid platforms and a normal law the fused kernel knows go through
-        :func:`~bladedamp.disk.fused_point_map_forces` (one numba call: point motion, normal
-        law, return map, AFT and the projections); otherwise (flexible platforms too,
-        whose point maps the fused kernel does not take) :meth:`forces_at_numpy`."""
-        stack = self.stacked_points()
-        fused = None if stack is None else fused_point_map_forces(stack[1], local, basis, stack[2], stack[3], stack[5],
-                                                                  stack[4], offsets, jacobian)
-        return self.forces_at_numpy(local, basis, offsets, jacobian) if fused is None else fused
-
-    def forces_at_numpy(self, local, basis, offsets, jacobian):
-        """:meth:`forces_at` through :func:`~bladedamp.disk.point_map_forces` (the point-contact
-        kernel and numpy projections; the reference of the fused kernel; any normal law and
-        flexible platforms)."""
-        C, nd, L = basis.n_coeffs, self.n_dampers, self.damper_local
-        stack = self.stacked_points()
-        if stack is None:
-            force = np.zeros((C, nd, L))
-            blocks = np.zeros((nd, C, L, C, L)) if jacobian else None
-            for d, c in enumerate(self.contacts):
-                f, j = c.forces_at(local[:, d], basis, offsets[d], jacobian)
-                force[:, d] = f
-                if jacobian:
-                    blocks[d] = j.reshape(C, L, C, L)
-            return force, blocks
-        _, B, k_t, mu, weights, law = stack                      # B (n_d, 2, P, 3, m)
-        m = B.shape[-1]
-        force, q_blocks, _ = point_map_forces(B, local.reshape(C, nd, 2, m), basis, k_t, mu, law, weights, offsets,
-                                              jacobian, max_passes=MAX_PASSES, tol=PERIODIC_TOL)
-        force = force.reshape(C, nd, L)
-        if not jacobian:
-            return force, None
-        blocks = np.zeros((nd, C, 2, m, C, 2, m))
-        for q in range(2):
-            blocks[:, :, q, :, :, q, :] = q_blocks[:, q]
-        return force, blocks.reshape(nd, C, L, C, L)
-
-    def approach(self, omega):
-        """Static approach (n_d, 2, P) [m] of every damper and its omega-derivative [m s/rad] at
-        ``omega`` [rad/s], as ``(offsets, doffsets)`` (last omega cached;
-        dampers that share their approach function, the same damper at every position, evaluate
-        it once: 16 calls were 0.05 of a residual's 0.9 ms)."""
-        last = self._last_approach            # one read: the element may be shared by threads
-        if last is None or last[0] != omega:
-            if "_approach_groups" not in self.__dict__:
-                functions = {}
-                index = [functions.setdefault(id(c.approach), (len(functions), c.approach))[0] for c in self.contacts]
-                self._approach_groups = ([f for _, f in functions.values()], np.array(index))
-            functions, index = self._approach_groups
-            out = [f(omega) for f in functions]
-            last = (omega, np.array([o[0] for o in out])[index], np.array([o[1] for o in out])[index])
-            self._last_approach = last
-        return last[1], last[2]
-
-    @property
-    def linear_normal_laws(self) -> bool:
-        """Whether every patch of every damper has a linear normal law (computed once)."""
-        if "_linear" not in self.__dict__:
-            self._linear = all(isinstance(p.normal_law, LinearNormalLaw) for c in self.contacts
-                               for p in c.geometry.patches)
-        return self._linear
-
-    def _sparse(self, blocks, C):
-        rows, cols = self._block_index(C)
-        n = C * self.n_local
-        return sp.csr_matrix((blocks.ravel(), (rows, cols)), shape=(n, n))
-
-    def evaluate(self, local, basis, omega, jacobian=True):
-        """``(force (C, n_d, L), Jacobian blocks (n_d, C*L, C*L) or None, d force / d omega
-        (C, n_d, L) or None)``; damper d's block in its own (coefficient, coordinate) order."""
-        C, nd, L = basis.n_coeffs, self.n_dampers, self.damper_local
-        local = np.asarray(local).reshape(C, nd, L)
-        offsets, doffsets = self.approach(omega)
-        force, blocks = self.forces_at(local, basis, offsets, jacobian)
-        if not jacobian:
-            return force, None, None
-        domega = None
-        if doffsets.any():
-            # as DamperContacts.harmonic_forces (the same kernel, disk.euler_rate): Euler's identity
-            # for linear normal laws, else a central difference in omega of all dampers at once
-            domega = np.empty(force.shape)
-            if not (self.linear_normal_laws and euler_rate(offsets, doffsets, blocks, local, force, domega)):
-                h = 1e-6 * omega
-                fp, _ = self.forces_at(local, basis, offsets + h * doffsets, False)
-                fm, _ = self.forces_at(local, basis, offsets - h * doffsets, False)
-                domega = (fp - fm) / (2 * h)
-        return force, blocks.reshape(nd, C * L, C * L), domega
-
-    def harmonic_forces(self, local, basis, omega, jacobian=True):
-        C = basis.n_coeffs
-        force, blocks, domega = self.evaluate(local, basis, omega, jacobian)
-        if not jacobian:
-            return force.reshape(C, self.n_local), None, None
-        jac = self._sparse(blocks, C)
-        return force.reshape(C, self.n_local), jac, None if domega is None else domega.ravel()
-
-
-@njit(cache=True)
-def _rotated(R, values, transposed):
-    """(C, n_d, L) coefficients rotated damper by damper: R_d values_d, or R_d^T values_d
-    (``transposed``), R (n_d, C, C) (:meth:`AssemblyContacts.grid_rotations`)."""
-    C, nd, L = values.shape
-    out = np.zeros(values.shape)
-    for d in range(nd):
-        for a in range(C):
-            for b in range(C):
-                r = R[d, b, a] if transposed else R[d, a, b]
-                if r != 0.0:
-                    for m in range(L):
-                        out[a, d, m] += r * values[b, d, m]
-    return out
-
-
-@njit(cache=True)
-def _rotated_blocks(R, blocks):
-    """Jacobian blocks (n_d, C, L, C, L) rotated damper by damper: R_d^T J_d R_d (the forces
-    come back by R_d^T from coefficients that went in by R_d). As a numpy einsum it was 15 % of
-    a 128-blade FRF point; R_d has 2 x 2 blocks, so the loops skip its zeros."""
-    nd, C, L = blocks.shape[0], blocks.shape[1], blocks.shape[2]
-    out = np.zeros(blocks.shape)
-    for d in range(nd):
-        for a in range(C):
-            for b in range(C):
-                rba = R[d, b, a]
-                if rba == 0.0:
-                    continue
-                for c in range(C):
-                    for e in range(C):
-                        w = rba * R[d, c, e]
-                        if w == 0.0:
-                            continue
-                        for m in range(L):
-                            for n in range(L):
-                                out[d, a, m, e, n] += w * blocks[d, b, m, c, n]
     return out
 
 
@@ -649,7 +396,7 @@ def _as_list(name, value, n):
 
 
 @dataclass
-class MistunedDisk:
+class MistunedDisk(DiskModel):
     """Bladed disk with an individual blade and damper at every position (Eq. 16-20).
 
     Parameters
@@ -722,13 +469,21 @@ class MistunedDisk:
             value = getattr(self, name)
             angles[name] = _as_list(name, list(value) if isinstance(value, np.ndarray) and value.ndim else value, s)
         gaps = _as_list("initial_gaps", self.initial_gaps, s)
-        # one TunedDisk per position: validates the parameters and builds each coupling
-        self.sectors = [TunedDisk(b, d, self.n_blades, self.engine_order, gl, gr, self.damper_radius,
-                                  self.excitation, self.rotor_speed_hz, self.damper_inertia, g)
-                        for b, d, gl, gr, g in zip(self.blades, self.dampers, angles["gamma_left"],
-                                                   angles["gamma_right"], gaps)]
-        self.excitation = self.sectors[0].excitation
+        self.engine_order = validation.integer("engine_order (EO)", self.engine_order, minimum=0)
+        # one description per damper position (the angles validated there), the same blades' points
+        self.positions = [DamperPosition(d, gl, gr, g, self.damper_radius, self.engine_order,
+                                         self.rotor_speed_hz).validate()
+                          for d, gl, gr, g in zip(self.dampers, angles["gamma_left"], angles["gamma_right"], gaps)]
+        self.validate_parameters(any(p.has_damper for p in self.positions))
         self._systems = {}
+
+    @property
+    def sectors(self) -> list[TunedDisk]:
+        """The former description of each position: a TunedDisk of blade k and damper k (built on
+        each call; the model is built from :attr:`positions` and :attr:`blades`)."""
+        return [TunedDisk(b, p.damper, self.n_blades, self.engine_order, p.gamma_left, p.gamma_right,
+                          self.damper_radius, self.excitation, self.rotor_speed_hz, self.damper_inertia, p.initial_gaps)
+                for b, p in zip(self.blades, self.positions)]
 
     def __getstate__(self):
         # the cached systems hold closures (their excitation) and are rebuilt on demand; a
@@ -789,14 +544,9 @@ class MistunedDisk:
         return self.blades[0].n_modes
 
     @property
-    def interblade_phase(self) -> float:
-        """dphi [rad] in (-pi, pi] of the engine order (:func:`bladedamp.disk.interblade_phase`)."""
-        return interblade_phase(self.engine_order, self.n_blades)
-
-    @property
     def active_dampers(self) -> list[int]:
         """Positions whose damper has a mass."""
-        return [k for k, d in enumerate(self.sectors) if d.has_damper]
+        return [k for k, p in enumerate(self.positions) if p.has_damper]
 
     @property
     def n_dof(self) -> int:
@@ -810,6 +560,29 @@ class MistunedDisk:
         start = self.n_sector * self.n_modes + 6 * d
         return slice(start, start + 6)
 
+    # ----- the layout of DiskModel: s blades, a damper at each position with a mass ----------
+    @property
+    def model_blades(self) -> list[ModalBlade]:
+        """The s blades written out (:class:`~bladedamp.disk.DiskModel`)."""
+        return self.blades
+
+    @property
+    def active_positions(self) -> list[int]:
+        """:attr:`active_dampers`."""
+        return self.active_dampers
+
+    def damper_unknowns(self, d: int) -> slice:
+        """:meth:`damper_slice`."""
+        return self.damper_slice(d)
+
+    def seated_damper(self, k: int, omega: float) -> np.ndarray:
+        """(6,) position ``k``'s damper seated frictionlessly under F_CG at ``omega`` [rad/s] (``seat``)."""
+        return self.positions[k].seated(omega)
+
+    def scales(self, system: HarmonicBalanceSystem, w0: float, w1: float) -> np.ndarray:
+        """:meth:`unknown_scales` (the former name)."""
+        return self.unknown_scales(system, w0, w1)
+
     @property
     def dof_names(self) -> tuple[str, ...]:
         modes = self.blades[0].mode_names or tuple(f"q{j + 1}" for j in range(self.n_modes))
@@ -820,7 +593,7 @@ class MistunedDisk:
     # ----- harmonic balance ------------------------------------------------------------
     def default_samples(self, harmonics) -> int:
         """HarmonicBasis' default sample count, as the tuned disk's: each damper is sampled on a
-        grid shifted by its interblade phase (:meth:`AssemblyContacts.grid_rotations`), so the
+        grid shifted by its interblade phase (:meth:`~bladedamp.disk.AssemblyContacts.grid_rotations`), so the
         count need not be a multiple of n / gcd(n, EO) (see the module notes)."""
         return HarmonicBasis(tuple(harmonics)).n_samples
 
@@ -837,7 +610,7 @@ class MistunedDisk:
         solver = self.linear_solver if linear_solver is None else linear_solver
         # one system per setting and disk: the FRF, its range extensions and the peak solves of a
         # Monte Carlo disk share it (building it took 28 ms, 0.3 of a solved peak's cost). The
-        # disk is fixed at construction (its sectors are built then), so the cache never goes stale.
+        # disk is fixed at construction (its positions are built then), so the cache never goes stale.
         key = (tuple(int(h) for h in harmonics), int(n_samples), float(static_retention), solver)
         systems = self.__dict__.setdefault("_systems", {})
         if key not in systems:
@@ -872,29 +645,26 @@ class MistunedDisk:
             sl = self.blade_slice(k)
             mass[sl, sl] = np.eye(nm)
             forces.append(b.shape("excitation").T @ self.excitation)
-        geometries, contacts, maps, static = [], [], [], None
+        contacts, maps, static = [], [], None
         if basis.has_static and active:
             static = sp.lil_matrix((N, N))
         shared = {}       # positions with the same damper, angles and gaps share geometry and approach
         for d, k in enumerate(active):
-            sector = self.sectors[k]
-            same = (id(sector.damper), sector.gamma_left, sector.gamma_right, id(sector.initial_gaps))
+            position = self.positions[k]
+            same = (id(position.damper), position.gamma_left, position.gamma_right, id(position.initial_gaps))
             if same not in shared:
-                g = sector.damper_geometry()
-                shared[same] = (g, sector.approach_function(g, basis))
+                g = position.damper_geometry()
+                shared[same] = (g, position.approach_function(g, basis))
             g, approach = shared[same]
-            geometries.append(g)
             sl = self.damper_slice(d)
             if self.damper_inertia:
                 mass[sl, sl] = g.inertia
-            offsets = sector.platform_offsets(g)
-            maps.append((g.G_D, g.G_P(offsets)))
             # damper k: blade k's OL platform, blade k+1's OR platform (that of the next sector's blade 0)
-            contacts.append(DamperContacts(g, approach,
-                                           contact_point_maps(g, offsets, self.blades[k], self.blades[(k + 1) % s])))
+            element, G_D, G_P = position.contacts(g, approach, self.blades[k], self.blades[(k + 1) % s])
+            contacts.append(element)
+            maps.append((G_D, G_P))
             if static is not None:
-                k_n = sum(p.normal_law.stiffness for p in g.patches)
-                static[sl, sl] = retention_stiffness(static_retention, k_n)
+                static[sl, sl] = DamperPosition.retention(g, static_retention)
         dphi = self.interblade_phase
 
         L = contacts[0].n_local if contacts else 12           # local coordinates per damper
@@ -935,9 +705,9 @@ class MistunedDisk:
         laws, radial = {}, []
         if basis.has_static:
             for d, k in enumerate(active):
-                key = id(self.sectors[k].damper)
+                key = id(self.positions[k].damper)
                 if key not in laws:
-                    laws[key] = (self.sectors[k].centrifugal_law(), [])
+                    laws[key] = (self.positions[k].centrifugal_law(), [])
                 laws[key][1].append(self.damper_slice(d).start + 2)
             radial = [(law, np.array(z)) for law, z in laws.values()]
 
@@ -956,51 +726,6 @@ class MistunedDisk:
         if system.uses_ring() and system.n_unknowns > system.ring_dense_limit:
             system.dense = False
         return system
-
-    def static_state(self, system: HarmonicBalanceSystem, omega: float) -> np.ndarray:
-        """Rest, or with a static harmonic every damper seated frictionlessly under F_CG."""
-        seats = ((self.damper_slice(d), self.sectors[k].damper_geometry(),
-                  self.sectors[k].centrifugal_force(omega / (2 * np.pi))[0]) for d, k in enumerate(self.active_dampers))
-        return seated_state(system, seats)
-
-    def initial_guess(self, system: HarmonicBalanceSystem, omega: float) -> np.ndarray:
-        """Stuck linear solution (C * n_dof,) at ``omega`` [rad/s] (one Newton step from the static
-        state; see :meth:`TunedDisk.initial_guess`)."""
-        x = self.static_state(system, omega)
-        R, J, _ = system.residual(x, omega)
-        return x - system.factorize(J)(R)
-
-    def start_solution(self, system: HarmonicBalanceSystem, omega: float, scales) -> np.ndarray:
-        """Solution at the first frequency (:func:`bladedamp.hbm.start.robust_start`, as the tuned
-        disk's): damped Newton from the stuck linear solution, then an excitation homotopy on the
-        dynamic excitation from the seated dampers. Returns the best iterate."""
-        f = system.excitation(omega)[0].reshape(system.basis.n_coeffs, system.n_dof).copy()
-        if system.basis.has_static:
-            f[system.basis.cos_index(0)] = 0.0          # the preload is not ramped
-        residual_scale = max(np.linalg.norm(system.residual(np.zeros(system.n_unknowns), omega, False)[0]), 1e-300)
-        return robust_start(system.residual, {"stuck linear solution": self.initial_guess(system, omega)}, omega,
-                            scales, f.ravel(), base=self.static_state(system, omega),
-                            residual_scale=residual_scale, factorize=system.factorize).x
-
-    def scales(self, system: HarmonicBalanceSystem, w0: float, w1: float) -> np.ndarray:
-        """Scale of each unknown (as :meth:`TunedDisk.unknown_scales`), pooled over the blades for each mode and
-        over the dampers for each damper DOF, so that every blade is measured alike, times sqrt(s)."""
-        C, N, nm, s = system.basis.n_coeffs, system.n_dof, self.n_modes, self.n_sector
-        X = np.array([np.abs(self.initial_guess(system, w)).reshape(C, N).max(axis=0)
-                      for w in np.linspace(w0, w1, 7)]).max(axis=0)
-        q = X[:s * nm].reshape(s, nm).max(axis=0)
-        q = np.maximum(q, 1e-3 * q.max() + 1e-300)
-        out = [np.tile(q, s)]
-        nd = len(self.active_dampers)
-        if nd:
-            u = X[s * nm:].reshape(nd, 6).max(axis=0)
-            phi = np.abs(np.stack([np.stack([b.shape("OL"), b.shape("OR")]) for b in self.blades]))
-            for g, platform in ((slice(0, 3), phi[:, :, :3].max()), (slice(3, 6), phi[:, :, 3:].max())):
-                u[g] = np.maximum(u[g], max(1e-3 * u[g].max(), 1e-3 * q.max() * platform) + 1e-300)
-            out.append(np.tile(u, nd))
-        # x sqrt(s): the scaled norm of s blades equals that of one sector, so the arc-length
-        # steps (and the number of points) are those of the tuned cyclic model
-        return np.sqrt(s) * np.tile(np.concatenate(out), C)
 
     def frequency_response(self, f_start_hz: float, f_end_hz: float, harmonics="auto", n_samples=None,
                            max_step: float = DEFAULT_MAX_STEP, tuned_peak_amplitude: float | None = None,
@@ -1033,7 +758,7 @@ class MistunedDisk:
         Without dynamic excitation (``excitation`` zero) the response is rest, exactly
         (:func:`~bladedamp.disk.rest_response`). Without dampers, a range holding the natural
         frequency of an excited blade mode without modal damping has no bounded response and is
-        refused with a ValueError (:meth:`TunedDisk.check_bounded` of each blade).
+        refused with a ValueError (:meth:`check_bounded`).
         ``cpu_budget_s`` [s] and ``point_budget``: the CPU time (``time.process_time``) and the
         continuation points this whole analysis may spend, the time integrations of
         ``check_stop`` and ``check_peak`` excepted (:class:`bladedamp.hbm.continuation.Budget`;
@@ -1041,85 +766,50 @@ class MistunedDisk:
         ends there with every point it has, status ``OUT_OF_BUDGET`` (not ``success``), and
         ``stopped_by`` and the message say what ran out and at which frequency.
         """
-        validation.positive("f_start_hz", f_start_hz)
-        validation.positive("f_end_hz", f_end_hz)
-        if f_start_hz == f_end_hz:
-            raise ValueError("f_end_hz must differ from f_start_hz")
         for name, on in (("check_stop", check_stop), ("check_peak", check_peak)):
             if on and any(b.flexible_platform for b in self.blades):
                 raise ValueError(f"{name} integrates the disk in time, which models rigid platforms only: "
                                  f"use rigid-platform blades or {name}=False")
-        if not self.active_dampers:         # every blade on its own: as a tuned disk without damper
-            for sector in self.sectors:
-                sector.check_bounded(f_start_hz, f_end_hz)
-        w0, w1 = 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz
+        w0, w1 = checked_range(self, f_start_hz, f_end_hz)
         if not np.any(self.excitation):
             return rest_response(self, w0, w1, max_step, harmonic_tolerance, lambda system, branch:
                                  MistunedResponse.from_branch(self, system, branch, tuned_peak_amplitude))
-        budget = Budget(cpu_budget_s, point_budget)
-
-        def solve(H):
-            first = self.default_samples(H)
-            return sampled_response(lambda n: solve_sampled(H, n), n_samples, first, AUTO_SAMPLES_GROWTH * first,
-                                    AUTO_SAMPLES_GROWTH_DISSIPATION * first)
-
-        def solve_sampled(H, n_samples):
-            system = self.hbm_system(H, n_samples)
-            scales = self.scales(system, w0, w1)
-            # the robust start (an excitation homotopy of the whole ring, which the budget cannot
-            # stop midway) is not begun once the budget has run out (the continuation then keeps no
-            # point and says so), and the start at the end of the range is computed once for the
-            # first try and its retry, which both ask for it
-            def start(w):
-                return np.zeros(system.n_unknowns) if budget.exhausted(w) else self.start_solution(system, w, scales)
-
-            at_end = []
-
-            def start_at_end():
-                if not at_end:
-                    at_end.append(start(w1))
-                return at_end[0].copy()
-
-            x0 = start(w0)
-            branch = continuation(system.residual, x0, w0, w1, x_scale=scales, factorize=system.factorize,
-                                  max_step=max_step, start_at_end=start_at_end,
-                                  retry_x_scale=self.retry_scales(system, scales), budget=budget,
-                                  **continuation_options)
-            response = MistunedResponse.from_branch(self, system, branch, tuned_peak_amplitude)
-            T = system.basis.n_samples
-
-            def refine(indices):
-                fine = self.hbm_system(system.basis.harmonics, REFINE_SAMPLES_FACTOR * T)
-                return MistunedResponse.from_branch(self, fine, branch.take(indices)).damper_dissipation
-
-            return with_checks(response, physical_checks(branch.omega, (w0, w1), response.damper_dissipation,
-                                                         response.excitation_work, max_step, T, refine,
-                                                         response.damper_work_bound))
-
         can_check = not any(b.flexible_platform for b in self.blades)
+        solve = branch_solver(self, f_start_hz, f_end_hz, n_samples, max_step, None, cpu_budget_s, point_budget,
+                              **continuation_options)
         response = peak_checked_response(self, self, solve, harmonics, harmonic_tolerance, max_harmonic,
                                          estimate_harmonic_error, check_peak, can_check)
+        if tuned_peak_amplitude is not None:       # kept for the amplification factors
+            response = dataclasses.replace(response, tuned_peak_amplitude=tuned_peak_amplitude)
         return with_stop_check(self, response, f_start_hz, check_stop)
 
-    def peak_check(self, response: "MistunedResponse", **options):
-        """:meth:`time_response` at the frequency of ``response``'s peak (the largest first-harmonic
-        tip amplitude of any blade), as :meth:`TunedDisk.peak_check`."""
-        return time_at_peak(self, response, **options)
+    # ----- the protocol of bladedamp.frf (the FRF driver) ----------------------------------
+    def check_bounded(self, f_start_hz: float, f_end_hz: float) -> None:
+        """ValueError where no bounded periodic response exists in ``f_start_hz``..``f_end_hz``
+        [Hz]: without dampers every blade is on its own, as a tuned disk without damper
+        (:func:`~bladedamp.disk.check_blade_bounded` of each blade); with dampers nothing is refused."""
+        if not self.active_dampers:
+            for blade in self.blades:
+                check_blade_bounded(blade, self.excitation, False, f_start_hz, f_end_hz)
+
+    def response_from_branch(self, system: HarmonicBalanceSystem, branch) -> "MistunedResponse":
+        """:meth:`MistunedResponse.from_branch` of this disk."""
+        return MistunedResponse.from_branch(self, system, branch)
+
+    def branch_energies(self, system: HarmonicBalanceSystem, branch, response: "MistunedResponse"):
+        """(excitation work (n,), each damper's dissipation (n, n_d), its work bound (n, n_d)) per
+        period [J] of ``response``."""
+        return response.excitation_work, response.damper_dissipation, response.damper_work_bound
+
+    def refined_dissipation(self, system: HarmonicBalanceSystem, branch) -> np.ndarray:
+        """(k, n_d) each damper's dissipation per period [J] of ``branch`` on ``system``."""
+        return MistunedResponse.from_branch(self, system, branch).damper_dissipation
 
     @staticmethod
     def time_output_amplitudes(check) -> np.ndarray:
         """(n_f, 3 s) first-harmonic tip amplitudes [m] of every blade of a :meth:`time_response`
         ``check``, ordered as :meth:`output_amplitudes`."""
         return check.tip_amplitude.reshape(len(check.tip_amplitude), -1)
-
-    def stop_check(self, response: "MistunedResponse", offset_hz: float = STOP_CHECK_OFFSET_HZ,
-                   f_start_hz: float | None = None, **options):
-        """Whether a periodic motion exists just beyond where ``response`` (a failed branch of
-        :meth:`frequency_response`) got furthest: :meth:`time_response` ``offset_hz`` [Hz] beyond
-        it (at ``f_start_hz`` [Hz] if it kept no point), as :meth:`TunedDisk.stop_check` (its
-        ``periodic``, ``status`` and :func:`~bladedamp.disk.stop_verdict`). One time integration of
-        the assembly."""
-        return time_check_beyond(self, response, offset_hz, f_start_hz, **options)
 
     # ----- the protocol of bladedamp.hbm.accuracy ----------------------------------------
     def output_amplitudes(self, coefficients: np.ndarray, basis: HarmonicBasis) -> np.ndarray:
@@ -1128,27 +818,6 @@ class MistunedDisk:
         q1 = (coefficients[:, j1, :s * nm] - 1j * coefficients[:, j1 + 1, :s * nm]).reshape(-1, s, nm)
         tips = np.stack([b.shape("tip")[:3] for b in self.blades])            # (s, 3, nm)
         return np.abs(np.einsum("pkm,kim->pki", q1, tips)).reshape(len(coefficients), 3 * s)
-
-    def point_map(self, basis, point: str = "tip", directions=(0,), blade: int = 0) -> np.ndarray:
-        """Real-form map (C*k, C*n_dof) from the unknowns of :meth:`hbm_system` to the motion of
-        blade ``blade``'s ``point`` in the k ``directions`` (0..5: x, y, z [m], rx, ry, rz [rad]),
-        as :meth:`TunedDisk.point_map`; add an element with ``system.add(element, map, name)``."""
-        from .disk import blade_point_map
-
-        blade = validation.integer("blade", blade, minimum=0, maximum=self.n_sector - 1)
-        return blade_point_map(self.blades[blade], basis, point, directions, self.n_dof, self.blade_slice(blade))
-
-    def unknown_scales(self, system: HarmonicBalanceSystem, omega_start: float, omega_end: float) -> np.ndarray:
-        """Scale of each unknown of ``system`` over omega_start..omega_end [rad/s] (:meth:`scales`)."""
-        return self.scales(system, omega_start, omega_end)
-
-    def retry_scales(self, system: HarmonicBalanceSystem, scales: np.ndarray) -> np.ndarray | None:
-        """The continuation's ``retry_x_scale``: ``scales`` with every damper's unknowns weighing
-        less in the arc length, as :meth:`TunedDisk.retry_scales` (:func:`bladedamp.disk.damper_weighted_scales`);
-        None without dampers."""
-        if not self.active_dampers:
-            return None
-        return damper_weighted_scales(scales, system.basis.n_coeffs, slice(self.n_sector * self.n_modes, None))
 
     @one_blas_thread
     def extend_response(self, response: "MistunedResponse", f_end_hz: float, max_step: float = DEFAULT_MAX_STEP,
@@ -1174,7 +843,7 @@ class MistunedDisk:
         x0 = response.coefficients[end].ravel()
         w0 = float(response.omega[end])
         lo, hi = sorted((w0, w_new))
-        scales = np.maximum(self.scales(system, lo, hi), np.abs(response.coefficients).max(axis=0).ravel())
+        scales = np.maximum(self.unknown_scales(system, lo, hi), np.abs(response.coefficients).max(axis=0).ravel())
         piece = continuation(system.residual, x0, w0, w_new, x_scale=scales, factorize=system.factorize,
                              max_step=max_step, retry_x_scale=self.retry_scales(system, scales), **continuation_options)
         old = response.coefficients.reshape(len(response.omega), -1)
@@ -1217,16 +886,6 @@ class MistunedDisk:
             out.append(None if solved is None else (solved[0], solved[1] / (2 * np.pi)))
         return out
 
-    def time_response(self, f_hz, **options):
-        """Steady state of every blade at each excitation frequency ``f_hz`` [Hz] (scalar or
-        array) by time integration of the full assembly (``len(blades) == n_blades``), from the
-        static equilibrium under F_CG (Eq. 26) or a harmonic solution's state
-        (``start_coefficients``); see :func:`bladedamp.timedomain.disk_time_response`.
-        Returns a :class:`bladedamp.timedomain.DiskTimeResponse`."""
-        from .timedomain import disk_time_response
-
-        return disk_time_response(self, f_hz, **options)
-
     def full_assembly(self) -> "MistunedDisk":
         """This model (:class:`bladedamp.hbm.monodromy.AssemblyModel`; a full assembly when
         :attr:`has_period_map`)."""
@@ -1243,40 +902,25 @@ class MistunedDisk:
         (:class:`bladedamp.hbm.monodromy.PeriodMapModel`)."""
         return self.n_sector == self.n_blades
 
-    def monodromy_matrix(self, coefficients, basis, omega: float, steps: int | None = None):
-        """(monodromy matrix, periodicity error) of the HBM solution ``coefficients`` at
-        ``omega`` [rad/s] (:func:`bladedamp.hbm.monodromy.disk_monodromy`)."""
-        result = disk_monodromy(self, coefficients, basis, omega, steps)
-        return result.matrix, result.periodicity_error
-
-
 @dataclass
-class MistunedResponse(FrequencyResponse):
-    """Frequency response of every blade of a :class:`MistunedDisk`.
+class MistunedResponse(DiskModelResponse):
+    """Frequency response of every blade of a :class:`MistunedDisk`: the attributes of
+    :class:`~bladedamp.disk.DiskModelResponse` (``tip_amplitude`` (n_points, s, 3) [m], each blade's;
+    the energies of the whole model; ``stop_check``, ``peak_check``) and
 
-    tip_amplitude : (n_points, s, 3) first-harmonic tip amplitude of each blade in x, y, z [m]
-    excitation_work, viscous_dissipation, dissipated_energy : (n_points,) per period, whole model [J]
     damper_dissipation : (n_points, n_active_dampers) friction dissipation of each damper [J]
     damper_work_bound : (n_points, n_active_dampers) each damper's energy scale per period, the
         largest work its force and motion harmonics could do (HarmonicBasis.work_bound) [J]
     tuned_peak_amplitude : the tuned disk's peak u_x [m] if given (amplification factors)
-    stop_check : for a branch that stopped before the end of its range, computed with
-        ``check_stop=True``: the time integration of the assembly just beyond where it got
-        furthest (a one-frequency :class:`bladedamp.timedomain.DiskTimeResponse`), else None
-    peak_check : for a branch that reached the end of its range, computed with
-        ``check_peak=True``: the time integration of the assembly at its peak's frequency, else None
+
+    ``peak_amplitude`` is the (s,) array of the blades' peaks (parabola-refined, :meth:`peaks`),
+    the same as :attr:`~bladedamp.disk.DiskModelResponse.blade_peak_amplitudes`; the largest of
+    them, a float as for the tuned disk, is ``largest_peak_amplitude``.
     """
 
-    tip_amplitude: np.ndarray = None
-    excitation_work: np.ndarray = None
-    viscous_dissipation: np.ndarray = None
-    dissipated_energy: np.ndarray = None
     damper_dissipation: np.ndarray = None
     damper_work_bound: np.ndarray = None
     tuned_peak_amplitude: float | None = None
-    stop_check: object = None
-    peak_check: object = None
-    disk: MistunedDisk = None
 
     @classmethod
     def from_branch(cls, disk: MistunedDisk, system: HarmonicBalanceSystem, branch, tuned_peak_amplitude=None):
@@ -1285,10 +929,9 @@ class MistunedResponse(FrequencyResponse):
         X = branch.x.reshape(-1, C, N)
         tip = disk.output_amplitudes(X, basis).reshape(len(X), s, 3)
         nd = len(disk.active_dampers)
-        exc, visc, diss, bound = [], [], np.zeros((len(branch.omega), nd)), np.zeros((len(branch.omega), nd))
+        exc, visc = cls.linear_energies(system, branch)
+        diss, bound = np.zeros((len(branch.omega), nd)), np.zeros((len(branch.omega), nd))
         for i, (x, w) in enumerate(zip(branch.x, branch.omega)):
-            exc.append(system.excitation_work(x, w))
-            visc.append(system.viscous_dissipation(x, w))
             if nd:
                 c = system.couplings[0]
                 local = (c.matrix @ x).reshape(C, c.element.n_local)
@@ -1296,8 +939,8 @@ class MistunedResponse(FrequencyResponse):
                 diss[i] = basis.work_per_cycle(force, local).reshape(nd, -1).sum(axis=1)
                 bound[i] = basis.work_bound(force, local).reshape(nd, -1).sum(axis=1)
         return cls(branch.omega, X, basis, disk.dof_names, branch.success, "", branch.iterations,
-                   branch.turning_points, notes=(continuation_note(branch),), tip_amplitude=tip, excitation_work=np.array(exc),
-                   viscous_dissipation=np.array(visc), dissipated_energy=diss.sum(axis=1), damper_dissipation=diss,
+                   branch.turning_points, notes=(continuation_note(branch),), tip_amplitude=tip, excitation_work=exc,
+                   viscous_dissipation=visc, dissipated_energy=diss.sum(axis=1), damper_dissipation=diss,
                    damper_work_bound=bound,
                    tuned_peak_amplitude=tuned_peak_amplitude, disk=disk, stopped_by=branch.stopped_by)
 
@@ -1362,10 +1005,6 @@ class MistunedResponse(FrequencyResponse):
             raise ValueError("tuned_peak_amplitude is needed for amplification factors (give it here or to frequency_response)")
         return self.peak_amplitude / validation.positive("tuned_peak_amplitude", ref)
 
-    def energy_balance_error(self) -> np.ndarray:
-        """|W_exc - W_visc - W_friction| / W_exc at every point (whole model)."""
-        return np.abs(self.excitation_work - self.viscous_dissipation - self.dissipated_energy) / np.abs(self.excitation_work)
-
     def plot(self, ax=None, *, tuned=None, direction: int = 0, highlight=None, title: str | None = None,
              measured=None):
         """Tip amplitude of every blade [mm] over frequency [Hz] (the paper's Figs. 13-17);
@@ -1393,16 +1032,6 @@ class MistunedResponse(FrequencyResponse):
             ax.plot(tuned.frequency_hz, 1e3 * tuned.tip_amplitude[:, direction], "k--", lw=2, label="tuned")
         elif self.tuned_peak_amplitude is not None:
             ax.axhline(1e3 * self.tuned_peak_amplitude, color="k", ls="--", lw=1.5, label="tuned peak")
-        ax.set_xlabel("excitation frequency [Hz]")
-        ax.set_ylabel(f"tip amplitude u_{'xyz'[direction]} [mm]")
         if title:
             ax.set_title(title)
-        ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=8)
-        if not self.success:
-            ax.set_title(textwrap.fill(self.status_message, 100), fontsize=8)   # what it means, not the log
-        if measured is not None:
-            from .measurement import draw_measurement
-
-            draw_measurement(ax, measured, model=self.disk)
-        return ax
+        return self.finish_plot(ax, direction, measured, legend=dict(fontsize=8))

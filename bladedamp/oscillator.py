@@ -18,15 +18,15 @@ import numpy as np
 from . import validation
 from .contact.laws import LinearNormalLaw
 from .contact.point import PointContactElement
+from .frf import branch_solver
 from .hbm.accuracy import HARMONIC_TOLERANCE, converged_response
-from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_POINT_BUDGET, Budget, continuation
+from .hbm.continuation import DEFAULT_CPU_BUDGET_S, DEFAULT_MAX_STEP, DEFAULT_POINT_BUDGET
 from .hbm.start import robust_start
 from .hbm.elements import CubicSpring
 from .hbm.fourier import HarmonicBasis
 from .hbm.monodromy import STEPS_PER_PERIOD, oscillator_monodromy
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import (REFINE_SAMPLES_FACTOR, FrequencyResponse, continuation_note, physical_checks, sampled_response,
-                       with_checks, with_range_end_estimate)
+from .response import FrequencyResponse, continuation_note, with_range_end_estimate
 from .timedomain import TimeResponse, oscillator_steady_state
 
 # most AFT samples per period the automatic sampling may choose (sampled_response; one DOF:
@@ -196,50 +196,49 @@ class FrictionOscillator:
         ends there with every point it has, status ``OUT_OF_BUDGET`` (not ``success``), and
         ``stopped_by`` and the message say what ran out and at which frequency.
         """
-        validation.positive("f_start_hz", f_start_hz)
-        validation.positive("f_end_hz", f_end_hz)
-        if f_start_hz == f_end_hz:
-            raise ValueError("f_end_hz must differ from f_start_hz")
-        self.check_bounded(f_start_hz, f_end_hz)
-        omega_start, omega_end = 2 * np.pi * f_start_hz, 2 * np.pi * f_end_hz
-        budget = Budget(cpu_budget_s, point_budget)
-        scale = self.unknown_scales(None, omega_start, omega_end)
-
-        def solve(H):
-            first = HarmonicBasis(tuple(H)).n_samples
-            if self.contact_angle != 0.0:
-                first = max(first, INCLINED_FIRST_SAMPLES)
-            return sampled_response(lambda n: solve_sampled(H, n), n_samples, first, MAX_AUTO_SAMPLES)
-
-        def solve_sampled(H, n_samples):
-            system = self.hbm_system(H, n_samples)
-            x0 = self._start_solution(system, omega_start, scale)
-            branch = continuation(system.residual, x0, omega_start, omega_end, x_scale=scale,
-                                  start_at_end=lambda: self._start_solution(system, omega_end, scale),
-                                  budget=budget, **continuation_options)
-            C = system.basis.n_coeffs
-            response = FrequencyResponse(branch.omega, branch.x.reshape(-1, C, 1), system.basis, ("x",),
-                                         branch.success, "", branch.iterations, branch.turning_points,
-                                         stopped_by=branch.stopped_by, notes=(continuation_note(branch),))
-            # per point: the excitation work, and the contact's dissipation and energy scale (one AFT)
-            work = np.array([system.excitation_work(x, w) for x, w in zip(branch.x, branch.omega)])
-            energies = np.array([[sum(e) for e in system.element_energies(x, w)]
-                                 for x, w in zip(branch.x, branch.omega)]).reshape(-1, 2)
-            T = system.basis.n_samples
-
-            def refine(indices):
-                fine = self.hbm_system(system.basis.harmonics, REFINE_SAMPLES_FACTOR * T)
-                return np.array([fine.element_dissipation(branch.x[i], branch.omega[i]) for i in indices])
-
-            return with_checks(response, physical_checks(branch.omega, (omega_start, omega_end), energies[:, :1],
-                                                         work, continuation_options.get("max_step") or 0.02,
-                                                         T, refine, energies[:, 1:],
-                                                         judge_solution_samples=T < MAX_AUTO_SAMPLES))
-
+        solve = branch_solver(self, f_start_hz, f_end_hz, n_samples, continuation_options.pop("max_step", DEFAULT_MAX_STEP),
+                              None, cpu_budget_s, point_budget, **continuation_options)
         return with_range_end_estimate(self, converged_response(self, solve, harmonics, harmonic_tolerance,
                                                                 max_harmonic))
 
-    def _start_solution(self, system: HarmonicBalanceSystem, omega: float, scale: float) -> np.ndarray:
+    # ----- the protocol of bladedamp.frf (the FRF driver) ----------------------------------
+    def sample_plan(self, harmonics) -> tuple[int, int, None]:
+        """(first, most, None) AFT samples per period of the automatic sampling
+        (:func:`bladedamp.response.sampled_response`): the basis default, at least
+        ``INCLINED_FIRST_SAMPLES`` for an inclined contact, up to ``MAX_AUTO_SAMPLES``."""
+        first = HarmonicBasis(tuple(harmonics)).n_samples
+        if self.contact_angle != 0.0:
+            first = max(first, INCLINED_FIRST_SAMPLES)
+        return first, MAX_AUTO_SAMPLES, None
+
+    def response_from_branch(self, system: HarmonicBalanceSystem, branch) -> FrequencyResponse:
+        """The :class:`~bladedamp.response.FrequencyResponse` of a continuation ``branch`` (one DOF, x)."""
+        return FrequencyResponse(branch.omega, branch.x.reshape(-1, system.basis.n_coeffs, 1), system.basis, ("x",),
+                                 branch.success, "", branch.iterations, branch.turning_points,
+                                 stopped_by=branch.stopped_by, notes=(continuation_note(branch),))
+
+    def branch_energies(self, system: HarmonicBalanceSystem, branch, response: FrequencyResponse):
+        """(excitation work (n,), the nonlinear elements' dissipation (n, 1), their work bound (n, 1))
+        per period [J] at every point of ``branch`` (one AFT each)."""
+        work = np.array([system.excitation_work(x, w) for x, w in zip(branch.x, branch.omega)])
+        energies = np.array([[sum(e) for e in system.element_energies(x, w)]
+                             for x, w in zip(branch.x, branch.omega)]).reshape(-1, 2)
+        return work, energies[:, :1], energies[:, 1:]
+
+    def refined_dissipation(self, system: HarmonicBalanceSystem, branch) -> np.ndarray:
+        """(k, elements) each nonlinear element's dissipation per period [J] at the points of ``branch``."""
+        return np.array([system.element_dissipation(x, w) for x, w in zip(branch.x, branch.omega)])
+
+    def judges_solution_samples(self, n_samples: int) -> bool:
+        """Below ``MAX_AUTO_SAMPLES`` the dissipation is judged at the solve's own samples too
+        (:func:`bladedamp.response.physical_checks`; see :meth:`frequency_response`)."""
+        return n_samples < MAX_AUTO_SAMPLES
+
+    def retry_scales(self, system: HarmonicBalanceSystem, scales) -> None:
+        """None: no retry with other scales (the oscillator has no damper unknowns)."""
+        return None
+
+    def start_solution(self, system: HarmonicBalanceSystem, omega: float, scale: float) -> np.ndarray:
         """Solution at the first frequency by :func:`bladedamp.hbm.start.robust_start`: damped
         Newton from the stuck linear solution (one Newton step from rest, where the contact
         sticks), then from the free one (no contact force), then the excitation homotopy."""

@@ -369,7 +369,7 @@ def assembly_arrays(disk) -> AssemblyArrays:
     (its static block: in the full assembly the map is real and the same for every harmonic,
     Eq. 16-20, 6-9), the loads (static F_CG on each damper, Eq. 26; the first-harmonic
     excitation with the engine-order phase of each blade) and the contact patches (point maps,
-    k_T, mu, weights, normal law, initial gaps) of :class:`~bladedamp.mistuned.AssemblyContacts`.
+    k_T, mu, weights, normal law, initial gaps) of :class:`~bladedamp.disk.AssemblyContacts`.
     """
     import scipy.sparse as sp
 

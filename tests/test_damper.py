@@ -380,7 +380,7 @@ def test_retention_spring_holds_a_rotation_as_the_translation_at_10_mm():
 
 
 def test_seated_state_is_the_rigid_seating_of_every_damper_in_the_static_harmonic():
-    """kinetics.seated_state serves the tuned sector and the mistuned assembly: each damper's
+    """One static seating (DiskModel.static_state) serves the tuned sector and the mistuned assembly: each damper's
     static harmonic is its frictionless rigid-platform seating under F_CG, whose normal loads
     carry F_CG radially; everything else (and every harmonic without a static one) is at rest."""
     from bladedamp.damper.kinetics import seat

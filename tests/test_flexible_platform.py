@@ -136,8 +136,8 @@ def test_beam_blades_keep_the_rigid_kinematics_in_the_full_assembly():
     def eq6(h):
         T = np.zeros((24, N), dtype=complex)
         for d in range(2):
-            g = disk.sectors[d].damper_geometry()
-            G_P = g.G_P(disk.sectors[d].platform_offsets(g))
+            g = disk.positions[d].damper_geometry()
+            G_P = g.G_P(disk.positions[d].platform_offsets(g, disk.blades[d].points))
             nxt = (d + 1) % s
             phase = np.exp(1j * h * s * disk.interblade_phase) if d + 1 == s else 1.0
             T[12 * d:12 * d + 12, nm * d:nm * d + nm] += -G_P[:, :6] @ disk.blades[d].shape("OL")

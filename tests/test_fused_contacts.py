@@ -48,7 +48,7 @@ def contact_state(system, x, omega):
 
 def state_counts(element, local, basis, offsets):
     """Samples in stick, slip and lift-off over all points (from point_contact_forces)."""
-    _, B, k_t, mu, weights, law = element.stacked_points()
+    B, k_t, mu, weights, law = element.stacked_points()          # a PointBatch
     C, nd = basis.n_coeffs, element.n_dampers
     coeffs = np.einsum("dqpij,cdqj->cdqpi", B, local.reshape(C, nd, 2, 6)).reshape(C, -1, 3)
     pts = point_contact_forces(coeffs, basis, k_t, mu, law, weights, np.ravel(offsets), jacobian=False)
@@ -125,7 +125,7 @@ def test_fused_kernel_power_law(harmonics):
     rng = np.random.default_rng(3)
     basis = system.basis
     element = system.couplings[0].element
-    assert normal_law_parameters(element.stacked_points()[5]) is not None
+    assert normal_law_parameters(element.stacked_points().normal_law) is not None
     for scale in (0.0, 3.0):
         element, local, offsets = contact_state(system, x0 * (1 + scale * rng.standard_normal(x0.size)), w)
         e_f, e_j, e_g = compare(element, local, basis, offsets)
@@ -144,13 +144,13 @@ def test_unknown_normal_law_falls_back_to_the_numpy_path():
     x0 = md.initial_guess(system, w)
     element, local, offsets = contact_state(system, 2 * x0, w)
     f_ref, j_ref = element.forces_at(local, system.basis, offsets, True)
-    law = element.stacked_points()[5]
+    law = element.stacked_points().normal_law
     # the same dampers with every patch's law an OtherLaw of the same stiffness, built anew
     contacts = [dataclasses.replace(c, geometry=dataclasses.replace(c.geometry, patches=tuple(
         dataclasses.replace(p, normal_law=OtherLaw(law.stiffness)) for p in c.geometry.patches)))
         for c in element.contacts]
     other = dataclasses.replace(element, contacts=contacts)
-    assert normal_law_parameters(other.stacked_points()[5]) is None
+    assert normal_law_parameters(other.stacked_points().normal_law) is None
     f, j = other.forces_at(local, system.basis, offsets, True)
     assert relative(f, f_ref) < 1e-12 and relative(j, j_ref) < 1e-12
 
@@ -183,7 +183,7 @@ def test_fused_jacobian_against_central_differences():
 
 def kernel(element, local, basis, offsets, max_passes=20, tol=1e-10, closed_form=True):
     """(forces, Jacobian blocks) of damper_contact_forces with the given return-map settings."""
-    _, B, k_t, mu, weights, law = element.stacked_points()
+    B, k_t, mu, weights, law = element.stacked_points()          # a PointBatch
     kind, params = normal_law_parameters(law)
     C, nd = basis.n_coeffs, element.n_dampers
     force, blocks = np.empty((C, nd, 12)), np.empty((nd, C, 12, C, 12))

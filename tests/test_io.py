@@ -20,6 +20,7 @@ import pytest  # noqa: E402
 
 import bladedamp as bd  # noqa: E402
 from bladedamp import io  # noqa: E402
+from bladedamp.disk import DiskModelResponse  # noqa: E402
 from bladedamp.mistuned import MistunedDisk, MistunedResponse  # noqa: E402
 from bladedamp.response import with_note  # noqa: E402
 from bladedamp.studies import design as sd  # noqa: E402
@@ -360,3 +361,30 @@ def test_every_result_class_is_saveable():
                sm.MassSweep, sm.MassOptimum, sd.EngineOrderSweep, sd.PlatformAngleStudy, sd.ContactState,
                sd.LiftoffMap, sd.DesignMap, mt.MistuningCase, mt.MonteCarloResult, mt.Arrangement]
     assert all(issubclass(c, io.Saveable) for c in classes)
+
+
+# ----- files saved before the one disk model (issue 34 item 2) ---------------------------------
+DATA = Path(__file__).parent / "data"
+
+
+def test_disk_responses_saved_before_the_one_disk_model_load():
+    """Files written by main 9e1a333, before DiskModel and DiskModelResponse: a tuned sector's
+    DiskResponse (the 1 g cylinder disk over 90-105 Hz, saved by main 427345c) and a 4-blade
+    MistunedResponse (kappa 1.01, 0.99, 1.02, 1.0 over 92-99 Hz, harmonics (1,), tuned peak
+    5e-4 m) load as their classes, with the names both responses now share: the energy balance
+    holds for their stored arrays, and the largest peak is the largest of the blades' peaks."""
+    tuned = bd.load(DATA / "disk_response_v1.npz")
+    ring = bd.load(DATA / "mistuned_response_v1.npz")
+    assert type(tuned) is bd.DiskResponse and type(ring) is MistunedResponse
+    assert ring.n_sector == 4 and ring.tuned_peak_amplitude == 5e-4 and ring.disk is None
+    for r in (tuned, ring):
+        assert isinstance(r, DiskModelResponse) and r.success
+        assert r.energy_balance_error().max() < 1e-9          # W_exc = W_visc + W_friction, point by point
+        assert isinstance(r.largest_peak_amplitude, float) and isinstance(r.largest_peak_frequency_hz, float)
+        assert r.largest_peak_amplitude == r.blade_peak_amplitudes.max()
+    assert tuned.blade_peak_amplitudes.shape == (1,)
+    assert tuned.largest_peak_amplitude == tuned.peak_amplitude == tuned.tip_amplitude[:, 0].max()
+    assert tuned.largest_peak_frequency_hz == tuned.peak_frequency_hz
+    np.testing.assert_array_equal(ring.blade_peak_amplitudes, ring.peak_amplitude)
+    assert ring.tip_amplitude.shape == (len(ring.omega), 4, 3)
+    np.testing.assert_array_equal(ring.amplification(), ring.peak_amplitude / 5e-4)

@@ -139,7 +139,7 @@ def test_per_position_platform_angles_and_gaps_repeat_as_a_sector():
     full = dataclasses.replace(full, gamma_right=list(angles) * 2, initial_gaps=[None, gaps] * 2)
     sector = dataclasses.replace(MistunedDisk.from_tuned(td, np.ones(2), n_sector=2), gamma_right=angles,
                                  initial_gaps=[None, gaps])
-    assert full.sectors[1].gamma_right == angles[1] and full.sectors[2].initial_gaps is None
+    assert full.positions[1].gamma_right == angles[1] and full.positions[2].initial_gaps is None
     rf, rs = run(full, (90.0, 104.0)), run(sector, (90.0, 104.0))
     ss = sector.hbm_system()
     scale = np.maximum(np.abs(rs.coefficients).max(axis=0).ravel(), 1e-3 * np.abs(rs.coefficients).max())
@@ -491,7 +491,7 @@ def test_automatic_aft_sampling_goes_through_sampled_response(monkeypatch):
     starts from default_samples(H) (the tuned disk's default) and may grow AUTO_SAMPLES_GROWTH
     times; a given n_samples is used as given. The growth itself on a failing branch:
     test_automatic_aft_sampling_rescues_a_retracing_branch (slow)."""
-    import bladedamp.mistuned as mistuned_module
+    import bladedamp.frf as frf_module
     from bladedamp.disk import AUTO_SAMPLES_GROWTH, AUTO_SAMPLES_GROWTH_DISSIPATION
     from bladedamp.response import sampled_response
 
@@ -501,7 +501,7 @@ def test_automatic_aft_sampling_goes_through_sampled_response(monkeypatch):
         calls.append((n_samples, first, most, most_for_dissipation))
         return sampled_response(solve, n_samples, first, most, most_for_dissipation)
 
-    monkeypatch.setattr(mistuned_module, "sampled_response", spy)
+    monkeypatch.setattr(frf_module, "sampled_response", spy)     # the one FRF driver's
     disk = MistunedDisk.from_tuned(tuned(5), [1.0, 1.01, 0.99, 1.005, 0.995])
     first = disk.default_samples((1,))
     r = run(disk, (94.0, 96.0), max_step=0.1)

@@ -24,7 +24,7 @@ same 2x2 solve is a Newton step making the slider start periodic (see
 :func:`point_contact_forces` works on given point coefficients; :func:`damper_contact_forces`
 is the same computation fused for the two patches of many dampers (point motion from the
 damper coordinates, normal law, return map, AFT and the projection back, in one numba call),
-used by :class:`bladedamp.mistuned.AssemblyContacts`. Both run the per-point return map
+used by :class:`bladedamp.disk.AssemblyContacts`. Both run the per-point return map
 :func:`_point_return_map`.
 """
 from __future__ import annotations

@@ -113,16 +113,3 @@ def seat(geometry: DamperGeometry, radial_force: float, tol: float = 1e-12, max_
     return u, approach, loads
 
 
-def seated_state(system, seats) -> np.ndarray:
-    """The state (C * n_dof,) without dynamic motion of a harmonic balance ``system``
-    (:class:`~bladedamp.hbm.system.HarmonicBalanceSystem`): rest, or with a static harmonic each
-    damper seated frictionlessly on rigid platforms under its centrifugal load (:func:`seat`) in
-    the static harmonic. ``seats``: iterable of (columns, geometry, radial_force): the damper's 6
-    DOFs among the system's (a slice or index array), its :class:`DamperGeometry` and F_CG [N]
-    (read only with a static harmonic)."""
-    x = np.zeros(system.n_unknowns)
-    if system.basis.has_static:
-        X = x.reshape(system.basis.n_coeffs, system.n_dof)
-        for columns, geometry, radial_force in seats:
-            X[system.basis.cos_index(0), columns] = seat(geometry, radial_force)[0]
-    return x
