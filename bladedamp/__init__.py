@@ -53,7 +53,7 @@ _LAZY = {
     "TimeDomainElement": "hbm", "CubicSpring": "hbm", "GapSpring": "hbm", "with_element": "hbm",
     "FrictionOscillator": "oscillator",
     "reference_disk": "reference",
-    "FrequencyResponse": "response", "Status": "response",
+    "FrequencyResponse": "response", "Status": "response", "Note": "response", "NoteKind": "response",
     "load": "io", "save": "io",
     "load_measurement": "measurement", "load_modes": "measurement", "MeasuredResponse": "measurement",
     "MeasuredModes": "measurement",

@@ -36,7 +36,7 @@ from .hbm.nonlinear_modes import linear_stuck_mode
 from .hbm.peaks import PeakSolver, first_harmonic_output
 from .hbm.system import Coupling, HarmonicBalanceSystem
 from .mistuned import MistunedDisk
-from .response import nearest_to_range, plot_branch, with_range_end_estimate
+from .response import continuation_note, nearest_to_range, plot_branch, with_range_end_estimate
 
 
 @dataclass
@@ -520,8 +520,9 @@ class DiskResponse(DiskModelResponse):
                        normal_load=load)
         else:
             out.update(dissipated_energy=np.zeros(npts))
-        return cls(branch.omega, X, basis, disk.dof_names, branch.success, branch.message, branch.iterations,
-                   branch.turning_points, disk=disk, stopped_by=branch.stopped_by, **out)
+        return cls(branch.omega, X, basis, disk.dof_names, branch.success, "", branch.iterations,
+                   branch.turning_points, disk=disk, stopped_by=branch.stopped_by, notes=(continuation_note(branch),),
+                   **out)
 
     def contact_state_shares(self) -> np.ndarray:
         """(n, 3) share of the period the damper's contact points stick, slip, are separated, the

@@ -55,7 +55,8 @@ from .hbm.start import robust_start
 from .hbm.fourier import HarmonicBasis
 from .hbm.monodromy import disk_monodromy
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import FrequencyResponse, harmonic_sentence, percent, with_amplitude_check, with_checks
+from .response import (FrequencyResponse, Note, NoteKind, harmonic_sentence, percent, with_amplitude_check,
+                       with_checks, with_note)
 
 DAMPER_DOFS = ("uD_x", "uD_y", "uD_z", "phiD_x", "phiD_y", "phiD_z")
 # the automatic AFT sampling of a disk's branch (TunedDisk and MistunedDisk) may grow the samples
@@ -1280,8 +1281,8 @@ def with_retention_check(model, response, limit: float = RETENTION_HELD_LIMIT):
     error = response.harmonic_error
     estimate = (f" (the enriched harmonic set's estimate, {percent(error)}, does not verify such a point)"
                 if np.isfinite(error) else "")
-    return dataclasses.replace(response, harmonic_error=float("nan"), harmonics_converged=False,
-                               unverified_reason=reason, message=f"{response.message}; not verified: {found}{estimate}")
+    return with_note(response, Note(NoteKind.RETENTION, f"not verified: {found}{estimate}"),
+                     harmonic_error=float("nan"), harmonics_converged=False, unverified_reason=reason)
 
 
 def peak_checked_response(model, system_model, solve, harmonics, tolerance: float, max_harmonic: int, estimate: bool,
@@ -1367,8 +1368,8 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
     if not check_peak:
         if not (can_check and response.harmonics_converged is False and not np.isfinite(enriched)):
             return response
-        return dataclasses.replace(response, message=response.message + "; frequency_response(..., check_peak=True) "
-                                   "checks the peak by time integration")
+        return with_note(response, Note(NoteKind.PEAK_CHECK, "frequency_response(..., check_peak=True) "
+                                        "checks the peak by time integration"))
     k = peak_index(model, response)
     at_peak = model.output_amplitudes(response.coefficients[k:k + 1], response.basis)[0]
     check = model.peak_check(response)
@@ -1398,7 +1399,7 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
             warnings.warn(f"at the peak, {f:.2f} Hz, the time integration leaves the curve for another periodic motion "
                           f"{percent(direct)} away: peak_check(result, start='static') gives the motion from rest",
                           AccuracyWarning, stacklevel=3)
-            return dataclasses.replace(response, peak_check=check, message=response.message + "; " + note)
+            return with_note(response, Note(NoteKind.PEAK_CHECK, note), peak_check=check)
     spread, doubled = 0.0, ""
     if direct > tolerance:           # a contradiction only beyond the check's own error bar: twice the steps
         finer = model.peak_check(response, steps_per_period=2 * int(check.steps_per_period))
@@ -1424,9 +1425,9 @@ def with_peak_check(model, response, check_peak: bool, tolerance: float = HARMON
     if not met:      # the sentence the result's status gives (bladedamp.response.status_message)
         warnings.warn(harmonic_sentence(response.basis.harmonics, error, tolerance, status == "drifting"),
                       AccuracyWarning, stacklevel=4)
-    return dataclasses.replace(response, harmonic_error=error, harmonic_tolerance=tolerance, harmonics_converged=met,
-                               peak_check=check, message=response.message + "; " + note,
-                               unverified_reason="" if met else response.unverified_reason)
+    return with_note(response, Note(NoteKind.PEAK_CHECK, note), harmonic_error=error, harmonic_tolerance=tolerance,
+                     harmonics_converged=met, peak_check=check,
+                     unverified_reason="" if met else response.unverified_reason)
 
 
 # The Floquet multipliers of a peak whose HBM orbit is within this periodicity error of a periodic
@@ -1558,17 +1559,17 @@ def with_stop_note(response, f_start_hz: float | None = None, check=None):
         return response
     if check is not None:
         where = "at the start" if not len(response.omega) else "beyond where the branch got furthest"
-        note = f"; {where}, {stop_verdict(check, response.basis.harmonics)}"
-        return dataclasses.replace(response, message=response.message + note, stop_check=check)
+        note = f"{where}, {stop_verdict(check, response.basis.harmonics)}"
+        return with_note(response, Note(NoteKind.STOP_CHECK, note), stop_check=check)
     model = type(response.disk).__name__ if response.disk is not None else "TunedDisk"
     if not len(response.omega):
         if f_start_hz is None:
             return response
-        note = (f"; {model}.time_response({f_start_hz:.6g}) tells by time integration whether a periodic motion "
+        note = (f"{model}.time_response({f_start_hz:.6g}) tells by time integration whether a periodic motion "
                 "exists at the start (where one does with the damper separated most of the period, brief impacts, "
                 "a richer harmonic set may find it: harmonics='auto'; frequency_response(..., check_stop=True) "
                 "runs it)")
-        return dataclasses.replace(response, message=response.message + note)
+        return with_note(response, Note(NoteKind.STOP_CHECK, note))
     states = getattr(response, "point_state", None)                 # DiskResponse's, else None
     dampers = getattr(response, "damper_dissipation", None)         # MistunedResponse's, else None
     if states is None and (dampers is None or not dampers.size):
@@ -1581,10 +1582,10 @@ def with_stop_note(response, f_start_hz: float | None = None, check=None):
         stick, slip, separated = 100 * response.contact_state_shares()[k]
         where += (f" the damper's contact points stick {stick:.0f} %, slip {slip:.0f} %, are separated "
                   f"{separated:.0f} % of the period")
-    note = (f"; {where}; {model}.stop_check(result) tells by time integration whether a periodic motion exists just "
+    note = (f"{where}; {model}.stop_check(result) tells by time integration whether a periodic motion exists just "
             "beyond (a light damper may hop on the platforms or keep rolling: then none does; "
             "frequency_response(..., check_stop=True) runs it)")
-    return dataclasses.replace(response, message=response.message + note)
+    return with_note(response, Note(NoteKind.STOP_CHECK, note))
 
 
 def contact_point_field(disk, response, field: str) -> np.ndarray:

@@ -26,7 +26,9 @@ File layout (readable with ``np.load(path, allow_pickle=False)`` and any npz rea
   numbers as [re, im]; NaN as JSON's NaN), and the
   :class:`~bladedamp.hbm.fourier.HarmonicBasis` by its harmonics and n_samples: the typed
   JSON form of :func:`encode_value` / :func:`decode_value` (also used for a solid blade's
-  ``solid_info``, :meth:`bladedamp.blade.solid.SolidModalBlade.npz_arrays`).
+  ``solid_info``, :meth:`bladedamp.blade.solid.SolidModalBlade.npz_arrays`). A response's
+  ``notes`` are such a tuple (of :class:`~bladedamp.response.Note`); a response file saved before
+  responses had notes holds its ``message`` instead, which loads as its one note.
 
 The model is not saved: a ``disk`` (TunedDisk or MistunedDisk) or ``system`` field is
 stored as absent, and a loaded result has ``disk=None`` (``system=None``). Rebuilding a disk
@@ -39,7 +41,9 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import enum
 import importlib
+import inspect
 import json
 import math
 import struct
@@ -215,7 +219,9 @@ def encode_value(value, where: str = "value"):
     unsigned, float, complex and unicode dtypes (dtype and shape kept, empty arrays included; an
     object array is stored as the array numpy infers from its items); tuples, lists and dicts
     (any hashable keys of these types: integer and tuple keys stay integers and tuples),
-    nested to any depth; and :class:`~bladedamp.hbm.fourier.HarmonicBasis`. Numpy scalars come
+    nested to any depth; :class:`~bladedamp.hbm.fourier.HarmonicBasis`; and the members of
+    bladedamp's enums and the dataclasses of bladedamp whose fields are of these types (e.g.
+    a response's :class:`~bladedamp.response.Note` s), found again by their class's name. Numpy scalars come
     back as the Python scalar of their kind (``np.float64`` -> float, ``np.int64`` -> int,
     ``np.bool_`` -> bool, ``np.complex128`` -> complex).
 
@@ -223,7 +229,8 @@ def encode_value(value, where: str = "value"):
     value as a JSON object with one tag: ``{"__tuple__": [...]}``, ``{"__dict__": [[key, value],
     ...]}``, ``{"__array__": nested lists, "dtype": str}`` (complex entries as [re, im] pairs;
     ``"shape"`` too when the array is empty), ``{"__complex__": [re, im]}``, ``{"__basis__":
-    {"harmonics": [...], "n_samples": n}}``. ``where`` names the value in the TypeError raised
+    {"harmonics": [...], "n_samples": n}}``, ``{"__enum__": "module:qualname", "name": member}``,
+    ``{"__record__": "module:qualname", "fields": {name: value, ...}}``. ``where`` names the value in the TypeError raised
     for any other type (e.g. ``"MassSweep.meta['x']"``)."""
     from .hbm.fourier import HarmonicBasis
 
@@ -239,6 +246,12 @@ def encode_value(value, where: str = "value"):
         return {"__complex__": [float(value.real), float(value.imag)]}
     if isinstance(value, HarmonicBasis):
         return {"__basis__": {"harmonics": [int(h) for h in value.harmonics], "n_samples": int(value.n_samples)}}
+    if isinstance(value, enum.Enum) and _class_name(type(value)):
+        return {"__enum__": _class_name(type(value)), "name": value.name}
+    if dataclasses.is_dataclass(value) and not isinstance(value, type) and _class_name(type(value)):
+        return {"__record__": _class_name(type(value)),
+                "fields": {f.name: encode_value(getattr(value, f.name), f"{where}.{f.name}")
+                           for f in dataclasses.fields(value)}}
     if isinstance(value, np.ndarray):
         if value.dtype.kind == "O":
             value = np.asarray(value.tolist())
@@ -256,8 +269,14 @@ def encode_value(value, where: str = "value"):
     if isinstance(value, dict):
         return {"__dict__": [[encode_value(k, where), encode_value(v, f"{where}[{k!r}]")] for k, v in value.items()]}
     raise TypeError(f"cannot save {where}: a {type(value).__module__}.{type(value).__qualname__} "
-                    "(encode_value takes None, bools, numbers, strings, numpy arrays, tuples, lists, dicts "
-                    "and HarmonicBasis)")
+                    "(encode_value takes None, bools, numbers, strings, numpy arrays, tuples, lists, dicts, "
+                    "HarmonicBasis, and bladedamp's enums and dataclasses)")
+
+
+def _class_name(cls) -> str:
+    """``module:qualname`` of a bladedamp class (found again by :func:`_resolve_name`), '' for another's."""
+    module = cls.__module__
+    return f"{module}:{cls.__qualname__}" if module == "bladedamp" or module.startswith("bladedamp.") else ""
 
 
 def decode_value(value):
@@ -285,6 +304,16 @@ def decode_value(value):
         else:
             a = np.asarray(value["__array__"], dtype=dtype)
         return a.reshape(value["shape"]) if "shape" in value else a
+    if "__enum__" in value:
+        cls = _resolve_name(value["__enum__"])
+        if not (isinstance(cls, type) and issubclass(cls, enum.Enum)):
+            raise ValueError(f"{value['__enum__']!r} is not an enum")
+        return cls[value["name"]]
+    if "__record__" in value:
+        cls = _resolve_name(value["__record__"])
+        if not (isinstance(cls, type) and dataclasses.is_dataclass(cls)):
+            raise ValueError(f"{value['__record__']!r} is not a dataclass")
+        return cls(**{k: decode_value(v) for k, v in value["fields"].items()})
     if "__tuple__" in value:
         return tuple(decode_value(v) for v in value["__tuple__"])
     if "__dict__" in value:
@@ -358,7 +387,10 @@ def _rebuild(meta: dict, prefix: str, arrays):
     for name in meta["absent"]:
         kwargs[name] = None
     fields = {f.name: f for f in dataclasses.fields(cls)}
-    init = {k: v for k, v in kwargs.items() if k in fields and fields[k].init}
+    # the constructor's arguments: the fields it takes and its init-only ones (e.g. a response's
+    # message, which a file saved before the response had notes holds)
+    takes = inspect.signature(cls).parameters
+    init = {k: v for k, v in kwargs.items() if k in takes}
     obj = cls(**init)
     for k, v in kwargs.items():
         if k in fields and not fields[k].init:
@@ -366,7 +398,8 @@ def _rebuild(meta: dict, prefix: str, arrays):
     return obj
 
 
-def _resolve(name: str):
+def _resolve_name(name: str):
+    """The bladedamp class named ``module:qualname``; ValueError for another's or none."""
     module, _, qualname = name.partition(":")
     if not (module == "bladedamp" or module.startswith("bladedamp.")):
         raise ValueError(f"a saved result's class must come from bladedamp (got {name!r})")
@@ -376,6 +409,11 @@ def _resolve(name: str):
             obj = getattr(obj, part)
     except (ImportError, AttributeError):
         raise ValueError(f"a saved result's class {name!r} does not exist in this bladedamp") from None
+    return obj
+
+
+def _resolve(name: str):
+    obj = _resolve_name(name)
     if not (isinstance(obj, type) and dataclasses.is_dataclass(obj)):
         raise ValueError(f"{name!r} is not a result class")
     return obj

@@ -68,7 +68,7 @@ from .hbm.linsolve import factorize as lu_factorize
 from .hbm.peaks import PEAK_MAX_ITERATIONS, PeakSolver, first_harmonic_output
 from .hbm.fourier import HarmonicBasis
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import refined_peak
+from .response import continuation_note, refined_peak
 
 
 def sparse_real_form(basis: HarmonicBasis, per_harmonic) -> sp.csr_matrix:
@@ -852,8 +852,8 @@ class MistunedDisk(DiskModel):
             iterations = np.concatenate([piece.iterations[:0:-1], response.iterations])
             turning = np.concatenate([k - piece.turning_points, response.turning_points + k])
         success = bool(response.success and piece.success)
-        message = piece.message if not piece.success else response.message
-        branch = Branch(omega, x, iterations, success, message, np.sort(turning).astype(int))
+        message, ran_out = (piece.message, piece.out_of_points) if not piece.success else (response.message, 0)
+        branch = Branch(omega, x, iterations, success, message, np.sort(turning).astype(int), out_of_points=ran_out)
         return MistunedResponse.from_branch(self, system, branch, response.tuned_peak_amplitude)
 
     @one_blas_thread
@@ -930,8 +930,8 @@ class MistunedResponse(DiskModelResponse):
                 force, _, _ = c.element.harmonic_forces(local, basis, w, False)
                 diss[i] = basis.work_per_cycle(force, local).reshape(nd, -1).sum(axis=1)
                 bound[i] = basis.work_bound(force, local).reshape(nd, -1).sum(axis=1)
-        return cls(branch.omega, X, basis, disk.dof_names, branch.success, branch.message, branch.iterations,
-                   branch.turning_points, tip_amplitude=tip, excitation_work=exc,
+        return cls(branch.omega, X, basis, disk.dof_names, branch.success, "", branch.iterations,
+                   branch.turning_points, notes=(continuation_note(branch),), tip_amplitude=tip, excitation_work=exc,
                    viscous_dissipation=visc, dissipated_energy=diss.sum(axis=1), damper_dissipation=diss,
                    damper_work_bound=bound,
                    tuned_peak_amplitude=tuned_peak_amplitude, disk=disk, stopped_by=branch.stopped_by)

@@ -26,7 +26,7 @@ from .hbm.elements import CubicSpring
 from .hbm.fourier import HarmonicBasis
 from .hbm.monodromy import STEPS_PER_PERIOD, oscillator_monodromy
 from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import FrequencyResponse, with_range_end_estimate
+from .response import FrequencyResponse, continuation_note, with_range_end_estimate
 from .timedomain import TimeResponse, oscillator_steady_state
 
 # most AFT samples per period the automatic sampling may choose (sampled_response; one DOF:
@@ -214,8 +214,8 @@ class FrictionOscillator:
     def response_from_branch(self, system: HarmonicBalanceSystem, branch) -> FrequencyResponse:
         """The :class:`~bladedamp.response.FrequencyResponse` of a continuation ``branch`` (one DOF, x)."""
         return FrequencyResponse(branch.omega, branch.x.reshape(-1, system.basis.n_coeffs, 1), system.basis, ("x",),
-                                 branch.success, branch.message, branch.iterations, branch.turning_points,
-                                 stopped_by=branch.stopped_by)
+                                 branch.success, "", branch.iterations, branch.turning_points,
+                                 stopped_by=branch.stopped_by, notes=(continuation_note(branch),))
 
     def branch_energies(self, system: HarmonicBalanceSystem, branch, response: FrequencyResponse):
         """(excitation work (n,), the nonlinear elements' dissipation (n, 1), their work bound (n, 1))

@@ -149,17 +149,20 @@ def sampled_response(solve, n_samples, first: int, most: int, most_for_dissipati
         n *= SAMPLES_GROWTH
     n_used = response.basis.n_samples
     failed_with = [str(t) for t in tried if t != n_used]
-    note = ""
+    notes = []
     most = not response.success and n_used * SAMPLES_GROWTH > (
         most if most_for_dissipation is None or not only_sampling_failed(response) else most_for_dissipation)
     if failed_with:
-        note += (f"; AFT samples per period raised to {n_used}{' (the most)' if most else ''} (the branch failed "
-                 f"with {', '.join(failed_with)})")
+        notes.append(f"AFT samples per period raised to {n_used}{' (the most)' if most else ''} (the branch failed "
+                     f"with {', '.join(failed_with)})")
     if empty is not None:
-        note += f"; with {empty} AFT samples per period the branch kept no point" + (f": {stopped_by}" if stopped_by else "")
-    if stopped_by:
-        return dataclasses.replace(response, message=response.message + note, success=False, stopped_by=stopped_by)
-    return dataclasses.replace(response, message=response.message + note) if note else response
+        notes.append(f"with {empty} AFT samples per period the branch kept no point"
+                     + (f": {stopped_by}" if stopped_by else ""))
+    changes = dict(success=False, stopped_by=stopped_by) if stopped_by else {}
+    if notes or changes:
+        notes = tuple(Note(NoteKind.AFT_SAMPLES, text) for text in notes)
+        return dataclasses.replace(response, notes=(*response.notes, *notes), **changes)
+    return response
 
 
 def refined_peak(frequency_hz, amplitude, i: int | None = None) -> tuple[float, float]:
@@ -191,10 +194,75 @@ def with_checks(response, failed: dict):
     message says why."""
     if not failed:
         return response
-    message = response.message + "; failed checks: " + "; ".join(f"{k}: {v}" for k, v in failed.items())
-    return dataclasses.replace(response, success=False, message=message,
-                               failed_checks={**(response.failed_checks or {}), **failed},
-                               reached_end=response.reached_range_end)
+    note = Note(NoteKind.FAILED_CHECKS, "failed checks: " + "; ".join(f"{k}: {v}" for k, v in failed.items()))
+    return with_note(response, note, success=False, failed_checks={**(response.failed_checks or {}), **failed},
+                     reached_end=response.reached_range_end)
+
+
+class NoteKind(enum.Enum):
+    """What a :class:`Note` of a frequency response says: the closed set of notes the package
+    adds to a result, in the order a computation adds them (the value is a short name)."""
+
+    CONTINUATION = "continuation"           # the continuation's own message: how the branch ended
+    AFT_SAMPLES = "AFT samples"             # sampled_response: how the AFT samples were chosen
+    FAILED_CHECKS = "failed checks"         # with_checks: the physical checks that failed
+    HARMONIC_ESTIMATE = "harmonic estimate"  # the estimate above the tolerance or not verified
+    HARMONIC_SEARCH = "harmonic search"     # harmonics='auto': a richer set not finished or not tried
+    RETENTION = "retention"                 # a peak held by the static retention spring: not verified
+    PEAK_CHECK = "peak check"               # the time integration at the peak, or how to run it
+    STOP_CHECK = "stop check"               # where and why the branch stopped, the time integration beyond
+    RANGE_END = "range end"                 # the largest amplitude at an end of the range
+
+
+@dataclass(frozen=True)
+class Note:
+    """One note of a frequency response (:attr:`FrequencyResponse.notes`): its ``kind`` (a
+    :class:`NoteKind`), the sentence ``text`` a user reads, and ``values``: {name: number} a
+    program reads instead of parsing the text (e.g. ``{"max_points": 5000}`` on the
+    CONTINUATION note of a branch that used up its points, :func:`continuation_note`)."""
+
+    kind: NoteKind
+    text: str
+    values: dict = field(default_factory=dict, hash=False)
+
+    def __post_init__(self):
+        if not isinstance(self.kind, NoteKind):
+            raise ValueError(f"kind must be a bladedamp.response.NoteKind (got {self.kind!r})")
+        if not isinstance(self.text, str):
+            raise ValueError(f"text must be a str (got {type(self.text).__name__})")
+
+
+#: what separates the notes in a response's message
+NOTE_SEPARATOR = "; "
+
+
+class NotesText(str):
+    """The text of a response's notes joined by ``NOTE_SEPARATOR`` (its :attr:`~FrequencyResponse.message`),
+    a str. A constructor given one with notes keeps the notes (``dataclasses.replace`` passes the
+    message it reads back), whereas a plain str given as ``message`` is the whole message."""
+
+
+def notes_text(notes) -> NotesText:
+    """The message of ``notes`` (a sequence of :class:`Note`): their texts joined in order."""
+    return NotesText(NOTE_SEPARATOR.join(n.text for n in notes))
+
+
+def with_note(response, note: Note, **changes):
+    """``response`` with ``note`` added after its notes (and the field ``changes``, as
+    ``dataclasses.replace``): the one way a result's message grows."""
+    return dataclasses.replace(response, notes=(*response.notes, note), **changes)
+
+
+def continuation_note(branch) -> Note:
+    """The CONTINUATION note of a :class:`~bladedamp.hbm.continuation.Branch`: its message, and
+    ``values`` {"max_points": n} where it used up its n points before the end of its range."""
+    return Note(NoteKind.CONTINUATION, str(branch.message),
+                {"max_points": int(branch.out_of_points)} if branch.out_of_points else {})
+
+
+def notes_of(response, kind: NoteKind) -> tuple:
+    """The notes of ``response`` of ``kind``, in order (none for a response without notes)."""
+    return tuple(n for n in getattr(response, "notes", ()) if n.kind is kind)
 
 
 class Status(enum.Enum):
@@ -421,7 +489,7 @@ def stop_sentence(response) -> str:
         return f"{where}; a periodic motion exists beyond, which a richer set (harmonics='auto') may follow"
     if response.failed_checks:
         return f"{where}; {check_sentence(response.failed_checks)}"
-    if "stopped after max_points" in response.message:
+    if any("max_points" in n.values for n in notes_of(response, NoteKind.CONTINUATION)):
         return f"{where}, all its max_points = {len(response.omega)} points used: raise max_points"
     more = "check_stop=True tells whether a periodic motion exists beyond" if hasattr(response, "stop_check") \
         else "shorten max_step or run with harmonics='auto'"
@@ -484,7 +552,7 @@ def with_range_end_estimate(model, response):
     f = response.frequency_hz
     bounds = tuple(float(b) for b in model.linear_natural_frequencies_hz(float(f.min()), float(f.max())))
     response = dataclasses.replace(response, linear_natural_frequencies_hz=bounds)
-    return dataclasses.replace(response, message=f"{response.message}; {range_end_note(response)}")
+    return with_note(response, Note(NoteKind.RANGE_END, range_end_note(response)))
 
 
 def nearest_to_range(frequencies_hz, f_low: float, f_high: float) -> float:
@@ -528,7 +596,11 @@ class FrequencyResponse(Saveable):
     basis : HarmonicBasis used
     dof_names : names of the degrees of freedom
     success : whether the continuation reached the end of the range
-    message : why it stopped
+    message : init only, and a read-only property: the text of ``notes`` joined by
+        ``NOTE_SEPARATOR`` in order (what a user reads: how the branch ended, then what each
+        later step found). Given as a plain str to the constructor (``from_branch``, a file
+        saved before notes existed, ``dataclasses.replace(r, message=...)``) it is the whole
+        message: one note of kind CONTINUATION, replacing ``notes``
     iterations : (n,) Newton iterations per point
     turning_points : indices of the points where d omega / ds changed sign (folds)
     harmonic_error : estimated error of the first-harmonic output amplitudes from the harmonic
@@ -557,6 +629,10 @@ class FrequencyResponse(Saveable):
         set (e.g. a disk's peak held by the harmonic balance's static retention spring,
         :func:`bladedamp.diskmodel.retention_check`), '' if nothing; with one, ``harmonic_error`` is
         nan (status COMPLETE_UNVERIFIED) until a time integration of the peak gives an estimate
+    notes : the :class:`Note` s of the result in the order they were added (:func:`with_note`):
+        the continuation's message first (kind CONTINUATION, :func:`continuation_note`), then
+        each later step's (the AFT samples, failed checks, harmonic estimate, peak and stop
+        checks, range end: :class:`NoteKind`); a program reads their ``kind`` and ``values``
 
     Derived, for every response (saved ones too): :attr:`status` (a :class:`Status`),
     :attr:`status_message` and :attr:`peak_at_range_end`.
@@ -567,7 +643,7 @@ class FrequencyResponse(Saveable):
     basis: HarmonicBasis
     dof_names: tuple[str, ...]
     success: bool
-    message: str
+    message: dataclasses.InitVar[str] = ""
     iterations: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     turning_points: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     harmonic_error: float = float("nan")
@@ -582,6 +658,16 @@ class FrequencyResponse(Saveable):
     stopped_by: str = ""
     linear_natural_frequencies_hz: tuple = ()
     unverified_reason: str = ""
+    notes: tuple = ()
+
+    def __post_init__(self, message):
+        # a plain str is the whole message; the NotesText that dataclasses.replace passes back keeps the notes
+        if message and (not isinstance(message, NotesText) or not self.notes):
+            self.notes = (Note(NoteKind.CONTINUATION, str(message)),)
+        self.notes = tuple(self.notes)
+        for note in self.notes:
+            if not isinstance(note, Note):
+                raise ValueError(f"notes must be bladedamp.response.Note objects (got {note!r})")
 
     @property
     def status(self) -> Status:
@@ -702,3 +788,9 @@ class FrequencyResponse(Saveable):
 
             draw_measurement(ax, measured, scale=scale)
         return ax
+
+
+# the message, derived from the notes (set after the class: ``message`` is also the init-only
+# argument of the constructor, whose default the dataclass reads from the class body)
+FrequencyResponse.message = property(lambda self: notes_text(self.notes),
+                                     doc="The text of :attr:`notes` joined in order (:func:`notes_text`), read only.")

@@ -437,6 +437,7 @@ def test_the_stall_guard_ends_a_stalled_branch_and_says_so():
             guarded = continuation(fun, x0, w0, w1, **options)
             creeping = continuation(stalling_zigzag(creep=0.5)[0], x0, w0, w1, **options)
     assert not free.success and len(free.omega) == 1000 and "max_points" in free.message
+    assert free.out_of_points == 1000 and guarded.out_of_points == 0      # the stop, typed
     assert len(free.turning_points) > 20 and free.omega.max() <= 10.1 + 1e-9
     assert not guarded.success and not guarded.stopped_by and "stalled" in guarded.message
     progress = (guarded.omega - w0) / (w1 - w0)

@@ -22,10 +22,13 @@ import bladedamp as bd  # noqa: E402
 from bladedamp import io  # noqa: E402
 from bladedamp.diskmodel import DiskModelResponse  # noqa: E402
 from bladedamp.mistuned import MistunedDisk, MistunedResponse  # noqa: E402
+from bladedamp.response import with_note  # noqa: E402
 from bladedamp.studies import design as sd  # noqa: E402
 from bladedamp.studies import mass as sm  # noqa: E402
 from bladedamp.studies import mistuning as mt  # noqa: E402
 from bladedamp.timedomain import DiskTimeResponse, TimeResponse  # noqa: E402
+
+DATA = Path(__file__).parent / "data"
 
 
 def assert_same(a, b, where="result"):
@@ -110,6 +113,30 @@ def test_frequency_response_round_trip(oscillator_frf, tmp_path):
     assert back.peak_amplitude == r.peak_amplitude and back.peak_frequency_hz == r.peak_frequency_hz
     np.testing.assert_array_equal(back.time_samples(), r.time_samples())     # the basis is rebuilt
     assert back.plot().get_lines()
+
+
+def test_notes_round_trip_with_their_kinds_values_and_order(oscillator_frf, tmp_path):
+    """A response's notes are saved (its message is not: it is derived from them) and loaded with
+    their kinds, texts, values and order; a file saved before responses had notes (main 427345c)
+    loads with the message it holds as its one note, of kind CONTINUATION."""
+    _, r = oscillator_frf
+    r = with_note(r, bd.Note(bd.NoteKind.STOP_CHECK, "beyond, a periodic motion"))
+    r = with_note(r, bd.Note(bd.NoteKind.CONTINUATION, "second", {"max_points": 7}))
+    back = round_trip(r, tmp_path)
+    assert back.notes == r.notes and [n.kind for n in back.notes][1:] == [bd.NoteKind.STOP_CHECK,
+                                                                          bd.NoteKind.CONTINUATION]
+    assert back.notes[-1].values == {"max_points": 7} and type(back.notes[-1].values["max_points"]) is int
+    assert back.message == r.message and back.status is r.status
+    with np.load(tmp_path / "r.npz", allow_pickle=False) as z:
+        fields = json.loads(str(z[io.META_KEY][()]))["fields"]
+    assert "message" not in fields and "notes" in fields
+    for name in ("oscillator_response_v1.npz", "disk_response_v1.npz"):
+        with np.load(DATA / name, allow_pickle=False) as z:
+            fields = json.loads(str(z[io.META_KEY][()]))["fields"]
+        assert "notes" not in fields
+        old = bd.load(DATA / name)
+        assert old.notes == (bd.Note(bd.NoteKind.CONTINUATION, fields["message"]),)
+        assert old.message == fields["message"] == "reached the end of the frequency range"
 
 
 def test_disk_response_round_trip_without_the_model(disk_frf, tmp_path):
@@ -272,7 +299,8 @@ def test_encoded_values_round_trip_with_their_types():
              "u8": np.array([0, 255], dtype=np.uint8), "bool": np.array([True, False]),
              "c128": np.array([1 + 2j, -0.5j]), "names": np.array(["1F", "2F", "1T"]), "0d": np.array(3.5),
              "empty": np.zeros((0, 3)), "empty_c": np.zeros((2, 0), dtype=complex),
-             "basis": bd.HarmonicBasis((0, 1, 3), 32),
+             "basis": bd.HarmonicBasis((0, 1, 3), 32), "kind": bd.NoteKind.RANGE_END,
+             "note": (bd.Note(bd.NoteKind.CONTINUATION, "stopped", {"max_points": 5, "f_hz": 12.5}),),
              "nested": {1: {"a": (np.array([1, 2]),), (2, "b"): {"deep": [1.0]}}, None: 0.0}}
     back = io.decode_value(json.loads(json.dumps(io.encode_value(value))))
     basis = back.pop("basis")
@@ -294,6 +322,10 @@ def test_encode_value_refuses_other_types_naming_the_value():
         io.encode_value(np.array([b"x"]), "a")
     with pytest.raises(ValueError, match="not an encoded value"):
         io.decode_value({"n_dofs": 3})                 # a plain JSON object is not an encoded dict
+    with pytest.raises(TypeError, match="cannot save n: a pathlib"):
+        io.encode_value(Path("x"), "n")                # neither an enum nor a dataclass of bladedamp
+    with pytest.raises(ValueError, match="must come from bladedamp"):
+        io.decode_value({"__record__": "os:stat_result", "fields": {}})
 
 
 # ----- the file ------------------------------------------------------------------------

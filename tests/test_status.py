@@ -13,9 +13,9 @@ import bladedamp as bd
 from bladedamp.mistuned import MistunedResponse
 from bladedamp.blade import reference_blade
 from bladedamp.hbm.fourier import HarmonicBasis
-from bladedamp.response import (PLAUSIBLE_TIP_DEFLECTION, REFINE_SAMPLES_FACTOR, STATUS_EXPLANATIONS, Status,
-                                physical_checks, range_end_of_largest, response_status, sampled_response,
-                                with_checks)
+from bladedamp.response import (PLAUSIBLE_TIP_DEFLECTION, REFINE_SAMPLES_FACTOR, STATUS_EXPLANATIONS, Note, NoteKind,
+                                Status, notes_of, physical_checks, range_end_of_largest, response_status,
+                                sampled_response, with_checks, with_note)
 
 DATA = Path(__file__).parent / "data"
 # issue 33: a result's status in one plain sentence (aimed at 140 characters; the numbers of the
@@ -109,6 +109,12 @@ def test_a_branch_that_runs_out_of_points_is_stopped():
     assert r.status is Status.STOPPED and not r.success
     first, = sentences(r.status_message)
     assert f"ends at {r.frequency_hz[r.furthest_index()]:.2f} Hz" in first
+    # the stop is read from the continuation's note, its values, not from its text
+    assert notes_of(r, NoteKind.CONTINUATION)[0].values == {"max_points": 5} and len(r.omega) == 5
+    assert "all its max_points = 5 points used: raise max_points" in first
+    # the same text without the value (a retry's "first try: stopped after max_points"): not said
+    plain = dataclasses.replace(r, notes=tuple(Note(n.kind, n.text) for n in r.notes))
+    assert "stopped after max_points" in plain.message and "raise max_points" not in plain.status_message
 
 
 def test_a_budget_stop_is_out_of_budget():
@@ -382,3 +388,47 @@ def test_a_failed_dissipation_check_states_the_aft_energy_error(complete):
     r = sampled_response(solve, None, 256, 4096)
     assert r.basis.n_samples == 4096 and "raised to 4096 (the most)" in r.message
     assert "AFT energy error -1 %" in r.status_message
+
+
+# ----- notes: the result's message as typed notes (issue 34 item 5) ----------------------------
+def test_notes_keep_their_order_and_the_message_is_the_old_concatenation(complete):
+    """A branch that fails its dissipation check with 256 AFT samples and passes with 1024, then
+    fails a step check: its notes in the order the steps added them, and its message the string
+    the steps built before notes existed (each appended "; " and its text to the message)."""
+    failed = {"dissipation": "negative friction dissipation at 1 points"}
+
+    def solve(n):
+        r = dataclasses.replace(complete, basis=HarmonicBasis((1,), n))
+        return r if n >= 1024 else with_checks(r, failed)
+    r = with_checks(sampled_response(solve, None, 256, 4096), {"step": "a step of 1 Hz"})
+    assert [n.kind for n in r.notes] == [NoteKind.CONTINUATION, NoteKind.AFT_SAMPLES, NoteKind.FAILED_CHECKS]
+    old = complete.message
+    old = old + "; AFT samples per period raised to 1024 (the branch failed with 256)"     # sampled_response's
+    old = old + "; failed checks: " + "; ".join(f"{k}: {v}" for k, v in {"step": "a step of 1 Hz"}.items())
+    assert r.message == old and complete.message == "reached the end of the frequency range"
+    assert r.notes[0] == complete.notes[0] and r.status is Status.CHECK_FAILED
+    # the harmonic estimate above the tolerance: the continuation's note, then the estimate's
+    above = oscillator_response(harmonic_tolerance=1e-6)
+    assert [n.kind for n in above.notes] == [NoteKind.CONTINUATION, NoteKind.HARMONIC_ESTIMATE]
+    assert above.message == f"{above.notes[0].text}; {above.notes[1].text}"
+    assert above.notes[1].text.startswith(f"harmonic error estimate {100 * above.harmonic_error:.2g} % exceeds")
+
+
+def test_a_message_given_as_text_is_one_continuation_note(complete):
+    """The compatible path: a message passed to the constructor (from a branch, a file saved
+    before notes existed, ``dataclasses.replace(r, message=...)``) is the whole message, one note;
+    ``replace`` without one keeps the notes; ``with_note`` appends."""
+    r = with_note(complete, Note(NoteKind.RANGE_END, "the largest amplitude is at the range end"))
+    assert dataclasses.replace(r, success=False).notes == r.notes
+    told = dataclasses.replace(r, message="as told")
+    assert told.message == "as told" and told.notes == (Note(NoteKind.CONTINUATION, "as told"),)
+    built = bd.FrequencyResponse(r.omega, r.coefficients, r.basis, r.dof_names, True, "reached the end")
+    assert built.notes == (Note(NoteKind.CONTINUATION, "reached the end"),)
+    again = bd.FrequencyResponse(r.omega, r.coefficients, r.basis, r.dof_names, True, r.message)   # its text
+    assert again.message == r.message and again.notes == (Note(NoteKind.CONTINUATION, r.message),)
+    with pytest.raises(AttributeError):
+        r.message = "x"                                          # derived: read only
+    with pytest.raises(ValueError, match="kind"):
+        Note("range end", "text")
+    with pytest.raises(ValueError, match="notes"):
+        dataclasses.replace(r, notes=("text",))

@@ -37,7 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..response import BUDGET_PREFIX, harmonic_sentence
+from ..response import BUDGET_PREFIX, Note, NoteKind, harmonic_sentence, with_note
 from .continuation import newton, stall_guard
 from .fourier import HarmonicBasis, enriched
 from .linsolve import one_blas_thread
@@ -188,9 +188,10 @@ def annotate(response, check: HarmonicCheck, tolerance: float):
         # branch that stopped or failed a check is said so by its status, whose advice is not the harmonics
         warnings.warn(harmonic_sentence(check.harmonics, check.error, tolerance, estimated=True), AccuracyWarning,
                       stacklevel=5)   # annotate, converged_response, its BLAS wrapper, the model, the caller
-    message = response.message + ("; " + note if note else "")
-    return dataclasses.replace(response, harmonic_error=check.error, harmonic_tolerance=tolerance,
-                               harmonics_converged=met, message=message)
+    changes = dict(harmonic_error=check.error, harmonic_tolerance=tolerance, harmonics_converged=met)
+    if note:
+        return with_note(response, Note(NoteKind.HARMONIC_ESTIMATE, note), **changes)
+    return dataclasses.replace(response, **changes)
 
 
 @one_blas_thread
@@ -241,9 +242,8 @@ def converged_response(model, solve, harmonics="auto", tolerance: float = HARMON
                     kept = annotate(best[0], best[1], tolerance)
                     what = (f"not computed: {response.stopped_by}" if not len(response.omega) else
                             f"stopped before the end of the range: {response.stopped_by}")
-                    return dataclasses.replace(kept, success=False, reached_end=kept.reached_range_end,
-                                               stopped_by=response.stopped_by,
-                                               message=f"{kept.message}; harmonics {tuple(H)} {what}")
+                    return with_note(kept, Note(NoteKind.HARMONIC_SEARCH, f"harmonics {tuple(H)} {what}"),
+                                     success=False, reached_end=kept.reached_range_end, stopped_by=response.stopped_by)
                 if response.stopped_by:
                     return response           # stopped as the caller asked: no estimate, no richer set
                 if best is not None and best[0].success and not response.reached_range_end:
@@ -255,9 +255,9 @@ def converged_response(model, solve, harmonics="auto", tolerance: float = HARMON
                     kept = annotate(best[0], best[1], tolerance)
                     where = (f"its branch got no further than {response.frequency_hz[response.furthest_index()]:.6g} Hz"
                              if len(response.omega) else "its branch kept no point")
-                    return dataclasses.replace(kept, message=(
-                        f"{kept.message}; harmonics {tuple(H)} did not converge to the end of the range ({where}), "
-                        f"so no richer set was tried"))
+                    return with_note(kept, Note(NoteKind.HARMONIC_SEARCH, (
+                        f"harmonics {tuple(H)} did not converge to the end of the range ({where}), "
+                        f"so no richer set was tried")))
                 check = harmonic_error(model, response, n_points=n_points) if len(response.omega) else None
             if check is None:
                 continue

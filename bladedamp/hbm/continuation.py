@@ -213,6 +213,8 @@ class Branch:
     checks : {name: bool} of :func:`branch_checks` (empty for a branch not made by :func:`continuation`)
     stopped_by : what ``stop_when`` said when it ended the branch ('' if it did not): the branch
         is then not ``success`` but not a failure of the method either, and is never retried
+    out_of_points : the ``max_points`` a branch used up before the end of its range (it stopped
+        there, its message says so); 0 if it did not
     """
 
     omega: np.ndarray
@@ -223,6 +225,7 @@ class Branch:
     turning_points: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))  # indices of folds
     checks: dict = field(default_factory=dict)   # name -> bool, see branch_checks
     stopped_by: str = ""
+    out_of_points: int = 0
 
     def reversed(self, message: str) -> "Branch":
         """This branch in the opposite order (a branch computed from the end of its range,
@@ -230,13 +233,13 @@ class Branch:
         n = len(self.omega)
         return Branch(self.omega[::-1].copy(), self.x[::-1].copy(), self.iterations[::-1].copy(), self.success,
                       message, np.sort(n - 1 - np.asarray(self.turning_points, dtype=int)), dict(self.checks),
-                      self.stopped_by)
+                      self.stopped_by, self.out_of_points)
 
     def take(self, indices) -> "Branch":
         """The points ``indices`` of this branch (for re-evaluating them, e.g. with a finer AFT)."""
         indices = np.asarray(indices, dtype=int)
         return Branch(self.omega[indices], self.x[indices], self.iterations[indices], self.success, self.message,
-                      stopped_by=self.stopped_by)
+                      stopped_by=self.stopped_by, out_of_points=self.out_of_points)
 
 
 def branch_checks(omega, omega_start, omega_end, max_step) -> dict:
@@ -874,7 +877,7 @@ class ArcLengthContinuation:
         self.its.append(land.iterations)
         return True
 
-    def finish(self, success, message):
+    def finish(self, success, message, out_of_points: int = 0):
         n = self.n
         Y = np.array(self.points) if self.points else np.zeros((0, n + 1))
         checks = branch_checks(Y[:, n], self.omega_start, self.omega_end, self.max_step)
@@ -886,7 +889,7 @@ class ArcLengthContinuation:
         d = np.sign(np.diff(Y[:, n]))
         turning = np.flatnonzero(d[1:] * d[:-1] < 0) + 1
         return Branch(Y[:, n], Y[:, :n], np.array(self.its, dtype=int), success, message, turning, checks,
-                      self.stopped_by)
+                      self.stopped_by, out_of_points)
 
     def stop_event(self, at_end: bool = False) -> str:
         """``stop_when`` at the last point kept, then the budget (which it charges one point; it
@@ -1019,4 +1022,5 @@ class ArcLengthContinuation:
         else:
             message = f"stopped after max_points = {self.max_points} points at omega = {points[-1][n]:.6g} rad/s"
             _warn(message, 3)
+            return self.finish(success, message, self.max_points)
         return self.finish(success, message)
