@@ -476,8 +476,8 @@ class DiskResponse(DiskModelResponse):
         and motion harmonics could do (HarmonicBasis.work_bound) [J]
     normal_load : (n, 2) mean normal load of OL, OR [N]
 
-    ``peak_amplitude`` (float) is the largest sampled |u_x| of the reference blade, the same as
-    :attr:`~DiskModelResponse.largest_peak_amplitude`.
+    ``peak_amplitude`` (float) is the largest sampled |u_x| of the reference blade;
+    :attr:`~DiskModelResponse.blade_peak_amplitudes` is it as a (1,) array.
     """
 
     modal_amplitude: np.ndarray = None

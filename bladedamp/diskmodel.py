@@ -1656,13 +1656,12 @@ class DiskModelResponse(FrequencyResponse):
         (a one-frequency DiskTimeResponse, :func:`with_peak_check`), else None
     disk : the model (None for a loaded result)
 
-    The peaks: :attr:`largest_peak_amplitude` (float [m]) and :attr:`largest_peak_frequency_hz`
-    (float [Hz]) are the largest tip amplitude u_x of any blade and its frequency, the same
-    quantity and type for both models; :attr:`blade_peak_amplitudes` and
-    :attr:`blade_peak_frequencies_hz` are (s,) arrays, one per blade written out ((1,) for the
-    tuned disk). ``peak_amplitude`` keeps its meaning per class: a float (the reference sector's
-    largest sample) on a :class:`DiskResponse`, the (s,) blade peaks (parabola-refined) on a
-    MistunedResponse.
+    The peaks, the same names and types for both models: :attr:`peak_amplitude` (float [m]) and
+    :attr:`peak_frequency_hz` (float [Hz]) are the largest tip amplitude u_x of any blade and its
+    frequency (on a :class:`DiskResponse` the reference sector's largest sample);
+    :attr:`blade_peak_amplitudes` and :attr:`blade_peak_frequencies_hz` are (s,) arrays, one per
+    blade written out ((1,) for the tuned disk; a MistunedResponse's parabola-refined, its
+    ``peaks()``), whose largest is ``peak_amplitude``.
     """
 
     tip_amplitude: np.ndarray = None
@@ -1685,27 +1684,14 @@ class DiskModelResponse(FrequencyResponse):
 
     @property
     def blade_peak_amplitudes(self) -> np.ndarray:
-        """(s,) peak first-harmonic tip amplitude u_x of each blade written out [m] ((1,) for the
-        tuned disk's reference sector)."""
+        """(s,) peak first-harmonic tip amplitude u_x of each blade written out [m]: here (1,), the
+        reference sector's :attr:`peak_amplitude` (a model of several blades overrides it)."""
         return np.atleast_1d(np.asarray(self.peak_amplitude, dtype=float))
 
     @property
     def blade_peak_frequencies_hz(self) -> np.ndarray:
         """(s,) frequency of each blade's peak [Hz], as :attr:`blade_peak_amplitudes`."""
         return np.atleast_1d(np.asarray(self.peak_frequency_hz, dtype=float))
-
-    @property
-    def largest_peak_amplitude(self) -> float:
-        """The largest peak first-harmonic tip amplitude u_x of any blade [m] (nan for an empty branch)."""
-        peaks = self.blade_peak_amplitudes
-        return float(peaks.max()) if peaks.size and len(self.omega) else float("nan")
-
-    @property
-    def largest_peak_frequency_hz(self) -> float:
-        """The frequency of :attr:`largest_peak_amplitude` [Hz] (nan for an empty branch)."""
-        peaks = self.blade_peak_amplitudes
-        return float(self.blade_peak_frequencies_hz[np.argmax(peaks)]) if peaks.size and len(self.omega) \
-            else float("nan")
 
     def finish_plot(self, ax, direction: int, measured=None, legend: dict | None = None):
         """The axes of a disk response's :meth:`plot` completed: labels, grid, legend, the status

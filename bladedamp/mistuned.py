@@ -905,9 +905,9 @@ class MistunedResponse(DiskModelResponse):
         largest work its force and motion harmonics could do (HarmonicBasis.work_bound) [J]
     tuned_peak_amplitude : the tuned disk's peak u_x [m] if given (amplification factors)
 
-    ``peak_amplitude`` is the (s,) array of the blades' peaks (parabola-refined, :meth:`peaks`),
-    the same as :attr:`~bladedamp.diskmodel.DiskModelResponse.blade_peak_amplitudes`; the largest of
-    them, a float as for the tuned disk, is ``largest_peak_amplitude``.
+    ``blade_peak_amplitudes`` / ``blade_peak_frequencies_hz`` are the (s,) blades' peaks and their
+    frequencies (parabola-refined, :meth:`peaks`); ``peak_amplitude`` / ``peak_frequency_hz``, floats
+    as on every response, are the largest of them and its frequency.
     """
 
     damper_dissipation: np.ndarray = None
@@ -976,14 +976,28 @@ class MistunedResponse(DiskModelResponse):
         return peak, freq
 
     @property
-    def peak_amplitude(self) -> np.ndarray:
-        """(s,) peak first-harmonic tip amplitude u_x of every blade [m]."""
+    def blade_peak_amplitudes(self) -> np.ndarray:
+        """(s,) peak first-harmonic tip amplitude u_x of every blade [m] (parabola-refined, :meth:`peaks`)."""
         return self.peaks()[0]
 
     @property
-    def peak_frequency_hz(self) -> np.ndarray:
-        """(s,) frequency of each blade's peak [Hz] (parabola-refined, as :attr:`peak_amplitude`)."""
+    def blade_peak_frequencies_hz(self) -> np.ndarray:
+        """(s,) frequency of each blade's peak [Hz] (parabola-refined, as :attr:`blade_peak_amplitudes`)."""
         return self.peaks()[1]
+
+    @property
+    def peak_amplitude(self) -> float:
+        """The largest peak first-harmonic tip amplitude u_x of any blade [m], the largest of
+        :attr:`blade_peak_amplitudes` (nan for an empty branch)."""
+        return float(self.peaks()[0].max()) if len(self.omega) else float("nan")
+
+    @property
+    def peak_frequency_hz(self) -> float:
+        """The frequency of :attr:`peak_amplitude` [Hz] (nan for an empty branch)."""
+        if not len(self.omega):
+            return float("nan")
+        peak, freq = self.peaks()
+        return float(freq[np.argmax(peak)])
 
     def peak_curve(self) -> np.ndarray:
         """(n, s) first-harmonic tip amplitude |u_x| of every blade at every point [m]: the
@@ -995,7 +1009,7 @@ class MistunedResponse(DiskModelResponse):
         ref = self.tuned_peak_amplitude if tuned_peak_amplitude is None else tuned_peak_amplitude
         if ref is None:
             raise ValueError("tuned_peak_amplitude is needed for amplification factors (give it here or to frequency_response)")
-        return self.peak_amplitude / validation.positive("tuned_peak_amplitude", ref)
+        return self.blade_peak_amplitudes / validation.positive("tuned_peak_amplitude", ref)
 
     def plot(self, ax=None, *, tuned=None, direction: int = 0, highlight=None, title: str | None = None,
              measured=None):
@@ -1008,7 +1022,7 @@ class MistunedResponse(DiskModelResponse):
 
         if ax is None:
             _, ax = plt.subplots(figsize=(7, 4.5))
-        peaks = self.peak_amplitude
+        peaks = self.blade_peak_amplitudes
         if highlight is None:
             highlight = sorted({int(np.argmax(peaks)), int(np.argmin(peaks))})
         from . import palette

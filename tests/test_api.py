@@ -121,15 +121,32 @@ def test_one_plot_signature_ax_first_then_keywords(cls):
     assert all(p.kind in (p.KEYWORD_ONLY, p.VAR_KEYWORD) for p in params[1:]), [(p.name, p.kind) for p in params]
 
 
-def test_mistuned_peaks_are_per_blade_arrays_under_the_same_names():
+def test_tuned_and_mistuned_peaks_have_the_same_names_and_types():
+    """Issue 34 item 2: on both disk responses ``peak_amplitude`` / ``peak_frequency_hz`` are floats
+    (the largest tip amplitude u_x of any blade and its frequency) and ``blade_peak_amplitudes`` /
+    ``blade_peak_frequencies_hz`` the (s,) blades' peaks ((1,) for the tuned reference sector); the
+    mistuned float is the largest of its blades' parabola-refined peaks (``peaks()``), at least
+    the largest sample of any blade and within 1 % of it."""
     td = dataclasses.replace(bd.reference_disk("cylinder", 1e-3), n_blades=4)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        r = MistunedDisk.from_tuned(td, [1.01, 0.99, 1.02, 1.0]).frequency_response(92.0, 99.0, harmonics=(1,),
-                                                                                   max_step=0.1)
-    assert r.peak_amplitude.shape == (4,) and r.peak_frequency_hz.shape == (4,)
-    assert np.all((r.peak_frequency_hz > 92.0) & (r.peak_frequency_hz < 99.0))
-    np.testing.assert_allclose(r.peak_amplitude.max(), r.tip_amplitude[:, :, 0].max(), rtol=1e-2)
+        tuned = td.frequency_response(88.0, 104.0, harmonics=(1,), max_step=0.1)      # resonance 102.3 Hz
+        ring = MistunedDisk.from_tuned(td, [1.01, 0.99, 1.02, 1.0]).frequency_response(92.0, 99.0, harmonics=(1,),
+                                                                                      max_step=0.1)
+    for r, s in ((tuned, 1), (ring, 4)):
+        assert type(r.peak_amplitude) is float and type(r.peak_frequency_hz) is float, type(r).__name__
+        assert isinstance(r.blade_peak_amplitudes, np.ndarray) and r.blade_peak_amplitudes.shape == (s,)
+        assert isinstance(r.blade_peak_frequencies_hz, np.ndarray) and r.blade_peak_frequencies_hz.shape == (s,)
+        assert r.peak_amplitude == r.blade_peak_amplitudes.max()
+        assert r.peak_frequency_hz == r.blade_peak_frequencies_hz[np.argmax(r.blade_peak_amplitudes)]
+        assert not r.peak_at_range_end and r.frequency_hz[0] < r.peak_frequency_hz < r.frequency_hz[-1]
+    assert tuned.peak_amplitude == tuned.tip_amplitude[:, 0].max()
+    peak, freq = ring.peaks()
+    np.testing.assert_array_equal(ring.blade_peak_amplitudes, peak)
+    np.testing.assert_array_equal(ring.blade_peak_frequencies_hz, freq)
+    assert np.all((freq > 92.0) & (freq < 99.0))
+    largest_sample = ring.tip_amplitude[:, :, 0].max()
+    assert largest_sample <= ring.peak_amplitude <= 1.01 * largest_sample
 
 
 # ----- plausible masses and lengths --------------------------------------------------------

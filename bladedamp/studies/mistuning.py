@@ -239,11 +239,11 @@ class MistuningCase(Saveable):
     @property
     def peak_amplitude(self) -> np.ndarray:
         """(16,) peak of every blade [m] (a sector model's blades repeated around the disk)."""
-        return np.resize(self.response.peak_amplitude, len(self.kappa))
+        return np.resize(self.response.blade_peak_amplitudes, len(self.kappa))
 
     @property
     def peak_frequency_hz(self) -> np.ndarray:
-        return np.resize(self.response.peak_frequency_hz, len(self.kappa))
+        return np.resize(self.response.blade_peak_frequencies_hz, len(self.kappa))
 
     def summary(self) -> dict:
         return {"kappa": [float(k) for k in self.kappa], "peak_tip_mm": [float(1e3 * p) for p in self.peak_amplitude],
@@ -318,7 +318,7 @@ def paper_cases(disk_factory=None, progress=None, f_range_hz=None, max_step: flo
     for (mass, name), r in zip(plan, parallel_map(_mistuned_case, cases, processes)):
         key = f"{name}_{1e3 * mass:g}g"
         out[key] = MistuningCase(key, mass, kappas[name], r, tuned[mass][0], tuned[mass][1])
-        tick(f"{key}: max peak {1e3 * r.peak_amplitude.max():.4f} mm (tuned {1e3 * tuned[mass][0]:.4f} mm), "
+        tick(f"{key}: max peak {1e3 * r.peak_amplitude:.4f} mm (tuned {1e3 * tuned[mass][0]:.4f} mm), "
              f"{len(r.omega)} points")
     return out
 
@@ -749,7 +749,7 @@ def optimise_arrangement(disk: TunedDisk, kappa, max_evaluations: int = 30, cand
             r = mistuned_response(disk, k[list(key)], f_range_hz, max_step=max_step, tuned_peak_amplitude=tuned_peak_amplitude)
             cache[key] = r
             if progress:
-                progress(len(cache), max_evaluations, f"max peak {1e3 * r.peak_amplitude.max():.4f} mm")
+                progress(len(cache), max_evaluations, f"max peak {1e3 * r.peak_amplitude:.4f} mm")
         return cache[key]
 
     given = np.arange(k.size)
@@ -757,10 +757,10 @@ def optimise_arrangement(disk: TunedDisk, kappa, max_evaluations: int = 30, cand
     heuristic = reorder(k)
     r_best = evaluate(heuristic)
     best = heuristic.copy()
-    history = [float(r_given.peak_amplitude.max()), float(r_best.peak_amplitude.max())]
+    history = [float(r_given.peak_amplitude), float(r_best.peak_amplitude)]
     n = k.size
     while len(cache) < max_evaluations:
-        p = int(np.argmax(r_best.peak_amplitude))
+        p = int(np.argmax(r_best.blade_peak_amplitudes))
         scores = []
         for j in range(n):
             if j == p:
@@ -776,11 +776,11 @@ def optimise_arrangement(disk: TunedDisk, kappa, max_evaluations: int = 30, cand
             if len(cache) >= max_evaluations:
                 break
             r = evaluate(o)
-            if r.peak_amplitude.max() < r_best.peak_amplitude.max() and (improved is None or r.peak_amplitude.max() < improved[1].peak_amplitude.max()):
+            if r.peak_amplitude < r_best.peak_amplitude and (improved is None or r.peak_amplitude < improved[1].peak_amplitude):
                 improved = (o, r)
         if improved is None:
             break
         best, r_best = improved
-        history.append(float(r_best.peak_amplitude.max()))
-    return Arrangement(k, best, float(r_best.peak_amplitude.max()), heuristic, float(cache[tuple(heuristic)].peak_amplitude.max()),
-                       float(r_given.peak_amplitude.max()), float(tuned_peak_amplitude), len(cache), history, r_best)
+        history.append(float(r_best.peak_amplitude))
+    return Arrangement(k, best, float(r_best.peak_amplitude), heuristic, float(cache[tuple(heuristic)].peak_amplitude),
+                       float(r_given.peak_amplitude), float(tuned_peak_amplitude), len(cache), history, r_best)
