@@ -358,11 +358,19 @@ def test_a_branch_retracing_itself_is_stopped_and_says_so():
     """Random disk 51 (a 7 g cylinder, (0, 1, 2, 3)): past a non-smooth fold at 94.18 Hz the
     branch went back and forth between 94.28 and 94.30 Hz at full steps, back to within
     1e-5..5e-7 of its own earlier points, until the 2000-point cap. It now stops after
-    MAX_REVISITS returns and says so (not success: issue 12 item 3 is not met there yet)."""
+    MAX_REVISITS returns and says so (not success: issue 12 item 3 is not met there yet).
+
+    The path in that back-and-forth depends on rounding: with the tuned start solved by the
+    system's LU instead of numpy's (a 1e-13 relative change of the start, issue 34) the branch
+    reverses onto itself at 94.68 Hz and runs back to its first point instead. The continuation
+    has two detectors of a retrace, MAX_REVISITS returns to earlier points and a return to the
+    branch's first point; either must stop it with the sentence that says so, long before the
+    2000-point cap."""
     from bladedamp.hbm.continuation import MAX_REVISITS
     r = _random_design("disk", 51)
     assert not r["success"]
-    assert "retraced its own path" in r["message"] and f"{MAX_REVISITS} returns" in r["message"]
+    assert "retraced its own path" in r["message"]
+    assert f"{MAX_REVISITS} returns" in r["message"] or "back to the start of the range" in r["message"], r["message"]
     assert r["points"] < 2000
 
 
