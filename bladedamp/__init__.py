@@ -61,7 +61,7 @@ _LAZY = {
     "nonlinear_mode": "hbm.nonlinear_modes",
     "precompile": "compilation",
 }
-__all__ = sorted(_LAZY) + ["frequency_response"]
+__all__ = sorted(_LAZY) + ["frequency_response", "peak_sensitivities"]
 
 
 __getattr__, __dir__ = lazy_attributes(__name__, _LAZY, globals())
@@ -103,3 +103,25 @@ def frequency_response(model, f_range_hz, harmonics="auto", stability: bool = Fa
             model = WithCouplings(model, extra)
         response = with_stability(model, response)
     return response
+
+
+def peak_sensitivities(model, f_range_hz, parameters, direction: int = 0, **options):
+    """The derivatives of ``model``'s resonance peak over ``f_range_hz = (start, end)`` [Hz] in the
+    design-file keys ``parameters`` (e.g. ``["damper.mass_g", "damper.friction_coefficient"]``;
+    :data:`bladedamp.diskmodel.SENSITIVITY_KEYS`): :func:`frequency_response` with ``options``, then
+    the peak (the largest tip amplitude in ``direction``, of any blade) solved by d|u|/dOmega = 0
+    and differentiated by the implicit function theorem with the analytic dR/dp
+    (:meth:`bladedamp.diskmodel.DiskModelResponse.peak_sensitivities`). Returns a
+    :class:`~bladedamp.response.PeakSensitivities`: ``result["damper.mass_g"].peak_amplitude`` [m per
+    g], ``.peak_frequency_hz`` [Hz per g]. A TunedDisk or MistunedDisk (TypeError otherwise);
+    ValueError for an unknown key, a range without a solvable peak, or a response that is not a
+    success (its status message says why)."""
+    from .diskmodel import DiskModel
+
+    if not isinstance(model, DiskModel):
+        raise TypeError(f"model must be a TunedDisk or MistunedDisk (got {type(model).__qualname__})")
+    response = frequency_response(model, f_range_hz, **options)
+    if not response.success:
+        raise ValueError(f"the frequency response is not a success, so its peak is not differentiated: "
+                         f"{response.status_message}")
+    return response.peak_sensitivities(parameters, direction)

@@ -103,6 +103,10 @@ class TunedDisk(DiskModel):
         return DamperPosition(self.damper, self.gamma_left, self.gamma_right, self.initial_gaps, self.damper_radius,
                               self.engine_order, self.rotor_speed_hz)
 
+    def position_of(self, k: int) -> DamperPosition:
+        """The damper position of every sector (:attr:`position`; ``k``: 0)."""
+        return self.position
+
     @property
     def model_blades(self) -> list[ModalBlade]:
         """[blade]: the reference sector's blade, the one blade written out (:class:`DiskModel`)."""

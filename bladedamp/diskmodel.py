@@ -43,7 +43,7 @@ from numba import njit
 
 from . import validation
 from .blade import PLATFORM_ANGLE, ModalBlade
-from .contact.laws import LinearNormalLaw
+from .contact.laws import LinearNormalLaw, RoughnessNormalLaw
 from .contact.patch import dof_jacobian
 from .contact.point import (MAX_PASSES, PERIODIC_TOL, PointContactSamples, damper_contact_forces, normal_law_parameters,
                             point_contact_forces)
@@ -54,9 +54,12 @@ from .hbm.continuation import Branch
 from .hbm.start import robust_start
 from .hbm.fourier import HarmonicBasis
 from .hbm.monodromy import disk_monodromy
-from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import (FrequencyResponse, Note, NoteKind, harmonic_sentence, percent, with_amplitude_check,
-                       with_checks, with_note)
+from .hbm.system import Coupling, HarmonicBalanceSystem, linear_forces
+from .hbm.peaks import PeakSolver, first_harmonic_output
+from .hbm.sensitivity import output_sensitivities, state_sensitivities
+from .hbm.sensitivity import peak_sensitivities as peak_derivatives
+from .response import (FrequencyResponse, Note, NoteKind, PeakSensitivities, Sensitivities, harmonic_sentence, percent,
+                       with_amplitude_check, with_checks, with_note)
 
 DAMPER_DOFS = ("uD_x", "uD_y", "uD_z", "phiD_x", "phiD_y", "phiD_z")
 # the automatic AFT sampling of a disk's branch (TunedDisk and MistunedDisk) may grow the samples
@@ -627,6 +630,56 @@ class AssemblyContacts:
                 domega = (fp - fm) / (2 * h)
         return force, blocks.reshape(nd, C * L, C * L), domega
 
+    def parameter_forces(self, local, basis, omega) -> dict:
+        """The logarithmic derivatives p dF/dp (C, n_local) [N, N m] of the forces at ``local``
+        (C, n_local) and ``omega`` [rad/s] in the contact parameters shared by every point, all
+        from one evaluation of the point-contact kernel with its exact Jacobian (no differences):
+
+        * ``"tangential"``: in every point's k_T. Scaling the tangential displacements by lambda
+          and k_T by 1 / lambda leaves the forces as they are (the trial force, the slip radius
+          and the separation instants do not change, the slider positions scale), so
+          k_T dF/dk_T = J_t c_t, the Jacobian's tangential columns times the tangential
+          coefficients, point by point;
+        * ``"law"``: in the normal law's scale c (N = c g(a): k_N for the linear law, N_ref (k_ref /
+          (p N_ref))^p for the power law). Scaling k_T and c together scales every force (H2), so
+          c dF/dc = F - J_t c_t;
+        * ``"friction"``: in mu, which enters through mu N only: mu dF/dmu = the tangential rows of
+          F - J_t c_t, zero on the normal rows;
+        * ``"approach"``: in the static approach's scale (every point's offset times 1 + epsilon):
+          the forces are homogeneous in (u_t, (u_zeta, offset)^(1/p)) of degree 1 for a law of
+          degree p (linear: p = 1), so offset dF/doffset = p (F - J_t c_t) - J_zeta c_zeta.
+
+        Raises ValueError for dampers whose patches do not stack (:meth:`stacked_points`) or a
+        normal law of another kind than LinearNormalLaw and RoughnessNormalLaw."""
+        stack = self.stacked_points()
+        if stack is None or type(stack.normal_law) not in (LinearNormalLaw, RoughnessNormalLaw):
+            raise ValueError("contact parameter derivatives need dampers whose two patches share their normal law "
+                             "(LinearNormalLaw or RoughnessNormalLaw), friction coefficient and point count")
+        C, nd, L = basis.n_coeffs, self.n_dampers, self.damper_local
+        local = np.ascontiguousarray(np.asarray(local, dtype=float).reshape(C, nd, L))
+        R = self.grid_rotations(basis)
+        if R is not None:
+            local = _rotated(R, local, False)
+        offsets, _ = self.approach(omega)
+        B, k_t, mu, weights, law = stack
+        m = B.shape[-1]
+        coeffs = np.einsum("dqpij,cdqj->cdqpi", B, local.reshape(C, nd, 2, m)).reshape(C, -1, 3)
+        pts = point_contact_forces(coeffs, basis, k_t, mu, law, weights, np.ravel(offsets), jacobian=True)
+        jac = pts.jacobian.reshape(pts.jacobian.shape[:3] + (3, C))            # (P', T, 3, direction, C)
+        along = np.einsum("ptidc,cpd->ptid", jac, coeffs)                    # J_direction c_direction
+        force, j_t, j_z = pts.force, along[..., 0] + along[..., 1], along[..., 2]
+        scale = force - j_t
+        friction = scale.copy()
+        friction[..., 2] = 0.0
+        degree = getattr(law, "exponent", 1.0)
+        out = {}
+        for name, samples in (("tangential", j_t), ("law", scale), ("friction", friction),
+                              ("approach", degree * scale - j_z)):
+            f_points = basis.to_coeffs(np.moveaxis(samples, 1, 0)).reshape(C, nd, 2, -1, 3)
+            f = np.ascontiguousarray(np.einsum("cdqpi,dqpij->cdqj", f_points, B).reshape(C, nd, L))
+            out[name] = (f if R is None else _rotated(R, f, True)).reshape(C, self.n_local)
+        return out
+
     def harmonic_forces(self, local, basis, omega, jacobian=True):
         C = basis.n_coeffs
         force, blocks, domega = self.evaluate(local, basis, omega, jacobian)
@@ -907,6 +960,64 @@ class DamperPosition:
         return approach
 
 
+#: the design-file keys whose derivatives :meth:`DiskModel.parameter_derivatives` gives, with
+#: their unit (the derivative is per this unit); ``[i]`` keys name one entry of a list
+SENSITIVITY_KEYS = {
+    "damper.mass_g": "g",
+    "damper.friction_coefficient": "-",
+    "damper.tangential_stiffness_per_length_n_per_m2": "N/m per m",
+    "damper.normal_to_tangential_stiffness": "-",
+    "damper.roughness_reference_load_n": "N",
+    "disk.damper_radius_mm": "mm",
+    "disk.rotor_speed_rpm": "rpm",
+    "disk.excitation_n_nm[i]": "N or N m",
+    "blade.natural_frequencies_hz[j]": "Hz",
+    "blade.damping_ratio": "-",
+    "blade.damping_ratio[j]": "-",
+    "mistuning.kappa[k]": "-",
+}
+
+
+def parameter_unit(key: str) -> str:
+    """The unit of a design-file key (:data:`SENSITIVITY_KEYS`): per this unit its derivatives are given."""
+    name, index = parse_parameter_key(key)
+    return SENSITIVITY_KEYS.get(name) or SENSITIVITY_KEYS[next(k for k in SENSITIVITY_KEYS if k.split("[")[0] == name)]
+
+
+def parse_parameter_key(key: str) -> tuple[str, int | None]:
+    """(name, index or None) of a design-file key such as ``damper.mass_g`` or
+    ``blade.natural_frequencies_hz[0]``; ValueError for anything else."""
+    text = str(key).strip()
+    name, index = text, None
+    if text.endswith("]") and "[" in text:
+        name, _, inner = text[:-1].partition("[")
+        if not inner.isdigit():
+            raise ValueError(f"parameter {key!r}: the index in [] must be a whole number >= 0")
+        index = int(inner)
+    known = {k.split("[")[0] for k in SENSITIVITY_KEYS}
+    if name not in known:
+        raise ValueError(f"parameter {key!r}: unknown or not differentiable; the keys with derivatives are "
+                         f"{', '.join(SENSITIVITY_KEYS)} (the geometry's are not yet)")
+    return name, index
+
+
+@dataclass
+class ParameterEffect:
+    """How a residual depends on one parameter p, per unit of p (:meth:`DiskModel.parameter_effect`):
+
+    matrices : {"mass" | "damping" | "stiffness" | "static_stiffness": dM/dp ...} (n_dof, n_dof)
+        [kg, N s/m, N/m per unit], the linear part's (:func:`~bladedamp.hbm.system.linear_forces`)
+    excitation : omega -> df/dp (C * n_dof,) [N per unit], or None
+    contact : {direction: d ln q / dp}, the contacts' logarithmic derivatives
+        (:meth:`AssemblyContacts.parameter_forces`) each weighted by the relative change of its
+        quantity q per unit of p
+    """
+
+    matrices: dict = field(default_factory=dict)
+    excitation: object = None
+    contact: dict = field(default_factory=dict)
+
+
 class DiskModel:
     """The behaviour of a bladed disk with underplatform dampers that does not depend on how it
     is assembled: the tuned disk's cyclic sector (:class:`TunedDisk`, one blade and one damper,
@@ -1047,6 +1158,201 @@ class DiskModel:
         """False: the dissipation is judged re-evaluated with more samples
         (:func:`bladedamp.response.physical_checks`)."""
         return False
+
+    # ----- derivatives in the design parameters ------------------------------------------
+    def parameter_derivatives(self, system: HarmonicBalanceSystem, keys):
+        """``dR_dp(x, omega) -> (k, C * n_dof)``: the analytic derivatives of ``system``'s residual
+        (this model's :meth:`hbm_system`) at the unknowns x (C * n_dof,) and ``omega`` [rad/s] in
+        the k design-file ``keys`` (:data:`SENSITIVITY_KEYS`; ``name[i]`` for one entry of a list),
+        per unit of each key as the design file writes it (per g for ``damper.mass_g``, per Hz for
+        ``blade.natural_frequencies_hz[j]``, per mm, per rpm, per N) [N per unit]. No differences:
+        the linear part's matrices and the excitation are differentiated in closed form
+        (:func:`~bladedamp.hbm.system.linear_forces`), the contacts by their homogeneity
+        (:meth:`AssemblyContacts.parameter_forces`). ValueError naming the key for an unknown key,
+        an index out of range, or a parameter this model does not have or cannot differentiate
+        (the list says which and why)."""
+        effects = [self.parameter_effect(system, key) for key in keys]
+        basis = system.basis
+        coupling = next((c for c in system.couplings if isinstance(c.element, (DamperContacts, AssemblyContacts))),
+                        None)
+        element = None if coupling is None else getattr(coupling.element, "element", coupling.element)
+        needs_contacts = any(e.contact for e in effects)
+
+        def dR_dp(x, omega):
+            out = np.zeros((len(effects), system.n_unknowns))
+            directions = None
+            if needs_contacts and coupling is not None:
+                local = (coupling.matrix @ x).reshape(basis.n_coeffs, element.n_local)
+                directions = element.parameter_forces(local, basis, omega)
+            for row, e in zip(out, effects):
+                if e.matrices:
+                    row += linear_forces(basis, x, omega, **e.matrices)
+                if e.excitation is not None:
+                    row -= e.excitation(omega)
+                if directions is not None:
+                    for name, factor in e.contact.items():
+                        coupling.add_forces(row, factor * directions[name].ravel())
+            return out
+
+        return dR_dp
+
+    def parameter_effect(self, system: HarmonicBalanceSystem, key: str) -> "ParameterEffect":
+        """How ``system``'s residual depends on the design-file ``key`` (see
+        :meth:`parameter_derivatives`): its :class:`ParameterEffect` per unit of the key."""
+        name, index = parse_parameter_key(key)
+        basis = system.basis
+        blades = self.model_blades
+        nm = blades[0].n_modes
+        positions = [self.position_of(k) for k in self.active_positions]
+        damper = positions[0].damper if positions else None
+        contact = getattr(damper, "contact", None)
+
+        def need(condition, why):
+            if not condition:
+                raise ValueError(f"parameter {key!r}: {why}")
+
+        if name in ("blade.natural_frequencies_hz", "blade.damping_ratio", "mistuning.kappa"):
+            if name == "mistuning.kappa":
+                need(len(blades) > 1, "a tuned disk has no per-blade mistuning factors (use a MistunedDisk)")
+                need(index is not None and 0 <= index < len(blades),
+                     f"give the blade as mistuning.kappa[k], k in 0..{len(blades) - 1}")
+            elif name == "blade.natural_frequencies_hz":
+                need(index is not None and 0 <= index < nm, f"give the mode as {name}[j], j in 0..{nm - 1}")
+            else:
+                need(index is None or 0 <= index < nm, f"the mode index must be in 0..{nm - 1}")
+            kappa = self.mistuning_factors
+            rows, d_stiffness, d_damping = [], [], []
+            for k, blade in enumerate(blades):
+                w0, zeta = blade.natural_angular_frequencies, blade.damping_ratios
+                for j in range(nm):
+                    if name == "mistuning.kappa":
+                        if k != index:
+                            continue
+                        dw, dz = w0[j] / kappa[k], 0.0            # omega_kj = kappa_k omega_j
+                    elif name == "blade.natural_frequencies_hz":
+                        if j != index:
+                            continue
+                        dw, dz = 2 * np.pi * kappa[k], 0.0        # per Hz of the design blade's f_j
+                    else:
+                        if index is not None and j != index:
+                            continue
+                        dw, dz = 0.0, 1.0
+                    rows.append(k * nm + j)
+                    d_stiffness.append(2 * w0[j] * dw)                      # K = omega^2 (Eq. 5)
+                    d_damping.append(2 * (zeta[j] * dw + dz * w0[j]))       # D = 2 zeta omega
+            n = system.n_dof
+            diag = (lambda v: sp.csr_matrix((np.asarray(v, dtype=float), (rows, rows)), shape=(n, n)))
+            return ParameterEffect({"stiffness": diag(d_stiffness), "damping": diag(d_damping)})
+        need(index is None or name == "disk.excitation_n_nm", "has no index")
+        if name == "disk.excitation_n_nm":
+            need(index is not None and 0 <= index < 6, f"give the component as {name}[i], i in 0..5 "
+                                                         "(F_x, F_y, F_z, M_x, M_y, M_z)")
+            unit = np.zeros(6)
+            unit[index] = 1.0
+            f = dataclasses.replace(self, excitation=unit).hbm_system(basis.harmonics, basis.n_samples) \
+                .excitation(1.0)[0].reshape(basis.n_coeffs, -1)
+            if basis.has_static:
+                f[basis.cos_index(0)] = 0.0                 # the centrifugal preload is not the excitation's
+            f = f.ravel()
+            return ParameterEffect(excitation=lambda omega: f)
+        need(name in SENSITIVITY_KEYS, f"unknown or not differentiable; the keys with derivatives are "
+                                       f"{', '.join(SENSITIVITY_KEYS)} (the geometry's are not yet)")
+        need(damper is not None, "the model has no damper")
+        need(len({id(p.damper) for p in positions}) == 1, "the dampers differ from position to position")
+        static = basis.has_static
+        need(static or all(p.initial_gaps is None or not np.any(p.initial_gaps) for p in positions),
+             "with initial gaps the seating without a static harmonic is not differentiated (include harmonic 0)")
+        degree = contact.roughness_exponent
+        mask = np.zeros((basis.n_coeffs, system.n_dof))
+        if static:
+            for d in range(len(positions)):
+                mask[basis.cos_index(0), self.damper_unknowns(d)] = 1.0
+        mask = mask.ravel()
+
+        def centrifugal(relative):
+            """F_CG times ``relative`` (d ln F_CG / dp): the static load, or the seating's approach."""
+            if static:
+                return ParameterEffect(excitation=lambda omega: relative * mask * system.excitation(omega)[0])
+            return ParameterEffect(contact={"approach": relative / degree})
+
+        def stiffness(relative_tangential, relative_normal):
+            """k_T and k_N times the given d ln k / dp: the contacts, the retention spring, the seating."""
+            law = {"law": degree * relative_normal, "tangential": relative_tangential}
+            if static:
+                return ParameterEffect({"static_stiffness": relative_normal * system.static_stiffness},
+                                       contact=law)
+            return ParameterEffect(contact={**law, "approach": -relative_normal})
+
+        if name == "damper.mass_g":
+            effect = centrifugal(1e-3 / damper.mass)
+            if self.damper_inertia:
+                dm = sp.lil_matrix((system.n_dof, system.n_dof))
+                mass = sp.csr_matrix(system.mass)
+                for d in range(len(positions)):
+                    sl = self.damper_unknowns(d)
+                    dm[sl, sl] = mass[sl, sl].toarray() * (1e-3 / damper.mass)
+                effect.matrices["mass"] = dm.tocsr()
+            return effect
+        if name == "disk.damper_radius_mm":
+            return centrifugal(1e-3 / self.damper_radius)
+        if name == "disk.rotor_speed_rpm":
+            need(self.rotor_speed_hz is not None, "the rotor speed follows the excitation frequency here "
+                                                  "(rotor_speed_rpm = 'auto'): give a fixed rotor speed")
+            return centrifugal(2 / (60 * self.rotor_speed_hz))
+        if name == "damper.friction_coefficient":
+            need(contact.friction_coefficient > 0, "the derivative in mu is taken at mu > 0")
+            return ParameterEffect(contact={"friction": 1 / contact.friction_coefficient})
+        if name == "damper.tangential_stiffness_per_length_n_per_m2":
+            k = contact.tangential_stiffness_per_length
+            return stiffness(1 / k, 1 / k)
+        if name == "damper.normal_to_tangential_stiffness":
+            return stiffness(0.0, 1 / contact.normal_to_tangential_stiffness)
+        # damper.roughness_reference_load_n: c = N_ref^(1-p) (k / p)^p, the seat a ~ c^(-1/p)
+        load = contact.roughness_reference_load
+        effect = ParameterEffect(contact={"law": (1 - degree) / load})
+        if not static:
+            effect.contact["approach"] = -(1 - degree) / (degree * load)
+        return effect
+
+    def parameter_value(self, key: str) -> float:
+        """The value of the design-file ``key`` (:meth:`parameter_derivatives`) in this model, in
+        the key's unit (g, mm, rpm, Hz, N, -)."""
+        name, index = parse_parameter_key(key)
+        blade = self.model_blades[0]
+        if name == "mistuning.kappa":
+            return float(self.mistuning_factors[index])
+        if name == "blade.natural_frequencies_hz":
+            return float(blade.natural_frequencies_hz[index] / self.mistuning_factors[0])
+        if name == "blade.damping_ratio":
+            return float(blade.damping_ratios[0 if index is None else index])
+        if name == "disk.excitation_n_nm":
+            return float(self.excitation[index])
+        if name == "disk.damper_radius_mm":
+            return 1e3 * self.damper_radius
+        if name == "disk.rotor_speed_rpm":
+            return float("nan") if self.rotor_speed_hz is None else 60.0 * self.rotor_speed_hz
+        positions = [self.position_of(k) for k in self.active_positions]
+        if not positions:
+            return float("nan")
+        damper = positions[0].damper
+        if name == "damper.mass_g":
+            return 1e3 * damper.mass
+        return float(getattr(damper.contact, {"damper.friction_coefficient": "friction_coefficient",
+                                              "damper.tangential_stiffness_per_length_n_per_m2":
+                                                  "tangential_stiffness_per_length",
+                                              "damper.normal_to_tangential_stiffness": "normal_to_tangential_stiffness",
+                                              "damper.roughness_reference_load_n": "roughness_reference_load"}[name]))
+
+    @property
+    def mistuning_factors(self) -> np.ndarray:
+        """(s,) each blade's mistuning factor kappa_k on the design blade's frequencies (ones: the
+        blades as they are; a :class:`~bladedamp.mistuned.MistunedDisk` made by ``from_tuned`` or
+        ``mistuned`` keeps its own)."""
+        return np.ones(len(self.model_blades))
+
+    def position_of(self, k: int) -> "DamperPosition":
+        """The :class:`DamperPosition` of position k (the tuned disk has one, k = 0)."""
+        return self.positions[k]
 
     # ----- outputs ---------------------------------------------------------------------------
     def point_map(self, basis: HarmonicBasis, point: str = "tip", directions=(0,), blade: int = 0) -> np.ndarray:
@@ -1671,6 +1977,76 @@ class DiskModelResponse(FrequencyResponse):
     stop_check: object = None
     peak_check: object = None
     disk: DiskModel = None
+
+    def blade_outputs(self, direction: int = 0) -> np.ndarray:
+        """(s, C * n_dof) complex rows: each blade's first-harmonic tip displacement in
+        ``direction`` (0, 1, 2: x, y, z) from the unknowns (:func:`~bladedamp.hbm.peaks.first_harmonic_output`)."""
+        blades = self.disk.model_blades
+        nm, n_dof = blades[0].n_modes, np.asarray(self.coefficients).reshape(len(self.omega), self.basis.n_coeffs, -1).shape[-1]
+        return np.array([first_harmonic_output(self.basis, n_dof, k * nm + np.arange(nm), b.shape("tip")[direction])
+                         for k, b in enumerate(blades)])
+
+    def model_system(self) -> HarmonicBalanceSystem:
+        """The harmonic balance this response solved (its model's :meth:`hbm_system` at its basis);
+        ValueError for a loaded result (no model)."""
+        if self.disk is None:
+            raise ValueError("this response has no model (a loaded result): compute it anew to differentiate it")
+        return self.disk.hbm_system(self.basis.harmonics, self.basis.n_samples)
+
+    def sensitivities(self, parameters, direction: int = 0) -> Sensitivities:
+        """The derivatives of every point of the branch in the design-file keys ``parameters``
+        (:meth:`DiskModel.parameter_derivatives`), at fixed frequency: dx/dp = -J^-1 dR/dp, one
+        factorisation per point shared by every parameter (:mod:`bladedamp.hbm.sensitivity`).
+        Returns a :class:`~bladedamp.response.Sensitivities` (each blade's tip amplitude in
+        ``direction`` and its derivatives, per unit of each key)."""
+        validation.integer("direction", direction, minimum=0, maximum=2)
+        keys = tuple(str(p) for p in parameters)
+        system = self.model_system()
+        dR_dp = self.disk.parameter_derivatives(system, keys)
+        outputs = self.blade_outputs(direction)
+        n, N = len(self.omega), system.n_unknowns
+        X = np.asarray(self.coefficients, dtype=float).reshape(n, N)
+        dx = np.zeros((n, len(keys), N))
+        amplitude, d_amplitude = np.zeros((n, len(outputs))), np.zeros((n, len(keys), len(outputs)))
+        for i, (x, w) in enumerate(zip(X, self.omega)):
+            dx[i] = state_sensitivities(system, x, float(w), dR_dp(x, float(w)))
+            for b, output in enumerate(outputs):
+                amplitude[i, b], d_amplitude[i, :, b] = output_sensitivities(output, x, dx[i])
+        return Sensitivities(keys, tuple(parameter_unit(k) for k in keys),
+                             np.array([self.disk.parameter_value(k) for k in keys]), self.omega / (2 * np.pi),
+                             amplitude, d_amplitude, dx.reshape(n, len(keys), self.basis.n_coeffs, -1))
+
+    def peak_sensitivities(self, parameters, direction: int = 0) -> PeakSensitivities:
+        """The derivatives of the resonance peak (the largest blade's largest tip amplitude in
+        ``direction``, solved by the peak condition d|u|/dOmega = 0) in the design-file keys
+        ``parameters``: d peak amplitude / dp [m per unit] and d peak frequency / dp [Hz per unit]
+        (:func:`bladedamp.hbm.sensitivity.peak_sensitivities`). ValueError where the peak cannot be
+        solved (at an end of the range, next to a fold)."""
+        validation.integer("direction", direction, minimum=0, maximum=2)
+        keys = tuple(str(p) for p in parameters)
+        system = self.model_system()
+        dR_dp = self.disk.parameter_derivatives(system, keys)
+        outputs = self.blade_outputs(direction)
+        n = len(self.omega)
+        X = np.asarray(self.coefficients, dtype=float).reshape(n, -1)
+        curves = np.abs(X @ outputs.T)                                      # (n, s)
+        blade = int(np.argmax(curves.max(axis=0)))
+        index = int(np.argmax(curves[:, blade]))
+        solver = PeakSolver(system, self.omega, X)
+        solved = solver.solve_state(index, outputs[blade])
+        where = f"at {self.omega[index] / (2 * np.pi):.6g} Hz"
+        if solved is None:
+            raise ValueError(f"the peak {where} could not be solved (at an end of the range or next to a fold): "
+                             "no peak derivatives")
+        _, w, x = solved
+        scale = max(np.linalg.norm(system.residual(np.zeros_like(x), w, False)[0]), 1e-300)
+        peak = peak_derivatives(system, x, w, outputs[blade], dR_dp, solver.x_scale, scale)
+        if peak is None:
+            raise ValueError(f"the peak {where}: a solve beside it did not converge or its curvature is not that of "
+                             "a maximum: no peak derivatives")
+        return PeakSensitivities(keys, tuple(parameter_unit(k) for k in keys),
+                                 np.array([self.disk.parameter_value(k) for k in keys]), peak.amplitude,
+                                 peak.omega / (2 * np.pi), blade, peak.d_amplitude, peak.d_omega / (2 * np.pi))
 
     @staticmethod
     def linear_energies(system: HarmonicBalanceSystem, branch) -> tuple[np.ndarray, np.ndarray]:

@@ -429,6 +429,10 @@ class MistunedDisk(DiskModel):
     rotor_speed_hz: float | None = None
     damper_inertia: bool = True
     initial_gaps: object = None
+    #: (s,) each blade's mistuning factor on the design blade's frequencies (``from_tuned``,
+    #: ``mistuned``), None: the blades as given (factors 1); what ``mistuning.kappa[k]``'s
+    #: derivative is taken in (:meth:`~bladedamp.diskmodel.DiskModel.parameter_derivatives`)
+    kappa: np.ndarray | None = field(default=None, repr=False, compare=False)
     #: linear solver of the continuation (:attr:`AssemblySystem.linear_solver`); set it on an
     #: instance (``disk.linear_solver = "condensation"``) to change that disk's solver
     linear_solver: ClassVar[str] = "auto"
@@ -501,7 +505,8 @@ class MistunedDisk(DiskModel):
         if kappa.shape != (self.n_sector,):
             raise ValueError(f"kappa (mistuning factors) must have {self.n_sector} entries, one per blade "
                              f"(got shape {kappa.shape})")
-        out = dataclasses.replace(self, blades=[b.scaled(k) for b, k in zip(self.blades, kappa)])
+        out = dataclasses.replace(self, blades=[b.scaled(k) for b, k in zip(self.blades, kappa)],
+                                  kappa=kappa * self.mistuning_factors)
         out._setup_source = self
         return out
 
@@ -523,7 +528,12 @@ class MistunedDisk(DiskModel):
         same = isinstance(dampers, str) and dampers == "same"
         return cls(blades, disk.damper if same else dampers, disk.n_blades, disk.engine_order,
                    disk.gamma_left, disk.gamma_right, disk.damper_radius, disk.excitation, disk.rotor_speed_hz,
-                   disk.damper_inertia, disk.initial_gaps)
+                   disk.damper_inertia, disk.initial_gaps, kappa=kappa)
+
+    @property
+    def mistuning_factors(self) -> np.ndarray:
+        """(s,) :attr:`kappa`, or ones where the blades were given as they are."""
+        return np.ones(self.n_sector) if self.kappa is None else np.asarray(self.kappa, dtype=float)
 
     # ----- layout ----------------------------------------------------------------------
     @property

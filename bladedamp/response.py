@@ -794,3 +794,153 @@ class FrequencyResponse(Saveable):
 # argument of the constructor, whose default the dataclass reads from the class body)
 FrequencyResponse.message = property(lambda self: notes_text(self.notes),
                                      doc="The text of :attr:`notes` joined in order (:func:`notes_text`), read only.")
+
+
+@dataclass
+class Sensitivities(Saveable):
+    """Derivatives of every point of a frequency response in design parameters, at fixed
+    frequency (``response.sensitivities(parameters)``; :mod:`bladedamp.hbm.sensitivity`).
+
+    parameters : (k,) the design-file keys; units : (k,) their units (per unit of which the
+        derivatives are); values : (k,) their values in the model [the key's unit]
+    frequency_hz : (n,) the branch's frequencies [Hz]
+    tip_amplitude : (n, s) each blade's first-harmonic tip amplitude [m] (s = 1: the tuned sector)
+    d_tip_amplitude : (n, k, s) its derivatives [m per unit of each key]
+    d_coefficients : (n, k, C, n_dof) the derivatives of the harmonic coefficients [SI per unit]
+    """
+
+    parameters: tuple
+    units: tuple
+    values: np.ndarray
+    frequency_hz: np.ndarray
+    tip_amplitude: np.ndarray
+    d_tip_amplitude: np.ndarray
+    d_coefficients: np.ndarray
+
+    def elasticities(self) -> np.ndarray:
+        """(n, k, s) relative sensitivities p / a da/dp [-]: the relative change of each blade's tip
+        amplitude per relative change of each parameter (nan where a = 0 or p = 0)."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.asarray(self.values)[None, :, None] * self.d_tip_amplitude / self.tip_amplitude[:, None, :]
+
+    def plot(self, ax=None, *, blade: int = 0):
+        """The elasticity p / a da/dp of blade ``blade``'s tip amplitude in each parameter over the
+        frequency (one curve per parameter) under the amplitude (mm); returns the figure."""
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            fig, (top, ax) = plt.subplots(2, 1, sharex=True, figsize=(7.5, 5.5), constrained_layout=True)
+        else:
+            fig, top = ax.figure, None
+        f = self.frequency_hz
+        if top is not None:
+            top.plot(f, 1e3 * self.tip_amplitude[:, blade], color="k")
+            top.set_ylabel("tip amplitude [mm]")
+            top.grid(alpha=0.3)
+        elasticity = self.elasticities()[:, :, blade]
+        for j, key in enumerate(self.parameters):
+            ax.plot(f, elasticity[:, j], label=key)
+        ax.axhline(0.0, color="0.5", lw=0.8)
+        ax.set_xlabel("excitation frequency [Hz]")
+        ax.set_ylabel("p / a  da/dp  [-]")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize="small")
+        return fig
+
+
+class PeakDerivative(tuple):
+    """(peak_amplitude [m per unit], peak_frequency_hz [Hz per unit]) of one parameter."""
+
+    __slots__ = ()
+
+    def __new__(cls, peak_amplitude: float, peak_frequency_hz: float):
+        return super().__new__(cls, (float(peak_amplitude), float(peak_frequency_hz)))
+
+    @property
+    def peak_amplitude(self) -> float:
+        return self[0]
+
+    @property
+    def peak_frequency_hz(self) -> float:
+        return self[1]
+
+
+@dataclass
+class PeakSensitivities(Saveable):
+    """Derivatives of a resonance peak in design parameters (``bladedamp.peak_sensitivities``):
+    a mapping from each design-file key to its :class:`PeakDerivative` (``result[key].peak_amplitude``
+    [m per unit of the key], ``.peak_frequency_hz`` [Hz per unit]).
+
+    parameters, units, values : (k,) the keys, their units and values [the key's unit]
+    peak_amplitude : the peak's tip amplitude [m]; peak_frequency_hz : its frequency [Hz]
+    blade : the blade whose peak it is (0 for the tuned sector)
+    d_peak_amplitude : (k,) [m per unit]; d_peak_frequency_hz : (k,) [Hz per unit]
+    """
+
+    parameters: tuple
+    units: tuple
+    values: np.ndarray
+    peak_amplitude: float
+    peak_frequency_hz: float
+    blade: int
+    d_peak_amplitude: np.ndarray
+    d_peak_frequency_hz: np.ndarray
+
+    def __getitem__(self, key: str) -> PeakDerivative:
+        if key not in self.parameters:
+            raise KeyError(f"{key!r} (the parameters are {', '.join(self.parameters)})")
+        j = self.parameters.index(key)
+        return PeakDerivative(self.d_peak_amplitude[j], self.d_peak_frequency_hz[j])
+
+    def __iter__(self):
+        return iter(self.parameters)
+
+    def __len__(self) -> int:
+        return len(self.parameters)
+
+    def keys(self):
+        return self.parameters
+
+    def items(self):
+        return [(k, self[k]) for k in self.parameters]
+
+    def elasticities(self) -> tuple[np.ndarray, np.ndarray]:
+        """(k,) and (k,): p / A dA/dp and p / f df/dp [-], the relative change of the peak amplitude
+        and frequency per relative change of each parameter."""
+        values = np.asarray(self.values, dtype=float)
+        return (values * self.d_peak_amplitude / self.peak_amplitude,
+                values * self.d_peak_frequency_hz / self.peak_frequency_hz)
+
+    def table(self) -> str:
+        """The derivatives as a text table (mm and Hz per unit of each key, and the elasticities)."""
+        ea, ef = self.elasticities()
+        width = max(len(k) for k in self.parameters) if self.parameters else 9
+        lines = [f"peak {1e3 * self.peak_amplitude:.4g} mm at {self.peak_frequency_hz:.5g} Hz (blade {self.blade})",
+                 f"{'parameter':<{width}}  {'value':>10}  {'dA/dp [mm/unit]':>16}  {'df/dp [Hz/unit]':>16}  "
+                 f"{'p/A dA/dp':>10}  {'p/f df/dp':>10}"]
+        for j, key in enumerate(self.parameters):
+            lines.append(f"{key:<{width}}  {self.values[j]:>10.4g}  {1e3 * self.d_peak_amplitude[j]:>16.4g}  "
+                         f"{self.d_peak_frequency_hz[j]:>16.4g}  {ea[j]:>10.3g}  {ef[j]:>10.3g}  "
+                         f"(per {self.units[j]})")
+        return "\n".join(lines)
+
+    def plot(self, ax=None):
+        """Bars of the elasticities p / A dA/dp and p / f df/dp of each parameter; returns the figure."""
+        import matplotlib.pyplot as plt
+
+        ea, ef = self.elasticities()
+        if ax is None:
+            fig, ax = plt.subplots(figsize=(7.5, 0.5 * len(self.parameters) + 1.8), constrained_layout=True)
+        else:
+            fig = ax.figure
+        y = np.arange(len(self.parameters))
+        ax.barh(y - 0.2, ea, height=0.4, label="peak amplitude", color="C0")
+        ax.barh(y + 0.2, ef, height=0.4, label="peak frequency", color="C1")
+        ax.set_yticks(y, self.parameters)
+        ax.invert_yaxis()
+        ax.axvline(0.0, color="0.4", lw=0.8)
+        ax.set_xlabel("relative sensitivity  p / y  dy/dp  [-]")
+        ax.set_title(f"peak {1e3 * self.peak_amplitude:.3g} mm at {self.peak_frequency_hz:.4g} Hz", fontsize="medium")
+        ax.grid(axis="x", alpha=0.3)
+        ax.legend(fontsize="small")
+        return fig

@@ -79,8 +79,13 @@ class PeakSolver:
         return abs(u), float(np.real(np.conj(u) * du) / max(abs(u), 1e-300))
 
     def solve(self, index: int, output) -> tuple[float, float] | None:
-        """(peak |u|, its frequency [rad/s]) of a local maximum of |u| = |output @ x| next to
-        branch point ``index`` (a local maximum of the sampled curve), or None where it is not
+        """(peak |u|, its frequency [rad/s]) of :meth:`solve_state`, or None."""
+        solved = self.solve_state(index, output)
+        return None if solved is None else solved[:2]
+
+    def solve_state(self, index: int, output) -> tuple[float, float, np.ndarray] | None:
+        """(peak |u|, its frequency [rad/s], the solution x (C * n_dof,) there) of a local maximum
+        of |u| = |output @ x| next to branch point ``index`` (a local maximum of the sampled curve), or None where it is not
         solved: at an end of the branch, a fold next to the sample, or a Newton solve that does
         not converge.
 
@@ -106,7 +111,8 @@ class PeakSolver:
         if not bracket:
             return None
         (w0, x0, d0, a0, g0), (w1, x1, d1, a1, g1) = bracket[0]
-        best, w_prev, moved = max((a0, w0), (a1, w1)), None, None
+        best, w_prev, moved = max((a0, w0, 0), (a1, w1, 1)), None, None
+        best = best[:2] + ((x0, x1)[best[2]],)
         for _ in range(self.max_iter):
             t = 0.5 if moved is not None and moved[0] == moved[1] else hermite_maximum(a0, g0, a1, g1, w1 - w0)
             w = w0 + (w1 - w0) * t
@@ -119,7 +125,8 @@ class PeakSolver:
             # one Jacobian less per iteration
             d = -r.solve(r.dR_domega)
             a, g = self._slope(output, r.x, d)
-            best = max(best, (a, w))
+            if (a, w) > best[:2]:
+                best = (a, w, r.x)
             if w_prev is not None and abs(w - w_prev) <= 1e-9 * w:
                 break
             w_prev = w
@@ -129,7 +136,7 @@ class PeakSolver:
                 w0, x0, a0, g0, d0 = w, r.x, a, g, d
             else:
                 w1, x1, a1, g1, d1 = w, r.x, a, g, d
-        return float(best[0]), float(best[1])
+        return float(best[0]), float(best[1]), best[2]
 
     @staticmethod
     def _brackets(left, right) -> bool:

@@ -282,6 +282,33 @@ class HarmonicBalanceSystem:
         return dissipation, bound
 
 
+def linear_forces(basis: HarmonicBasis, x: np.ndarray, omega: float, mass=None, damping=None, stiffness=None,
+                  static_stiffness=None) -> np.ndarray:
+    """``A(Omega) x`` (C*n,) of the given matrices (n, n) (dense or scipy.sparse; None: zero)
+    without forming A: the same dynamic stiffness as :meth:`HarmonicBasis.dynamic_stiffness`
+    (K_0 - Omega^2 M_2 + Omega G, harmonic-major) with ``static_stiffness`` on the static
+    harmonic, applied to the coefficients ``x`` (C*n,) [m] at ``omega`` [rad/s]. A is linear in
+    the matrices, so with their derivatives in a parameter this is dR/dp of the linear part
+    (:mod:`bladedamp.hbm.sensitivity`) [N per unit of the parameter]."""
+    C = basis.n_coeffs
+    X = np.asarray(x, dtype=float).reshape(C, -1)
+    out = np.zeros(X.shape)
+
+    def times(matrix, Y):                  # Y @ matrix.T, matrix dense or sparse
+        return np.asarray((matrix @ Y.T).T)
+
+    if stiffness is not None:
+        out += times(stiffness, X)
+    if mass is not None:
+        out -= omega ** 2 * times(mass, basis.order.astype(float)[:, None] ** 2 * X)
+    if damping is not None:
+        out += omega * times(damping, basis.derivative @ X)
+    if static_stiffness is not None and basis.has_static:
+        j = basis.cos_index(0)
+        out[j] += times(static_stiffness, X[j:j + 1])[0]
+    return out.ravel()
+
+
 def with_element(system: HarmonicBalanceSystem, element: NonlinearElement, matrix, name: str = "") -> HarmonicBalanceSystem:
     """``system`` with ``element`` added through the real-form map ``matrix`` (see
     :meth:`HarmonicBalanceSystem.add`); ``system`` itself is not changed."""

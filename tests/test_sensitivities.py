@@ -1,0 +1,225 @@
+"""Derivatives of responses and peaks in design parameters (issue 36 item 1) against central
+differences of full solves (every parameter perturbed in the model itself, the system built
+anew, Newton to 1e-13 from the unperturbed solution) and against closed forms.
+
+Tolerance: relative 1e-5 (the issue's). With a step of 1e-6 of the parameter the differences'
+truncation is O(1e-12) and their rounding about the Newton tolerance over the step (1e-13 / 1e-6
+= 1e-7); the analytic derivatives agree to 1e-7 or better where the response is smooth."""
+import dataclasses
+
+import numpy as np
+import pytest
+
+import bladedamp as bd
+from bladedamp.diskmodel import parse_parameter_key
+from bladedamp.hbm.newton import newton
+from bladedamp.hbm.system import linear_forces
+from bladedamp.mistuned import MistunedDisk
+
+RTOL = 1e-5
+STEP = 1e-6
+
+
+def perturbed(disk, key, h):
+    """``disk`` with the design-file ``key`` moved by h (in the key's unit), built anew."""
+    name, index = parse_parameter_key(key)
+    contact = disk.damper.contact if disk.damper is not None else None
+    fields = {"damper.friction_coefficient": "friction_coefficient",
+              "damper.tangential_stiffness_per_length_n_per_m2": "tangential_stiffness_per_length",
+              "damper.normal_to_tangential_stiffness": "normal_to_tangential_stiffness",
+              "damper.roughness_reference_load_n": "roughness_reference_load"}
+    if name in fields:
+        value = getattr(contact, fields[name]) + h
+        damper = dataclasses.replace(disk.damper, contact=dataclasses.replace(contact, **{fields[name]: value}))
+        return dataclasses.replace(disk, damper=damper)
+    if name == "damper.mass_g":
+        return dataclasses.replace(disk, damper=dataclasses.replace(disk.damper, mass=disk.damper.mass + 1e-3 * h))
+    if name == "disk.damper_radius_mm":
+        return dataclasses.replace(disk, damper_radius=disk.damper_radius + 1e-3 * h)
+    if name == "disk.rotor_speed_rpm":
+        return dataclasses.replace(disk, rotor_speed_hz=disk.rotor_speed_hz + h / 60)
+    if name == "disk.excitation_n_nm":
+        e = disk.excitation.copy()
+        e[index] += h
+        return dataclasses.replace(disk, excitation=e)
+    if name == "blade.natural_frequencies_hz":
+        f = disk.blade.natural_frequencies_hz.copy()
+        f[index] += h
+        return dataclasses.replace(disk, blade=disk.blade.with_frequencies(f))
+    if name == "blade.damping_ratio":
+        z = disk.blade.damping_ratios.copy()
+        z[slice(None) if index is None else index] += h
+        return dataclasses.replace(disk, blade=dataclasses.replace(disk.blade, damping_ratios=z))
+    raise AssertionError(key)
+
+
+def central_difference(build, key, value, response, i):
+    """d|u_blade|/dp at point i of ``response`` by central differences of Newton solves of the
+    models ``build(key, +-h)``."""
+    h = STEP * abs(value)
+    x0, w = response.coefficients[i].ravel(), float(response.omega[i])
+    outputs = response.blade_outputs(0)
+    amplitudes = []
+    for sign in (1, -1):
+        system = build(key, sign * h).hbm_system(response.basis.harmonics, response.basis.n_samples)
+        solved = newton(system.residual, x0, w, np.abs(x0).max(), 1.0, tol=1e-13, factorize=system.factorize)
+        assert solved.converged
+        amplitudes.append(np.abs(outputs @ solved.x))
+    return (amplitudes[0] - amplitudes[1]) / (2 * h)
+
+
+def check_points(response, build, keys, points):
+    sens = response.sensitivities(keys)
+    for i in points:
+        for j, key in enumerate(keys):
+            fd = central_difference(build, key, sens.values[j], response, i)
+            scale = np.abs(fd).max()
+            assert scale > 0, key
+            assert np.abs(sens.d_tip_amplitude[i, j] - fd).max() <= RTOL * scale, (key, i, sens.d_tip_amplitude[i, j], fd)
+
+
+@pytest.fixture(scope="module")
+def reference_static():
+    disk = bd.reference_disk("cylinder", 1e-3)
+    return disk, disk.frequency_response(93.0, 97.0, harmonics=(0, 1, 2, 3), n_samples=64,
+                                         estimate_harmonic_error=False)
+
+
+def test_linear_forces_is_the_dynamic_stiffness_times_x():
+    disk = bd.reference_disk("cylinder", 1e-3)
+    system = disk.hbm_system((0, 1, 2), 32)
+    x = np.random.default_rng(0).normal(size=system.n_unknowns)
+    A, _ = system.dynamic_stiffness(600.0)
+    expected = A @ x
+    got = linear_forces(system.basis, x, 600.0, system.mass, system.damping, system.stiffness, system.static_stiffness)
+    assert np.abs(got - expected).max() <= 1e-12 * np.abs(expected).max()
+
+
+def test_tuned_point_derivatives_with_static_harmonic_match_differences(reference_static):
+    disk, response = reference_static
+    keys = ["damper.mass_g", "damper.friction_coefficient", "damper.tangential_stiffness_per_length_n_per_m2",
+            "damper.normal_to_tangential_stiffness", "disk.damper_radius_mm", "disk.excitation_n_nm[0]",
+            "blade.natural_frequencies_hz[0]", "blade.damping_ratio"]
+    n = len(response.omega)
+    check_points(response, lambda k, h: perturbed(disk, k, h), keys, [n // 4, n // 2])
+
+
+def test_one_harmonic_power_law_wedge_derivatives_match_differences():
+    """Without a static harmonic the preload enters through the seating's approach (the
+    'approach' direction), with the power law through its scale and exponent."""
+    disk = bd.reference_disk("wedge", 2e-3)
+    contact = dataclasses.replace(disk.damper.contact, roughness_exponent=1.5)
+    disk = dataclasses.replace(disk, damper=dataclasses.replace(disk.damper, contact=contact))
+    response = disk.frequency_response(92.0, 100.0, harmonics=(1,), n_samples=64, estimate_harmonic_error=False)
+    keys = ["damper.mass_g", "damper.friction_coefficient", "damper.tangential_stiffness_per_length_n_per_m2",
+            "damper.normal_to_tangential_stiffness", "damper.roughness_reference_load_n", "disk.damper_radius_mm"]
+    n = len(response.omega)
+    check_points(response, lambda k, h: perturbed(disk, k, h), keys, [n // 3, n // 2])
+
+
+def test_mistuned_point_derivatives_match_differences():
+    tuned = dataclasses.replace(bd.reference_disk("cylinder", 0.3e-3), n_blades=4)
+    kappa = np.array([1.0, 1.01, 0.99, 1.02])
+    disk = MistunedDisk.from_tuned(tuned, kappa)
+    response = disk.frequency_response(92.0, 99.0, harmonics=(0, 1, 2), n_samples=32, estimate_harmonic_error=False)
+
+    def build(key, h):
+        if key.startswith("mistuning.kappa"):
+            k = kappa.copy()
+            k[parse_parameter_key(key)[1]] += h
+            return MistunedDisk.from_tuned(tuned, k)
+        return MistunedDisk.from_tuned(perturbed(tuned, key, h), kappa)
+
+    keys = ["damper.mass_g", "damper.friction_coefficient", "mistuning.kappa[2]", "blade.natural_frequencies_hz[0]",
+            "blade.damping_ratio[0]", "disk.excitation_n_nm[0]"]
+    check_points(response, build, keys, [len(response.omega) // 2])
+
+
+def precise_peak(model, response, x, w):
+    """(peak |u|, Omega*) of ``model`` by bisection on the sign of the slope d|u|/dOmega (each a
+    Newton solve to 1e-14) to 1e-15 of Omega: the peak of the full solve, kink or not."""
+    system = model.hbm_system(response.basis.harmonics, response.basis.n_samples)
+    output = response.blade_outputs(0)[0]
+
+    def at(omega, start):
+        r = newton(system.residual, start, omega, np.abs(start).max(), 1.0, tol=1e-14, factorize=system.factorize)
+        assert r.converged
+        u, du = output @ r.x, output @ -r.solve(r.dR_domega)
+        return r.x, float(np.real(np.conj(u) * du)) / abs(u), abs(u)
+
+    low, high = w * (1 - 1e-5), w * (1 + 1e-5)
+    x_low, g_low, _ = at(low, x)
+    _, g_high, _ = at(high, x)
+    assert g_low > 0 > g_high
+    while high - low > 1e-15 * w:
+        middle = 0.5 * (low + high)
+        x_mid, g_mid, _ = at(middle, x_low)
+        if g_mid > 0:
+            low, x_low = middle, x_mid
+        else:
+            high = middle
+    return at(low, x_low)[2], 0.5 * (low + high)
+
+
+def test_peak_derivatives_on_a_kink_match_differences_of_full_solves():
+    """The reference 1 g cylinder's peak (one harmonic) sits on a kink of the sampled friction
+    (the slope jumps from +2e-6 to -5.6e-6 within 1e-11 of Omega*): the envelope theorem alone is
+    wrong there, the two-sided formula of hbm.sensitivity is exact to first order."""
+    disk = bd.reference_disk("cylinder", 1e-3)
+    response = disk.frequency_response(90.0, 100.0, harmonics=(1,), n_samples=64, estimate_harmonic_error=False)
+    keys = ["damper.mass_g", "damper.friction_coefficient", "disk.excitation_n_nm[0]"]
+    peak = response.peak_sensitivities(keys)
+    X = response.coefficients.reshape(len(response.omega), -1)
+    i = int(np.argmax(response.tip_amplitude[:, 0]))
+    for key, value in zip(keys, peak.values):
+        h = STEP * abs(value)
+        plus = precise_peak(perturbed(disk, key, h), response, X[i], response.omega[i])
+        minus = precise_peak(perturbed(disk, key, -h), response, X[i], response.omega[i])
+        d_amplitude = (plus[0] - minus[0]) / (2 * h)
+        d_frequency = (plus[1] - minus[1]) / (2 * h) / (2 * np.pi)
+        assert abs(peak[key].peak_amplitude - d_amplitude) <= RTOL * abs(d_amplitude), key
+        assert abs(peak[key].peak_frequency_hz - d_frequency) <= RTOL * abs(d_frequency), key
+
+
+def test_stuck_damper_peak_is_linear_in_the_excitation():
+    """Closed form: a damper that never slips (mu = 2, a small excitation) leaves the system
+    linear, so the peak amplitude is proportional to the excitation (elasticity exactly 1) and
+    its frequency does not depend on it; the smooth peak's formula (second order) gives both."""
+    disk = bd.reference_disk("cylinder", 1e-3)
+    contact = dataclasses.replace(disk.damper.contact, friction_coefficient=2.0)
+    disk = dataclasses.replace(disk, damper=dataclasses.replace(disk.damper, contact=contact),
+                               excitation=np.array([1e-3, 0, 0, 0, 0, 0]))
+    peak = bd.peak_sensitivities(disk, (94.5, 97.0), ["disk.excitation_n_nm[0]"], harmonics=(0, 1),
+                                 n_samples=32, estimate_harmonic_error=False)
+    d = peak["disk.excitation_n_nm[0]"]
+    assert abs(d.peak_amplitude * 1e-3 / peak.peak_amplitude - 1) <= 1e-7
+    assert abs(d.peak_frequency_hz) * 1e-3 <= 1e-7 * peak.peak_frequency_hz
+
+
+def test_parameter_errors_name_the_key(reference_static):
+    disk, response = reference_static
+    with pytest.raises(ValueError, match="damper.mass_kg"):
+        response.sensitivities(["damper.mass_kg"])
+    with pytest.raises(ValueError, match="gamma_left_deg"):
+        response.sensitivities(["disk.gamma_left_deg"])
+    with pytest.raises(ValueError, match="MistunedDisk"):
+        response.sensitivities(["mistuning.kappa[0]"])
+    with pytest.raises(ValueError, match=r"j in 0\.\.3"):
+        response.sensitivities(["blade.natural_frequencies_hz[7]"])
+    with pytest.raises(ValueError, match="rotor_speed_rpm"):
+        response.sensitivities(["disk.rotor_speed_rpm"])
+    with pytest.raises(TypeError):
+        bd.peak_sensitivities(bd.FrictionOscillator(), (10.0, 20.0), ["damper.mass_g"])
+
+
+def test_results_save_and_load(tmp_path, reference_static):
+    _, response = reference_static
+    peak = response.peak_sensitivities(["damper.mass_g", "damper.friction_coefficient"])
+    loaded = bd.load(peak.save(tmp_path / "peak"))
+    assert loaded.parameters == peak.parameters
+    assert np.array_equal(loaded.d_peak_amplitude, peak.d_peak_amplitude)
+    assert loaded["damper.mass_g"] == peak["damper.mass_g"]
+    sens = response.sensitivities(["damper.mass_g"])
+    again = bd.load(sens.save(tmp_path / "sens"))
+    assert np.array_equal(again.d_tip_amplitude, sens.d_tip_amplitude)
+    assert "damper.mass_g" in peak.table()
