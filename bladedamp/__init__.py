@@ -11,7 +11,7 @@ import cycle). From the top:
     front ends       cli > app > viz | compare | reproduce (the paper's pipeline) > report | design (files)
                      | compilation
     studies          studies (mass, engine orders, platform angles, Monte Carlo, backbone)
-    reference        reference (the paper's disk: reference_disk)
+    reference        reference (the paper's disk: reference_disk) | fit (contact parameters from measurements)
     disk models      disk (the tuned sector) | oscillator > mistuned (the full ring) > diskmodel (what
                      both disks share: damper position, contact element, DiskModel, checks)
     FRF driver       frf (one frequency-response driver of every model)
@@ -60,6 +60,8 @@ _LAZY = {
     "load_design": "design",
     "nonlinear_mode": "hbm.nonlinear_modes",
     "precompile": "compilation",
+    "fit_contact": "fit", "ContactFit": "fit",
+    "Sensitivities": "response", "PeakSensitivities": "response",
 }
 __all__ = sorted(_LAZY) + ["frequency_response", "peak_sensitivities"]
 

@@ -103,6 +103,14 @@ class TunedDisk(DiskModel):
         return DamperPosition(self.damper, self.gamma_left, self.gamma_right, self.initial_gaps, self.damper_radius,
                               self.engine_order, self.rotor_speed_hz)
 
+    def with_dampers(self, change) -> "TunedDisk":
+        """This disk with its damper replaced by ``change(damper)`` (a new disk; none without a damper)."""
+        return self if self.damper is None else dataclasses.replace(self, damper=change(self.damper))
+
+    def with_blades(self, change) -> "TunedDisk":
+        """This disk with its blade replaced by ``change(0, blade)`` (a new disk)."""
+        return dataclasses.replace(self, blade=change(0, self.blade))
+
     def position_of(self, k: int) -> DamperPosition:
         """The damper position of every sector (:attr:`position`; ``k``: 0)."""
         return self.position

@@ -1343,6 +1343,56 @@ class DiskModel:
                                               "damper.normal_to_tangential_stiffness": "normal_to_tangential_stiffness",
                                               "damper.roughness_reference_load_n": "roughness_reference_load"}[name]))
 
+    def with_parameters(self, values: dict) -> "DiskModel":
+        """A copy of this model with the design-file keys of ``values`` ({key: value in the key's
+        unit}, the keys of :meth:`parameter_derivatives`) set, built anew (validated as any model);
+        this model is left as it is. ``blade.natural_frequencies_hz[j]`` sets the design blade's
+        f_j (each blade's is kappa_k f_j), ``mistuning.kappa[k]`` blade k's factor."""
+        out = self
+        contact_fields = {"damper.friction_coefficient": "friction_coefficient",
+                          "damper.tangential_stiffness_per_length_n_per_m2": "tangential_stiffness_per_length",
+                          "damper.normal_to_tangential_stiffness": "normal_to_tangential_stiffness",
+                          "damper.roughness_reference_load_n": "roughness_reference_load"}
+        for key, value in values.items():
+            name, index = parse_parameter_key(key)
+            value = float(value)
+            if name in contact_fields:
+                out = out.with_dampers(lambda d: dataclasses.replace(
+                    d, contact=dataclasses.replace(d.contact, **{contact_fields[name]: value})))
+            elif name == "damper.mass_g":
+                out = out.with_dampers(lambda d: dataclasses.replace(d, mass=1e-3 * value))
+            elif name == "disk.damper_radius_mm":
+                out = dataclasses.replace(out, damper_radius=1e-3 * value)
+            elif name == "disk.rotor_speed_rpm":
+                out = dataclasses.replace(out, rotor_speed_hz=value / 60.0)
+            elif name == "disk.excitation_n_nm":
+                excitation = np.array(out.excitation, dtype=float)
+                excitation[index] = value
+                out = dataclasses.replace(out, excitation=excitation)
+            elif name == "blade.damping_ratio":
+                def damped(k, blade, index=index, value=value):
+                    zeta = np.array(blade.damping_ratios, dtype=float)
+                    zeta[slice(None) if index is None else index] = value
+                    return dataclasses.replace(blade, damping_ratios=zeta)
+                out = out.with_blades(damped)
+            elif name == "blade.natural_frequencies_hz":
+                kappa = out.mistuning_factors
+
+                def tuned_to(k, blade, index=index, value=value, kappa=kappa):
+                    f = np.array(blade.natural_frequencies_hz, dtype=float)
+                    f[index] = kappa[k] * value
+                    return blade.with_frequencies(f)
+                out = out.with_blades(tuned_to)
+            else:                                           # mistuning.kappa[k]
+                kappa = out.mistuning_factors.copy()
+                if len(kappa) < 2 or not 0 <= index < len(kappa):
+                    raise ValueError(f"parameter {key!r}: give the blade as mistuning.kappa[k], k in "
+                                     f"0..{len(kappa) - 1} of a MistunedDisk")
+                ratio, kappa[index] = value / kappa[index], value
+                out = dataclasses.replace(out.with_blades(lambda k, b: b.scaled(ratio) if k == index else b),
+                                          kappa=kappa)
+        return out
+
     @property
     def mistuning_factors(self) -> np.ndarray:
         """(s,) each blade's mistuning factor kappa_k on the design blade's frequencies (ones: the

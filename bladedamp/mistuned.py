@@ -530,6 +530,14 @@ class MistunedDisk(DiskModel):
                    disk.gamma_left, disk.gamma_right, disk.damper_radius, disk.excitation, disk.rotor_speed_hz,
                    disk.damper_inertia, disk.initial_gaps, kappa=kappa)
 
+    def with_dampers(self, change) -> "MistunedDisk":
+        """This disk with every damper d replaced by ``change(d)`` (a new disk; positions without one keep none)."""
+        return dataclasses.replace(self, dampers=[None if d is None else change(d) for d in self.dampers])
+
+    def with_blades(self, change) -> "MistunedDisk":
+        """This disk with blade k replaced by ``change(k, blade)`` (a new disk)."""
+        return dataclasses.replace(self, blades=[change(k, b) for k, b in enumerate(self.blades)])
+
     @property
     def mistuning_factors(self) -> np.ndarray:
         """(s,) :attr:`kappa`, or ones where the blades were given as they are."""
