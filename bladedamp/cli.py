@@ -3,6 +3,8 @@
   bladedamp init design.toml          write the reference design, every key commented
   bladedamp frf design.toml           frequency response of the design's disk
   bladedamp optimize design.toml      optimal damper mass (and platform angle or contact height)
+  bladedamp sensitivities design.toml derivatives of the resonance peak in design parameters
+  bladedamp fit design.toml m.csv     contact parameters fitted to measured responses
   bladedamp eo-sweep design.toml      optimal mass over engine orders
   bladedamp zzenf design.toml         interference (ZZENF) diagram: natural frequencies per nodal diameter
   bladedamp campbell design.toml      Campbell diagram: damped resonance at each engine order over rotor speed
@@ -363,6 +365,78 @@ def optimize_command(args) -> int:
     optimize_outputs(out, design, optimum, angles, heights)
     return _done(out, t0, f"optimal mass {1e3 * optimum.mass:.4g} g, peak {1e3 * optimum.peak_amplitude:.4f} mm, "
                           f"reduction {fmt_percent(optimum.reduction)}")
+
+
+def _parameter_keys(args, disk) -> list:
+    """The design-file keys of ``--parameters`` (whole keys or their last part), each one this
+    disk can differentiate (checked on a small system before any solve); UsageError naming it."""
+    from .diskmodel import resolve_parameter_key
+
+    try:
+        keys = [resolve_parameter_key(p) for p in args.parameters]
+        if len(set(keys)) != len(keys):
+            raise ValueError("a parameter is given twice")
+        disk.parameter_derivatives(disk.hbm_system((0, 1), 16), keys)
+    except ValueError as exc:
+        raise UsageError(f"--parameters: {exc}") from None
+    return keys
+
+
+def sensitivities_command(args) -> int:
+    """``bladedamp sensitivities``: the derivatives of the resonance peak in design parameters."""
+    from .report import sensitivity_outputs
+
+    t0 = time.perf_counter()
+    design = _load(args)
+    disk, a = design.disk, design.analysis
+    keys = _parameter_keys(args, disk)
+    out = output_dir(output_folder(args), args.overwrite)
+    progress = Progress()
+    progress.compiling()
+    progress(f"frequency response {a.f_start_hz:g}-{a.f_end_hz:g} Hz")
+    response = disk.frequency_response(a.f_start_hz, a.f_end_hz, **a.options())
+    if not response.success:
+        print(f"bladedamp sensitivities: the frequency response is not a success, its peak is not differentiated: "
+              f"{response.status_message}", file=sys.stderr)
+        return 1
+    progress(f"derivatives of the peak in {len(keys)} parameters")
+    try:
+        peak = response.peak_sensitivities(keys)
+    except ValueError as exc:
+        print(f"bladedamp sensitivities: {exc}", file=sys.stderr)
+        return 1
+    sensitivity_outputs(out, design, peak)
+    print(peak.table())
+    return _done(out, t0, f"peak {1e3 * peak.peak_amplitude:.4f} mm at {peak.peak_frequency_hz:.4f} Hz")
+
+
+def fit_command(args) -> int:
+    """``bladedamp fit``: contact parameters fitted to measured responses."""
+    from .fit import fit_contact
+    from .measurement import load_measurement
+    from .report import fit_outputs
+
+    t0 = time.perf_counter()
+    design = _load(args)
+    disk = _damped(design, "fit")
+    keys = _parameter_keys(args, disk)
+    measured = [load_measurement(m, unit=args.measured_unit) for m in args.measured]
+    forces = args.excitation_n
+    if forces is not None:
+        if len(forces) != len(measured):
+            raise UsageError(f"--excitation-n: give one force per measured file ({len(measured)}; got {len(forces)})")
+        for f in forces:
+            if not (math.isfinite(f) and f > 0):
+                raise UsageError(f"--excitation-n {f:g}: must be a force amplitude > 0 N")
+    out = output_dir(output_folder(args), args.overwrite)
+    progress = Progress()
+    progress.compiling()
+    progress(f"least squares of {len(keys)} parameters on {len(measured)} measurement(s)")
+    fit = fit_contact(disk, measured, keys, excitations=forces, harmonics=design.analysis.study_harmonics)
+    fit_outputs(out, design, fit, [m.name for m in args.measured])
+    print(fit.table())
+    return _done(out, t0, f"fit {'converged' if fit.success else 'not converged'}, relative residual rms "
+                          f"{fit.residual_rms:.3g}")
 
 
 def engine_orders(args, design) -> tuple:
@@ -832,6 +906,43 @@ def build_parser() -> argparse.ArgumentParser:
                    help="also optimise the mass at each of these wedge contact heights [mm], in (0, 100]")
     processes_arg(p)
     out_arg(p, "results/<design file name>/optimize")
+    figure_args(p)
+
+    def parameters_arg(p, default=None):
+        p.add_argument("--parameters", nargs="+", metavar="KEY", required=default is None, default=default,
+                       help="design-file keys, whole (damper.mass_g) or their last part (mass_g); an entry of a list as\n"
+                            "natural_frequencies_hz[0]. With derivatives: mass_g, friction_coefficient,\n"
+                            "tangential_stiffness_per_length_n_per_m2, normal_to_tangential_stiffness,\n"
+                            "roughness_reference_load_n, damper_radius_mm, rotor_speed_rpm (fixed speed),\n"
+                            "excitation_n_nm[i], natural_frequencies_hz[j], damping_ratio (or [j])")
+
+    p = command("sensitivities", sensitivities_command, "derivatives of the resonance peak in design parameters",
+                "The frequency response over [analysis] frequency_range_hz, its peak solved by d|u|/dOmega = 0 and\n"
+                "differentiated in each --parameters key with the analytic dR/dp (the implicit function theorem):\n"
+                "d peak / dp [mm per unit], d frequency / dp [Hz per unit] and the relative sensitivities.\n"
+                "Writes sensitivities.png, peak_sensitivities.npz, results.json, summary.md.")
+    design_arg(p)
+    parameters_arg(p, ["mass_g", "friction_coefficient", "tangential_stiffness_per_length_n_per_m2",
+                       "normal_to_tangential_stiffness", "damper_radius_mm", "excitation_n_nm[0]",
+                       "natural_frequencies_hz[0]", "damping_ratio"])
+    out_arg(p, "results/<design file name>/sensitivities")
+    figure_args(p)
+
+    p = command("fit", fit_command, "contact parameters fitted to measured responses",
+                "Least squares of the --parameters keys (the design's values the start) so that the reference blade's\n"
+                "tip response in x matches the measured files (one per excitation level: UFF 58 or CSV, as frf\n"
+                "--measured), with the analytic Jacobian; estimates with confidence intervals, correlations, and\n"
+                "the parameters the data do not identify. Frequency responses with [analysis] harmonics (the\n"
+                "paper's [1] where 'auto'). Writes fit.png, fit.npz, results.json, summary.md.")
+    design_arg(p)
+    p.add_argument("measured", type=Path, nargs="+", metavar="MEASURED", help="measured responses, one per excitation level")
+    parameters_arg(p, ["friction_coefficient", "tangential_stiffness_per_length_n_per_m2"])
+    p.add_argument("--excitation-n", type=float, nargs="+", metavar="N",
+                   help="the force amplitude of each measurement [N], along the design's excitation (default: the\n"
+                        "design's excitation for all); an FRF (a unit per N) is scaled by it")
+    p.add_argument("--measured-unit", metavar="UNIT", help="the unit of measured files that do not state it "
+                   "(e.g. m/s^2/N, g/N, mm)")
+    out_arg(p, "results/<design file name>/fit")
     figure_args(p)
 
     def engine_orders_arg(p):

@@ -984,6 +984,25 @@ def parameter_unit(key: str) -> str:
     return SENSITIVITY_KEYS.get(name) or SENSITIVITY_KEYS[next(k for k in SENSITIVITY_KEYS if k.split("[")[0] == name)]
 
 
+def resolve_parameter_key(name: str) -> str:
+    """The design-file key of ``name``: a whole key as given (``damper.mass_g``), or its last
+    part alone where that names one key (``mass_g``, ``natural_frequencies_hz[0]``); ValueError
+    naming it otherwise."""
+    text = str(name).strip()
+    if "." in text:
+        parse_parameter_key(text)
+        return text
+    base, bracket, rest = text.partition("[")
+    matches = [k.split("[")[0] for k in SENSITIVITY_KEYS if k.split("[")[0].split(".")[-1] == base]
+    matches = list(dict.fromkeys(matches))
+    if len(matches) != 1:
+        raise ValueError(f"parameter {name!r}: {'ambiguous' if matches else 'unknown or not differentiable'}; the "
+                         f"keys with derivatives are {', '.join(SENSITIVITY_KEYS)} (the geometry's are not yet)")
+    key = matches[0] + bracket + rest
+    parse_parameter_key(key)
+    return key
+
+
 def parse_parameter_key(key: str) -> tuple[str, int | None]:
     """(name, index or None) of a design-file key such as ``damper.mass_g`` or
     ``blade.natural_frequencies_hz[0]``; ValueError for anything else."""

@@ -295,7 +295,8 @@ def fit_contact(model: DiskModel, measured, parameters=("damper.friction_coeffic
                                       max_step=max_step, estimate_harmonic_error=False)
         curves.append((branch.frequency_hz, branch.tip_amplitude[:, 0] if branch.tip_amplitude.ndim == 2
                        else branch.tip_amplitude[:, 0, 0], np.full(len(branch.omega), l)))
-    message = solution.message if solution.success else f"not converged: {solution.message}"
+    said = str(solution.message).rstrip(".")
+    message = said if solution.success else f"not converged: {said}"
     if not identified.all():
         message += "; not identified by these data: " + ", ".join(k for k, i in zip(keys, identified) if not i)
     return ContactFit(keys, tuple(parameter_unit(k) for k in keys), initial, estimate, standard_error, interval,

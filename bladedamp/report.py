@@ -1162,3 +1162,68 @@ def campbell_outputs(out: Path, design, diagram) -> dict:
                   f"max_step {design.analysis.max_step:g}; diagram {rpm[0]:.0f}-{rpm[-1]:.0f} rpm, up to "
                   f"{diagram.f_max_hz:g} Hz.")
     return summary
+
+
+def sensitivity_outputs(out: Path, design, peak) -> dict:
+    """sensitivities.png, results.json, summary.md and peak_sensitivities.npz of ``bladedamp
+    sensitivities`` (a :class:`~bladedamp.response.PeakSensitivities`)."""
+    ea, ef = peak.elasticities()
+    rows = [{"parameter": k, "unit": u, "value": v, "d_peak_amplitude_mm_per_unit": 1e3 * da,
+             "d_peak_frequency_hz_per_unit": df, "relative_amplitude": a, "relative_frequency": f}
+            for k, u, v, da, df, a, f in zip(peak.parameters, peak.units, peak.values, peak.d_peak_amplitude,
+                                             peak.d_peak_frequency_hz, ea, ef)]
+    summary = {"design": design.path, "peak_amplitude_mm": 1e3 * peak.peak_amplitude,
+               "peak_frequency_hz": peak.peak_frequency_hz, "blade": peak.blade, "sensitivities": rows}
+    fig = peak.plot()
+    fig.axes[0].set_title(design_title(design, "sensitivities of the peak") + "\n" + fig.axes[0].get_title(),
+                          fontsize="medium")
+    files = save_figure(fig, out / "sensitivities.png")
+    saved = save_result(peak, out / "peak_sensitivities")
+    files += [saved] if saved else []
+    write_json(out / "results.json", summary)
+    files.append("results.json")
+    lines = ["## Peak and its derivatives", "",
+             f"Peak u_x {_mm(peak.peak_amplitude)} at {peak.peak_frequency_hz:.4f} Hz, solved by d|u|/dOmega = 0 and "
+             "differentiated with the analytic dR/dp (the implicit function theorem).", "",
+             "| parameter | value | d peak / dp [mm per unit] | d frequency / dp [Hz per unit] | p/A dA/dp | p/f df/dp |",
+             "|---|---|---|---|---|---|"]
+    lines += [f"| `{r['parameter']}` | {r['value']:.5g}{'' if r['unit'] == '-' else ' ' + r['unit']} | "
+              f"{r['d_peak_amplitude_mm_per_unit']:.4g} | "
+              f"{r['d_peak_frequency_hz_per_unit']:.4g} | {r['relative_amplitude']:.3g} | {r['relative_frequency']:.3g} |"
+              for r in rows]
+    lines += ["", "p/A dA/dp: the relative change of the peak per relative change of the parameter (0.5: 1 % more "
+              "of the parameter raises the peak by 0.5 %).", ""]
+    write_summary(out, "sensitivities", design, lines, files)
+    return summary
+
+
+def fit_outputs(out: Path, design, fit, sources) -> dict:
+    """fit.png, results.json, summary.md and fit.npz of ``bladedamp fit`` (a
+    :class:`~bladedamp.fit.ContactFit`; ``sources``: the measured files, one per excitation)."""
+    rows = [{"parameter": k, "unit": u, "start": s, "estimate": e, "standard_error": se, "interval": list(i),
+             "identified": bool(ok)}
+            for k, u, s, e, se, i, ok in zip(fit.parameters, fit.units, fit.initial, fit.estimate, fit.standard_error,
+                                              fit.interval, fit.identified)]
+    summary = {"design": design.path, "measured": [str(s) for s in sources], "excitations_n_nm": fit.excitations,
+               "parameters": rows, "correlation": fit.correlation, "confidence": fit.confidence,
+               "residual_rms": fit.residual_rms, "frequency_responses_solved": fit.n_responses,
+               "converged": fit.success, "message": fit.message}
+    fig = fit.plot()
+    files = save_figure(fig, out / "fit.png")
+    saved = save_result(fit, out / "fit")
+    files += [saved] if saved else []
+    write_json(out / "results.json", summary)
+    files.append("results.json")
+    pct = int(round(100 * fit.confidence))
+    lines = ["## Fitted parameters", "",
+             f"Least squares on {len(fit.frequency_hz)} measured points of {len(sources)} measurement(s) "
+             f"({', '.join(f'`{s}`' for s in sources)}); {fit.message}; relative residual rms "
+             f"{fit.residual_rms:.3g}.", "",
+             f"| parameter | start | estimate | standard error | {pct} % interval |", "|---|---|---|---|---|"]
+    lines += [f"| `{r['parameter']}` | {r['start']:.5g} | {r['estimate']:.5g} | {r['standard_error']:.3g} | "
+              + ("not identified by these data |" if not r["identified"] else
+                 f"[{r['interval'][0]:.5g}, {r['interval'][1]:.5g}]{'' if r['unit'] == '-' else ' ' + r['unit']} |")
+              for r in rows]
+    lines.append("")
+    write_summary(out, "fit", design, lines, files)
+    return summary

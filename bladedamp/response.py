@@ -930,7 +930,7 @@ class PeakSensitivities(Saveable):
 
         ea, ef = self.elasticities()
         if ax is None:
-            fig, ax = plt.subplots(figsize=(7.5, 0.5 * len(self.parameters) + 1.8), constrained_layout=True)
+            fig, ax = plt.subplots(figsize=(9.0, 0.5 * len(self.parameters) + 2.2), constrained_layout=True)
         else:
             fig = ax.figure
         y = np.arange(len(self.parameters))

@@ -316,7 +316,7 @@ def test_help_is_plain_text_with_help_for_every_option():
     parser = build_parser()
     subs = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
     assert set(subs.choices) == {"init", "frf", "optimize", "eo-sweep", "zzenf", "campbell", "montecarlo", "show", "compare",
-                                  "app", "reproduce", "precompile"}
+                                  "app", "reproduce", "precompile", "sensitivities", "fit"}
     for name, p in subs.choices.items():
         text = p.format_help()
         assert "``" not in text and ":func:" not in text and ".. " not in text, name

@@ -1,0 +1,74 @@
+"""``bladedamp sensitivities`` and ``bladedamp fit`` on a design file: their outputs, their
+numbers against the library's, and their one-line errors (exit code 2)."""
+import json
+
+import numpy as np
+import pytest
+
+import bladedamp as bd
+from bladedamp.cli import main
+from bladedamp.design import load_design
+from bladedamp.fit import model_points
+
+FAST = "[analysis]\nfrequency_range_hz = [92.0, 99.0]\nharmonics = [1]\n"
+
+
+def one_error_line(err, *needles):
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in err, err
+    for needle in needles:
+        assert needle in lines[0], (needle, lines[0])
+
+
+@pytest.mark.filterwarnings("ignore::bladedamp.hbm.accuracy.AccuracyWarning")
+def test_sensitivities_writes_the_peak_derivatives_of_the_library(tmp_path, capsys):
+    design = tmp_path / "wing.toml"
+    design.write_text(FAST)
+    out = tmp_path / "sens"
+    assert main(["sensitivities", str(design), "--parameters", "mass_g", "friction_coefficient", "--out", str(out)]) == 0
+    result = json.loads((out / "results.json").read_text())
+    assert [r["parameter"] for r in result["sensitivities"]] == ["damper.mass_g", "damper.friction_coefficient"]
+    d = load_design(design)
+    peak = d.disk.frequency_response(92.0, 99.0, **d.analysis.options()).peak_sensitivities(
+        ["damper.mass_g", "damper.friction_coefficient"])
+    assert result["sensitivities"][0]["d_peak_amplitude_mm_per_unit"] == pytest.approx(1e3 * peak.d_peak_amplitude[0],
+                                                                                      rel=1e-9)
+    assert {"sensitivities.png", "summary.md", "peak_sensitivities.npz"} <= {p.name for p in out.iterdir()}
+    assert bd.load(out / "peak_sensitivities.npz").parameters == peak.parameters
+
+
+def test_fit_recovers_the_friction_coefficient_from_csv_files(tmp_path, capsys):
+    truth = bd.reference_disk("cylinder", 1e-3)
+    f = np.linspace(92.0, 99.0, 20)
+    files = []
+    for force in (0.05, 0.2):
+        u, _ = model_points(truth.with_parameters({"disk.excitation_n_nm[0]": force}), f, ("damper.mass_g",), (1,),
+                            None, 0.05)
+        path = tmp_path / f"rig_{force}.csv"
+        path.write_text("frequency [Hz], amplitude [mm]\n" + "".join(f"{x:.6f}, {1e3 * abs(y):.10g}\n"
+                                                                     for x, y in zip(f, u)))
+        files.append(str(path))
+    design = tmp_path / "start.toml"
+    design.write_text(FAST + "[damper]\nfriction_coefficient = 0.2\n")
+    out = tmp_path / "fit"
+    assert main(["fit", str(design), *files, "--parameters", "friction_coefficient", "--excitation-n", "0.05", "0.2",
+                 "--out", str(out)]) == 0
+    result = json.loads((out / "results.json").read_text())
+    assert result["parameters"][0]["estimate"] == pytest.approx(0.3, rel=1e-4)      # noise-free data
+    assert {"fit.png", "summary.md", "fit.npz"} <= {p.name for p in out.iterdir()}
+
+
+@pytest.mark.parametrize("argv, needles", [
+    (["sensitivities", "{d}", "--parameters", "gamma_left_deg"], ["--parameters", "gamma_left_deg"]),
+    (["sensitivities", "{d}", "--parameters", "rotor_speed_rpm"], ["rotor_speed_rpm", "fixed rotor speed"]),
+    (["fit", "{d}", "{m}", "--excitation-n", "0.1", "0.2"], ["--excitation-n", "one force per measured file"]),
+    (["fit", "{d}", "{d}"], ["{d}"]),
+])
+def test_bad_options_and_files_end_in_one_line(tmp_path, capsys, argv, needles):
+    design = tmp_path / "wing.toml"
+    design.write_text(FAST)
+    measured = tmp_path / "m.csv"
+    measured.write_text("frequency [Hz], amplitude [mm]\n95.0, 0.3\n")
+    argv = [a.format(d=design, m=measured) for a in argv] + ["--out", str(tmp_path / "o")]
+    assert main(argv) == 2
+    one_error_line(capsys.readouterr().err, *[n.format(d=design) for n in needles])
