@@ -185,22 +185,8 @@ class TunedDisk(DiskModel):
                 M[nm:, nm:] = geometry.inertia
             contacts, G_D, G_P = self.position.contacts(geometry, self.approach_function(geometry, basis), self.blade,
                                                         self.blade)
-            phi = np.vstack([self.blade.shape("OL"), self.blade.shape("OR")])  # (12, nm)
-            dphi = self.interblade_phase
-            w_rows, left_rows, right_rows = contact_rows(contacts.contact_local, nm)
-
-            def sector_map(h):
-                phase = np.ones(12, dtype=complex)
-                phase[6:] = np.exp(1j * h * dphi)          # Eq. 24: the OR platform is the next blade's
-                out = np.zeros((contacts.n_local, n), dtype=complex)
-                out[w_rows, :nm] = -G_P @ (phase[:, None] * phi)
-                out[w_rows, nm:] = G_D
-                if contacts.flexible:                      # the platforms' modal coordinates:
-                    out[left_rows, :nm] = np.eye(nm)       # OL on this blade, OR on the next
-                    out[right_rows, :nm] = phase[-1] * np.eye(nm)
-                return out
-
-            couplings.append(Coupling(contacts, basis.real_form(sector_map), "damper contacts"))
+            couplings.append(Coupling(contacts, self.contact_coupling(basis, [(G_D, G_P)], contacts.n_local,
+                                                                      contacts.flexible), "damper contacts"))
             if basis.has_static:
                 static_stiffness = np.zeros((n, n))
                 static_stiffness[nm:, nm:] = DamperPosition.retention(geometry, static_retention)
@@ -217,6 +203,33 @@ class TunedDisk(DiskModel):
             return f.ravel(), df.ravel()
 
         return HarmonicBalanceSystem(basis, M, D, K, excitation, couplings, static_stiffness)
+
+    def contact_coupling(self, basis: HarmonicBasis, kinematics, n_local: int, flexible: bool) -> np.ndarray:
+        """The real-form map (C n_local, C n) from the sector's unknowns to its damper's local
+        coordinates (Eq. 6, 24): w = G_D u_D - G_P [Phi_OL; e^{i h dphi} Phi_OR] q for the rigid
+        kinematics ``kinematics`` = [(G_D (12, 6), G_P (12, 12))] (one damper), and with
+        ``flexible`` platforms the platforms' modal coordinates (OL on this blade, OR on the
+        next). Linear in (G_D, G_P): with their derivatives and ``flexible`` False it is the map's
+        derivative (:meth:`~bladedamp.diskmodel.DiskModel.parameter_effect`)."""
+        (G_D, G_P), = kinematics
+        nm = self.blade.n_modes
+        n = nm + 6
+        phi = np.vstack([self.blade.shape("OL"), self.blade.shape("OR")])  # (12, nm)
+        dphi = self.interblade_phase
+        w_rows, left_rows, right_rows = contact_rows(n_local // 2, nm)
+
+        def sector_map(h):
+            phase = np.ones(12, dtype=complex)
+            phase[6:] = np.exp(1j * h * dphi)          # Eq. 24: the OR platform is the next blade's
+            out = np.zeros((n_local, n), dtype=complex)
+            out[w_rows, :nm] = -G_P @ (phase[:, None] * phi)
+            out[w_rows, nm:] = G_D
+            if flexible:                               # the platforms' modal coordinates:
+                out[left_rows, :nm] = np.eye(nm)       # OL on this blade, OR on the next
+                out[right_rows, :nm] = phase[-1] * np.eye(nm)
+            return out
+
+        return basis.real_form(sector_map)
 
     def _centrifugal_law(self):
         """:meth:`DamperPosition.centrifugal_law` of the damper."""

@@ -647,7 +647,8 @@ class AssemblyContacts:
           F - J_t c_t, zero on the normal rows;
         * ``"approach"``: in the static approach's scale (every point's offset times 1 + epsilon):
           the forces are homogeneous in (u_t, (u_zeta, offset)^(1/p)) of degree 1 for a law of
-          degree p (linear: p = 1), so offset dF/doffset = p (F - J_t c_t) - J_zeta c_zeta.
+          degree p (linear: p = 1), so offset dF/doffset = p (F - J_t c_t) - J_zeta c_zeta;
+          ``"approach_left"``, ``"approach_right"``: the same of the OL patch's points alone, of the OR's.
 
         Raises ValueError for dampers whose patches do not stack (:meth:`stacked_points`) or a
         normal law of another kind than LinearNormalLaw and RoughnessNormalLaw."""
@@ -672,9 +673,14 @@ class AssemblyContacts:
         friction = scale.copy()
         friction[..., 2] = 0.0
         degree = getattr(law, "exponent", 1.0)
+        approach = degree * scale - j_z
+        by_patch = approach.reshape(nd, 2, -1, *approach.shape[1:])
+        left, right = (np.zeros_like(by_patch) for _ in range(2))
+        left[:, 0], right[:, 1] = by_patch[:, 0], by_patch[:, 1]
         out = {}
-        for name, samples in (("tangential", j_t), ("law", scale), ("friction", friction),
-                              ("approach", degree * scale - j_z)):
+        for name, samples in (("tangential", j_t), ("law", scale), ("friction", friction), ("approach", approach),
+                              ("approach_left", left.reshape(approach.shape)),
+                              ("approach_right", right.reshape(approach.shape))):
             f_points = basis.to_coeffs(np.moveaxis(samples, 1, 0)).reshape(C, nd, 2, -1, 3)
             f = np.ascontiguousarray(np.einsum("cdqpi,dqpij->cdqj", f_points, B).reshape(C, nd, L))
             out[name] = (f if R is None else _rotated(R, f, True)).reshape(C, self.n_local)
@@ -975,7 +981,13 @@ SENSITIVITY_KEYS = {
     "blade.damping_ratio": "-",
     "blade.damping_ratio[j]": "-",
     "mistuning.kappa[k]": "-",
+    "disk.gamma_left_deg": "deg",
+    "disk.gamma_right_deg": "deg",
+    "damper.cylinder_radius_mm": "mm",
 }
+#: the geometry's keys: (the damper's geometry_derivative parameter, its SI unit per key unit)
+GEOMETRY_KEYS = {"disk.gamma_left_deg": ("gamma_left", np.pi / 180), "disk.gamma_right_deg": ("gamma_right", np.pi / 180),
+                 "damper.cylinder_radius_mm": ("radius", 1e-3)}
 
 
 def parameter_unit(key: str) -> str:
@@ -997,7 +1009,8 @@ def resolve_parameter_key(name: str) -> str:
     matches = list(dict.fromkeys(matches))
     if len(matches) != 1:
         raise ValueError(f"parameter {name!r}: {'ambiguous' if matches else 'unknown or not differentiable'}; the "
-                         f"keys with derivatives are {', '.join(SENSITIVITY_KEYS)} (the geometry's are not yet)")
+                         f"keys with derivatives are {', '.join(SENSITIVITY_KEYS)} (the wedge's geometry and the contact length are "
+                         "not yet)")
     key = matches[0] + bracket + rest
     parse_parameter_key(key)
     return key
@@ -1016,7 +1029,7 @@ def parse_parameter_key(key: str) -> tuple[str, int | None]:
     known = {k.split("[")[0] for k in SENSITIVITY_KEYS}
     if name not in known:
         raise ValueError(f"parameter {key!r}: unknown or not differentiable; the keys with derivatives are "
-                         f"{', '.join(SENSITIVITY_KEYS)} (the geometry's are not yet)")
+                         f"{', '.join(SENSITIVITY_KEYS)} (the wedge's geometry and the contact length are not yet)")
     return name, index
 
 
@@ -1030,11 +1043,14 @@ class ParameterEffect:
     contact : {direction: d ln q / dp}, the contacts' logarithmic derivatives
         (:meth:`AssemblyContacts.parameter_forces`) each weighted by the relative change of its
         quantity q per unit of p
+    coupling : dT/dp, the derivative of the contacts' real-form map T (its shape), or None: the
+        residual's T^T F(T x) changes by dT^T F + T^T J (dT x)
     """
 
     matrices: dict = field(default_factory=dict)
     excitation: object = None
     contact: dict = field(default_factory=dict)
+    coupling: object = None
 
 
 class DiskModel:
@@ -1197,13 +1213,22 @@ class DiskModel:
         element = None if coupling is None else getattr(coupling.element, "element", coupling.element)
         needs_contacts = any(e.contact for e in effects)
 
+        needs_forces = any(e.coupling is not None for e in effects)
+
         def dR_dp(x, omega):
             out = np.zeros((len(effects), system.n_unknowns))
-            directions = None
-            if needs_contacts and coupling is not None:
+            directions = forces = None
+            if (needs_contacts or needs_forces) and coupling is not None:
                 local = (coupling.matrix @ x).reshape(basis.n_coeffs, element.n_local)
-                directions = element.parameter_forces(local, basis, omega)
+                if needs_contacts:
+                    directions = element.parameter_forces(local, basis, omega)
+                if needs_forces:
+                    force, jac, _ = coupling.element.harmonic_forces(local, basis, omega, True)
+                    forces = force.ravel(), jac
             for row, e in zip(out, effects):
+                if e.coupling is not None and forces is not None:
+                    row += e.coupling.T @ forces[0]
+                    coupling.add_forces(row, forces[1] @ (e.coupling @ x))
                 if e.matrices:
                     row += linear_forces(basis, x, omega, **e.matrices)
                 if e.excitation is not None:
@@ -1274,8 +1299,10 @@ class DiskModel:
                 f[basis.cos_index(0)] = 0.0                 # the centrifugal preload is not the excitation's
             f = f.ravel()
             return ParameterEffect(excitation=lambda omega: f)
+        if name in GEOMETRY_KEYS:
+            return self.geometry_effect(system, key, name, positions)
         need(name in SENSITIVITY_KEYS, f"unknown or not differentiable; the keys with derivatives are "
-                                       f"{', '.join(SENSITIVITY_KEYS)} (the geometry's are not yet)")
+                                       f"{', '.join(SENSITIVITY_KEYS)} (the wedge's geometry and the contact length are not yet)")
         need(damper is not None, "the model has no damper")
         need(len({id(p.damper) for p in positions}) == 1, "the dampers differ from position to position")
         static = basis.has_static
@@ -1333,6 +1360,49 @@ class DiskModel:
             effect.contact["approach"] = -(1 - degree) / (degree * load)
         return effect
 
+    def geometry_effect(self, system: HarmonicBalanceSystem, key: str, name: str, positions) -> "ParameterEffect":
+        """The :class:`ParameterEffect` of a geometry key (:data:`GEOMETRY_KEYS`) on ``system``: the
+        contacts' map T through the rigid kinematics G_D, G_P (their frames, the contact centres and
+        the platform offsets, :meth:`~bladedamp.damper.geometry.CylinderDamper.geometry_derivative`),
+        the damper's inertia, and without a static harmonic the seating's approach of each patch
+        (its frictionless load, :meth:`~bladedamp.damper.geometry.DamperGeometry.normal_load_log_derivatives`)."""
+        basis = system.basis
+        damper = positions[0].damper if positions else None
+        if damper is None or getattr(damper, "kind", None) != "cylinder":
+            raise ValueError(f"parameter {key!r}: the geometry's derivatives are those of a cylinder damper "
+                             "(a wedge's are not yet)")
+        if any(p.initial_gaps is not None and np.any(p.initial_gaps) for p in positions):
+            raise ValueError(f"parameter {key!r}: not with initial gaps (a misfit's seating is not differentiated)")
+        if any(b.flexible_platform for b in self.model_blades):
+            raise ValueError(f"parameter {key!r}: not with flexible platforms (their point maps follow the geometry)")
+        parameter, unit = GEOMETRY_KEYS[name]
+        kinematics, d_inertia = [], None
+        blade = self.model_blades[0]
+        zero_points = {"OL": np.zeros(3), "OR": np.zeros(3)}
+        for position in positions:
+            geometry = position.damper_geometry()
+            d_frames, d_centres, d_inertia = position.damper.geometry_derivative(position.gamma_left,
+                                                                                 position.gamma_right, parameter)
+            offsets = position.platform_offsets(geometry, blade.points)
+            # the offsets are affine in the centres: their derivative is the map of the centres' alone
+            d_offsets = position.platform_offsets(dataclasses.replace(geometry, centres=d_centres), zero_points)
+            kinematics.append((unit * geometry.G_D_derivative(d_frames, d_centres),
+                               unit * geometry.G_P_derivative(offsets, d_frames, d_offsets)))
+        coupling = next(c for c in system.couplings if isinstance(c.element, (DamperContacts, AssemblyContacts)))
+        n_local = coupling.matrix.shape[0] // basis.n_coeffs // len(positions)
+        effect = ParameterEffect(coupling=self.contact_coupling(basis, kinematics, n_local, False))
+        if self.damper_inertia and np.any(d_inertia):
+            dm = sp.lil_matrix((system.n_dof, system.n_dof))
+            for d in range(len(positions)):
+                sl = self.damper_unknowns(d)
+                dm[sl, sl] = unit * d_inertia
+            effect.matrices["mass"] = dm.tocsr()
+        if not basis.has_static:
+            degree = damper.contact.roughness_exponent
+            loads = unit * positions[0].damper_geometry().normal_load_log_derivatives(parameter) / degree
+            effect.contact = {"approach_left": loads[0], "approach_right": loads[1]}
+        return effect
+
     def parameter_value(self, key: str) -> float:
         """The value of the design-file ``key`` (:meth:`parameter_derivatives`) in this model, in
         the key's unit (g, mm, rpm, Hz, N, -)."""
@@ -1348,6 +1418,8 @@ class DiskModel:
             return float(self.excitation[index])
         if name == "disk.damper_radius_mm":
             return 1e3 * self.damper_radius
+        if name in ("disk.gamma_left_deg", "disk.gamma_right_deg"):
+            return float(np.degrees(getattr(self.position_of(0), name[5:-4])))
         if name == "disk.rotor_speed_rpm":
             return float("nan") if self.rotor_speed_hz is None else 60.0 * self.rotor_speed_hz
         positions = [self.position_of(k) for k in self.active_positions]
@@ -1356,6 +1428,8 @@ class DiskModel:
         damper = positions[0].damper
         if name == "damper.mass_g":
             return 1e3 * damper.mass
+        if name == "damper.cylinder_radius_mm":
+            return 1e3 * damper.radius if hasattr(damper, "radius") else float("nan")
         return float(getattr(damper.contact, {"damper.friction_coefficient": "friction_coefficient",
                                               "damper.tangential_stiffness_per_length_n_per_m2":
                                                   "tangential_stiffness_per_length",
@@ -1382,6 +1456,10 @@ class DiskModel:
                 out = out.with_dampers(lambda d: dataclasses.replace(d, mass=1e-3 * value))
             elif name == "disk.damper_radius_mm":
                 out = dataclasses.replace(out, damper_radius=1e-3 * value)
+            elif name in ("disk.gamma_left_deg", "disk.gamma_right_deg"):
+                out = dataclasses.replace(out, **{name[5:-4]: float(np.radians(value))})
+            elif name == "damper.cylinder_radius_mm":
+                out = out.with_dampers(lambda d: dataclasses.replace(d, radius=1e-3 * value))
             elif name == "disk.rotor_speed_rpm":
                 out = dataclasses.replace(out, rotor_speed_hz=value / 60.0)
             elif name == "disk.excitation_n_nm":

@@ -676,32 +676,13 @@ class MistunedDisk(DiskModel):
             if static is not None:
                 static[sl, sl] = DamperPosition.retention(g, static_retention)
         dphi = self.interblade_phase
-
         L = contacts[0].n_local if contacts else 12           # local coordinates per damper
-        w_rows, left_rows, right_rows = contact_rows(L // 2, nm)
-
-        def contact_map(h):
-            T = sp.lil_matrix((L * len(active), N), dtype=complex)
-            for d, k in enumerate(active):
-                G_D, G_P = maps[d]
-                nxt = (k + 1) % s
-                phase = np.exp(1j * h * s * dphi) if k + 1 == s else 1.0   # next sector's blade 0
-                rows = L * d + w_rows if L != 12 else slice(12 * d, 12 * d + 12)
-                T[rows, self.blade_slice(k)] = -G_P[:, :6] @ self.blades[k].shape("OL")
-                T[rows, self.blade_slice(nxt)] = T[rows, self.blade_slice(nxt)].toarray() \
-                    - phase * (G_P[:, 6:] @ self.blades[nxt].shape("OR"))
-                T[rows, self.damper_slice(d)] = G_D
-                if L != 12:                  # flexible platforms: the modal coordinates of both blades
-                    T[L * d + left_rows, self.blade_slice(k)] = np.eye(nm)
-                    T[L * d + right_rows, self.blade_slice(nxt)] = phase * np.eye(nm)
-            return T.tocsr()
-
         couplings = []
         if active:
             # each damper sampled on its own grid, shifted by its travelling-wave phase (exact tuned = cyclic at any T)
             grid_phase = np.array([k * dphi for k in active]) if dphi else None
-            couplings.append(Coupling(AssemblyContacts(contacts, grid_phase=grid_phase), sparse_real_form(basis, contact_map),
-                                      "damper contacts"))
+            couplings.append(Coupling(AssemblyContacts(contacts, grid_phase=grid_phase),
+                                      self.contact_coupling(basis, maps, L, L != 12), "damper contacts"))
         j1 = basis.cos_index(1)
         f1 = np.zeros((C, N))
         for k, f in enumerate(forces):
@@ -736,6 +717,35 @@ class MistunedDisk(DiskModel):
         if system.uses_ring() and system.n_unknowns > system.ring_dense_limit:
             system.dense = False
         return system
+
+    def contact_coupling(self, basis: HarmonicBasis, kinematics, n_local: int, flexible: bool) -> sp.csr_matrix:
+        """The real-form map (C n_local n_d, C N) from the ring's unknowns to every damper's local
+        coordinates (Eq. 6 with Eq. 16-20): damper d (on blade k) sees blade k's OL platform and
+        blade k+1's OR platform (the next sector's blade 0 turned by its phase) through its rigid
+        kinematics ``kinematics[d]`` = (G_D (12, 6), G_P (12, 12)), and with ``flexible`` platforms
+        both blades' modal coordinates. Linear in the kinematics: with their derivatives and
+        ``flexible`` False it is the map's derivative."""
+        nm, s, N = self.n_modes, self.n_sector, self.n_dof
+        active, dphi, L = self.active_dampers, self.interblade_phase, n_local
+        w_rows, left_rows, right_rows = contact_rows(L // 2, nm)
+
+        def contact_map(h):
+            T = sp.lil_matrix((L * len(active), N), dtype=complex)
+            for d, k in enumerate(active):
+                G_D, G_P = kinematics[d]
+                nxt = (k + 1) % s
+                phase = np.exp(1j * h * s * dphi) if k + 1 == s else 1.0   # next sector's blade 0
+                rows = L * d + w_rows if L != 12 else slice(12 * d, 12 * d + 12)
+                T[rows, self.blade_slice(k)] = -G_P[:, :6] @ self.blades[k].shape("OL")
+                T[rows, self.blade_slice(nxt)] = T[rows, self.blade_slice(nxt)].toarray() \
+                    - phase * (G_P[:, 6:] @ self.blades[nxt].shape("OR"))
+                T[rows, self.damper_slice(d)] = G_D
+                if flexible:                 # flexible platforms: the modal coordinates of both blades
+                    T[L * d + left_rows, self.blade_slice(k)] = np.eye(nm)
+                    T[L * d + right_rows, self.blade_slice(nxt)] = phase * np.eye(nm)
+            return T.tocsr()
+
+        return sparse_real_form(basis, contact_map)
 
     def frequency_response(self, f_start_hz: float, f_end_hz: float, harmonics="auto", n_samples=None,
                            max_step: float = DEFAULT_MAX_STEP, tuned_peak_amplitude: float | None = None,

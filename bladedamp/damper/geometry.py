@@ -47,6 +47,30 @@ def rigid_map(rotation: np.ndarray, offset: np.ndarray) -> np.ndarray:
     return G
 
 
+def rigid_map_derivative(rotation: np.ndarray, offset: np.ndarray, d_rotation: np.ndarray,
+                         d_offset: np.ndarray) -> np.ndarray:
+    """The derivative (6, 6) of :func:`rigid_map` (``rotation``, ``offset``) along (``d_rotation``,
+    ``d_offset``): [[dR, -dR [r]x - R [dr]x], [0, dR]] (the map is bilinear)."""
+    G = np.zeros((6, 6))
+    G[:3, :3] = d_rotation
+    G[:3, 3:] = -d_rotation @ skew(offset) - rotation @ skew(d_offset)
+    G[3:, 3:] = d_rotation
+    return G
+
+
+def contact_normal_derivative(side: str, gamma: float) -> np.ndarray:
+    """d :func:`contact_normal` / d gamma [1/rad]."""
+    s, c = np.sin(gamma), np.cos(gamma)
+    return np.array([-c, 0.0, s]) if side == "OL" else np.array([c, 0.0, s])
+
+
+def contact_frame_derivative(d_normal: np.ndarray) -> np.ndarray:
+    """The derivative of :func:`contact_frame` along ``d_normal`` (its rows xi = eta x zeta and
+    zeta are linear in the normal, eta is fixed)."""
+    eta = np.array([0.0, 1.0, 0.0])
+    return np.array([np.cross(eta, d_normal), np.zeros(3), d_normal])
+
+
 def contact_normal(side: str, gamma: float) -> np.ndarray:
     """Unit normal from the platform into the damper (blade frame) for platform angle gamma [rad]."""
     s, c = np.sin(gamma), np.cos(gamma)
@@ -162,6 +186,33 @@ class DamperGeometry:
         for c, (R, dr) in enumerate(zip(self.frames, platform_offsets)):
             G[6 * c:6 * c + 6, 6 * c:6 * c + 6] = rigid_map(R, np.asarray(dr, dtype=float))
         return G
+
+    def G_D_derivative(self, d_frames: np.ndarray, d_centres: np.ndarray) -> np.ndarray:
+        """(12, 6) the derivative of :attr:`G_D` along frames and centres changing by ``d_frames``
+        (2, 3, 3) and ``d_centres`` (2, 3) per unit of a parameter."""
+        return np.vstack([rigid_map_derivative(R, r, dR, dr)
+                          for R, r, dR, dr in zip(self.frames, self.centres, d_frames, d_centres)])
+
+    def G_P_derivative(self, platform_offsets, d_frames: np.ndarray, d_offsets) -> np.ndarray:
+        """(12, 12) the derivative of :meth:`G_P` (``platform_offsets`` (2, 3)) along the frames'
+        and the offsets' changes ``d_frames`` (2, 3, 3), ``d_offsets`` (2, 3) per unit of a parameter."""
+        G = np.zeros((12, 12))
+        for c, (R, r, dR, dr) in enumerate(zip(self.frames, platform_offsets, d_frames, d_offsets)):
+            G[6 * c:6 * c + 6, 6 * c:6 * c + 6] = rigid_map_derivative(R, np.asarray(r, dtype=float), dR,
+                                                                       np.asarray(dr, dtype=float))
+        return G
+
+    def normal_load_log_derivatives(self, parameter: str) -> np.ndarray:
+        """(d ln N_OL, d ln N_OR) / d ``parameter`` [1/rad] of :meth:`frictionless_normal_loads`:
+        "gamma_left" or "gamma_right" (zeros for any other parameter: the loads depend on the
+        angles only)."""
+        gl, gr = self.gamma_left, self.gamma_right
+        cot = 1 / np.tan(gl + gr)
+        if parameter == "gamma_left":
+            return np.array([-cot, 1 / np.tan(gl) - cot])
+        if parameter == "gamma_right":
+            return np.array([1 / np.tan(gr) - cot, -cot])
+        return np.zeros(2)
 
     def frictionless_normal_loads(self, radial_force: float) -> np.ndarray:
         """Normal loads (N_OL, N_OR) [N] balancing a radial force on the damper, rigid platforms.
@@ -283,6 +334,24 @@ class CylinderDamper:
         angle = np.linspace(0, 2 * np.pi, 49)[:-1]
         section = self.radius * np.column_stack([np.cos(angle), np.sin(angle)])
         return DamperGeometry(frames, centres, patches, M, section, gamma_left, gamma_right)
+
+    def geometry_derivative(self, gamma_left: float, gamma_right: float, parameter: str):
+        """(d frames (2, 3, 3), d centres (2, 3) [m], d inertia (6, 6)) of :meth:`geometry` per unit
+        of ``parameter``: "gamma_left" or "gamma_right" [per rad], "radius" [per m]. The contact
+        patches do not depend on them."""
+        normals = [contact_normal("OL", gamma_left), contact_normal("OR", gamma_right)]
+        d_frames, d_centres, d_inertia = np.zeros((2, 3, 3)), np.zeros((2, 3)), np.zeros((6, 6))
+        if parameter in ("gamma_left", "gamma_right"):
+            c = 0 if parameter == "gamma_left" else 1
+            dn = contact_normal_derivative(CONTACTS[c], (gamma_left, gamma_right)[c])
+            d_frames[c] = contact_frame_derivative(dn)
+            d_centres[c] = -self.radius * dn
+        elif parameter == "radius":
+            d_centres = -np.array(normals)
+            d_inertia[3:, 3:] = np.diag([self.mass * self.radius / 2, self.mass * self.radius, self.mass * self.radius / 2])
+        else:
+            raise ValueError(f"a cylinder's geometry has no derivative in {parameter!r} (gamma_left, gamma_right, radius)")
+        return d_frames, d_centres, d_inertia
 
 
 @dataclass
