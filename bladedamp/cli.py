@@ -344,6 +344,8 @@ def optimize_command(args) -> int:
     for h in args.contact_height_mm or ():
         if not 0 < h <= 100:
             raise UsageError(f"--contact-height-mm {h:g}: must be in (0, 100] mm")
+    if args.parameters:
+        return optimize_parameters(args, design, disk, t0)
     out = output_dir(output_folder(args), args.overwrite)
     progress = Progress()
     progress.compiling()
@@ -437,6 +439,44 @@ def fit_command(args) -> int:
     print(fit.table())
     return _done(out, t0, f"fit {'converged' if fit.success else 'not converged'}, relative residual rms "
                           f"{fit.residual_rms:.3g}")
+
+
+def optimize_parameters(args, design, disk, t0) -> int:
+    """``bladedamp optimize --parameters``: the lowest peak over several parameters together, by
+    L-BFGS-B with the analytic gradient (:func:`bladedamp.studies.gradient.optimal_design`)."""
+    from .report import gradient_optimize_outputs
+    from .studies.gradient import default_bounds, optimal_design
+
+    if args.gamma_right_deg or args.contact_height_mm:
+        raise UsageError("--parameters optimises the keys together: give gamma_right_deg as one of them instead of "
+                         "--gamma-right-deg / --contact-height-mm")
+    keys = _parameter_keys(args, disk)
+    a = design.analysis
+    mass_g = tuple(1e3 * m for m in a.mass_bounds)
+    bounds = {k: default_bounds(disk, k, mass_g) for k in keys}
+    for key, low, high in args.bound or ():
+        try:
+            from .diskmodel import resolve_parameter_key
+
+            full = resolve_parameter_key(key)
+            low, high = float(low), float(high)
+        except ValueError as exc:
+            raise UsageError(f"--bound {key} {low} {high}: {exc}") from None
+        if full not in bounds:
+            raise UsageError(f"--bound {key}: not one of --parameters ({', '.join(keys)})")
+        if not (math.isfinite(low) and math.isfinite(high) and low < high):
+            raise UsageError(f"--bound {key} {low:g} {high:g}: must be finite with LOW < HIGH")
+        bounds[full] = (low, high)
+    out = output_dir(output_folder(args), args.overwrite)
+    progress = Progress()
+    progress.compiling()
+    progress(f"lowest peak over {', '.join(keys)} (L-BFGS-B, analytic gradient, {args.starts} starts)")
+    optimum = optimal_design(disk, keys, [bounds[k] for k in keys], a.f_range_hz, harmonics=a.study_harmonics,
+                             n_starts=args.starts)
+    gradient_optimize_outputs(out, design, optimum, a.study_harmonics)
+    print(optimum.table())
+    return _done(out, t0, f"peak {1e3 * optimum.peak_amplitude:.4f} mm at the optimum "
+                          f"({100 * optimum.reduction:.1f} % below the design's), {optimum.n_responses} frequency responses")
 
 
 def engine_orders(args, design) -> tuple:
@@ -845,6 +885,15 @@ def build_parser() -> argparse.ArgumentParser:
     def design_arg(p):
         p.add_argument("design", type=Path, help="the design file (TOML; write one with: bladedamp init design.toml)")
 
+    def parameters_arg(p, default=None):
+        p.add_argument("--parameters", nargs="+", metavar="KEY", required=default is None, default=default,
+                       help="design-file keys, whole (damper.mass_g) or their last part (mass_g); an entry of a list as\n"
+                            "natural_frequencies_hz[0]. With derivatives: mass_g, friction_coefficient,\n"
+                            "tangential_stiffness_per_length_n_per_m2, normal_to_tangential_stiffness,\n"
+                            "roughness_reference_load_n, damper_radius_mm, rotor_speed_rpm (fixed speed),\n"
+                            "excitation_n_nm[i], natural_frequencies_hz[j], damping_ratio (or [j]), and a cylinder's\n"
+                            "gamma_left_deg, gamma_right_deg, cylinder_radius_mm")
+
     def out_arg(p, default):
         p.add_argument("--out", type=Path, default=None,
                        help=f"output folder, created if needed and checked before computing; one that holds files\n"
@@ -897,24 +946,24 @@ def build_parser() -> argparse.ArgumentParser:
     p = command("optimize", optimize_command, "optimal damper mass of a design",
                 "The damper mass of the lowest resonance amplitude in [analysis] mass_range_g (global on a log\n"
                 "grid, then a bounded search), optionally re-optimised at several right platform angles or wedge\n"
-                "contact heights. Peak searches use [analysis] harmonics, or the paper's [1] where it is 'auto'.\n"
+                "contact heights; or, with --parameters, the lowest peak over several keys together by L-BFGS-B\n"
+                "with the analytic gradient, from several starts. Peak searches use [analysis] harmonics, or the\n"
+                "paper's [1] where it is 'auto'.\n"
                 "Writes optimize.png, results.json, summary.md and the results' npz files.")
     design_arg(p)
     p.add_argument("--gamma-right-deg", type=float, nargs="+", metavar="DEG",
                    help="also optimise the mass at each of these right platform angles [deg], in (0, 90)")
     p.add_argument("--contact-height-mm", type=float, nargs="+", metavar="MM",
                    help="also optimise the mass at each of these wedge contact heights [mm], in (0, 100]")
+    parameters_arg(p, [])
+    p.add_argument("--bound", nargs=3, action="append", metavar=("KEY", "LOW", "HIGH"),
+                   help="with --parameters: the search range of one of them (default: mass_range_g for mass_g,\n"
+                        "15-65 deg for the platform angles, 0.5-5 mm for cylinder_radius_mm, else -50 %%..+100 %%)")
+    p.add_argument("--starts", type=int, default=3,
+                   help="with --parameters: starting points (the design, then Sobol points in the box; default 3)")
     processes_arg(p)
     out_arg(p, "results/<design file name>/optimize")
     figure_args(p)
-
-    def parameters_arg(p, default=None):
-        p.add_argument("--parameters", nargs="+", metavar="KEY", required=default is None, default=default,
-                       help="design-file keys, whole (damper.mass_g) or their last part (mass_g); an entry of a list as\n"
-                            "natural_frequencies_hz[0]. With derivatives: mass_g, friction_coefficient,\n"
-                            "tangential_stiffness_per_length_n_per_m2, normal_to_tangential_stiffness,\n"
-                            "roughness_reference_load_n, damper_radius_mm, rotor_speed_rpm (fixed speed),\n"
-                            "excitation_n_nm[i], natural_frequencies_hz[j], damping_ratio (or [j])")
 
     p = command("sensitivities", sensitivities_command, "derivatives of the resonance peak in design parameters",
                 "The frequency response over [analysis] frequency_range_hz, its peak solved by d|u|/dOmega = 0 and\n"

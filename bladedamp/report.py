@@ -1227,3 +1227,49 @@ def fit_outputs(out: Path, design, fit, sources) -> dict:
     lines.append("")
     write_summary(out, "fit", design, lines, files)
     return summary
+
+
+def gradient_optimize_outputs(out: Path, design, optimum, harmonics) -> dict:
+    """optimize.png (the design's and the optimum's frequency responses), design_optimum.npz,
+    results.json, summary.md of ``bladedamp optimize --parameters`` (a
+    :class:`~bladedamp.studies.gradient.DesignOptimum`; ``harmonics`` those of its responses)."""
+    import matplotlib.pyplot as plt
+
+    a = design.analysis
+    disk = design.disk
+    best = disk.with_parameters(dict(zip(optimum.parameters, optimum.optimum)))
+    fig, ax = plt.subplots(figsize=(7.5, 4.6), constrained_layout=True)
+    for model, label, style in ((disk, "design", "--"), (best, "optimum", "-")):
+        response = model.frequency_response(*a.f_range_hz, harmonics=harmonics)
+        ax.plot(response.frequency_hz, 1e3 * _tip_x(response), style, label=f"{label}: peak "
+                f"{1e3 * response.peak_amplitude:.4f} mm", color=palette.DAMPER.get(disk.damper.kind))
+    ax.set(xlabel="excitation frequency [Hz]", ylabel="tip amplitude u_x [mm]",
+           title=design_title(design, "lowest peak over " + ", ".join(k.split(".")[-1] for k in optimum.parameters)))
+    ax.grid(True, alpha=0.3)
+    place_legend(ax, fontsize=8)
+    files = save_figure(fig, out / "optimize.png")
+    saved = save_result(optimum, out / "design_optimum")
+    files += [saved] if saved else []
+    rows = [{"parameter": k, "unit": u, "design": v0, "optimum": v, "bounds": list(b), "on_bound": bool(ab),
+             "d_peak_amplitude_mm_per_unit": 1e3 * d}
+            for k, u, v0, v, b, ab, d in zip(optimum.parameters, optimum.units, optimum.initial, optimum.optimum,
+                                             optimum.bounds, optimum.at_bound, optimum.d_peak_amplitude)]
+    summary = {"design": design.path, "parameters": rows, "peak_amplitude_mm": 1e3 * optimum.peak_amplitude,
+               "peak_frequency_hz": optimum.peak_frequency_hz,
+               "design_peak_amplitude_mm": 1e3 * optimum.initial_peak_amplitude,
+               "reduction_from_design_pct": 100 * optimum.reduction, "frequency_responses": optimum.n_responses,
+               "converged": optimum.success, "message": optimum.message}
+    write_json(out / "results.json", summary)
+    files.append("results.json")
+    lines = ["## The lowest peak over several parameters", "",
+             f"L-BFGS-B with the analytic gradient from {len(optimum.starts)} starts ({optimum.message}); "
+             f"{optimum.n_responses} frequency responses. Peak u_x {_mm(optimum.peak_amplitude)} at "
+             f"{optimum.peak_frequency_hz:.3f} Hz against {_mm(optimum.initial_peak_amplitude)} of the design "
+             f"({fmt_percent(optimum.reduction)} lower).", "",
+             "| parameter | design | optimum | bounds | d peak / dp there [mm per unit] |", "|---|---|---|---|---|"]
+    lines += [f"| `{r['parameter']}` | {r['design']:.5g} | {r['optimum']:.5g}{' (on a bound)' if r['on_bound'] else ''} | "
+              f"[{r['bounds'][0]:.4g}, {r['bounds'][1]:.4g}] {r['unit']} | {r['d_peak_amplitude_mm_per_unit']:.3g} |"
+              for r in rows]
+    lines.append("")
+    write_summary(out, "optimize", design, lines, files, analysis_line(design, studies=True))
+    return summary
