@@ -667,7 +667,7 @@ class AssemblyContacts:
         coeffs = np.einsum("dqpij,cdqj->cdqpi", B, local.reshape(C, nd, 2, m)).reshape(C, -1, 3)
         pts = point_contact_forces(coeffs, basis, k_t, mu, law, weights, np.ravel(offsets), jacobian=True)
         jac = pts.jacobian.reshape(pts.jacobian.shape[:3] + (3, C))            # (P', T, 3, direction, C)
-        along = np.einsum("ptidc,cpd->ptid", jac, coeffs)                    # J_direction c_direction
+        along = (jac * np.moveaxis(coeffs, 0, -1)[:, None, None]).sum(axis=-1)   # J_direction c_direction
         force, j_t, j_z = pts.force, along[..., 0] + along[..., 1], along[..., 2]
         scale = force - j_t
         friction = scale.copy()
@@ -677,12 +677,18 @@ class AssemblyContacts:
         by_patch = approach.reshape(nd, 2, -1, *approach.shape[1:])
         left, right = (np.zeros_like(by_patch) for _ in range(2))
         left[:, 0], right[:, 1] = by_patch[:, 0], by_patch[:, 1]
+        names = ("tangential", "law", "friction", "approach", "approach_left", "approach_right")
+        samples = np.stack([j_t, scale, friction, approach, left.reshape(approach.shape),
+                            right.reshape(approach.shape)])                            # (6, P', T, 3)
+        # every direction at once: the analysis (T -> C), then the points' maps back to the dampers
+        n, P = len(names), B.shape[2]
+        f_points = (basis.analysis @ np.moveaxis(samples, 2, 0).reshape(samples.shape[2], -1)).reshape(C, n, nd, 2, P * 3)
+        by_contact = np.moveaxis(f_points, (2, 3), (0, 1)).reshape(nd * 2, C * n, P * 3)
+        forces = (by_contact @ B.reshape(nd * 2, P * 3, m)).reshape(nd, 2, C, n, m)
+        forces = np.moveaxis(forces, (3, 2), (0, 1)).reshape(n, C, nd, L)
         out = {}
-        for name, samples in (("tangential", j_t), ("law", scale), ("friction", friction), ("approach", approach),
-                              ("approach_left", left.reshape(approach.shape)),
-                              ("approach_right", right.reshape(approach.shape))):
-            f_points = basis.to_coeffs(np.moveaxis(samples, 1, 0)).reshape(C, nd, 2, -1, 3)
-            f = np.ascontiguousarray(np.einsum("cdqpi,dqpij->cdqj", f_points, B).reshape(C, nd, L))
+        for name, f in zip(names, forces):
+            f = np.ascontiguousarray(f)
             out[name] = (f if R is None else _rotated(R, f, True)).reshape(C, self.n_local)
         return out
 

@@ -108,17 +108,19 @@ def peak_sensitivities(system, x: np.ndarray, omega: float, output: np.ndarray, 
     a = abs(complex(output @ x))
 
     def side(w):
-        """(|u|, slope g, da/dp (k,)) at the converged point at ``w`` [rad/s], or None."""
+        """[|u|, slope g, (x, solve, w) for da/dp] at the converged point at ``w`` [rad/s], or None."""
         r = newton(system.residual, x + tangent * (w - omega), w, x_scale, residual_scale, tol=tol,
                    factorize=system.factorize)
         if not r.converged:
             return None
         amplitude, (slope,) = output_sensitivities(output, r.x, -r.solve(r.dR_domega))
-        return amplitude, slope, output_sensitivities(output, r.x, state_sensitivities(
-            system, r.x, w, dR_dp(r.x, w), r.solve))[1]
+        return [amplitude, slope, (r.x, r.solve, w)]
 
     def derivatives(left, right, spacing):
-        (_, g_minus, s_minus), (_, g_plus, s_plus) = left, right
+        """The peak's derivatives from the two sides (their da/dp evaluated here, only for the pair used)."""
+        (_, g_minus, (x_m, solve_m, w_m)), (_, g_plus, (x_p, solve_p, w_p)) = left, right
+        s_minus = output_sensitivities(output, x_m, state_sensitivities(system, x_m, w_m, dR_dp(x_m, w_m), solve_m))[1]
+        s_plus = output_sensitivities(output, x_p, state_sensitivities(system, x_p, w_p, dR_dp(x_p, w_p), solve_p))[1]
         d_omega = (s_plus - s_minus) / (g_minus - g_plus)
         d_amplitude = 0.5 * (s_minus + g_minus * d_omega + s_plus + g_plus * d_omega)
         return PeakSensitivity(a, omega, x, d_amplitude, d_omega, (g_minus, g_plus), spacing)
