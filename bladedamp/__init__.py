@@ -115,15 +115,19 @@ def peak_sensitivities(model, f_range_hz, parameters, direction: int = 0, **opti
     and differentiated by the implicit function theorem with the analytic dR/dp
     (:meth:`bladedamp.diskmodel.DiskModelResponse.peak_sensitivities`). Returns a
     :class:`~bladedamp.response.PeakSensitivities`: ``result["damper.mass_g"].peak_amplitude`` [m per
-    g], ``.peak_frequency_hz`` [Hz per g]. A TunedDisk or MistunedDisk (TypeError otherwise);
+    g], ``.peak_frequency_hz`` [Hz per g]. A TunedDisk or MistunedDisk, or a FrictionOscillator (its
+    fields as keys, per SI unit: :attr:`FrictionOscillator.PARAMETERS`; TypeError for anything else);
     ValueError for an unknown key, a range without a solvable peak, or a response that is not a
     success (its status message says why)."""
     from .diskmodel import DiskModel
+    from .oscillator import FrictionOscillator
 
-    if not isinstance(model, DiskModel):
-        raise TypeError(f"model must be a TunedDisk or MistunedDisk (got {type(model).__qualname__})")
+    if not isinstance(model, (DiskModel, FrictionOscillator)):
+        raise TypeError(f"model must be a TunedDisk, MistunedDisk or FrictionOscillator (got {type(model).__qualname__})")
     response = frequency_response(model, f_range_hz, **options)
     if not response.success:
         raise ValueError(f"the frequency response is not a success, so its peak is not differentiated: "
                          f"{response.status_message}")
+    if isinstance(model, FrictionOscillator):
+        return model.peak_sensitivities(response, parameters)
     return response.peak_sensitivities(parameters, direction)

@@ -55,11 +55,10 @@ from .hbm.start import robust_start
 from .hbm.fourier import HarmonicBasis
 from .hbm.monodromy import disk_monodromy
 from .hbm.system import Coupling, HarmonicBalanceSystem, linear_forces
-from .hbm.peaks import PeakSolver, first_harmonic_output
-from .hbm.sensitivity import output_sensitivities, state_sensitivities
-from .hbm.sensitivity import peak_sensitivities as peak_derivatives
-from .response import (FrequencyResponse, Note, NoteKind, PeakSensitivities, Sensitivities, harmonic_sentence, percent,
-                       with_amplitude_check, with_checks, with_note)
+from .hbm.peaks import first_harmonic_output
+from .response import (FrequencyResponse, Note, NoteKind, PeakSensitivities, Sensitivities, branch_sensitivities,
+                       harmonic_sentence, percent, solved_peak_sensitivities, with_amplitude_check, with_checks,
+                       with_note)
 
 DAMPER_DOFS = ("uD_x", "uD_y", "uD_z", "phiD_x", "phiD_y", "phiD_z")
 # the automatic AFT sampling of a disk's branch (TunedDisk and MistunedDisk) may grow the samples
@@ -2148,58 +2147,29 @@ class DiskModelResponse(FrequencyResponse):
 
     def sensitivities(self, parameters, direction: int = 0) -> Sensitivities:
         """The derivatives of every point of the branch in the design-file keys ``parameters``
-        (:meth:`DiskModel.parameter_derivatives`), at fixed frequency: dx/dp = -J^-1 dR/dp, one
-        factorisation per point shared by every parameter (:mod:`bladedamp.hbm.sensitivity`).
-        Returns a :class:`~bladedamp.response.Sensitivities` (each blade's tip amplitude in
-        ``direction`` and its derivatives, per unit of each key)."""
+        (:meth:`DiskModel.parameter_derivatives`), at fixed frequency
+        (:func:`~bladedamp.response.branch_sensitivities`): each blade's tip amplitude in
+        ``direction`` and its derivatives, per unit of each key."""
         validation.integer("direction", direction, minimum=0, maximum=2)
         keys = tuple(str(p) for p in parameters)
         system = self.model_system()
-        dR_dp = self.disk.parameter_derivatives(system, keys)
-        outputs = self.blade_outputs(direction)
-        n, N = len(self.omega), system.n_unknowns
-        X = np.asarray(self.coefficients, dtype=float).reshape(n, N)
-        dx = np.zeros((n, len(keys), N))
-        amplitude, d_amplitude = np.zeros((n, len(outputs))), np.zeros((n, len(keys), len(outputs)))
-        for i, (x, w) in enumerate(zip(X, self.omega)):
-            dx[i] = state_sensitivities(system, x, float(w), dR_dp(x, float(w)))
-            for b, output in enumerate(outputs):
-                amplitude[i, b], d_amplitude[i, :, b] = output_sensitivities(output, x, dx[i])
-        return Sensitivities(keys, tuple(parameter_unit(k) for k in keys),
-                             np.array([self.disk.parameter_value(k) for k in keys]), self.omega / (2 * np.pi),
-                             amplitude, d_amplitude, dx.reshape(n, len(keys), self.basis.n_coeffs, -1))
+        return branch_sensitivities(system, self.omega, self.coefficients, self.blade_outputs(direction),
+                                    self.disk.parameter_derivatives(system, keys), keys,
+                                    tuple(parameter_unit(k) for k in keys), [self.disk.parameter_value(k) for k in keys])
 
     def peak_sensitivities(self, parameters, direction: int = 0) -> PeakSensitivities:
         """The derivatives of the resonance peak (the largest blade's largest tip amplitude in
         ``direction``, solved by the peak condition d|u|/dOmega = 0) in the design-file keys
         ``parameters``: d peak amplitude / dp [m per unit] and d peak frequency / dp [Hz per unit]
-        (:func:`bladedamp.hbm.sensitivity.peak_sensitivities`). ValueError where the peak cannot be
+        (:func:`~bladedamp.response.solved_peak_sensitivities`). ValueError where the peak cannot be
         solved (at an end of the range, next to a fold)."""
         validation.integer("direction", direction, minimum=0, maximum=2)
         keys = tuple(str(p) for p in parameters)
         system = self.model_system()
-        dR_dp = self.disk.parameter_derivatives(system, keys)
-        outputs = self.blade_outputs(direction)
-        n = len(self.omega)
-        X = np.asarray(self.coefficients, dtype=float).reshape(n, -1)
-        curves = np.abs(X @ outputs.T)                                      # (n, s)
-        blade = int(np.argmax(curves.max(axis=0)))
-        index = int(np.argmax(curves[:, blade]))
-        solver = PeakSolver(system, self.omega, X)
-        solved = solver.solve_state(index, outputs[blade])
-        where = f"at {self.omega[index] / (2 * np.pi):.6g} Hz"
-        if solved is None:
-            raise ValueError(f"the peak {where} could not be solved (at an end of the range or next to a fold): "
-                             "no peak derivatives")
-        _, w, x = solved
-        scale = max(np.linalg.norm(system.residual(np.zeros_like(x), w, False)[0]), 1e-300)
-        peak = peak_derivatives(system, x, w, outputs[blade], dR_dp, solver.x_scale, scale)
-        if peak is None:
-            raise ValueError(f"the peak {where}: a solve beside it did not converge or its curvature is not that of "
-                             "a maximum: no peak derivatives")
-        return PeakSensitivities(keys, tuple(parameter_unit(k) for k in keys),
-                                 np.array([self.disk.parameter_value(k) for k in keys]), peak.amplitude,
-                                 peak.omega / (2 * np.pi), blade, peak.d_amplitude, peak.d_omega / (2 * np.pi))
+        return solved_peak_sensitivities(system, self.omega, self.coefficients, self.blade_outputs(direction),
+                                         self.disk.parameter_derivatives(system, keys), keys,
+                                         tuple(parameter_unit(k) for k in keys),
+                                         [self.disk.parameter_value(k) for k in keys])
 
     @staticmethod
     def linear_energies(system: HarmonicBalanceSystem, branch) -> tuple[np.ndarray, np.ndarray]:

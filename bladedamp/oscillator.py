@@ -25,8 +25,10 @@ from .hbm.start import robust_start
 from .hbm.elements import CubicSpring
 from .hbm.fourier import HarmonicBasis
 from .hbm.monodromy import STEPS_PER_PERIOD, oscillator_monodromy
-from .hbm.system import Coupling, HarmonicBalanceSystem
-from .response import FrequencyResponse, continuation_note, with_range_end_estimate
+from .hbm.peaks import first_harmonic_output
+from .hbm.system import Coupling, HarmonicBalanceSystem, linear_forces
+from .response import (FrequencyResponse, PeakSensitivities, Sensitivities, branch_sensitivities, continuation_note,
+                       solved_peak_sensitivities, with_range_end_estimate)
 from .timedomain import TimeResponse, oscillator_steady_state
 
 # most AFT samples per period the automatic sampling may choose (sampled_response; one DOF:
@@ -160,6 +162,92 @@ class FrictionOscillator:
         f[basis.cos_index(1)] = self.forcing
         return HarmonicBalanceSystem(basis, [[self.mass]], [[self.damping]], [[self.stiffness]],
                                      lambda omega: (f, np.zeros(C)), couplings)
+
+    # ----- derivatives in the parameters -------------------------------------------------
+    #: the fields with derivatives (:meth:`parameter_derivatives`), in SI (contact_angle in rad)
+    PARAMETERS = ("mass", "stiffness", "damping", "contact_stiffness", "friction_coefficient", "normal_load",
+                  "normal_stiffness", "forcing", "cubic_stiffness", "contact_angle")
+
+    def parameter_derivatives(self, system: HarmonicBalanceSystem, keys):
+        """``dR_dp(x, omega) -> (k, C)``: the analytic derivatives of ``system`` (this oscillator's
+        :meth:`hbm_system`) at x (C,) and omega [rad/s] in the fields ``keys`` (:attr:`PARAMETERS`,
+        SI units) [N per unit]: the linear part and the forcing in closed form, the contact by its
+        homogeneity (k_T dF/dk_T = J_t c_t, mu dF_t/dmu = F_t - J_tt c_t, k_N dF/dk_N = F - J_t c_t,
+        the preload offset N0 / k_N: offset dF/doffset = F - J c, the law being linear), the cubic
+        spring's force per k3, and the contact direction's angle through the map
+        (dT^T F + T^T J dT x). ValueError naming an unknown key."""
+        keys = tuple(str(k) for k in keys)
+        for key in keys:
+            if key not in self.PARAMETERS:
+                raise ValueError(f"parameter {key!r}: an oscillator's parameters with derivatives are "
+                                 f"{', '.join(self.PARAMETERS)}")
+            if key == "friction_coefficient" and self.friction_coefficient == 0:
+                raise ValueError("parameter 'friction_coefficient': the derivative in mu is taken at mu > 0")
+        basis = system.basis
+        C = basis.n_coeffs
+        contact = system.couplings[0]
+        tangential = np.array([i % 3 < 2 for i in range(contact.matrix.shape[0])])
+        alpha = self.contact_angle
+        d_map = basis.real_form(lambda h: np.array([[-np.sin(alpha)], [0.0], [-np.cos(alpha)]]))
+        unit = np.zeros(C)
+        unit[basis.cos_index(1)] = 1.0
+        one = np.ones((1, 1))
+
+        def dR_dp(x, omega):
+            local = contact.matrix @ x
+            force, jac, _ = contact.element.harmonic_forces(local.reshape(C, 3), basis, omega, True)
+            force = force.ravel()
+            j_t = jac[:, tangential] @ local[tangential]
+            scale = force - j_t
+            out = np.zeros((len(keys), C))
+            for row, key in zip(out, keys):
+                if key in ("mass", "damping", "stiffness"):
+                    row += linear_forces(basis, x, omega, **{key: one})
+                elif key == "forcing":
+                    row -= unit
+                elif key == "cubic_stiffness":
+                    row += CubicSpring(1.0).harmonic_forces(x.reshape(C, 1), basis, omega, False)[0].ravel()
+                elif key == "contact_angle":
+                    row += d_map.T @ force + contact.matrix.T @ (jac @ (d_map @ x))
+                else:
+                    direction = {"contact_stiffness": j_t / self.contact_stiffness,
+                                 "friction_coefficient": np.where(tangential, scale, 0.0) / self.friction_coefficient,
+                                 "normal_stiffness": (scale - (force - jac @ local)) / self.normal_stiffness,
+                                 "normal_load": (force - jac @ local) / max(self.normal_load, 1e-300)}[key]
+                    contact.add_forces(row, direction)
+            return out
+
+        return dR_dp
+
+    def parameter_value(self, key: str) -> float:
+        """The value of field ``key`` (:attr:`PARAMETERS`) [SI]."""
+        if key not in self.PARAMETERS:
+            raise ValueError(f"parameter {key!r}: an oscillator's parameters with derivatives are "
+                             f"{', '.join(self.PARAMETERS)}")
+        return float(getattr(self, key))
+
+    def output(self, basis: HarmonicBasis) -> np.ndarray:
+        """(C,) complex: the first-harmonic displacement x_1 = a_1 - i b_1 of the unknowns."""
+        return first_harmonic_output(basis, 1, [0], [1.0])
+
+    def sensitivities(self, response: FrequencyResponse, parameters) -> Sensitivities:
+        """The derivatives of every point of this oscillator's ``response`` in its fields
+        ``parameters`` (:attr:`PARAMETERS`, per SI unit; :func:`~bladedamp.response.branch_sensitivities`)."""
+        keys = tuple(str(p) for p in parameters)
+        system = self.hbm_system(response.basis.harmonics, response.basis.n_samples)
+        return branch_sensitivities(system, response.omega, response.coefficients, self.output(response.basis),
+                                    self.parameter_derivatives(system, keys), keys, tuple("SI" for _ in keys),
+                                    [self.parameter_value(k) for k in keys])
+
+    def peak_sensitivities(self, response: FrequencyResponse, parameters) -> PeakSensitivities:
+        """The derivatives of the peak of this oscillator's ``response`` in its fields ``parameters``
+        (:func:`~bladedamp.response.solved_peak_sensitivities`): d peak amplitude / dp [m per SI
+        unit], d peak frequency / dp [Hz per SI unit]."""
+        keys = tuple(str(p) for p in parameters)
+        system = self.hbm_system(response.basis.harmonics, response.basis.n_samples)
+        return solved_peak_sensitivities(system, response.omega, response.coefficients, self.output(response.basis),
+                                         self.parameter_derivatives(system, keys), keys, tuple("SI" for _ in keys),
+                                         [self.parameter_value(k) for k in keys])
 
     def frequency_response(self, f_start_hz: float, f_end_hz: float, harmonics="auto", n_samples=None,
                            harmonic_tolerance: float = HARMONIC_TOLERANCE, max_harmonic: int = 9,

@@ -10,6 +10,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .hbm.continuation import branch_checks
+from .hbm.peaks import PeakSolver
+from .hbm.sensitivity import output_sensitivities, peak_sensitivities, state_sensitivities
 from .hbm.fourier import HarmonicBasis, enriched
 from .io import Saveable
 
@@ -944,3 +946,51 @@ class PeakSensitivities(Saveable):
         ax.grid(axis="x", alpha=0.3)
         ax.legend(fontsize="small")
         return fig
+
+
+def branch_sensitivities(system, omega, coefficients, outputs, dR_dp, keys, units, values) -> Sensitivities:
+    """The :class:`Sensitivities` of a branch of ``system`` (``omega`` (n,) [rad/s], ``coefficients``
+    (n, C * n_dof)) in k parameters (``keys``, their ``units`` and ``values``): at every point
+    dx/dp = -J^-1 dR/dp with one factorisation for all (``dR_dp(x, omega) -> (k, C * n_dof)``, the
+    model's analytic derivatives; :mod:`bladedamp.hbm.sensitivity`) and the amplitudes of the s
+    complex ``outputs`` (s, C * n_dof) and their derivatives."""
+    outputs = np.atleast_2d(outputs)
+    n, N = len(omega), system.n_unknowns
+    X = np.asarray(coefficients, dtype=float).reshape(n, N)
+    dx = np.zeros((n, len(keys), N))
+    amplitude, d_amplitude = np.zeros((n, len(outputs))), np.zeros((n, len(keys), len(outputs)))
+    for i, (x, w) in enumerate(zip(X, omega)):
+        dx[i] = state_sensitivities(system, x, float(w), dR_dp(x, float(w)))
+        for b, output in enumerate(outputs):
+            amplitude[i, b], d_amplitude[i, :, b] = output_sensitivities(output, x, dx[i])
+    return Sensitivities(tuple(keys), tuple(units), np.asarray(values, dtype=float), np.asarray(omega) / (2 * np.pi),
+                         amplitude, d_amplitude, dx.reshape(n, len(keys), system.basis.n_coeffs, -1))
+
+
+def solved_peak_sensitivities(system, omega, coefficients, outputs, dR_dp, keys, units, values) -> PeakSensitivities:
+    """The :class:`PeakSensitivities` of the largest amplitude of the s complex ``outputs`` (s,
+    C * n_dof) on a branch of ``system`` (as :func:`branch_sensitivities`): the peak solved by
+    d|u|/dOmega = 0 (:class:`~bladedamp.hbm.peaks.PeakSolver`) next to the largest sample, then
+    differentiated (:func:`bladedamp.hbm.sensitivity.peak_sensitivities`). ValueError where it
+    cannot be solved (at an end of the range, next to a fold) or no pair of points beside it
+    brackets a maximum."""
+    outputs = np.atleast_2d(outputs)
+    n = len(omega)
+    X = np.asarray(coefficients, dtype=float).reshape(n, -1)
+    curves = np.abs(X @ outputs.T)                                      # (n, s)
+    blade = int(np.argmax(curves.max(axis=0)))
+    index = int(np.argmax(curves[:, blade]))
+    solver = PeakSolver(system, omega, X)
+    solved = solver.solve_state(index, outputs[blade])
+    where = f"at {omega[index] / (2 * np.pi):.6g} Hz"
+    if solved is None:
+        raise ValueError(f"the peak {where} could not be solved (at an end of the range or next to a fold): "
+                         "no peak derivatives")
+    _, w, x = solved
+    scale = max(np.linalg.norm(system.residual(np.zeros_like(x), w, False)[0]), 1e-300)
+    peak = peak_sensitivities(system, x, w, outputs[blade], dR_dp, solver.x_scale, scale)
+    if peak is None:
+        raise ValueError(f"the peak {where}: a solve beside it did not converge or no pair of points beside it "
+                         "brackets a maximum: no peak derivatives")
+    return PeakSensitivities(tuple(keys), tuple(units), np.asarray(values, dtype=float), peak.amplitude,
+                             peak.omega / (2 * np.pi), blade, peak.d_amplitude, peak.d_omega / (2 * np.pi))

@@ -254,3 +254,38 @@ def test_with_parameters_is_the_independent_perturbation():
         sa, sb = a.hbm_system((0, 1), 16), b.hbm_system((0, 1), 16)
         x = np.random.default_rng(3).normal(scale=1e-5, size=sa.n_unknowns)
         assert np.allclose(sa.residual(x, 600.0, False)[0], sb.residual(x, 600.0, False)[0], rtol=1e-12, atol=0)
+
+
+@pytest.mark.parametrize("oscillator", [bd.FrictionOscillator(),
+                                        bd.FrictionOscillator(contact_angle=0.3, cubic_stiffness=1e7, forcing=1.5)],
+                         ids=["flat", "inclined-cubic"])
+def test_oscillator_point_derivatives_match_differences(oscillator):
+    """Every field of the oscillator (the inclined contact's angle through the map, the normal
+    law's stiffness and preload through the approach) against central differences."""
+    response = oscillator.frequency_response(10.0, 30.0, harmonics=(0, 1, 2, 3), n_samples=64)
+    keys = [k for k in oscillator.PARAMETERS if oscillator.parameter_value(k) != 0]
+    sens = oscillator.sensitivities(response, keys)
+    output = oscillator.output(response.basis)
+    i = int(np.argmax(sens.tip_amplitude[:, 0])) - 3
+    x0, w = response.coefficients[i].ravel(), float(response.omega[i])
+    for j, key in enumerate(keys):
+        h = STEP * abs(sens.values[j])
+        amplitudes = []
+        for sign in (1, -1):
+            system = dataclasses.replace(oscillator, **{key: sens.values[j] + sign * h}).hbm_system(
+                response.basis.harmonics, response.basis.n_samples)
+            solved = newton(system.residual, x0, w, np.abs(x0).max(), 1.0, tol=1e-13)
+            amplitudes.append(abs(output @ solved.x))
+        fd = (amplitudes[0] - amplitudes[1]) / (2 * h)
+        floor = 1e-8 * sens.tip_amplitude[i, 0] / abs(sens.values[j])      # k_N of a flat contact: both zero
+        assert abs(sens.d_tip_amplitude[i, j, 0] - fd) <= RTOL * abs(fd) + floor, key
+
+
+def test_oscillator_in_gross_slip_peaks_at_the_free_natural_frequency():
+    """Closed form: with the contact slipping through nearly all the period (F far above mu N0)
+    the resonance lies at sqrt(k / m) / 2 pi, so its relative sensitivities to m and k are -1/2
+    and +1/2 (to the share of the period the contact sticks, 0.1 % here)."""
+    peak = bd.peak_sensitivities(bd.FrictionOscillator(forcing=5.0), (10.0, 30.0), ["mass", "stiffness"],
+                                 harmonics=(0, 1, 2, 3), n_samples=64)
+    _, frequency = peak.elasticities()
+    assert frequency == pytest.approx([-0.5, 0.5], abs=1e-3)
