@@ -208,8 +208,10 @@ def test_parameter_errors_name_the_key(reference_static):
         response.sensitivities(["blade.natural_frequencies_hz[7]"])
     with pytest.raises(ValueError, match="rotor_speed_rpm"):
         response.sensitivities(["disk.rotor_speed_rpm"])
-    with pytest.raises(TypeError):
+    with pytest.raises(ValueError, match="an oscillator's parameters"):
         bd.peak_sensitivities(bd.FrictionOscillator(), (10.0, 20.0), ["damper.mass_g"])
+    with pytest.raises(TypeError):
+        bd.peak_sensitivities(object(), (10.0, 20.0), ["damper.mass_g"])
 
 
 def test_results_save_and_load(tmp_path, reference_static):
