@@ -891,8 +891,8 @@ def build_parser() -> argparse.ArgumentParser:
                             "natural_frequencies_hz[0]. With derivatives: mass_g, friction_coefficient,\n"
                             "tangential_stiffness_per_length_n_per_m2, normal_to_tangential_stiffness,\n"
                             "roughness_reference_load_n, damper_radius_mm, rotor_speed_rpm (fixed speed),\n"
-                            "excitation_n_nm[i], natural_frequencies_hz[j], damping_ratio (or [j]), and a cylinder's\n"
-                            "gamma_left_deg, gamma_right_deg, cylinder_radius_mm")
+                            "excitation_n_nm[i], natural_frequencies_hz[j], damping_ratio (or [j]), gamma_left_deg,\n"
+                            "gamma_right_deg, length_mm, cylinder_radius_mm, contact_height_mm")
 
     def out_arg(p, default):
         p.add_argument("--out", type=Path, default=None,

@@ -44,7 +44,7 @@ from numba import njit
 from . import validation
 from .blade import PLATFORM_ANGLE, ModalBlade
 from .contact.laws import LinearNormalLaw, RoughnessNormalLaw
-from .contact.patch import dof_jacobian
+from .contact.patch import dof_jacobian, rigid_point_map
 from .contact.point import (MAX_PASSES, PERIODIC_TOL, PointContactSamples, damper_contact_forces, normal_law_parameters,
                             point_contact_forces)
 from .damper.geometry import CylinderDamper, DamperGeometry, WedgeDamper
@@ -629,7 +629,7 @@ class AssemblyContacts:
                 domega = (fp - fm) / (2 * h)
         return force, blocks.reshape(nd, C * L, C * L), domega
 
-    def parameter_forces(self, local, basis, omega) -> dict:
+    def parameter_forces(self, local, basis, omega, d_maps=()) -> dict:
         """The logarithmic derivatives p dF/dp (C, n_local) [N, N m] of the forces at ``local``
         (C, n_local) and ``omega`` [rad/s] in the contact parameters shared by every point, all
         from one evaluation of the point-contact kernel with its exact Jacobian (no differences):
@@ -647,7 +647,9 @@ class AssemblyContacts:
         * ``"approach"``: in the static approach's scale (every point's offset times 1 + epsilon):
           the forces are homogeneous in (u_t, (u_zeta, offset)^(1/p)) of degree 1 for a law of
           degree p (linear: p = 1), so offset dF/doffset = p (F - J_t c_t) - J_zeta c_zeta;
-          ``"approach_left"``, ``"approach_right"``: the same of the OL patch's points alone, of the OR's.
+          ``"approach_left"``, ``"approach_right"``: the same of the OL patch's points alone, of the OR's;
+        * ``"point_maps"``: for each derivative dB (n_d, 2, P, 3, m) of the point maps in ``d_maps``
+          (points that move on their patch), dB^T f + B^T J (dB local) (a list, in that order).
 
         Raises ValueError for dampers whose patches do not stack (:meth:`stacked_points`) or a
         normal law of another kind than LinearNormalLaw and RoughnessNormalLaw."""
@@ -689,6 +691,17 @@ class AssemblyContacts:
         for name, f in zip(names, forces):
             f = np.ascontiguousarray(f)
             out[name] = (f if R is None else _rotated(R, f, True)).reshape(C, self.n_local)
+        out["point_maps"] = []
+        if len(d_maps):
+            f_coefficients = np.moveaxis(basis.to_coeffs(np.moveaxis(force, 1, 0)).reshape(C, nd, 2, P, 3), 0, -1)
+        for dB in d_maps:
+            dB = np.broadcast_to(dB, B.shape)
+            dc = np.einsum("dqpij,cdqj->cdqpi", dB, local.reshape(C, nd, 2, m)).reshape(C, -1, 3)
+            moved = (jac * np.moveaxis(dc, 0, -1)[:, None, None]).sum(axis=(-1, -2))          # (P', T, 3)
+            f_moved = np.moveaxis(basis.to_coeffs(np.moveaxis(moved, 1, 0)).reshape(C, nd, 2, P, 3), 0, -1)
+            f = (np.einsum("dqpic,dqpij->cdqj", f_moved, B) + np.einsum("dqpic,dqpij->cdqj", f_coefficients, dB))
+            f = np.ascontiguousarray(f.reshape(C, nd, L))
+            out["point_maps"].append((f if R is None else _rotated(R, f, True)).reshape(C, self.n_local))
         return out
 
     def harmonic_forces(self, local, basis, omega, jacobian=True):
@@ -989,10 +1002,13 @@ SENSITIVITY_KEYS = {
     "disk.gamma_left_deg": "deg",
     "disk.gamma_right_deg": "deg",
     "damper.cylinder_radius_mm": "mm",
+    "damper.contact_height_mm": "mm",
+    "damper.length_mm": "mm",
 }
 #: the geometry's keys: (the damper's geometry_derivative parameter, its SI unit per key unit)
 GEOMETRY_KEYS = {"disk.gamma_left_deg": ("gamma_left", np.pi / 180), "disk.gamma_right_deg": ("gamma_right", np.pi / 180),
-                 "damper.cylinder_radius_mm": ("radius", 1e-3)}
+                 "damper.cylinder_radius_mm": ("radius", 1e-3), "damper.contact_height_mm": ("contact_height", 1e-3),
+                 "damper.length_mm": ("length", 1e-3)}
 
 
 def parameter_unit(key: str) -> str:
@@ -1014,8 +1030,7 @@ def resolve_parameter_key(name: str) -> str:
     matches = list(dict.fromkeys(matches))
     if len(matches) != 1:
         raise ValueError(f"parameter {name!r}: {'ambiguous' if matches else 'unknown or not differentiable'}; the "
-                         f"keys with derivatives are {', '.join(SENSITIVITY_KEYS)} (the wedge's geometry and the contact length are "
-                         "not yet)")
+                         f"keys with derivatives are {', '.join(SENSITIVITY_KEYS)})")
     key = matches[0] + bracket + rest
     parse_parameter_key(key)
     return key
@@ -1034,7 +1049,7 @@ def parse_parameter_key(key: str) -> tuple[str, int | None]:
     known = {k.split("[")[0] for k in SENSITIVITY_KEYS}
     if name not in known:
         raise ValueError(f"parameter {key!r}: unknown or not differentiable; the keys with derivatives are "
-                         f"{', '.join(SENSITIVITY_KEYS)} (the wedge's geometry and the contact length are not yet)")
+                         f"{', '.join(SENSITIVITY_KEYS)})")
     return name, index
 
 
@@ -1050,12 +1065,15 @@ class ParameterEffect:
         quantity q per unit of p
     coupling : dT/dp, the derivative of the contacts' real-form map T (its shape), or None: the
         residual's T^T F(T x) changes by dT^T F + T^T J (dT x)
+    point_maps : dB/dp (n_d, 2, P, 3, m), the derivative of the patches' point maps (points that
+        move on their faces), or None
     """
 
     matrices: dict = field(default_factory=dict)
     excitation: object = None
     contact: dict = field(default_factory=dict)
     coupling: object = None
+    point_maps: object = None
 
 
 class DiskModel:
@@ -1216,7 +1234,8 @@ class DiskModel:
         coupling = next((c for c in system.couplings if isinstance(c.element, (DamperContacts, AssemblyContacts))),
                         None)
         element = None if coupling is None else getattr(coupling.element, "element", coupling.element)
-        needs_contacts = any(e.contact for e in effects)
+        needs_contacts = any(e.contact or e.point_maps is not None for e in effects)
+        d_maps = [e.point_maps for e in effects if e.point_maps is not None]
 
         needs_forces = any(e.coupling is not None for e in effects)
 
@@ -1226,7 +1245,8 @@ class DiskModel:
             if (needs_contacts or needs_forces) and coupling is not None:
                 local = (coupling.matrix @ x).reshape(basis.n_coeffs, element.n_local)
                 if needs_contacts:
-                    directions = element.parameter_forces(local, basis, omega)
+                    directions = element.parameter_forces(local, basis, omega, d_maps)
+                    moved = iter(directions["point_maps"])
                 if needs_forces:
                     force, jac, _ = coupling.element.harmonic_forces(local, basis, omega, True)
                     forces = force.ravel(), jac
@@ -1241,6 +1261,8 @@ class DiskModel:
                 if directions is not None:
                     for name, factor in e.contact.items():
                         coupling.add_forces(row, factor * directions[name].ravel())
+                    if e.point_maps is not None:
+                        coupling.add_forces(row, next(moved).ravel())
             return out
 
         return dR_dp
@@ -1307,7 +1329,7 @@ class DiskModel:
         if name in GEOMETRY_KEYS:
             return self.geometry_effect(system, key, name, positions)
         need(name in SENSITIVITY_KEYS, f"unknown or not differentiable; the keys with derivatives are "
-                                       f"{', '.join(SENSITIVITY_KEYS)} (the wedge's geometry and the contact length are not yet)")
+                                       f"{', '.join(SENSITIVITY_KEYS)})")
         need(damper is not None, "the model has no damper")
         need(len({id(p.damper) for p in positions}) == 1, "the dampers differ from position to position")
         static = basis.has_static
@@ -1368,19 +1390,26 @@ class DiskModel:
     def geometry_effect(self, system: HarmonicBalanceSystem, key: str, name: str, positions) -> "ParameterEffect":
         """The :class:`ParameterEffect` of a geometry key (:data:`GEOMETRY_KEYS`) on ``system``: the
         contacts' map T through the rigid kinematics G_D, G_P (their frames, the contact centres and
-        the platform offsets, :meth:`~bladedamp.damper.geometry.CylinderDamper.geometry_derivative`),
-        the damper's inertia, and without a static harmonic the seating's approach of each patch
-        (its frictionless load, :meth:`~bladedamp.damper.geometry.DamperGeometry.normal_load_log_derivatives`)."""
+        the platform offsets, the damper's ``geometry_derivative``), the damper's inertia, the
+        patches' points (a wedge's height, the length) and stiffnesses (the length: k_T and k_N are
+        per length), and without a static harmonic a cylinder's seating: each patch's approach
+        follows its frictionless load (:meth:`~bladedamp.damper.geometry.DamperGeometry.normal_load_log_derivatives`)
+        and k_N. A wedge's seating leaves a moment to its faces, so its geometry needs the static
+        harmonic (the seating then is the harmonic balance's)."""
         basis = system.basis
         damper = positions[0].damper if positions else None
-        if damper is None or getattr(damper, "kind", None) != "cylinder":
-            raise ValueError(f"parameter {key!r}: the geometry's derivatives are those of a cylinder damper "
-                             "(a wedge's are not yet)")
+        parameter, unit = GEOMETRY_KEYS[name]
+        kind = getattr(damper, "kind", None)
+        if kind is None or (parameter == "radius" and kind != "cylinder") or \
+                (parameter == "contact_height" and kind != "wedge"):
+            raise ValueError(f"parameter {key!r}: the model's damper ({kind or 'none'}) has no such dimension")
+        if kind == "wedge" and not basis.has_static:
+            raise ValueError(f"parameter {key!r}: a wedge's geometry is differentiated with the static harmonic "
+                             "(harmonic 0) in the set, whose balance seats it")
         if any(p.initial_gaps is not None and np.any(p.initial_gaps) for p in positions):
             raise ValueError(f"parameter {key!r}: not with initial gaps (a misfit's seating is not differentiated)")
         if any(b.flexible_platform for b in self.model_blades):
             raise ValueError(f"parameter {key!r}: not with flexible platforms (their point maps follow the geometry)")
-        parameter, unit = GEOMETRY_KEYS[name]
         kinematics, d_inertia = [], None
         blade = self.model_blades[0]
         zero_points = {"OL": np.zeros(3), "OR": np.zeros(3)}
@@ -1402,10 +1431,24 @@ class DiskModel:
                 sl = self.damper_unknowns(d)
                 dm[sl, sl] = unit * d_inertia
             effect.matrices["mass"] = dm.tocsr()
-        if not basis.has_static:
-            degree = damper.contact.roughness_exponent
-            loads = unit * positions[0].damper_geometry().normal_load_log_derivatives(parameter) / degree
-            effect.contact = {"approach_left": loads[0], "approach_right": loads[1]}
+        degree = damper.contact.roughness_exponent
+        geometry = positions[0].damper_geometry()
+        if parameter in ("contact_height", "length"):          # the points move along xi (height), eta (length)
+            size = damper.contact_height if parameter == "contact_height" else damper.length
+            effect.point_maps = unit * np.stack([
+                rigid_point_map(p.xi / size if parameter == "contact_height" else 0 * p.xi,
+                                p.eta / size if parameter == "length" else 0 * p.eta)
+                - rigid_point_map(0 * p.xi, 0 * p.eta) for p in geometry.patches])[None]
+        if parameter == "length":                              # k_T, k_N per length (the retention spring's k_N)
+            relative = unit / damper.length
+            effect.contact.update({"tangential": relative, "law": degree * relative})
+            if basis.has_static:
+                effect.matrices["static_stiffness"] = relative * system.static_stiffness
+            else:
+                effect.contact["approach"] = -relative
+        if not basis.has_static and parameter in ("gamma_left", "gamma_right"):
+            loads = unit * geometry.normal_load_log_derivatives(parameter) / degree
+            effect.contact.update({"approach_left": loads[0], "approach_right": loads[1]})
         return effect
 
     def parameter_value(self, key: str) -> float:
@@ -1435,6 +1478,10 @@ class DiskModel:
             return 1e3 * damper.mass
         if name == "damper.cylinder_radius_mm":
             return 1e3 * damper.radius if hasattr(damper, "radius") else float("nan")
+        if name == "damper.contact_height_mm":
+            return 1e3 * damper.contact_height if hasattr(damper, "contact_height") else float("nan")
+        if name == "damper.length_mm":
+            return 1e3 * damper.length
         return float(getattr(damper.contact, {"damper.friction_coefficient": "friction_coefficient",
                                               "damper.tangential_stiffness_per_length_n_per_m2":
                                                   "tangential_stiffness_per_length",
@@ -1463,8 +1510,10 @@ class DiskModel:
                 out = dataclasses.replace(out, damper_radius=1e-3 * value)
             elif name in ("disk.gamma_left_deg", "disk.gamma_right_deg"):
                 out = dataclasses.replace(out, **{name[5:-4]: float(np.radians(value))})
-            elif name == "damper.cylinder_radius_mm":
-                out = out.with_dampers(lambda d: dataclasses.replace(d, radius=1e-3 * value))
+            elif name in ("damper.cylinder_radius_mm", "damper.contact_height_mm", "damper.length_mm"):
+                field_name = {"damper.cylinder_radius_mm": "radius", "damper.contact_height_mm": "contact_height",
+                              "damper.length_mm": "length"}[name]
+                out = out.with_dampers(lambda d, f=field_name: dataclasses.replace(d, **{f: 1e-3 * value}))
             elif name == "disk.rotor_speed_rpm":
                 out = dataclasses.replace(out, rotor_speed_hz=value / 60.0)
             elif name == "disk.excitation_n_nm":

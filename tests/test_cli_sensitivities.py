@@ -59,7 +59,7 @@ def test_fit_recovers_the_friction_coefficient_from_csv_files(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("argv, needles", [
-    (["sensitivities", "{d}", "--parameters", "length_mm"], ["--parameters", "length_mm"]),
+    (["sensitivities", "{d}", "--parameters", "n_blades"], ["--parameters", "n_blades"]),
     (["sensitivities", "{d}", "--parameters", "rotor_speed_rpm"], ["rotor_speed_rpm", "fixed rotor speed"]),
     (["fit", "{d}", "{m}", "--excitation-n", "0.1", "0.2"], ["--excitation-n", "one force per measured file"]),
     (["fit", "{d}", "{d}"], ["{d}"]),

@@ -68,5 +68,5 @@ def test_fit_arguments_are_checked(synthetic):
         fit_contact(truth, measured, KEYS, excitations=[0.1])
     with pytest.raises(ValueError, match="confidence"):
         fit_contact(truth, measured, KEYS, confidence=1.5)
-    with pytest.raises(ValueError, match="length_mm"):
-        fit_contact(truth, measured, ("damper.length_mm",))
+    with pytest.raises(ValueError, match="n_blades"):
+        fit_contact(truth, measured, ("disk.n_blades",))

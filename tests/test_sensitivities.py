@@ -200,8 +200,10 @@ def test_parameter_errors_name_the_key(reference_static):
     disk, response = reference_static
     with pytest.raises(ValueError, match="damper.mass_kg"):
         response.sensitivities(["damper.mass_kg"])
-    with pytest.raises(ValueError, match="contact_height_mm"):
-        response.sensitivities(["damper.contact_height_mm"])
+    with pytest.raises(ValueError, match="no such dimension"):
+        response.sensitivities(["damper.contact_height_mm"])            # a cylinder has none
+    with pytest.raises(ValueError, match="n_blades"):
+        response.sensitivities(["disk.n_blades"])
     with pytest.raises(ValueError, match="MistunedDisk"):
         response.sensitivities(["mistuning.kappa[0]"])
     with pytest.raises(ValueError, match=r"j in 0\.\.3"):
@@ -227,16 +229,19 @@ def test_results_save_and_load(tmp_path, reference_static):
     assert "damper.mass_g" in peak.table()
 
 
-@pytest.mark.parametrize("harmonics", [(0, 1, 2), (1,)])
-def test_cylinder_geometry_derivatives_match_differences(harmonics):
+@pytest.mark.parametrize("kind, harmonics", [("cylinder", (0, 1, 2)), ("cylinder", (1,)), ("wedge", (0, 1, 2))])
+def test_geometry_derivatives_match_differences(kind, harmonics):
     """The platform angles move the contact frames, centres and platform offsets (the contacts'
-    map T) and, without a static harmonic, each patch's seating load; the cylinder radius moves
-    the centres along the normals and the rotary inertia, which leaves the rigid-platform
-    response unchanged to rounding (both the derivative and the differences are zero there:
-    compared with the floor 1e-8 a / p)."""
-    disk = bd.reference_disk("cylinder", 1e-3)
+    map T), a wedge's section and inertia, and, without a static harmonic, each patch's seating
+    load; the length the points along the faces, the stiffnesses per length and the inertia; a
+    wedge's height its section and the points across its faces. The cylinder radius moves the
+    centres along the normals and the rotary inertia, which leaves the rigid-platform response
+    unchanged to rounding (both the derivative and the differences are zero there: compared with
+    the floor 1e-8 a / p)."""
+    disk = bd.reference_disk(kind, 1e-3 if kind == "cylinder" else 0.3e-3)
     response = disk.frequency_response(92.0, 99.0, harmonics=harmonics, n_samples=32, estimate_harmonic_error=False)
-    keys = ["disk.gamma_left_deg", "disk.gamma_right_deg", "damper.cylinder_radius_mm"]
+    keys = ["disk.gamma_left_deg", "disk.gamma_right_deg", "damper.length_mm",
+            "damper.cylinder_radius_mm" if kind == "cylinder" else "damper.contact_height_mm"]
     sens = response.sensitivities(keys)
     i = len(response.omega) // 2
     for j, key in enumerate(keys):
@@ -244,6 +249,21 @@ def test_cylinder_geometry_derivatives_match_differences(harmonics):
                                 response, i)
         floor = 1e-8 * sens.tip_amplitude[i].max() / sens.values[j]
         assert np.abs(sens.d_tip_amplitude[i, j] - fd).max() <= RTOL * np.abs(fd).max() + floor, key
+
+
+def test_polygon_inertia_derivative_is_that_of_the_section():
+    """The hand-written tangents of the prism's centroid and inertia against central differences
+    of the same function (a polynomial of the vertices: the differences' truncation is O(h^2))."""
+    from bladedamp.damper.geometry import polygon_inertia
+
+    rng = np.random.default_rng(5)
+    poly = np.array([[0.0, 0.0], [2e-3, -1.5e-3], [-1.8e-3, -1.2e-3]])
+    d_poly = rng.normal(size=poly.shape)
+    _, _, d_cg, d_M = polygon_inertia(poly, 1e-3, 0.02, d_poly, 0.3)
+    h = 1e-9
+    (cp, Mp, _, _), (cm, Mm, _, _) = (polygon_inertia(poly + s * h * d_poly, 1e-3, 0.02 + s * h * 0.3) for s in (1, -1))
+    assert np.allclose(d_cg, (cp - cm) / (2 * h), rtol=1e-6, atol=1e-9)
+    assert np.allclose(d_M, (Mp - Mm) / (2 * h), rtol=1e-6, atol=1e-12)
 
 
 def test_with_parameters_is_the_independent_perturbation():

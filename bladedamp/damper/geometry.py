@@ -229,27 +229,47 @@ def _check_angles(gamma_left, gamma_right):
     validation.in_range("gamma_right (platform angle, rad)", gamma_right, 0.0, np.pi / 2, closed="neither")
 
 
-def _polygon_inertia(poly: np.ndarray, mass: float, length: float) -> tuple[np.ndarray, np.ndarray]:
-    """Centroid (x, z) and 6x6 mass matrix of a uniform prism with cross-section ``poly`` (x, z) along y."""
-    x, z = poly[:, 0], poly[:, 1]
-    x1, z1 = np.roll(x, -1), np.roll(z, -1)
+def polygon_inertia(poly: np.ndarray, mass: float, length: float, d_poly=None, d_length: float = 0.0):
+    """Centroid (x, z) (2,) and 6x6 mass matrix of a uniform prism of ``mass`` [kg] and ``length``
+    [m] along y with the cross-section ``poly`` (k, 2) (x, z) [m], and their derivatives along the
+    section's change ``d_poly`` (k, 2) and the length's ``d_length`` (per unit of a parameter; zero
+    when not given): ``(cg, M, d_cg, d_M)``. The moments are polynomials of the vertices, so each
+    line carries its value and its tangent (forward differentiation by hand, exact)."""
+    poly = np.asarray(poly, dtype=float)
+    d_poly = np.zeros_like(poly) if d_poly is None else np.asarray(d_poly, dtype=float)
+    x, z, dx, dz = poly[:, 0], poly[:, 1], d_poly[:, 0], d_poly[:, 1]
+    x1, z1, dx1, dz1 = (np.roll(v, -1) for v in (x, z, dx, dz))
     cross = x * z1 - x1 * z
-    area = cross.sum() / 2
-    cx = ((x + x1) * cross).sum() / (6 * area)
-    cz = ((z + z1) * cross).sum() / (6 * area)
+    d_cross = dx * z1 + x * dz1 - dx1 * z - x1 * dz
+    area, d_area = cross.sum() / 2, d_cross.sum() / 2
+
+    def moment(weight, d_weight):
+        """(sum(weight cross), its tangent)."""
+        return (weight * cross).sum(), (d_weight * cross + weight * d_cross).sum()
+
+    sx, d_sx = moment(x + x1, dx + dx1)
+    sz, d_sz = moment(z + z1, dz + dz1)
+    cx, cz = sx / (6 * area), sz / (6 * area)
+    d_cx, d_cz = d_sx / (6 * area) - cx * d_area / area, d_sz / (6 * area) - cz * d_area / area
     # second moments about the origin, then shifted to the centroid (per unit area)
-    ixx_a = ((z ** 2 + z * z1 + z1 ** 2) * cross).sum() / 12  # int z^2 dA
-    izz_a = ((x ** 2 + x * x1 + x1 ** 2) * cross).sum() / 12  # int x^2 dA
-    ixz_a = ((x * z1 + 2 * x * z + 2 * x1 * z1 + x1 * z) * cross).sum() / 24
+    sxx, d_sxx = moment(z ** 2 + z * z1 + z1 ** 2, 2 * z * dz + dz * z1 + z * dz1 + 2 * z1 * dz1)
+    szz, d_szz = moment(x ** 2 + x * x1 + x1 ** 2, 2 * x * dx + dx * x1 + x * dx1 + 2 * x1 * dx1)
+    sxz, d_sxz = moment(x * z1 + 2 * x * z + 2 * x1 * z1 + x1 * z,
+                        dx * z1 + x * dz1 + 2 * (dx * z + x * dz) + 2 * (dx1 * z1 + x1 * dz1) + dx1 * z + x1 * dz)
+    ixx_a, izz_a, ixz_a = sxx / 12, szz / 12, sxz / 24           # int z^2 dA, int x^2 dA, int x z dA
+    d_ixx, d_izz, d_ixz = d_sxx / 12, d_szz / 12, d_sxz / 24
     zz = ixx_a / area - cz ** 2   # mean z'^2
     xx = izz_a / area - cx ** 2   # mean x'^2
     xz = ixz_a / area - cx * cz
-    yy = length ** 2 / 12
-    inertia = mass * np.array([[yy + zz, 0.0, -xz], [0.0, xx + zz, 0.0], [-xz, 0.0, xx + yy]])
-    M = np.zeros((6, 6))
+    d_zz = d_ixx / area - ixx_a * d_area / area ** 2 - 2 * cz * d_cz
+    d_xx = d_izz / area - izz_a * d_area / area ** 2 - 2 * cx * d_cx
+    d_xz = d_ixz / area - ixz_a * d_area / area ** 2 - d_cx * cz - cx * d_cz
+    yy, d_yy = length ** 2 / 12, length * d_length / 6
+    M, dM = np.zeros((6, 6)), np.zeros((6, 6))
     M[:3, :3] = mass * np.eye(3)
-    M[3:, 3:] = inertia
-    return np.array([cx, cz]), M
+    M[3:, 3:] = mass * np.array([[yy + zz, 0.0, -xz], [0.0, xx + zz, 0.0], [-xz, 0.0, xx + yy]])
+    dM[3:, 3:] = mass * np.array([[d_yy + d_zz, 0.0, -d_xz], [0.0, d_xx + d_zz, 0.0], [-d_xz, 0.0, d_xx + d_yy]])
+    return np.array([cx, cz]), M, np.array([d_cx, d_cz]), dM
 
 
 # Plausible ranges of a damper's mass and dimensions (a PlausibilityWarning outside, not an
@@ -337,8 +357,9 @@ class CylinderDamper:
 
     def geometry_derivative(self, gamma_left: float, gamma_right: float, parameter: str):
         """(d frames (2, 3, 3), d centres (2, 3) [m], d inertia (6, 6)) of :meth:`geometry` per unit
-        of ``parameter``: "gamma_left" or "gamma_right" [per rad], "radius" [per m]. The contact
-        patches do not depend on them."""
+        of ``parameter``: "gamma_left" or "gamma_right" [per rad], "radius" or "length" [per m]. The
+        contact patches do not depend on the angles and the radius; with the length their points
+        and stiffnesses change (:func:`bladedamp.diskmodel` differentiates them)."""
         normals = [contact_normal("OL", gamma_left), contact_normal("OR", gamma_right)]
         d_frames, d_centres, d_inertia = np.zeros((2, 3, 3)), np.zeros((2, 3)), np.zeros((6, 6))
         if parameter in ("gamma_left", "gamma_right"):
@@ -349,8 +370,11 @@ class CylinderDamper:
         elif parameter == "radius":
             d_centres = -np.array(normals)
             d_inertia[3:, 3:] = np.diag([self.mass * self.radius / 2, self.mass * self.radius, self.mass * self.radius / 2])
+        elif parameter == "length":                  # transverse m (3 r^2 + l^2) / 12
+            d_inertia[3, 3] = d_inertia[5, 5] = self.mass * self.length / 6
         else:
-            raise ValueError(f"a cylinder's geometry has no derivative in {parameter!r} (gamma_left, gamma_right, radius)")
+            raise ValueError(f"a cylinder's geometry has no derivative in {parameter!r} "
+                             "(gamma_left, gamma_right, radius, length)")
         return d_frames, d_centres, d_inertia
 
 
@@ -386,18 +410,49 @@ class WedgeDamper:
 
     def geometry(self, gamma_left: float, gamma_right: float) -> DamperGeometry:
         _check_angles(gamma_left, gamma_right)
-        normals = [contact_normal("OL", gamma_left), contact_normal("OR", gamma_right)]
-        frames = np.array([contact_frame(n) for n in normals])
+        frames, centres, M, poly, cg = self.section(gamma_left, gamma_right)[:5]
         h = self.contact_height
-        # faces run from the apex (origin) downwards along -xi_OL ... check: xi points down the face
-        ends = [h * frames[c, 0] for c in range(2)]
-        for c in range(2):
-            if ends[c][2] > 0:  # make the face run downwards from the apex
-                ends[c] = -ends[c]
-        poly = np.array([[0.0, 0.0], [ends[1][0], ends[1][2]], [ends[0][0], ends[0][2]]])
-        if (poly[1, 0] - poly[0, 0]) * (poly[2, 1] - poly[0, 1]) - (poly[2, 0] - poly[0, 0]) * (poly[1, 1] - poly[0, 1]) < 0:
-            poly = poly[[0, 2, 1]]
-        cg, M = _polygon_inertia(poly, self.mass, self.length)
-        centres = np.array([np.array([e[0] / 2 - cg[0], 0.0, e[2] / 2 - cg[1]]) for e in ends])
         patches = tuple(self.contact.patch(h, self.length, self.contact.points_across_height) for _ in CONTACTS)
         return DamperGeometry(frames, centres, patches, M, poly - cg, gamma_left, gamma_right)
+
+    def section(self, gamma_left: float, gamma_right: float, parameter: str | None = None):
+        """(frames (2, 3, 3), contact centres (2, 3) [m], inertia (6, 6), cross-section polygon (3, 2)
+        (x, z) [m], its centroid (2,), and the derivatives of the first three per unit of
+        ``parameter``: "gamma_left", "gamma_right" [per rad], "contact_height", "length" [per m]
+        (zeros for None)). The faces run from the apex down along each contact's xi, of height
+        h_C; the polygon's orientation and the faces' sense are fixed by the values (the
+        derivatives keep them)."""
+        angles = (gamma_left, gamma_right)
+        normals = [contact_normal(side, g) for side, g in zip(CONTACTS, angles)]
+        frames = np.array([contact_frame(n) for n in normals])
+        d_frames = np.zeros((2, 3, 3))
+        if parameter in ("gamma_left", "gamma_right"):
+            c = CONTACTS.index("OL" if parameter == "gamma_left" else "OR")
+            d_frames[c] = contact_frame_derivative(contact_normal_derivative(CONTACTS[c], angles[c]))
+        h = self.contact_height
+        d_h = 1.0 if parameter == "contact_height" else 0.0
+        d_length = 1.0 if parameter == "length" else 0.0
+        # faces run from the apex (origin) downwards along -xi_OL ... check: xi points down the face
+        sense = [-1.0 if h * frames[c, 0][2] > 0 else 1.0 for c in range(2)]      # make each face run down
+        ends = [sense[c] * h * frames[c, 0] for c in range(2)]
+        d_ends = [sense[c] * (d_h * frames[c, 0] + h * d_frames[c, 0]) for c in range(2)]
+        order = [0, 1, 2]
+        poly = np.array([[0.0, 0.0], [ends[1][0], ends[1][2]], [ends[0][0], ends[0][2]]])
+        d_poly = np.array([[0.0, 0.0], [d_ends[1][0], d_ends[1][2]], [d_ends[0][0], d_ends[0][2]]])
+        if (poly[1, 0] - poly[0, 0]) * (poly[2, 1] - poly[0, 1]) - (poly[2, 0] - poly[0, 0]) * (poly[1, 1] - poly[0, 1]) < 0:
+            order = [0, 2, 1]
+        poly, d_poly = poly[order], d_poly[order]
+        cg, M, d_cg, d_M = polygon_inertia(poly, self.mass, self.length, d_poly, d_length)
+        centres = np.array([np.array([e[0] / 2 - cg[0], 0.0, e[2] / 2 - cg[1]]) for e in ends])
+        d_centres = np.array([np.array([de[0] / 2 - d_cg[0], 0.0, de[2] / 2 - d_cg[1]]) for de in d_ends])
+        return frames, centres, M, poly, cg, d_frames, d_centres, d_M
+
+    def geometry_derivative(self, gamma_left: float, gamma_right: float, parameter: str):
+        """(d frames (2, 3, 3), d centres (2, 3) [m], d inertia (6, 6)) of :meth:`geometry` per unit
+        of ``parameter``: "gamma_left" or "gamma_right" [per rad], "contact_height" or "length"
+        [per m] (:meth:`section`). The contact patches' points move with the height and the
+        length too (:meth:`ContactPatch` xi, eta): :func:`bladedamp.diskmodel` differentiates them."""
+        if parameter not in ("gamma_left", "gamma_right", "contact_height", "length"):
+            raise ValueError(f"a wedge's geometry has no derivative in {parameter!r} "
+                             "(gamma_left, gamma_right, contact_height, length)")
+        return self.section(gamma_left, gamma_right, parameter)[5:]
