@@ -942,6 +942,7 @@ class PeakSensitivities(Saveable):
         ax.invert_yaxis()
         ax.axvline(0.0, color="0.4", lw=0.8)
         ax.set_xlabel("relative sensitivity  p / y  dy/dp  [-]")
+        ax.set_ylabel("design parameter p [-]")
         ax.set_title(f"peak {1e3 * self.peak_amplitude:.3g} mm at {self.peak_frequency_hz:.4g} Hz", fontsize="medium")
         ax.grid(axis="x", alpha=0.3)
         ax.legend(fontsize="small")

@@ -128,6 +128,19 @@ def test_monte_carlo_plot():
     check_figure(fig, None)
 
 
+
+def test_peak_sensitivities_plot():
+    """The bars of the peak's relative sensitivities (built by hand: no solve), the categorical
+    parameter axis labelled too; the title names the design once the caller adds it."""
+    from bladedamp.response import PeakSensitivities
+
+    peak = PeakSensitivities(("damper.mass_g", "damper.friction_coefficient", "disk.excitation_n_nm[0]"),
+                             ("g", "-", "N or N m"), np.array([1.0, 0.3, 0.1]), 4.9e-4, 95.3, 0,
+                             np.array([3.5e-6, 6.9e-6, 4.8e-3]), np.array([0.44, 1.6, -4.6]))
+    fig = peak.plot()
+    fig.suptitle("reference disk, 1 g cylinder")
+    check_figure(fig, "reference disk")
+
 # ---------------------------------------------------------------------------------------
 # the report's figures (bladedamp reproduce), written to files and checked as saved
 # ---------------------------------------------------------------------------------------
