@@ -33,6 +33,7 @@ from .hbm.newton import newton
 from .hbm.sensitivity import state_sensitivities
 from .io import Saveable
 from .measurement import as_measurement
+from .plotting import place_legend
 
 #: a direction of the scaled parameters whose singular value of J is below this fraction of the
 #: largest is not identified by the data (its estimate moves without changing the fit)
@@ -115,7 +116,8 @@ class ContactFit(Saveable):
 
     def plot(self, ax=None):
         """The measured responses (markers) and the model's at the estimate (lines) and at the
-        start (dashed), one colour per measurement, in one figure (mm); returns the figure."""
+        start (dashed), one colour per measurement, in one figure (mm, logarithmic: the levels'
+        responses differ by their forces); returns the figure."""
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -134,12 +136,13 @@ class ContactFit(Saveable):
                     label=f"fitted, {label}")
             ax.plot(f[order], 1e3 * np.abs(self.initial_fit[on])[order], "--", lw=0.8, color=f"C{l}", alpha=0.6,
                     label="start" if l == len(self.excitations) - 1 else None)
+        ax.set_yscale("log")                   # the levels' responses differ by their forces
         ax.set_xlabel("excitation frequency [Hz]")
         ax.set_ylabel("tip amplitude [mm]")
         ax.set_title("fit: " + ", ".join(f"{k.split('.')[-1]} = {v:.4g}" for k, v in zip(self.parameters, self.estimate)),
                      fontsize="medium")
         ax.grid(alpha=0.3)
-        ax.legend(fontsize="small", ncol=2)
+        place_legend(ax, fontsize="small", ncol=2)
         return fig
 
 
