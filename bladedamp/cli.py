@@ -470,7 +470,9 @@ def optimize_parameters(args, design, disk, t0) -> int:
     out = output_dir(output_folder(args), args.overwrite)
     progress = Progress()
     progress.compiling()
-    progress(f"lowest peak over {', '.join(keys)} (L-BFGS-B, analytic gradient, {args.starts} starts)")
+    if args.starts is not None and args.starts < 1:
+        raise UsageError(f"--starts {args.starts}: must be at least 1")
+    progress(f"lowest peak over {', '.join(keys)} (screening, then L-BFGS-B with the analytic gradient)")
     optimum = optimal_design(disk, keys, [bounds[k] for k in keys], a.f_range_hz, harmonics=a.study_harmonics,
                              n_starts=args.starts)
     gradient_optimize_outputs(out, design, optimum, a.study_harmonics)
@@ -959,8 +961,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--bound", nargs=3, action="append", metavar=("KEY", "LOW", "HIGH"),
                    help="with --parameters: the search range of one of them (default: mass_range_g for mass_g,\n"
                         "15-65 deg for the platform angles, 0.5-5 mm for cylinder_radius_mm, else -50 %%..+100 %%)")
-    p.add_argument("--starts", type=int, default=3,
-                   help="with --parameters: starting points (the design, then Sobol points in the box; default 3)")
+    p.add_argument("--starts", type=int, default=None,
+                   help="with --parameters: local searches, from the best of the design and 4 Sobol points per\n"
+                        "parameter in the box (default: one fewer than the parameters, at least one)")
     processes_arg(p)
     out_arg(p, "results/<design file name>/optimize")
     figure_args(p)

@@ -3,10 +3,13 @@
 The objective is the resonance peak of the tuned disk's tip amplitude in x over a frequency
 range; its gradient in the design-file keys comes with it from one frequency response
 (:meth:`~bladedamp.diskmodel.DiskModelResponse.peak_sensitivities`: the analytic dR/dp and the
-implicit function theorem). scipy's L-BFGS-B minimises it within bounds from several starts (the
-design's own values, then points of a scrambled Sobol sequence in the box, seeded): a damper's
-peak over its mass has one minimum, but over angles and masses together it need not. Parameters
-whose bounds span more than a decade (the mass) are searched in their logarithm.
+implicit function theorem). A damper's peak over its mass has one minimum, but over angles and
+masses together it need not (the reference cylinder over mass and gamma_L has one near 27 deg and
+a lower one on the bound 60 deg). So the search screens first: the peak at the design and at
+``n_screen`` points of a scrambled Sobol sequence in the box (seeded; 4 per parameter by
+default); then scipy's L-BFGS-B minimises within the bounds from the ``n_starts`` best of them
+(one fewer than the parameters, at least one).
+Parameters whose bounds span more than a decade (the mass) are searched in their logarithm.
 
 Each evaluation is one frequency response and its peak's derivatives; a design whose response
 fails or whose peak cannot be solved there (at an end of the range: the resonance left it) ends
@@ -25,9 +28,9 @@ from ..io import Saveable
 #: bounds whose ratio high / low exceeds this are searched in the logarithm of the parameter
 LOG_SCALE_RATIO = 10.0
 #: a start ends once an iteration lowers the peak by less than this [mm] (L-BFGS-B's ftol on the
-#: peak in mm): 0.1 um, below the harmonic balance's own accuracy of a peak (about 1 %); the AFT's
+#: peak in mm): 0.01 um, far below the harmonic balance's own accuracy of a peak (about 1 %); the AFT's
 #: kinks keep the gradient from vanishing, so the gradient test alone would not end a start
-PEAK_TOLERANCE_MM = 1e-4
+PEAK_TOLERANCE_MM = 1e-5
 
 
 @dataclass
@@ -42,8 +45,8 @@ class DesignOptimum(Saveable):
     d_peak_amplitude : (k,) the peak's derivatives at the optimum [m per unit] (zero in a
         direction where the optimum is interior; of the sign that leaves the box where on a bound)
     at_bound : (k,) whether each optimal value lies on its bound
-    starts : (s, k) the starting points; start_peaks : (s,) the peak each start ended on [m] (NaN:
-        it failed at once)
+    starts : (s, k) the local searches' starting points (the best screened); start_peaks : (s,) the
+        peak each ended on [m] (NaN: it failed)
     n_responses : frequency responses solved in all
     success, message : whether a start converged (the optimiser's test), and what happened
     """
@@ -139,33 +142,40 @@ def sobol_starts(bounds: np.ndarray, n: int, seed: int, log: np.ndarray) -> np.n
     return np.where(log, np.exp(np.log(low) + unit * (np.log(high) - np.log(low))), low + unit * (high - low))
 
 
-def optimal_design(disk, parameters, bounds, f_range_hz, harmonics=(1,), n_starts: int = 3, seed: int = 0,
-                   max_iterations: int = 25, **options) -> DesignOptimum:
-    """The lowest resonance peak of ``disk`` (a TunedDisk; its values the first start) over the
-    design-file keys ``parameters`` within ``bounds`` ((k, 2) [the keys' units]), by L-BFGS-B with
-    the analytic gradient from ``n_starts`` starts (the design, then Sobol points, ``seed``). Each
-    evaluation solves the frequency response over ``f_range_hz`` [Hz] with ``harmonics`` and
-    ``options`` (``frequency_response``'s) and its peak's derivatives. ``max_iterations`` per start.
-    ValueError for bad arguments or a design whose own peak cannot be solved."""
+def optimal_design(disk, parameters, bounds, f_range_hz, harmonics=(1,), n_starts: int | None = None,
+                   n_screen: int | None = None, seed: int = 0, max_iterations: int = 25, **options) -> DesignOptimum:
+    """The lowest resonance peak of ``disk`` (a TunedDisk) over the design-file keys ``parameters``
+    within ``bounds`` ((k, 2) [the keys' units]): the peak at the design and at ``n_screen`` Sobol
+    points (``seed``; default 4 k), then L-BFGS-B with the analytic gradient from the ``n_starts``
+    best of them (default k - 1, at least 1). Each evaluation solves the frequency response over ``f_range_hz``
+    [Hz] with ``harmonics`` and ``options`` (``frequency_response``'s) and its peak's derivatives.
+    ``max_iterations`` per start. ValueError for bad arguments or a design whose own peak cannot
+    be solved."""
     import scipy.optimize
 
     keys = tuple(str(p) for p in parameters)
     bounds = np.asarray(bounds, dtype=float).reshape(len(keys), 2)
     if not np.all(np.isfinite(bounds)) or np.any(bounds[:, 0] >= bounds[:, 1]):
         raise ValueError(f"bounds must be finite (low, high) pairs with low < high, one per parameter (got {bounds.tolist()})")
-    validation.integer("n_starts", n_starts, minimum=1)
+    n_starts = max(1, len(keys) - 1) if n_starts is None else validation.integer("n_starts", n_starts, minimum=1)
+    n_screen = 4 * len(keys) if n_screen is None else validation.integer("n_screen", n_screen, minimum=0)
     validation.integer("max_iterations", max_iterations, minimum=1)
     log = (bounds[:, 0] > 0) & (bounds[:, 1] / np.where(bounds[:, 0] > 0, bounds[:, 0], 1) > LOG_SCALE_RATIO)
     initial = np.array([disk.parameter_value(k) for k in keys])
     count = [0]
     cache = {}
 
-    def to_z(p):
-        p = np.clip(p, bounds[:, 0], bounds[:, 1])
+    def warp(p):                              # the logarithm of the wide-ranging parameters
         return np.where(log, np.log(np.where(log, p, 1.0)), p)
 
+    low, span = warp(bounds[:, 0]), warp(bounds[:, 1]) - warp(bounds[:, 0])
+
+    def to_z(p):                              # the box mapped to the unit cube: comparable variables
+        return (warp(np.clip(p, bounds[:, 0], bounds[:, 1])) - low) / span
+
     def to_p(z):
-        return np.where(log, np.exp(z), z)
+        w = low + span * np.asarray(z)
+        return np.where(log, np.exp(w), w)
 
     def peak(p):
         key = tuple(np.round(p, 14))
@@ -181,12 +191,18 @@ def optimal_design(disk, parameters, bounds, f_range_hz, harmonics=(1,), n_start
     def objective(z):
         p = to_p(z)
         result = peak(p)
-        dp_dz = np.where(log, p, 1.0)
+        dp_dz = np.where(log, p, 1.0) * span
         return 1e3 * result.peak_amplitude, 1e3 * result.d_peak_amplitude * dp_dz      # mm: a well-scaled value
 
     first = peak(np.clip(initial, bounds[:, 0], bounds[:, 1]))
-    starts = np.vstack([np.clip(initial, bounds[:, 0], bounds[:, 1]), sobol_starts(bounds, n_starts - 1, seed, log)])
-    z_bounds = list(zip(to_z(bounds[:, 0]), to_z(bounds[:, 1])))
+    screened = []
+    for point in np.vstack([np.clip(initial, bounds[:, 0], bounds[:, 1]), sobol_starts(bounds, n_screen, seed, log)]):
+        try:
+            screened.append((peak(point).peak_amplitude, tuple(point)))
+        except ValueError:                        # the response failed, or its peak left the range
+            continue
+    starts = np.array([p for _, p in sorted(screened)[:n_starts]])
+    z_bounds = [(0.0, 1.0)] * len(keys)
     best, start_peaks, converged, messages = None, [], False, []
     for start in starts:
         try:
