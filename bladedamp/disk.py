@@ -192,15 +192,15 @@ class TunedDisk(DiskModel):
                 static_stiffness[nm:, nm:] = DamperPosition.retention(geometry, static_retention)
 
         centrifugal = self._centrifugal_law() if self.has_damper and basis.has_static else None
+        j0 = basis.cos_index(0) * n + nm + 2 if centrifugal is not None else None   # F_CG's entry
+        dynamic = np.zeros(C * n)
+        dynamic[j1 * n:j1 * n + nm] = modal_force
 
         def excitation(omega):
-            f, df = np.zeros((C, n)), np.zeros((C, n))
-            f[j1, :nm] = modal_force
+            f, df = dynamic.copy(), np.zeros(C * n)
             if centrifugal is not None:
-                F, dF = centrifugal(omega)
-                f[basis.cos_index(0), nm + 2] = F       # radially outwards on the damper
-                df[basis.cos_index(0), nm + 2] = dF
-            return f.ravel(), df.ravel()
+                f[j0], df[j0] = centrifugal(omega)      # radially outwards on the damper
+            return f, df
 
         return HarmonicBalanceSystem(basis, M, D, K, excitation, couplings, static_stiffness)
 
@@ -274,7 +274,10 @@ class TunedDisk(DiskModel):
         ``(0, 1, 2, 3)`` is used as given, and its error estimate is reported. ``max_harmonic``
         caps the automatic choice (default 7: the smallest cap at which both reference disks meet
         1 %; the cost grows with the harmonics (benchmarks/README.md, 'Moved from the package's
-        docstrings', disk.py, 'max_harmonic'); a result above the tolerance says so).
+        docstrings', disk.py, 'max_harmonic'); a result above the tolerance says so). After a
+        complete branch above the tolerance, the sets that point solves at its checked points find
+        above it too are skipped (:func:`bladedamp.hbm.accuracy.predicted_set`): the answer is
+        the first set whose own branch meets the tolerance, as set by set, or a richer one.
         ``max_step`` is the largest arc-length step in scaled units (the frequency range is 1;
         smaller: more points). The result is ``success`` only if the branch reached the end and
         passed :func:`bladedamp.response.physical_checks` and
@@ -346,7 +349,7 @@ class TunedDisk(DiskModel):
                               lambda basis: self.amplitude_stop(basis, stop_above, stop_direction),
                               cpu_budget_s, point_budget, **continuation_options)
         response = peak_checked_response(self, model, solve, harmonics, harmonic_tolerance, max_harmonic,
-                                         estimate_harmonic_error, check_peak, can_check)
+                                         estimate_harmonic_error, check_peak, can_check, predict=True)
         return with_range_end_estimate(self, with_stop_check(self, response, f_start_hz, check_stop))
 
     # ----- the protocol of bladedamp.frf (the FRF driver) ----------------------------------

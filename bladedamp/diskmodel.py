@@ -919,8 +919,13 @@ class DamperPosition:
         return lambda omega: (c * omega ** 2, 2 * c * omega)
 
     def seated(self, omega: float) -> np.ndarray:
-        """(6,) the damper seated frictionlessly under F_CG at ``omega`` [rad/s] (``seat``)."""
-        return seat(self.damper_geometry(), self.centrifugal_force(omega)[0])[0]
+        """(6,) the damper seated frictionlessly under F_CG at ``omega`` [rad/s] (``seat``; the
+        geometry built once for these fields: every start and scale of a branch seats the damper)."""
+        key = (id(self.damper), self.gamma_left, self.gamma_right, id(self.initial_gaps))
+        cached = self.__dict__.get("_seat_geometry")
+        if cached is None or cached[0] != key:
+            cached = self.__dict__["_seat_geometry"] = (key, self.damper_geometry())
+        return seat(cached[1], self.centrifugal_force(omega)[0])[0]
 
     def contacts(self, geometry: DamperGeometry, approach, left: ModalBlade, right: ModalBlade):
         """(DamperContacts, G_D (12, 6), G_P (12, 12)) of the damper here between blade ``left``
@@ -1793,7 +1798,7 @@ def with_retention_check(model, response, limit: float = RETENTION_HELD_LIMIT):
 
 
 def peak_checked_response(model, system_model, solve, harmonics, tolerance: float, max_harmonic: int, estimate: bool,
-                          check_peak: bool, can_check: bool):
+                          check_peak: bool, can_check: bool, predict: bool = False):
     """The response of ``model.frequency_response`` (a :class:`TunedDisk` or
     :class:`~bladedamp.mistuned.MistunedDisk`) before its stop check: the branches of ``solve``
     with their harmonic error estimate (:func:`~bladedamp.hbm.accuracy.converged_response` on
@@ -1804,10 +1809,12 @@ def peak_checked_response(model, system_model, solve, harmonics, tolerance: floa
     AccuracyWarning, and an implausible amplitude (its status says so) has none; every other
     warning raised on the way is raised again at the caller of ``frequency_response``. A peak held
     by the static retention spring (:func:`with_retention_check`, where the time integration models
-    the disk: ``can_check``) is not verified, and its warning replaces the estimate's."""
+    the disk: ``can_check``) is not verified, and its warning replaces the estimate's. ``predict``:
+    the automatic choice skips the sets its point solves find above the tolerance
+    (:func:`~bladedamp.hbm.accuracy.predicted_set`)."""
     with warnings.catch_warnings(record=True) as raised:
         response = converged_response(system_model, solve, harmonics, tolerance, max_harmonic, estimate=estimate,
-                                      guard_stalls=True)
+                                      guard_stalls=True, predict=predict)
     response = with_amplitude_check(response, blade_span(model))
     if can_check:
         response = with_retention_check(model, response)

@@ -384,8 +384,9 @@ def test_a_budget_that_runs_out_on_a_richer_set_keeps_the_complete_branch_of_the
     partial one: where the budget runs out on the branch of a richer harmonic set, the answer is
     the poorer set's complete branch with its own error estimate, OUT_OF_BUDGET (the search
     stopped), the message naming the set that did not finish. The reference 1 g cylinder's (0, 1)
-    branch is above the 1 % tolerance (the automatic choice goes on to (0, 1, 2, 3)); a point
-    budget 10 points longer than that branch runs out on the (0, 1, 2, 3) branch."""
+    branch is above the 1 % tolerance (the automatic choice goes on: its prediction skips
+    (0, 1, 2, 3), whose points change by more than 1 % in (0, ..., 5)); a point budget 10 points
+    longer than that branch runs out on the (0, ..., 5) branch."""
     import bladedamp as bd
     from bladedamp.response import Status
 
@@ -400,7 +401,16 @@ def test_a_budget_that_runs_out_on_a_richer_set_keeps_the_complete_branch_of_the
     np.testing.assert_array_equal(r.coefficients, poorer.coefficients)
     assert r.harmonic_error == poorer.harmonic_error
     assert r.stopped_by.startswith("budget: ") and r.stopped_by in r.message
-    assert "harmonics (0, 1, 2, 3) stopped before the end of the range" in r.message
+    assert "harmonics (0, 1, 2, 3, 4, 5) stopped before the end of the range" in r.message
+
+
+def cut_at_half(r):
+    """The branch of response ``r`` cut at half its points: a branch that failed short of the end."""
+    from bladedamp.response import FrequencyResponse
+
+    k = len(r.omega) // 2
+    return FrequencyResponse(r.omega[:k], r.coefficients[:k], r.basis, r.dof_names, False,
+                             f"continuation did not converge after omega = {r.omega[k - 1]:.6g} rad/s")
 
 
 def test_a_richer_set_that_fails_short_of_the_end_ends_the_automatic_choice():
@@ -412,7 +422,7 @@ def test_a_richer_set_that_fails_short_of_the_end_ends_the_automatic_choice():
     its enriched set), the message naming the set that did not converge and where it stopped.
     The failure of (0, 1, 2, 3) is made here by cutting its real branch at half its points."""
     from bladedamp.hbm.accuracy import converged_response
-    from bladedamp.response import FrequencyResponse, Status
+    from bladedamp.response import Status
 
     osc = FrictionOscillator(**INCLINED)
     with warnings.catch_warnings():
@@ -424,12 +434,7 @@ def test_a_richer_set_that_fails_short_of_the_end_ends_the_automatic_choice():
 
     def solve(H):
         asked.append(H)
-        r = full[H]
-        if H == (0, 1):
-            return r
-        k = len(r.omega) // 2
-        return FrequencyResponse(r.omega[:k], r.coefficients[:k], r.basis, r.dof_names, False,
-                                 f"continuation did not converge after omega = {r.omega[k - 1]:.6g} rad/s")
+        return full[H] if H == (0, 1) else cut_at_half(full[H])
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -481,3 +486,55 @@ def test_the_richer_sets_branches_are_stall_guarded_for_the_disks_only(guard_sta
         converged_response(osc, solve, max_harmonic=3, guard_stalls=guard_stalls)
     assert "max_points" in ends[(0, 1)]
     assert ("stalled" in ends[(0, 1, 2, 3)]) == guard_stalls, ends
+
+
+def test_the_prediction_skips_only_sets_above_the_tolerance_and_keeps_the_answer():
+    """``converged_response(predict=True)`` (the tuned disk's automatic choice) computes fewer
+    branches than the set-by-set search and returns the same answer here: the issue's inclined
+    oscillator, whose (0, 1) branch is 2-3x off. Each set it skips, computed on its own, fails its
+    own estimate (the independent check of the prediction: the set-by-set search's own verdict)."""
+    from bladedamp.frf import branch_solver
+    from bladedamp.hbm.accuracy import HARMONIC_TOLERANCE, converged_response
+
+    osc = FrictionOscillator(**INCLINED)
+    solve = branch_solver(osc, *RANGE_HZ)
+    asked = {False: [], True: []}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = {p: converged_response(osc, lambda H, p=p: asked[p].append(H) or solve(H), max_harmonic=9, predict=p)
+             for p in (False, True)}
+        skipped = [H for H in asked[False] if H not in asked[True]]
+        own = {H: harmonic_error(osc, solve(H)).error for H in skipped}
+    assert set(asked[True]) < set(asked[False]) and skipped, asked      # the prediction saved a branch
+    assert all(e > HARMONIC_TOLERANCE for e in own.values()), own
+    assert r[True].basis.harmonics == r[False].basis.harmonics
+    np.testing.assert_array_equal(r[True].coefficients, r[False].coefficients)
+    assert r[True].harmonic_error == r[False].harmonic_error and r[True].message == r[False].message
+
+
+def test_a_predicted_set_that_fails_falls_back_on_the_skipped_sets():
+    """Where the set the prediction goes to does not reach the end of the range, the skipped sets
+    are computed in turn: the answer is the set-by-set search's (here the issue's inclined
+    oscillator, its branch of the predicted set cut at half its points as in
+    test_a_richer_set_that_fails_short_of_the_end_ends_the_automatic_choice)."""
+    from bladedamp.frf import branch_solver
+    from bladedamp.hbm.accuracy import converged_response
+
+    osc = FrictionOscillator(**INCLINED)
+    solve = branch_solver(osc, *RANGE_HZ)
+    asked = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        converged_response(osc, lambda H: asked.append(H) or solve(H), max_harmonic=9, predict=True)
+    predicted = asked[1]                          # the set computed after (0, 1)
+    assert predicted != (0, 1, 2, 3), asked       # the prediction skipped (0, 1, 2, 3)
+
+    def cut(H):
+        return cut_at_half(solve(H)) if H == predicted else solve(H)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = {p: converged_response(osc, cut, max_harmonic=9, predict=p) for p in (False, True)}
+    assert r[True].basis.harmonics == r[False].basis.harmonics
+    np.testing.assert_array_equal(r[True].coefficients, r[False].coefficients)
+    assert r[True].message == r[False].message

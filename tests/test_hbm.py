@@ -443,3 +443,22 @@ def test_chord_corrector_follows_the_same_branch():
     a_newton = np.abs(newton_branch.x).max(axis=1).max()
     a_chord = np.abs(chord_branch.x).max(axis=1).max()
     assert abs(a_chord / a_newton - 1) < 2e-2 and scale > 0
+
+
+def test_work_per_cycle_is_the_tensordot_of_its_definition():
+    """HarmonicBasis.work_per_cycle (its products written out for speed) equals, bit for bit, the
+    tensordot form of its definition, sum_c w_c F_c (D X)_c with w = 2 pi for the static term and
+    pi otherwise, for coefficient arrays of one, two and three axes, and that sum is the mean of
+    f dw/dtau over the samples times 2 pi (discrete Parseval)."""
+    rng = np.random.default_rng(1)
+    for harmonics in ((1,), (0, 1), (0, 1, 2, 3, 4, 5)):
+        basis = HarmonicBasis(harmonics)
+        C = basis.n_coeffs
+        weights = np.where(basis.order == 0, 2 * np.pi, np.pi)
+        for shape in ((C,), (C, 1), (C, 10), (C, 3, 12)):
+            F, X = rng.normal(size=shape), rng.normal(size=shape)
+            reference = np.tensordot(weights, F * np.tensordot(basis.derivative, X, axes=(1, 0)), axes=(0, 0))
+            work = basis.work_per_cycle(F, X)
+            assert np.shape(work) == np.shape(reference) and np.array_equal(work, reference), (harmonics, shape)
+            f, dx = basis.to_time(F), basis.to_time(basis.derivative @ X.reshape(C, -1)).reshape((-1,) + shape[1:])
+            np.testing.assert_allclose(work, 2 * np.pi * (f * dx).mean(axis=0), rtol=1e-12, atol=1e-12)

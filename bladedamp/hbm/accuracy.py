@@ -23,6 +23,10 @@ So every answer is checked against an enriched harmonic set:
   mean normal loads, which move when the normal loads vary (lift-off, inclined contacts).
   When no set meets the tolerance, the richest is returned and says so (``harmonics_converged``
   False, and the message).
+* **prediction** (:func:`predicted_set`, the tuned disk's choice): after a complete branch above
+  the tolerance, the richer sets are first solved at its checked points only, each lifted from
+  the last one's solutions there, and the sets whose points change by more than the tolerance
+  are not computed as branches; the first set without such a point is, and decides as above.
 
 A model takes part by giving ``hbm_system(harmonics, n_samples)``, ``output_amplitudes
 (coefficients, basis) -> (n, k)``, ``static_state(system, omega) -> x`` (rest, or the dampers
@@ -119,10 +123,10 @@ def lift(model, coefficients: np.ndarray, basis, system, omega: float) -> np.nda
     return X.ravel()
 
 
-def _enriched_amplitudes(model, coefficients, basis, system, omega, scales, tol):
-    """The first-harmonic output amplitudes (k,) of the solution of the enriched ``system`` at
-    ``omega`` [rad/s] from ``coefficients`` (C, n_dof) of ``basis`` lifted into it, or None if
-    neither the plain nor the damped Newton converges."""
+def enriched_solution(model, coefficients, basis, system, omega, scales, tol):
+    """The solution (C', n_dof) of the enriched ``system`` at ``omega`` [rad/s] from
+    ``coefficients`` (C, n_dof) of ``basis`` lifted into it, or None if neither the plain nor the
+    damped Newton converges."""
     x0 = lift(model, coefficients, basis, system, omega)
     rs = max(np.linalg.norm(system.residual(np.zeros_like(x0), omega, False)[0]), 1e-300)
     sol = newton(system.residual, x0, omega, scales, rs, tol=tol, max_iter=20, factorize=system.factorize)
@@ -133,42 +137,107 @@ def _enriched_amplitudes(model, coefficients, basis, system, omega, scales, tol)
         x, converged = sol.x, sol.converged
     if not converged:
         return None
-    return model.output_amplitudes(x.reshape(1, system.basis.n_coeffs, -1), system.basis)[0]
+    return x.reshape(system.basis.n_coeffs, -1)
+
+
+class EnrichedSet:
+    """Point solves of ``model`` in the harmonic set ``target`` (at least ``n_samples`` AFT
+    samples, the unknowns scaled over ``omega_range`` [rad/s]), each lifted from a solution of a
+    poorer set: :meth:`solve` (the one solver of the estimate and of the prediction)."""
+
+    def __init__(self, model, target, n_samples: int, omega_range, tol: float):
+        self.model, self.target, self.tol = model, tuple(target), tol
+        self.n_samples = max(HarmonicBasis(self.target).n_samples, int(n_samples))
+        self.system = model.hbm_system(self.target, self.n_samples)
+        self.scales = model.unknown_scales(self.system, *omega_range)
+        self.finer = None
+
+    def solve(self, coefficients, basis, omega: float):
+        """(solution (C', n_dof), its basis) of the enriched set at ``omega`` [rad/s] from
+        ``coefficients`` (C, n_dof) of ``basis``, or None where the Newton fails also with
+        :data:`ENRICHED_SAMPLES_GROWTH` x the samples."""
+        x = enriched_solution(self.model, coefficients, basis, self.system, omega, self.scales, self.tol)
+        if x is not None:
+            return x, self.system.basis
+        # Newton may fail on the AFT's sampling of a contact event (a lift-off instant between
+        # samples), not on the harmonics: once more with ENRICHED_SAMPLES_GROWTH x the samples
+        # (the change then includes the branch's own sampling error too)
+        if self.finer is None:
+            self.finer = self.model.hbm_system(self.target, ENRICHED_SAMPLES_GROWTH * self.n_samples)
+        x = enriched_solution(self.model, coefficients, basis, self.finer, omega, self.scales, self.tol)
+        return None if x is None else (x, self.finer.basis)
+
+    def amplitudes(self, solved) -> np.ndarray:
+        """The first-harmonic output amplitudes (k,) of a :meth:`solve` result."""
+        x, basis = solved
+        return self.model.output_amplitudes(x[None], basis)[0]
+
+
+def checked_solutions(model, response, harmonics=None, n_points: int = 5, tol: float = 1e-10):
+    """(:class:`HarmonicCheck`, the enriched solutions): :func:`harmonic_error` with, for each
+    checked point, the :meth:`EnrichedSet.solve` result (None where it failed)."""
+    basis = response.basis
+    target = tuple(harmonics) if harmonics is not None else enriched(basis.harmonics)
+    amp = model.output_amplitudes(response.coefficients, basis)          # (n, k)
+    idx = check_points(amp.max(axis=1) if amp.size else np.zeros(0), response.turning_points, n_points)
+    errors = np.full(idx.size, np.nan)
+    solutions = [None] * idx.size
+    if idx.size:
+        # the enriched set with at least the response's AFT samples (the sampling is not the
+        # question here: with fewer, a sampling error would pass for a harmonic one)
+        w = response.omega
+        richer = EnrichedSet(model, target, basis.n_samples, (float(w.min()), float(w.max())), tol)
+        peak = max(float(amp.max()), 1e-300)
+        for k, i in enumerate(idx):
+            solutions[k] = richer.solve(response.coefficients[i], basis, float(w[i]))
+            if solutions[k] is not None:
+                errors[k] = np.abs(richer.amplitudes(solutions[k]) - amp[i]).max() / peak
+    finite = errors[np.isfinite(errors)]
+    error = float(finite.max()) if finite.size and np.isfinite(errors[0]) else float("nan")
+    return HarmonicCheck(basis.harmonics, target, error, response.omega[idx], errors, idx), solutions
 
 
 @one_blas_thread
 def harmonic_error(model, response, harmonics=None, n_points: int = 5, tol: float = 1e-10) -> HarmonicCheck:
     """Error estimate of ``response`` (computed by ``model``) against the enriched set
     ``harmonics`` (default :func:`enriched` of the response's), see the module docstring."""
-    basis = response.basis
-    target = tuple(harmonics) if harmonics is not None else enriched(basis.harmonics)
-    amp = model.output_amplitudes(response.coefficients, basis)          # (n, k)
-    idx = check_points(amp.max(axis=1) if amp.size else np.zeros(0), response.turning_points, n_points)
-    errors = np.full(idx.size, np.nan)
-    if idx.size:
-        # the enriched set with at least the response's AFT samples (the sampling is not the
-        # question here: with fewer, a sampling error would pass for a harmonic one)
-        n_samples = max(HarmonicBasis(target).n_samples, basis.n_samples)
-        system = model.hbm_system(target, n_samples)
-        w = response.omega
-        scales = model.unknown_scales(system, float(w.min()), float(w.max()))
-        peak = max(float(amp.max()), 1e-300)
-        finer = None
-        for k, i in enumerate(idx):
-            a = _enriched_amplitudes(model, response.coefficients[i], basis, system, float(w[i]), scales, tol)
-            if a is None:
-                # Newton may fail on the AFT's sampling of a contact event (a lift-off instant
-                # between samples), not on the harmonics: once more
-                # with ENRICHED_SAMPLES_GROWTH x the samples (the change then includes the branch's
-                # own sampling error too)
-                if finer is None:
-                    finer = model.hbm_system(target, ENRICHED_SAMPLES_GROWTH * n_samples)
-                a = _enriched_amplitudes(model, response.coefficients[i], basis, finer, float(w[i]), scales, tol)
-            if a is not None:
-                errors[k] = np.abs(a - amp[i]).max() / peak
-    finite = errors[np.isfinite(errors)]
-    error = float(finite.max()) if finite.size and np.isfinite(errors[0]) else float("nan")
-    return HarmonicCheck(basis.harmonics, target, error, response.omega[idx], errors, idx)
+    return checked_solutions(model, response, harmonics, n_points, tol)[0]
+
+
+def predicted_set(model, response, check: HarmonicCheck, solutions, sets, tolerance: float,
+                  tol: float = 1e-10) -> int:
+    """The index in ``sets`` of the first set the automatic choice computes after ``response``'s
+    (the branch of ``sets[i]``; ``check`` its estimate against ``sets[i + 1]`` and ``solutions``
+    the enriched points of :func:`checked_solutions`). Instead of whole branches, the richer sets
+    are solved at those points only, each lifted from the previous set's solution there
+    (:class:`EnrichedSet`): a set is skipped where one of its points changes by more than
+    ``tolerance`` (relative to ``response``'s peak amplitude) in the next set, the points whose last
+    change was the largest solved first (one such point is enough). The first set without one is
+    computed, and its branch and its own estimate decide as for any set. A skipped set would fail
+    its own estimate at that frequency, so the prediction can make the answer richer than a
+    set-by-set search, not poorer."""
+    k = sets.index(tuple(response.basis.harmonics)) + 1
+    if k >= len(sets) or tuple(check.enriched) != sets[k]:
+        return k                      # solutions of another set than the next: nothing to lift on
+    amp = model.output_amplitudes(response.coefficients, response.basis)
+    peak = max(float(amp.max()), 1e-300)
+    omega_range = (float(response.omega.min()), float(response.omega.max()))
+    points = [(float(w), s, e) for w, s, e in zip(check.omega, solutions, check.errors) if s is not None]
+    while k < len(sets) - 1 and points:
+        richer = EnrichedSet(model, sets[k + 1], max(s[1].n_samples for _, s, _ in points), omega_range, tol)
+        changed, solved = False, []
+        for w, s, last in sorted(points, key=lambda p: -p[2]):
+            solution = richer.solve(s[0], s[1], w)
+            if solution is not None:
+                e = float(np.abs(richer.amplitudes(solution) - richer.amplitudes(s)).max() / peak)
+                solved.append((w, solution, e))
+                if e > tolerance:
+                    changed = True
+                    break
+        if not changed:
+            return k
+        k, points = k + 1, solved
+    return k
 
 
 def annotate(response, check: HarmonicCheck, tolerance: float):
@@ -196,7 +265,8 @@ def annotate(response, check: HarmonicCheck, tolerance: float):
 
 @one_blas_thread
 def converged_response(model, solve, harmonics="auto", tolerance: float = HARMONIC_TOLERANCE,
-                       max_harmonic: int = 3, n_points: int = 5, estimate: bool = True, guard_stalls: bool = False):
+                       max_harmonic: int = 3, n_points: int = 5, estimate: bool = True, guard_stalls: bool = False,
+                       predict: bool = False):
     """The branch of ``solve(harmonics) -> response`` with its harmonic error estimate.
 
     ``harmonics="auto"``: the sets of :func:`auto_sets` (``max_harmonic``) in turn until one meets
@@ -212,7 +282,12 @@ def converged_response(model, solve, harmonics="auto", tolerance: float = HARMON
     within :func:`~bladedamp.hbm.continuation.stall_guard` (a stalled branch ends early). Not for
     the oscillator: a lightly damped oscillator's richer branch may reach the end only past a
     stretch the guard ends (benchmarks/README.md, 'Moved from the package's docstrings',
-    accuracy.py)."""
+    accuracy.py).
+    ``predict`` (the tuned disk's): after a complete branch above the tolerance, the sets whose
+    points :func:`predicted_set` finds above it too are not computed (their branches cost about as
+    much as the answer's: benchmarks/README.md, 'Automatic harmonics at the cost of the answer');
+    where the first branch computed after a skip is not ``success`` (and no stop or budget ended
+    it), the skipped sets are computed in turn as without the prediction."""
     if isinstance(harmonics, str):
         if harmonics != "auto":
             raise ValueError(f"harmonics must be 'auto' or a tuple of integers >= 0 (got {harmonics!r})")
@@ -221,17 +296,23 @@ def converged_response(model, solve, harmonics="auto", tolerance: float = HARMON
                              "estimate_harmonic_error=True (or give the harmonics, e.g. (1,))")
         if not (np.isfinite(tolerance) and tolerance > 0):
             raise ValueError(f"harmonic_tolerance must be a finite number > 0 (got {tolerance!r})")
-        best = None
-        for H in auto_sets(max_harmonic):
+        sets = auto_sets(max_harmonic)
+        best, k, skipped, computed = None, 0, None, {}
+        while k < len(sets):
+            H = sets[k]
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", AccuracyWarning)
-                if guard_stalls and best is not None and best[0].success:
+                guarded = guard_stalls and best is not None and best[0].success
+                if (H, guarded) in computed:      # the set a skip went to, computed again after a fallback
+                    response = computed[H, guarded]
+                elif guarded:
                     # a poorer set's branch reached the end: a stalled branch of this set ends early
                     # (it could change the answer only by reaching the end)
                     with stall_guard():
                         response = solve(tuple(H))
                 else:
                     response = solve(tuple(H))
+                computed[H, guarded] = response
                 ran_out = response.stopped_by.startswith(BUDGET_PREFIX)
                 if response.stopped_by and best is not None and (not len(response.omega)
                                                                  or (ran_out and best[0].success)):
@@ -246,6 +327,10 @@ def converged_response(model, solve, harmonics="auto", tolerance: float = HARMON
                                      success=False, reached_end=kept.reached_range_end, stopped_by=response.stopped_by)
                 if response.stopped_by:
                     return response           # stopped as the caller asked: no estimate, no richer set
+                if skipped is not None and not response.success:
+                    # the set a skip went to failed: the skipped sets in turn, without prediction
+                    k, skipped, predict = skipped, None, False
+                    continue
                 if best is not None and best[0].success and not response.reached_range_end:
                     # a richer set whose every branch (both ends, retry, finer samples) failed short
                     # of the end where a poorer set's reached it: the richer sets after it are not
@@ -258,13 +343,22 @@ def converged_response(model, solve, harmonics="auto", tolerance: float = HARMON
                     return with_note(kept, Note(NoteKind.HARMONIC_SEARCH, (
                         f"harmonics {tuple(H)} did not converge to the end of the range ({where}), "
                         f"so no richer set was tried")))
-                check = harmonic_error(model, response, n_points=n_points) if len(response.omega) else None
+                check, solutions = None, None
+                if len(response.omega):
+                    if predict:
+                        check, solutions = checked_solutions(model, response, n_points=n_points)
+                    else:
+                        check = harmonic_error(model, response, n_points=n_points)
+            k, skipped = k + 1, None
             if check is None:
                 continue
             if response.success or best is None or not best[0].success:
                 best = (response, check)     # a complete branch is never replaced by a failed one
             if response.success and np.isfinite(check.error) and check.error <= tolerance:
                 break
+            if predict and response.success and k < len(sets):
+                ahead = predicted_set(model, response, check, solutions, sets, tolerance)
+                k, skipped = ahead, (k if ahead > k else None)
         if best is None:
             return response
         return annotate(best[0], best[1], tolerance)

@@ -73,6 +73,8 @@ class HarmonicBasis:
                 deriv[j, j + 1] = h      # a' = h b
                 deriv[j + 1, j] = -h     # b' = -h a
         object.__setattr__(self, "derivative", deriv)
+        # the first coefficient of each harmonic (cos_index, asked at every residual evaluation)
+        object.__setattr__(self, "_first_index", {h: int(np.flatnonzero(order == h)[0]) for h in harmonics})
 
     @property
     def n_coeffs(self) -> int:
@@ -89,8 +91,11 @@ class HarmonicBasis:
         return 2 * np.pi * np.arange(self.n_samples) / self.n_samples
 
     def cos_index(self, h: int) -> int:
-        """Index of the coefficient a_h (or c_0 for h = 0)."""
-        return int(np.flatnonzero(self.order == h)[0])
+        """Index of the coefficient a_h (or c_0 for h = 0); IndexError for a harmonic not in the basis."""
+        try:
+            return self._first_index[h]
+        except KeyError:
+            raise IndexError(f"harmonic {h!r} is not in the basis {self.harmonics}") from None
 
     # ----- signals -------------------------------------------------------------------
     def to_time(self, coeffs: np.ndarray) -> np.ndarray:
@@ -142,9 +147,14 @@ class HarmonicBasis:
         Both are coefficient arrays (C, ...); summed over the coefficient axis only.
         Exact for the sampled signals (discrete Parseval), so it is the energy the AFT sees.
         """
-        velocity = np.tensordot(self.derivative, displacement, axes=(1, 0))  # dw/dtau
+        # np.tensordot's own products (the same BLAS calls on the same 2-D views, without its
+        # Python set-up: a branch's energies evaluate this at every point)
+        displacement = np.asarray(displacement)
+        C = self.n_coeffs
+        velocity = np.dot(self.derivative, displacement.reshape(C, -1)).reshape(displacement.shape)  # dw/dtau
+        product = np.asarray(force) * velocity
         weights = np.where(self.order == 0, 2 * np.pi, np.pi)
-        return np.tensordot(weights, force * velocity, axes=(0, 0))
+        return np.dot(weights.reshape(1, C), product.reshape(C, -1)).reshape(product.shape[1:])
 
     def work_bound(self, force: np.ndarray, displacement: np.ndarray) -> np.ndarray:
         """The largest work per period that harmonics of these amplitudes can do, pi sum_h h
@@ -207,15 +217,34 @@ class HarmonicBasis:
         return kron(np.eye(C), stiffness), kron(np.diag(self.order.astype(float) ** 2), mass), \
             kron(self.derivative, damping)
 
-    def dynamic_stiffness(self, omega: float, mass, damping, stiffness, parts=None, derivative=True):
+    @staticmethod
+    def dynamic_stiffness_pattern(parts):
+        """``(flat indices, K_0, M_2, G at them)`` of the entries of :meth:`dynamic_stiffness_parts`
+        ``parts`` where any of them is nonzero (the harmonic blocks: A is block diagonal up to
+        the cos/sin pairs), for :meth:`dynamic_stiffness` to fill those alone."""
+        index = np.flatnonzero(np.logical_or.reduce([np.asarray(p) != 0 for p in parts]).ravel())
+        return (index,) + tuple(np.asarray(p).ravel()[index] for p in parts)
+
+    def dynamic_stiffness(self, omega: float, mass, damping, stiffness, parts=None, derivative=True, pattern=None):
         """Real-form dynamic stiffness and its derivative in omega.
 
         Harmonic h block: K - (h Omega)^2 M + i h Omega D (paper Eq. 5 in modal form).
-        ``parts``: :meth:`dynamic_stiffness_parts` of the same matrices if already built.
+        ``parts``: :meth:`dynamic_stiffness_parts` of the same matrices if already built;
+        ``pattern``: :meth:`dynamic_stiffness_pattern` of them (the same numbers, only the nonzero
+        entries computed: 4-5x fewer operations for a tuned sector).
         Returns ``(A, dA_domega)``, each (C*n, C*n) (``dA_domega`` None without ``derivative``).
         """
         stiffness_part, inertia, gyro = parts if parts is not None else \
             self.dynamic_stiffness_parts(mass, damping, stiffness)
+        if pattern is not None:
+            index, k0, m2, g = pattern
+            A = np.zeros(stiffness_part.shape)
+            A.reshape(-1)[index] = k0 - m2 * omega ** 2 + g * omega      # the operations below, in their order
+            if not derivative:
+                return A, None
+            dA = np.zeros(stiffness_part.shape)
+            dA.reshape(-1)[index] = -2 * omega * m2 + g
+            return A, dA
         # A = K_0 - Omega^2 M_2 + Omega G, the same operations in place (two arrays instead of four)
         A = np.multiply(inertia, omega ** 2)
         np.subtract(stiffness_part, A, out=A)

@@ -188,10 +188,11 @@ class HarmonicBalanceSystem:
         ``derivative``), or scipy.sparse for a sparse system."""
         if self.sparse:
             return self._sparse_dynamic_stiffness(omega)
-        if self._dense_parts is None:      # the Omega-independent parts, built once
-            self._dense_parts = self.basis.dynamic_stiffness_parts(self.mass, self.damping, self.stiffness)
-        A, dA = self.basis.dynamic_stiffness(omega, self.mass, self.damping, self.stiffness, self._dense_parts,
-                                             derivative)
+        if self._dense_parts is None:      # the Omega-independent parts and their nonzero pattern, built once
+            parts = self.basis.dynamic_stiffness_parts(self.mass, self.damping, self.stiffness)
+            self._dense_parts = (parts, self.basis.dynamic_stiffness_pattern(parts))
+        A, dA = self.basis.dynamic_stiffness(omega, self.mass, self.damping, self.stiffness, self._dense_parts[0],
+                                             derivative, self._dense_parts[1])
         if self.static_stiffness is not None and self.basis.has_static:
             n = self.n_dof
             j = self.basis.cos_index(0)
