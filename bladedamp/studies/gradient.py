@@ -28,9 +28,9 @@ from ..io import Saveable
 #: bounds whose ratio high / low exceeds this are searched in the logarithm of the parameter
 LOG_SCALE_RATIO = 10.0
 #: a start ends once an iteration lowers the peak by less than this [mm] (L-BFGS-B's ftol on the
-#: peak in mm): 0.01 um, far below the harmonic balance's own accuracy of a peak (about 1 %); the AFT's
+#: peak in mm): 0.1 um, below the harmonic balance's own accuracy of a peak (about 1 %); the AFT's
 #: kinks keep the gradient from vanishing, so the gradient test alone would not end a start
-PEAK_TOLERANCE_MM = 1e-5
+PEAK_TOLERANCE_MM = 1e-4
 
 
 @dataclass
