@@ -963,7 +963,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "15-65 deg for the platform angles, 0.5-5 mm for cylinder_radius_mm, else -50 %%..+100 %%)")
     p.add_argument("--starts", type=int, default=None,
                    help="with --parameters: local searches, from the best of the design and 4 Sobol points per\n"
-                        "parameter in the box (default: one fewer than the parameters, at least one)")
+                        "parameter in the box (default: one per parameter)")
     processes_arg(p)
     out_arg(p, "results/<design file name>/optimize")
     figure_args(p)
