@@ -98,6 +98,31 @@ def factorize(A):
     return DenseLU(A)
 
 
+# Dense or sparse Jacobian (HarmonicBalanceSystem.storage "auto"): sparse from SPARSE_MIN_UNKNOWNS
+# unknowns on where at most SPARSE_MAX_FILL of its entries are nonzero. The crossover of one Newton
+# iteration (residual with Jacobian, LU, solve; benchmarks/bench_sparse_crossover.py and
+# benchmarks/README.md, 'Dense or sparse Jacobian: the crossover'): rings of 2-64 sectors with point
+# contacts between them and the reference disk's full assembly turn from dense to sparse between
+# 170-280 unknowns (dense 1.7-2.8x faster) and 320-340 (equal to 1.7x slower); the LU alone of a
+# matrix of fill 0.375 is no faster sparse up to 2400 unknowns, one of fill 0.2 from 300 on.
+SPARSE_MIN_UNKNOWNS = 300
+SPARSE_MAX_FILL = 0.3
+
+
+def prefers_sparse(n_unknowns: int, nonzeros: int) -> bool:
+    """Whether a square Jacobian of ``n_unknowns`` rows with ``nonzeros`` nonzero entries is
+    assembled and factorised faster as a scipy.sparse matrix than as a dense one: at least
+    SPARSE_MIN_UNKNOWNS unknowns and a fill ``nonzeros / n_unknowns**2`` of at most
+    SPARSE_MAX_FILL (the measured crossover, see there). Raises ValueError for a negative
+    ``n_unknowns`` or ``nonzeros`` outside [0, n_unknowns**2]."""
+    n, nnz = int(n_unknowns), int(nonzeros)
+    if n < 0:
+        raise ValueError(f"n_unknowns must be >= 0 (got {n_unknowns})")
+    if not 0 <= nnz <= n * n:
+        raise ValueError(f"nonzeros must be in [0, n_unknowns**2] = [0, {n * n}] (got {nonzeros})")
+    return n >= SPARSE_MIN_UNKNOWNS and nnz <= SPARSE_MAX_FILL * n * n
+
+
 def solve(A, b):
     """Solve A y = b for a dense ndarray or a scipy.sparse matrix (sparse LU, COLAMD ordering)."""
     if sp.issparse(A):
