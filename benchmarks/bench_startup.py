@@ -27,6 +27,7 @@ import datetime
 import json
 import os
 import platform
+import resource
 import subprocess
 import sys
 import tempfile
@@ -53,9 +54,15 @@ PRECOMPILE = "import time; t = time.perf_counter(); import bladedamp; bladedamp.
              "print(time.perf_counter() - t)"
 
 
+CPU = []      # CPU time [s] (user + system) of each subprocess run, in order
+
+
 def run(code: str, cache: str, root: str = ROOT):
     env = dict(os.environ, NUMBA_CACHE_DIR=cache, PYTHONPATH=root)
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=tempfile.gettempdir())
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    CPU.append(after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime)
     if out.returncode:
         raise RuntimeError(out.stderr[-2000:])
     text = out.stdout.strip().splitlines()[-1]
@@ -68,7 +75,12 @@ def main(argv=None):
     parser.add_argument("--compare", metavar="CHECKOUT", default=None,
                         help="also the first call on an empty and on a filled cache of another checkout of "
                              "bladedamp (e.g. a git worktree of an earlier commit), in the same run")
+    parser.add_argument("--precompile-only", action="store_true",
+                        help="only `bladedamp.precompile()` on an empty cache (and in the --compare checkout, "
+                             "alternated), with the process's CPU time")
     args = parser.parse_args(argv)
+    if args.precompile_only:
+        return precompile_only(args)
     print(f"# bench_startup {datetime.datetime.now():%Y-%m-%d %H:%M}, {platform.processor() or platform.machine()}, "
           f"{os.cpu_count()} cores, load {os.getloadavg()[0]:.2f}")
     rows = {"import": [], "cold": [], "warm": [], "precompile": [], "after": []}
@@ -78,6 +90,7 @@ def main(argv=None):
             rows["cold"].append(run(FRF, cold))               # empty cache: compiles
             rows["warm"].append(run(FRF, cold))               # filled by the run before
             rows["precompile"].append(run(PRECOMPILE, pre))   # empty cache: compiles every kernel
+            rows.setdefault("precompile cpu", []).append(CPU[-1])
             rows["after"].append(run(FRF, pre))
         if args.compare:
             with tempfile.TemporaryDirectory() as other:
@@ -94,7 +107,8 @@ def main(argv=None):
     print(f"first call, filled cache                {warm:7.2f} s   = {warm / own:.2f} x")
     print(f"  compile cost of the first call        {cold - warm:7.2f} s")
     print(f"  load cost (cache, scipy, first use)   {warm - own:7.2f} s")
-    print(f"bladedamp.precompile(), empty cache     {min(rows['precompile']):7.2f} s")
+    print(f"bladedamp.precompile(), empty cache     {min(rows['precompile']):7.2f} s   "
+          f"({min(rows['precompile cpu']):.2f} s CPU, the whole process)")
     print(f"first call after precompile            {after:7.2f} s   = {after / own:.2f} x")
     if args.compare:
         o_cold = min(r["first"] for r in rows["other cold"])
@@ -102,6 +116,26 @@ def main(argv=None):
         o_own = min(r["second"] for r in rows["other warm"])
         print(f"{args.compare}: first call empty cache {o_cold:.2f} s, filled {o_warm:.2f} s, own cost {o_own:.2f} s; "
               f"compile cost {o_cold - o_warm:.2f} s against {cold - warm:.2f} s here")
+
+
+def precompile_only(args):
+    """`bladedamp.precompile()` on an empty cache, here and (alternated) in the --compare checkout:
+    wall time inside the process and the process's CPU time (import, compilation, the tiny runs)."""
+    print(f"# bench_startup --precompile-only {datetime.datetime.now():%Y-%m-%d %H:%M}, "
+          f"{os.cpu_count()} cores, uptime: {subprocess.run(['uptime'], capture_output=True, text=True).stdout.strip()}")
+    roots = [("this checkout", ROOT)] + ([("compare", args.compare)] if args.compare else [])
+    cpu = {name: [] for name, _ in roots}
+    for _ in range(args.repeat):
+        for name, root in roots:
+            with tempfile.TemporaryDirectory() as cache:
+                wall = run(PRECOMPILE, cache, root)
+            cpu[name].append(CPU[-1])
+            print(f"{name:14s} precompile, empty cache: {wall:6.2f} s wall, {CPU[-1]:6.2f} s CPU", flush=True)
+    for name, _ in roots:
+        print(f"{name:14s} best {min(cpu[name]):6.2f} s CPU, median {sorted(cpu[name])[len(cpu[name]) // 2]:6.2f} s")
+    if args.compare:
+        print(f"ratio this / compare (best CPU): {min(cpu['this checkout']) / min(cpu['compare']):.2f}")
+    print(f"# uptime at the end: {subprocess.run(['uptime'], capture_output=True, text=True).stdout.strip()}")
 
 
 if __name__ == "__main__":

@@ -23,10 +23,10 @@ import sys
 import time
 import warnings
 
-# [s] compiling every kernel on an empty cache, an upper bound of bladedamp.precompile()'s time
-# (benchmarks/README.md, "Start-up and the numba compile cost"); a command compiles the kernels
-# it uses, at most that
-COLD_COMPILE_SECONDS = 30
+# [s] CPU time of bladedamp.precompile() on an empty cache, about (49 s measured on the 2-core
+# machine, benchmarks/README.md, "`bladedamp precompile` from an empty cache (item 5)"); a command
+# compiles the kernels it uses, at most that
+COLD_COMPILE_SECONDS = 50
 
 
 def kernel_cache_folders() -> list[str]:
@@ -101,8 +101,8 @@ def _disk_paths():
         small().frequency_response(94.0, 94.2, harmonics=(1,), max_step=0.5)
     finally:
         AssemblySystem.dense_limit = dense_limit
-    for dtype in (np.int32, np.int64):          # scipy's sparse LU permutations, and numpy's
-        permutation_sign(np.arange(3, dtype=dtype))
+    # scipy's sparse LU permutations (int32) are passed as np.intp: one signature
+    permutation_sign(np.arange(3, dtype=np.intp))
 
 
 GROUPS = {"oscillator": _oscillator_paths, "disk": _disk_paths}

@@ -5,6 +5,7 @@ import warnings
 import numpy as np
 import pytest
 import scipy.optimize
+import scipy.sparse as sp
 from conftest import central_difference, duffing_jenkins_residual, relative_matrix_error
 
 from bladedamp import FrictionOscillator
@@ -462,3 +463,100 @@ def test_work_per_cycle_is_the_tensordot_of_its_definition():
             assert np.shape(work) == np.shape(reference) and np.array_equal(work, reference), (harmonics, shape)
             f, dx = basis.to_time(F), basis.to_time(basis.derivative @ X.reshape(C, -1)).reshape((-1,) + shape[1:])
             np.testing.assert_allclose(work, 2 * np.pi * (f * dx).mean(axis=0), rtol=1e-12, atol=1e-12)
+
+
+# ---------------------------------------------------------------------------------------
+# Dense or sparse Jacobian: the same numbers, chosen by size and fill (issue 37, item 4)
+# ---------------------------------------------------------------------------------------
+def point_contact_ring(n, harmonics=(0, 1, 2, 3), coupled_stiffness=0.0):
+    """A ring of ``n`` sectors of two 3D unit masses (springs 1e6 N/m in a chain from the ground),
+    each sector's outer mass tied to the next one's by a preloaded friction point contact, the
+    outer masses forced with engine order 1; ``coupled_stiffness`` [N/m] adds a spring of that
+    stiffness between every pair of DOFs (a full stiffness matrix). Matrices and contact map sparse."""
+    from bladedamp.contact.laws import LinearNormalLaw
+    from bladedamp.contact.point import PointContactElement
+    from bladedamp.hbm.system import HarmonicBalanceSystem
+
+    basis = HarmonicBasis(harmonics, 32)
+    C, N = basis.n_coeffs, 6 * n
+    K = sp.kron(sp.identity(n), sp.kron(sp.csr_matrix([[2e6, -1e6], [-1e6, 1e6]]), sp.identity(3)), format="csr")
+    if coupled_stiffness:
+        K = sp.csr_matrix(K + coupled_stiffness * (N * np.eye(N) - np.ones((N, N))))
+    M = sp.identity(N, format="csr")
+    outer = 6 * np.arange(n) + 3
+    rows = np.arange(3 * n)
+    T0 = sp.csr_matrix((np.r_[np.ones(3 * n), -np.ones(3 * n)],
+                        (np.r_[rows, rows], np.r_[np.roll(outer, -1).repeat(3) + np.tile(np.arange(3), n),
+                                                  outer.repeat(3) + np.tile(np.arange(3), n)])), shape=(3 * n, N))
+    f = np.zeros((C, N))
+    j = basis.cos_index(1)
+    f[j, outer], f[j + 1, outer] = np.cos(2 * np.pi * np.arange(n) / n), -np.sin(2 * np.pi * np.arange(n) / n)
+    element = PointContactElement(np.full(n, 1e5), 0.3, LinearNormalLaw(1e5), np.ones(n), np.full(n, 1e-5))
+    return HarmonicBalanceSystem(basis, M, 2.0 * M + 2e-6 * K, K, lambda w: (f.ravel(), np.zeros(C * N)),
+                                 [Coupling(element, sp.kron(sp.identity(C), T0, format="csr"), "ring")])
+
+
+def ring_state(system):
+    """A state where the ring's contacts stick, slip and (some) lift off: the linear response
+    near the first mode, scaled to 20 um."""
+    w = 0.9 * np.sqrt(1e6 * (3 - np.sqrt(5)) / 2)
+    x = system.linear_solution(w)
+    return x * 2e-5 / np.abs(x).max(), w
+
+
+def test_dense_and_sparse_assembly_give_the_same_residual_jacobian_and_step():
+    """storage "dense" and "sparse" of one system (336 unknowns): the residual, dR/domega and the
+    Jacobian differ only by the order of their sums, at most m u sum|terms| per entry, u = 2^-53
+    and m <= N + C n_local the terms of a sum; the Newton step by at most N u cond(J) relative
+    (backward-stable LU, growth factor 1: the bound of a first-order perturbation)."""
+    import dataclasses as dc
+
+    base = point_contact_ring(8)
+    x, w = ring_state(base)
+    dense, sparse = dc.replace(base, storage="dense"), dc.replace(base, storage="sparse")
+    Rd, Jd, Rwd = dense.residual(x, w)
+    Rs, Js, Rws = sparse.residual(x, w)
+    assert isinstance(Jd, np.ndarray) and sp.issparse(Js) and not dense.sparse and sparse.sparse
+    N, C = x.size, base.basis.n_coeffs
+    u, m = 2.0 ** -53, N + C * base.couplings[0].element.n_local
+    A, dA = dense.dynamic_stiffness(w)
+    T = np.abs(base.couplings[0].matrix.toarray())
+    force, jac, _ = base.couplings[0].element.harmonic_forces((base.couplings[0].matrix @ x).reshape(C, -1),
+                                                              base.basis, w)
+    f, _ = base.excitation(w)
+    scale_r = np.abs(A) @ np.abs(x) + np.abs(f) + T.T @ np.abs(force.ravel())
+    assert np.all(np.abs(Rd - Rs) <= m * u * scale_r)
+    assert np.all(np.abs(Rwd - Rws) <= m * u * (np.abs(dA) @ np.abs(x)))
+    scale_j = np.abs(A) + T.T @ np.abs(jac) @ T
+    assert np.all(np.abs(Jd - Js.toarray()) <= m * u * scale_j)
+    step_d, step_s = dense.factorize(Jd)(Rd), sparse.factorize(Js)(Rs)
+    bound = N * u * np.linalg.cond(Jd)
+    assert np.linalg.norm(step_d - step_s) <= bound * np.linalg.norm(step_d) + np.linalg.norm(np.linalg.solve(Jd, Rd - Rs))
+    assert bound < 1e-6, "the comparison says something"
+
+
+@pytest.mark.parametrize("n, coupled, expect_sparse", [(4, 0.0, False), (8, 0.0, True), (8, 1.0, False)],
+                         ids=["168 unknowns", "336 unknowns, fill 0.06", "336 unknowns, full stiffness"])
+def test_automatic_storage_follows_size_and_fill(n, coupled, expect_sparse):
+    """storage "auto" (the default): dense below SPARSE_MIN_UNKNOWNS whatever the matrices given
+    (here all sparse), sparse above it at a fill <= SPARSE_MAX_FILL, dense above that fill; the
+    Jacobian is then the one the chosen storage gives (the dense one identical, the sparse one the
+    same matrix)."""
+    import dataclasses as dc
+
+    from bladedamp.hbm import linsolve
+
+    auto = point_contact_ring(n, coupled_stiffness=coupled)
+    x, w = ring_state(auto)
+    assert auto.sparse, "before the first residual the given matrices' format"
+    R, J, Rw = auto.residual(x, w)
+    N = x.size
+    assert auto.sparse == expect_sparse == sp.issparse(J)
+    forced = dc.replace(auto, storage="sparse" if expect_sparse else "dense")
+    Rf, Jf, Rwf = forced.residual(x, w)
+    fill = (Jf.count_nonzero() if expect_sparse else np.count_nonzero(Jf)) / N ** 2
+    assert expect_sparse == (N >= linsolve.SPARSE_MIN_UNKNOWNS and fill <= linsolve.SPARSE_MAX_FILL)
+    assert np.array_equal(R, Rf) and np.array_equal(Rw, Rwf)
+    assert np.array_equal(J.toarray(), Jf.toarray()) if expect_sparse else np.array_equal(J, Jf)
+    R2, J2, _ = auto.residual(x, w)                       # the choice is kept
+    assert sp.issparse(J2) == expect_sparse and np.array_equal(R2, R)

@@ -150,3 +150,19 @@ def test_bordered_forms_the_indices_once_per_pattern():
         if M is other:
             assert A.indices is not previous.indices
         previous = A
+
+
+def test_prefers_sparse_at_the_measured_crossover():
+    """The dense / sparse choice: sparse exactly from SPARSE_MIN_UNKNOWNS unknowns at a fill of at
+    most SPARSE_MAX_FILL; a size or count out of range is a ValueError naming it."""
+    from bladedamp.hbm.linsolve import SPARSE_MAX_FILL, SPARSE_MIN_UNKNOWNS, prefers_sparse
+
+    n = SPARSE_MIN_UNKNOWNS
+    limit = int(SPARSE_MAX_FILL * n * n)
+    assert prefers_sparse(n, limit) and not prefers_sparse(n, limit + 1)
+    assert not prefers_sparse(n - 1, n - 1)                  # diagonal, but small
+    assert prefers_sparse(10 * n, 10 * n)
+    with pytest.raises(ValueError, match="n_unknowns"):
+        prefers_sparse(-1, 0)
+    with pytest.raises(ValueError, match="nonzeros"):
+        prefers_sparse(n, n * n + 1)

@@ -188,7 +188,8 @@ def test_jacobian_against_finite_differences_and_generic_assembly():
     s = md.hbm_system()
     assert s.basis.n_samples == 64 and s.couplings[0].element.grid_rotations(s.basis) is not None
     R, J, Rw = s.residual(x, w)
-    generic = HarmonicBalanceSystem(s.basis, s.mass, s.damping, s.stiffness, s.excitation, s.couplings)
+    generic = HarmonicBalanceSystem(s.basis, s.mass, s.damping, s.stiffness, s.excitation, s.couplings,
+                                    storage="sparse")
     Rg, Jg, Rwg = generic.residual(x, w)
     assert np.abs(R - Rg).max() <= 1e-12 * np.abs(R).max() + 1e-12 * np.abs(s.excitation(w)[0]).max()
     assert isinstance(J, np.ndarray), "a small assembly returns a dense Jacobian"

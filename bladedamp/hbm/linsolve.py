@@ -98,6 +98,31 @@ def factorize(A):
     return DenseLU(A)
 
 
+# Dense or sparse Jacobian (HarmonicBalanceSystem.storage "auto"): sparse from SPARSE_MIN_UNKNOWNS
+# unknowns on where at most SPARSE_MAX_FILL of its entries are nonzero. The crossover of one Newton
+# iteration (residual with Jacobian, LU, solve; benchmarks/bench_sparse_crossover.py and
+# benchmarks/README.md, 'Dense or sparse Jacobian: the crossover'): rings of 2-64 sectors with point
+# contacts between them and the reference disk's full assembly turn from dense to sparse between
+# 170-280 unknowns (dense 1.7-2.8x faster) and 320-340 (equal to 1.7x slower); the LU alone of a
+# matrix of fill 0.375 is no faster sparse up to 2400 unknowns, one of fill 0.2 from 300 on.
+SPARSE_MIN_UNKNOWNS = 300
+SPARSE_MAX_FILL = 0.3
+
+
+def prefers_sparse(n_unknowns: int, nonzeros: int) -> bool:
+    """Whether a square Jacobian of ``n_unknowns`` rows with ``nonzeros`` nonzero entries is
+    assembled and factorised faster as a scipy.sparse matrix than as a dense one: at least
+    SPARSE_MIN_UNKNOWNS unknowns and a fill ``nonzeros / n_unknowns**2`` of at most
+    SPARSE_MAX_FILL (the measured crossover, see there). Raises ValueError for a negative
+    ``n_unknowns`` or ``nonzeros`` outside [0, n_unknowns**2]."""
+    n, nnz = int(n_unknowns), int(nonzeros)
+    if n < 0:
+        raise ValueError(f"n_unknowns must be >= 0 (got {n_unknowns})")
+    if not 0 <= nnz <= n * n:
+        raise ValueError(f"nonzeros must be in [0, n_unknowns**2] = [0, {n * n}] (got {nonzeros})")
+    return n >= SPARSE_MIN_UNKNOWNS and nnz <= SPARSE_MAX_FILL * n * n
+
+
 def solve(A, b):
     """Solve A y = b for a dense ndarray or a scipy.sparse matrix (sparse LU, COLAMD ordering)."""
     if sp.issparse(A):
@@ -309,7 +334,8 @@ def _lu_signed(A):
 
     def solve(b):
         return lu.solve(np.asarray(b, dtype=float))
-    solve.sign = int(np.prod(np.sign(d)) * permutation_sign(lu.perm_r) * permutation_sign(lu.perm_c))
+    solve.sign = int(np.prod(np.sign(d)) * permutation_sign(lu.perm_r.astype(np.intp)) *
+                     permutation_sign(lu.perm_c.astype(np.intp)))
     solve.logabsdet = float(np.sum(np.log(np.abs(d))))
     solve.method = "lu"
     return solve
@@ -317,7 +343,8 @@ def _lu_signed(A):
 
 @njit(cache=True)
 def permutation_sign(perm) -> int:
-    """Sign (+1 / -1) of the permutation ``perm`` (an arrangement of 0..n-1), by its cycles."""
+    """Sign (+1 / -1) of the permutation ``perm`` (an arrangement of 0..n-1), by its cycles. The
+    package passes np.intp arrays (one compiled signature; scipy's LU permutations are int32)."""
     n = perm.size
     seen = np.zeros(n, dtype=np.bool_)
     sign = 1
@@ -591,6 +618,16 @@ def _ring_gather_csc(data, indices, indptr, owner, local, links, D, Up, Lo, col,
 
 
 @njit(cache=True)
+def copy_matrix(source, target):
+    """target[:, :] = source (2D, the same shape, not checked) by explicit loops: numba's array
+    assignment compiles a shape check whose error message (string formatting) cost about 5 s of
+    CPU time on a cold cache (benchmarks/README.md, 'Start-up and the numba compile cost')."""
+    for i in range(source.shape[0]):
+        for j in range(source.shape[1]):
+            target[i, j] = source[i, j]
+
+
+@njit(cache=True)
 def mm_subtract(A, B, C):
     """C -= A @ B (2D, in place; C shares no memory with A or B). Each C[i, j] has a_il b_lj
     subtracted in the order of l; with one column (the solves' right-hand sides) in a register
@@ -751,7 +788,7 @@ def _ring_condense(Aqq, Aqc, Acq, links, D, Up, Lo, col, row, qpiv, X):
         sign *= s
         logdet += l
         worst = max(worst, norm * _inverse_norm1(Aqq[j], qpiv[j]))
-        X[j] = Aqc[j]
+        copy_matrix(Aqc[j], X[j])
         lu_solve_inplace(Aqq[j], qpiv[j], X[j])
         S[:] = 0.0
         mm_subtract(Acq[j], X[j], S)                 # S = -Acq X
@@ -802,7 +839,7 @@ def _ring_factor(D, Up, Lo, col, row, corner, P, ppiv, X, Y, F, Z, zpiv):
         for i in range(b):
             E[i, b] = col[k, i]
             Fk[b, i] = row[k, i]
-        Pk[:] = D[k]
+        copy_matrix(D[k], Pk)
         if k > 0:
             mm_subtract(Lo[k - 1], X[k - 1], Pk)
             mm_subtract(Lo[k - 1], Y[k - 1], E)
@@ -815,7 +852,7 @@ def _ring_factor(D, Up, Lo, col, row, corner, P, ppiv, X, Y, F, Z, zpiv):
         worst = max(worst, norm * _inverse_norm1(Pk, ppiv[k]))
         lu_solve_inplace(Pk, ppiv[k], E)                   # Y[k] = P_k^-1 E_k
         if k < n - 2:
-            X[k] = Up[k]
+            copy_matrix(Up[k], X[k])
             lu_solve_inplace(Pk, ppiv[k], X[k])
         mm_subtract(Fk, E, Z)
     s, l, _ = lu_factor_inplace(Z, zpiv)

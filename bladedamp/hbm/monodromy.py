@@ -226,9 +226,15 @@ def disk_period_map(states, steps, dt, n_q, m_q, c_q, k_q, minv, f_static, f_cos
         disk_period(steps, dt, n_q, m_q, c_q, k_q, minv, f_static, f_cos, f_sin, Tb, idx, pt_local, B, k_t, mu,
                     weight, offset, law_kind, law_par, t_nnz, t_col, b_nnz, b_col, tip, x, x_prev, slider,
                     tip_samples, tip_dft, damper_mean, damper_dft, damper_work, point_states, energies)
-        out[b, :N] = x
-        out[b, N:2 * N] = x_prev
-        out[b, 2 * N:] = slider.ravel()
+        # element by element: an array assignment compiles numba's shape check and its error
+        # message (about 4 s of a cold cache's CPU time; benchmarks/README.md, 'Start-up and the
+        # numba compile cost')
+        for i in range(N):
+            out[b, i] = x[i]
+            out[b, N + i] = x_prev[i]
+        for p in range(P):
+            out[b, 2 * N + 2 * p] = slider[p, 0]
+            out[b, 2 * N + 2 * p + 1] = slider[p, 1]
     return out
 
 

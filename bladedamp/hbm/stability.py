@@ -163,7 +163,7 @@ def determinant_sign(A) -> int:
         diag = lu.U.diagonal()
         sign = np.prod(np.sign(diag))
         for perm in (lu.perm_r, lu.perm_c):
-            sign *= permutation_sign(perm)
+            sign *= permutation_sign(perm.astype(np.intp))
         return int(sign)
     sign, _ = np.linalg.slogdet(np.asarray(A))
     return int(np.sign(sign))

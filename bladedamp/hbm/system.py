@@ -19,6 +19,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .fourier import HarmonicBasis
+from .linsolve import SPARSE_MIN_UNKNOWNS, prefers_sparse
 from .linsolve import factorize as lu_factorize
 
 
@@ -126,6 +127,16 @@ class HarmonicBalanceSystem:
     couplings : nonlinear elements with their maps
     static_stiffness : optional (n, n) stiffness acting on the static harmonic only (e.g. to fix
         a position that nothing else fixes statically) [N/m]
+    storage : "auto" (default), "dense" or "sparse": how the Jacobian is assembled and
+        factorised, whatever the format (ndarray or scipy.sparse) of the matrices given. "auto"
+        chooses by size and fill (:func:`~bladedamp.hbm.linsolve.prefers_sparse`): dense below
+        SPARSE_MIN_UNKNOWNS unknowns (decided at the first residual); from there on the first
+        Jacobian is assembled sparse and its count of nonzero entries decides, once, for every
+        later evaluation (above SPARSE_MAX_FILL dense, that first evaluation repeated densely).
+        Until the choice is made :attr:`sparse` follows the matrices given.
+
+    A dense and a sparse assembly of the same system give the same residual and Jacobian to
+    rounding.
     """
 
     basis: HarmonicBasis
@@ -135,14 +146,38 @@ class HarmonicBalanceSystem:
     excitation: Callable[[float], tuple[np.ndarray, np.ndarray]]
     couplings: list[Coupling] = field(default_factory=list)
     static_stiffness: np.ndarray | None = None
+    storage: str = "auto"
     _sparse_parts: tuple | None = field(default=None, init=False, repr=False)
     _dense_parts: tuple | None = field(default=None, init=False, repr=False)
+    _sparse_choice: bool | None = field(default=None, init=False, repr=False)
+    _assembly_couplings: dict = field(default_factory=dict, init=False, repr=False, compare=False)
+
+    _storages = ("auto", "dense", "sparse")
 
     @property
     def sparse(self) -> bool:
-        """Whether the system is assembled with scipy.sparse matrices."""
+        """Whether the Jacobian is assembled with scipy.sparse matrices: as :attr:`storage` says;
+        for "auto" the choice once made (at the first residual), before it whether any of the
+        matrices given is sparse. Raises ValueError for a storage other than "auto", "dense",
+        "sparse"."""
+        if self.storage not in self._storages:
+            raise ValueError(f"storage must be one of {self._storages} (got {self.storage!r})")
+        if self.storage != "auto":
+            return self.storage == "sparse"
+        if self._sparse_choice is not None:
+            return self._sparse_choice
         return any(sp.issparse(m) for m in (self.mass, self.damping, self.stiffness)) or \
             any(sp.issparse(c.matrix) for c in self.couplings)
+
+    def _assembled_couplings(self, sparse: bool) -> list:
+        """The couplings with their maps in the assembly's format (scipy CSR for a sparse one,
+        ndarray for a dense one), converted once; the same objects where they already are."""
+        if sparse not in self._assembly_couplings:
+            self._assembly_couplings[sparse] = [
+                c if sp.issparse(c.matrix) == sparse else
+                Coupling(c.element, sp.csr_matrix(c.matrix) if sparse else c.matrix.toarray(), c.name)
+                for c in self.couplings]
+        return self._assembly_couplings[sparse]
 
     @property
     def n_dof(self) -> int:
@@ -179,6 +214,7 @@ class HarmonicBalanceSystem:
         other = copy.copy(self)
         other.damping, other.stiffness = damping, stiffness
         other._sparse_parts = other._dense_parts = None
+        other._assembly_couplings = dict(self._assembly_couplings)
         return other
 
     def dynamic_stiffness(self, omega: float, derivative: bool = True):
@@ -186,17 +222,21 @@ class HarmonicBalanceSystem:
         harmonic dynamic stiffness of M, D, K with the static stiffness on the static harmonic;
         dense (C*n, C*n) ndarrays (new arrays at each call; dA/domega None without
         ``derivative``), or scipy.sparse for a sparse system."""
-        if self.sparse:
+        return self._dynamic_stiffness(omega, derivative, self.sparse)
+
+    def _dynamic_stiffness(self, omega, derivative, sparse):
+        """:meth:`dynamic_stiffness` assembled sparse or dense (``sparse``)."""
+        if sparse:
             return self._sparse_dynamic_stiffness(omega)
         if self._dense_parts is None:      # the Omega-independent parts and their nonzero pattern, built once
-            parts = self.basis.dynamic_stiffness_parts(self.mass, self.damping, self.stiffness)
+            parts = self.basis.dynamic_stiffness_parts(*(_dense(m) for m in (self.mass, self.damping, self.stiffness)))
             self._dense_parts = (parts, self.basis.dynamic_stiffness_pattern(parts))
-        A, dA = self.basis.dynamic_stiffness(omega, self.mass, self.damping, self.stiffness, self._dense_parts[0],
-                                             derivative, self._dense_parts[1])
+        A, dA = self.basis.dynamic_stiffness(omega, None, None, None, self._dense_parts[0], derivative,
+                                             self._dense_parts[1])
         if self.static_stiffness is not None and self.basis.has_static:
             n = self.n_dof
             j = self.basis.cos_index(0)
-            A[j * n:(j + 1) * n, j * n:(j + 1) * n] += self.static_stiffness
+            A[j * n:(j + 1) * n, j * n:(j + 1) * n] += _dense(self.static_stiffness)
         return A, dA
 
     def linear_solution(self, omega: float) -> np.ndarray:
@@ -226,16 +266,27 @@ class HarmonicBalanceSystem:
         return lu_factorize(A)
 
     def residual(self, x: np.ndarray, omega: float, jacobian: bool = True):
-        """``(R, dR/dx, dR/domega)``; the last two are None when ``jacobian`` is False."""
+        """``(R, dR/dx, dR/domega)``; the last two are None when ``jacobian`` is False. The
+        Jacobian is a dense ndarray or a scipy CSC matrix as :attr:`sparse` says (for
+        :attr:`storage` "auto" chosen here, see the class)."""
         basis = self.basis
         C = basis.n_coeffs
-        A, dA = self.dynamic_stiffness(omega, jacobian)
+        sparse = self.sparse
+        choosing = self.storage == "auto" and self._sparse_choice is None
+        if choosing:
+            if self.n_unknowns < SPARSE_MIN_UNKNOWNS:
+                self._sparse_choice = sparse = False
+                choosing = False
+            elif not jacobian:
+                choosing = False            # decided by the first Jacobian; until then as given
+            else:
+                sparse = True               # assembled sparse, its nonzeros counted below
+        A, dA = self._dynamic_stiffness(omega, jacobian, sparse)
         f, df = self.excitation(omega)
         R = A @ x - f
-        sparse = sp.issparse(A)
         J = (A.copy() if sparse else A) if jacobian else None       # dense A is new at each call: J grows in it
         Rw = dA @ x - df if jacobian else None
-        for c in self.couplings:
+        for c in self._assembled_couplings(sparse):
             local = (c.matrix @ x).reshape(C, c.element.n_local)
             force, jac, domega = c.element.harmonic_forces(local, basis, omega, jacobian)
             c.add_forces(R, force.ravel())
@@ -245,6 +296,10 @@ class HarmonicBalanceSystem:
                     c.add_forces(Rw, domega)
         if sparse and jacobian:
             J = J.tocsc()
+        if choosing:
+            self._sparse_choice = prefers_sparse(J.shape[0], J.count_nonzero())
+            if not self._sparse_choice:
+                return self.residual(x, omega, jacobian)          # this evaluation again, dense
         return R, J, Rw
 
     def excitation_work(self, x: np.ndarray, omega: float) -> float:
@@ -310,6 +365,11 @@ def linear_forces(basis: HarmonicBasis, x: np.ndarray, omega: float, mass=None, 
     return out.ravel()
 
 
+def _dense(matrix):
+    """An ndarray of ``matrix`` (a scipy.sparse matrix is converted)."""
+    return matrix.toarray() if sp.issparse(matrix) else matrix
+
+
 def with_element(system: HarmonicBalanceSystem, element: NonlinearElement, matrix, name: str = "") -> HarmonicBalanceSystem:
     """``system`` with ``element`` added through the real-form map ``matrix`` (see
     :meth:`HarmonicBalanceSystem.add`); ``system`` itself is not changed."""
@@ -327,4 +387,5 @@ def with_element(system: HarmonicBalanceSystem, element: NonlinearElement, matri
                          f"{shape} for this system (C = {C} coefficients, n_local = {n_local}, "
                          f"n_dof = {system.n_dof}); got {matrix.shape}")
     return HarmonicBalanceSystem(system.basis, system.mass, system.damping, system.stiffness, system.excitation,
-                                 list(system.couplings) + [Coupling(element, matrix, name)], system.static_stiffness)
+                                 list(system.couplings) + [Coupling(element, matrix, name)], system.static_stiffness,
+                                 system.storage)
