@@ -93,8 +93,8 @@ def branch_solver(model: FrequencyResponseModel, f_start_hz: float, f_end_hz: fl
     :func:`~bladedamp.hbm.continuation.continuation`; ``cpu_budget_s`` [s] and ``point_budget``
     are the whole analysis' (:class:`~bladedamp.hbm.continuation.Budget`, shared by every
     ``solve``). The robust start is not begun once the budget has run out, nor any further solve
-    of it (the continuation then keeps no point and says so), and the start at the end of the range is computed once for a
-    branch and its retry."""
+    of it (the continuation then keeps no point and says so), and the start at the end of the
+    range is computed once for a branch and its retry."""
     w0, w1 = checked_range(model, f_start_hz, f_end_hz)
     if stop_when_for is not None and continuation_options.get("stop_when") is not None:
         raise ValueError("give stop_when or the model's own stop (stop_above), not both")

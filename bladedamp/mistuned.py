@@ -291,9 +291,9 @@ class AssemblySystem(HarmonicBalanceSystem):
         (:func:`_linear_residual`, :func:`_csr_matvec_add`, :func:`_jacobian_values`) in the
         order of the scipy / numpy operations they replaced, so R and dR/domega are the same
         numbers (tested); the Jacobian's contact part T^T J_c T by :func:`_project_blocks`, equal to
-        the dense products to rounding (tested against their bound). The sparse Jacobian is a copy of one template matrix (:attr:`jacobian_template`)
-        holding the new values: every Jacobian of the system shares the template's index arrays
-        (do not change them in place; :func:`~bladedamp.hbm.continuation.bordered_matrix` relies on
+        the dense products to rounding (tested against their bound). The sparse Jacobian is a
+        copy of one template matrix (:attr:`jacobian_template`) holding the new values: every
+        Jacobian of the system shares the template's index arrays (do not change them in place; :func:`~bladedamp.hbm.continuation.bordered_matrix` relies on
         them to reuse its bordered pattern; timings: benchmarks/README.md, 'Moved from the
         package's docstrings', mistuned.py)."""
         if self.couplings and self.contact_blocks is None:

@@ -77,8 +77,9 @@ def bordered_matrix(J, column, row, column_scale, factor):
         pattern = _bordered_pattern(n, J.indices, J.indptr)
         start = pattern.start
         out = np.empty(start + n + 1)
-        bordered_columns(np.asarray(J.data, dtype=float), J.indptr, np.ascontiguousarray(column_scale * factor, dtype=float),
-                         np.ascontiguousarray(row, dtype=float), out)
+        bordered_columns(np.asarray(J.data, dtype=float), J.indptr,
+                         np.ascontiguousarray(column_scale * factor, dtype=float), np.ascontiguousarray(row, dtype=float),
+                         out)
         out[start:start + n] = column * factor
         out[-1] = row[n]
         bordered = copy.copy(pattern.matrix)
