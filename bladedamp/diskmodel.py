@@ -958,15 +958,17 @@ class DamperPosition:
             return lambda omega: (rest, zero)
         if np.any(gaps != 0):
             # a misfit: the seating is not homogeneous in F_CG; seat at each load, d/dF by central
-            # differences of the (smooth away from touch-down) seating
+            # differences of the (smooth away from touch-down) seating; F_CG's law validated once, here
             cache = {}
+            centrifugal = self.centrifugal_law()
 
             def approach(omega):
                 if omega not in cache:
-                    F, dF = self.centrifugal_force(omega)
-                    a = seat(geometry, F)[1]
+                    F, dF = centrifugal(omega)          # F >= 0: the law's constant is validated
+                    a = seat(geometry, F, validate=False)[1]
                     h = 1e-6 * max(F, 1e-12)
-                    da = (seat(geometry, F + h)[1] - seat(geometry, max(F - h, 0.0))[1]) / (F + h - max(F - h, 0.0))
+                    da = (seat(geometry, F + h, validate=False)[1]
+                          - seat(geometry, max(F - h, 0.0), validate=False)[1]) / (F + h - max(F - h, 0.0))
                     cache.clear()
                     cache[omega] = (a, da * dF)
                 return cache[omega]
@@ -1153,7 +1155,8 @@ class DiskModel:
         R, J, _ = system.residual(x, omega)
         return x - system.factorize(J)(R)
 
-    def start_solution(self, system: HarmonicBalanceSystem, omega: float, scales, tol: float = 1e-10) -> np.ndarray:
+    def start_solution(self, system: HarmonicBalanceSystem, omega: float, scales, tol: float = 1e-10,
+                       out_of_time=None) -> np.ndarray:
         """Solution (C * n_dof,) of ``system`` at the first frequency ``omega`` [rad/s], robust in
         gross slip (:func:`bladedamp.hbm.start.robust_start`); ``scales`` (C * n_dof,) from
         :meth:`unknown_scales`.
@@ -1161,7 +1164,8 @@ class DiskModel:
         Damped Newton from the stuck linear solution; if that fails (a light damper sliding far
         from its stuck state), an excitation homotopy on the dynamic excitation (the centrifugal
         preload stays), from the seated dampers. Returns the best iterate (the continuation then
-        reports honestly if it is not a solution)."""
+        reports honestly if it is not a solution). ``out_of_time``: None or () -> bool (the
+        analysis' budget), asked before each solve of the start (``robust_start``)."""
         f = system.excitation(omega)[0].reshape(system.basis.n_coeffs, system.n_dof).copy()
         if system.basis.has_static:
             f[system.basis.cos_index(0)] = 0.0          # the preload is not ramped
@@ -1169,7 +1173,7 @@ class DiskModel:
         residual_scale = max(np.linalg.norm(system.residual(np.zeros(system.n_unknowns), omega, False)[0]), 1e-300)
         return robust_start(system.residual, {"stuck linear solution": self.initial_guess(system, omega)},
                             omega, scales, f.ravel(), base=base, residual_scale=residual_scale, tol=tol,
-                            factorize=system.factorize).x
+                            factorize=system.factorize, out_of_time=out_of_time).x
 
     def unknown_scales(self, system: HarmonicBalanceSystem, omega_start: float, omega_end: float) -> np.ndarray:
         """Scale (C * n_dof,) of each unknown of ``system`` over omega_start..omega_end [rad/s]

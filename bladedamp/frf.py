@@ -44,8 +44,9 @@ class FrequencyResponseModel(Protocol):
     def retry_scales(self, system, scales):
         """The continuation's ``retry_x_scale`` (None: no retry with other scales)."""
 
-    def start_solution(self, system, omega: float, scales):
-        """A solution (C * n_dof,) at ``omega``, robust in gross slip."""
+    def start_solution(self, system, omega: float, scales, out_of_time=None):
+        """A solution (C * n_dof,) at ``omega``, robust in gross slip; ``out_of_time``: None or
+        () -> bool, once True no further solve of the start is begun (its best iterate returned)."""
 
     def response_from_branch(self, system, branch):
         """The model's response object of a continuation ``branch``."""
@@ -91,9 +92,9 @@ def branch_solver(model: FrequencyResponseModel, f_start_hz: float, f_end_hz: fl
     (None: the continuation's default) and ``continuation_options`` go to
     :func:`~bladedamp.hbm.continuation.continuation`; ``cpu_budget_s`` [s] and ``point_budget``
     are the whole analysis' (:class:`~bladedamp.hbm.continuation.Budget`, shared by every
-    ``solve``). The robust start is not begun once the budget has run out (the continuation then
-    keeps no point and says so), and the start at the end of the range is computed once for a
-    branch and its retry."""
+    ``solve``). The robust start is not begun once the budget has run out, nor any further solve
+    of it (the continuation then keeps no point and says so), and the start at the end of the
+    range is computed once for a branch and its retry."""
     w0, w1 = checked_range(model, f_start_hz, f_end_hz)
     if stop_when_for is not None and continuation_options.get("stop_when") is not None:
         raise ValueError("give stop_when or the model's own stop (stop_above), not both")
@@ -110,7 +111,8 @@ def branch_solver(model: FrequencyResponseModel, f_start_hz: float, f_end_hz: fl
         scales = model.unknown_scales(system, w0, w1)
 
         def start(w):
-            return np.zeros(system.n_unknowns) if budget.exhausted(w) else model.start_solution(system, w, scales)
+            return (np.zeros(system.n_unknowns) if budget.exhausted(w) else
+                    model.start_solution(system, w, scales, out_of_time=lambda: bool(budget.exhausted(w))))
 
         at_end = []
 

@@ -326,16 +326,17 @@ class FrictionOscillator:
         """None: no retry with other scales (the oscillator has no damper unknowns)."""
         return None
 
-    def start_solution(self, system: HarmonicBalanceSystem, omega: float, scale: float) -> np.ndarray:
+    def start_solution(self, system: HarmonicBalanceSystem, omega: float, scale: float, out_of_time=None) -> np.ndarray:
         """Solution at the first frequency by :func:`bladedamp.hbm.start.robust_start`: damped
         Newton from the stuck linear solution (one Newton step from rest, where the contact
-        sticks), then from the free one (no contact force), then the excitation homotopy."""
+        sticks), then from the free one (no contact force), then the excitation homotopy;
+        ``out_of_time``: None or () -> bool (the analysis' budget), asked before each solve."""
         R, J, _ = system.residual(np.zeros(system.n_unknowns), omega)
         stuck = -np.linalg.solve(J, R)
         free = system.linear_solution(omega)
         forcing = system.excitation(omega)[0]
         return robust_start(system.residual, {"stuck linear": stuck, "free linear": free}, omega, scale,
-                            forcing).x
+                            forcing, out_of_time=out_of_time).x
 
     # ----- the protocol of bladedamp.hbm.accuracy ----------------------------------------
     def output_amplitudes(self, coefficients: np.ndarray, basis: HarmonicBasis) -> np.ndarray:

@@ -325,6 +325,42 @@ def test_robust_start_finds_the_oscillator_solution_in_gross_slip():
     assert s.converged
 
 
+def test_robust_start_begins_no_solve_once_out_of_time():
+    """``out_of_time`` (an analysis' budget, issue 32 item 2) is asked before every damped
+    Newton solve of the start: on a residual without a root (x^2 + 1, so every guess and every
+    homotopy level fails) the start evaluates no residual after the first True it is told, and
+    returns its best iterate, not converged; out of time from the first question, no residual is
+    evaluated and the zero-excitation base comes back. Without it the same start makes more
+    solves than the cap used here (the cap can bind)."""
+    calls = []
+
+    def no_root(x, omega, jacobian=True):
+        calls.append(1)
+        return np.array([x[0] ** 2 + 1.0]), np.array([[2 * x[0]]]), np.array([0.0])
+
+    guesses, base = {"a": np.array([0.3]), "b": np.array([2.0])}, np.array([0.5])
+    questions = []
+    robust_start(no_root, guesses, 1.0, 1.0, np.array([1.0]), base=base, max_levels=20,
+                 out_of_time=lambda: questions.append(1) or False)
+    unlimited = len(calls)
+    assert len(questions) > 5
+    for cap in (1, 2, 5):
+        calls.clear()
+        asked, at_timeout = [], []
+
+        def out_of_time():
+            asked.append(1)
+            if len(asked) > cap and not at_timeout:
+                at_timeout.append(len(calls))
+            return len(asked) > cap
+        s = robust_start(no_root, guesses, 1.0, 1.0, np.array([1.0]), base=base, max_levels=20, out_of_time=out_of_time)
+        assert not s.converged and np.isfinite(s.residual_norm)
+        assert at_timeout and len(calls) == at_timeout[0]      # nothing evaluated after the first True
+        assert 0 < len(calls) < unlimited
+    calls.clear()
+    s = robust_start(no_root, guesses, 1.0, 1.0, np.array([1.0]), base=np.array([0.7]), out_of_time=lambda: True)
+    assert not s.converged and not calls and s.x[0] == 0.7
+
 
 def test_damped_newton_gives_up_where_it_stagnates_and_not_where_it_converges_slowly():
     """R(x) = x^2 + 1 has no real root: |R| cannot fall below 1, so Newton with the start's line

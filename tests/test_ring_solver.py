@@ -189,6 +189,39 @@ def test_ring_on_mistuned_jacobians(kind, harmonics, n):
         assert solve.sign == int(np.linalg.slogdet(dense)[0])
 
 
+@pytest.mark.parametrize("n, bordered, with_interior", [(5, True, True), (2, False, True), (3, True, False)])
+def test_sparse_blocks_are_the_dense_blocks(n, bordered, with_interior):
+    """BlockRing.blocks of a sparse matrix (scattered through the per-pattern map of its stored
+    entries, formed once per pattern and kept for the last two) holds exactly the entries the
+    dense matrix's blocks are indexed from: equal bit for bit, for a first matrix of a pattern,
+    another matrix of the same index arrays (the map reused), a second pattern, and the first
+    again; n = 2 (both couplings summed in Up) and 3 included. A nonzero entry off the ring's
+    pattern gives None (the caller's LU), a stored zero there does not."""
+    rng = np.random.default_rng(n)
+    A, ring = ring_matrix(rng, n, links=None if with_interior else [], bordered=bordered)
+    S = sp.csc_matrix(A)
+    S2 = S.copy()
+    S2.indices, S2.indptr = S.indices, S.indptr                 # same index arrays, new values
+    S2.data = rng.standard_normal(S.nnz)
+    other = sp.csc_matrix(A + np.diag(np.full(A.shape[0], 0.5)))    # another pattern object
+    for M in (S, S2, other, S, S2):
+        got, ref = ring.blocks(M), ring.blocks(M.toarray())
+        assert got[0] == ref[0] and got[6] == ref[6]
+        for a, b in zip(got[1:6] + got[7:], ref[1:6] + ref[7:]):
+            assert np.array_equal(a, b)
+    g = ring.groups
+    if n > 3:
+        off = A.copy()
+        off[g[0][0], g[2][0]] = 1.0                              # blocks 0 and 2: not neighbours
+        assert ring.blocks(sp.csc_matrix(off)) is None
+        off[g[0][0], g[2][0]] = 0.0
+        stored = sp.csc_matrix(off)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", sp.SparseEfficiencyWarning)
+            stored[g[0][0], g[2][0]] = 0.0                         # explicitly stored zero
+        assert stored.nnz == S.nnz + 1 and ring.blocks(stored) is not None
+
+
 def test_ring_on_sectors_and_missing_dampers():
     """A two-blade sector of an 8-blade disk (the last damper couples blade 1 to the next
     sector's blade 0, turned by the interblade phase) and a full assembly with two massless

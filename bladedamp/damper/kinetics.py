@@ -69,7 +69,7 @@ def retention_stiffness(static_retention: float, normal_stiffness: float) -> np.
     return r * k_n * np.diag([1, 1, 1, l2, l2, l2])
 
 
-def seat(geometry: DamperGeometry, radial_force: float, tol: float = 1e-12, max_iter: int = 50):
+def seat(geometry: DamperGeometry, radial_force: float, tol: float = 1e-12, max_iter: int = 50, validate: bool = True):
     """Static seating of the damper under a radial force, frictionless, rigid platforms.
 
     Points with an initial gap (``ContactPatch.initial_gap``) touch only once the damper has
@@ -80,8 +80,12 @@ def seat(geometry: DamperGeometry, radial_force: float, tol: float = 1e-12, max_
     force fixes (the axial position, the cylinder's roll) are left at zero (least squares).
 
     Returns (u_D (6,), approach (2, P) per-point static approach [m], loads (2,) [N]).
+    ``validate=False`` skips the check of ``radial_force`` (ValueError unless >= 0 [N]): for a
+    caller whose force is non-negative by construction and that seats at every residual
+    evaluation (a misfitting damper's static approach, :meth:`bladedamp.diskmodel.DamperPosition.approach_function`).
     """
-    validation.nonnegative("radial_force", radial_force)
+    if validate:
+        validation.nonnegative("radial_force", radial_force)
     G = geometry.G_D.reshape(2, 6, 6)
     if radial_force == 0:
         return np.zeros(6), -np.array([p.initial_gap for p in geometry.patches]), np.zeros(2)

@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
+from numba import njit
 
 from .. import validation
 from .linsolve import factorize as lu_factorize
@@ -76,8 +77,9 @@ def bordered_matrix(J, column, row, column_scale, factor):
         pattern = _bordered_pattern(n, J.indices, J.indptr)
         start = pattern.start
         out = np.empty(start + n + 1)
-        out[pattern.moved] = J.data * np.repeat(column_scale * factor, pattern.counts)
-        out[pattern.ends] = row[:n]
+        bordered_columns(np.asarray(J.data, dtype=float), J.indptr,
+                         np.ascontiguousarray(column_scale * factor, dtype=float), np.ascontiguousarray(row, dtype=float),
+                         out)
         out[start:start + n] = column * factor
         out[-1] = row[n]
         bordered = copy.copy(pattern.matrix)
@@ -88,6 +90,19 @@ def bordered_matrix(J, column, row, column_scale, factor):
     A[:n, n] = column * factor
     A[n] = row
     return A
+
+
+@njit(cache=True)
+def bordered_columns(data, indptr, scale, row, out):
+    """The first n columns of :func:`bordered_matrix`'s CSC values: column j of J (CSC ``data``,
+    ``indptr``, n columns) times ``scale[j]``, then the border row's ``row[j]``, column after
+    column (entry p of column j lands at p + j; :class:`_BorderedPattern`'s ``moved`` and
+    ``ends``). The same products as ``J.data * np.repeat(scale, counts)``, so the same numbers."""
+    for j in range(indptr.size - 1):
+        s = scale[j]
+        for p in range(indptr[j], indptr[j + 1]):
+            out[p + j] = data[p] * s
+        out[indptr[j + 1] + j] = row[j]
 
 
 def _unit_last(n: int) -> np.ndarray:

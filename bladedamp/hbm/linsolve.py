@@ -486,13 +486,30 @@ class BlockRing:
         m, nq = q.shape
         if sp.issparse(A):
             A = A if sp.isspmatrix_csc(A) else sp.csc_matrix(A)
-            D, Up, Lo = np.zeros((n, b, b)), np.zeros((n, b, b)), np.zeros((n, b, b))
-            col, row, corner = np.zeros((n, b)), np.zeros((n, b)), np.zeros(1)
-            Aqq, Aqc, Acq = np.zeros((m, nq, nq)), np.zeros((m, nq, 2 * b + 1)), np.zeros((m, 2 * b + 1, nq))
-            ok = _ring_gather_csc(np.asarray(A.data, dtype=float), A.indices, A.indptr, self._owner, self._local,
-                                  self.links, D, Up, Lo, col, row, corner, Aqq, Aqc, Acq)
-            if not ok:
+            shapes = ((n, b, b), (n, b, b), (n, b, b), (n, b), (n, b), (1,), (m, nq, nq), (m, nq, 2 * b + 1),
+                      (m, 2 * b + 1, nq))
+            # where each stored entry of the pattern goes in the blocks (flat), formed once per
+            # pattern: a system's Jacobians share their index arrays, and so do their bordered
+            # copies (continuation.bordered_matrix); the last two patterns are kept (the
+            # Jacobian's and its bordered one's). One read and one write of the slot: a ring may
+            # be shared by threads
+            known = self.__dict__.get("_gather", ())
+            last = next((g for g in known if g[0] is A.indices and g[1] is A.indptr), None)
+            if last is None:
+                sizes = [int(np.prod(shape)) for shape in shapes]
+                offsets = np.concatenate([[0], np.cumsum(sizes)])
+                views = [np.arange(offsets[k], offsets[k + 1]).reshape(shape).astype(float)
+                         for k, shape in enumerate(shapes)]
+                slots = np.full(A.indices.size, -1.0)
+                _ring_slots(A.indices, A.indptr, self._owner, self._local, self.links, *views, slots)
+                last = (A.indices, A.indptr, slots.astype(np.int64), offsets)
+                self._gather = (last,) + tuple(known[:1])
+            _, _, slots, offsets = last
+            flat = np.zeros(offsets[-1])
+            if not _ring_scatter(np.asarray(A.data, dtype=float), slots, flat):
                 return None
+            D, Up, Lo, col, row, corner, Aqq, Aqc, Acq = (flat[offsets[k]:offsets[k + 1]].reshape(shape)
+                                                          for k, shape in enumerate(shapes))
             corner = corner[0] if bordered else 1.0
             return bordered, D, Up, Lo, col, row, corner, Aqq, Aqc, Acq
         A = np.asarray(A, dtype=float)
@@ -558,62 +575,70 @@ class BlockRing:
 
 
 @njit(cache=True)
-def _ring_gather_csc(data, indices, indptr, owner, local, links, D, Up, Lo, col, row, corner, Aqq, Aqc, Acq):
-    """Scatter a CSC matrix into the blocks of :meth:`BlockRing.blocks` (owner: ring block
-    0..n-1, interior block n + j, or -1 for the border; local: the index within it). False if
-    an entry lies off the ring's pattern."""
+def _ring_slots(indices, indptr, owner, local, links, D, Up, Lo, col, row, corner, Aqq, Aqc, Acq, slots):
+    """Where each stored entry p of a CSC pattern (``indices``, ``indptr``) goes in the blocks of
+    :meth:`BlockRing.blocks` (owner: ring block 0..n-1, interior block n + j, or -1 for the
+    border; local: the index within it): ``slots[p]`` (float, -1 on entry) is set to the value
+    the block arrays D ... Acq hold at that place, their own positions in one flat buffer;
+    entries off the ring's pattern keep -1. The map of :func:`_ring_scatter`."""
     n, b = D.shape[0], D.shape[1]
     for j in range(indptr.size - 1):
         oj, lj = owner[j], local[j]
         for p in range(indptr[j], indptr[j + 1]):
-            v = data[p]
-            if v == 0.0:
-                continue
             i = indices[p]
             oi, li = owner[i], local[i]
             if oi >= 0 and oi < n:
                 if oj >= 0 and oj < n:
                     if oi == oj:
-                        D[oi, li, lj] += v
+                        slots[p] = D[oi, li, lj]
                     elif oj == (oi + 1) % n:
-                        Up[oi, li, lj] += v
+                        slots[p] = Up[oi, li, lj]
                     elif oi == (oj + 1) % n:
-                        Lo[oj, li, lj] += v
-                    else:
-                        return False
+                        slots[p] = Lo[oj, li, lj]
                 elif oj < 0:
-                    col[oi, li] += v
+                    slots[p] = col[oi, li]
                 else:
                     a = links[oj - n]
                     if oi == a:
-                        Acq[oj - n, li, lj] += v
+                        slots[p] = Acq[oj - n, li, lj]
                     elif oi == (a + 1) % n:
-                        Acq[oj - n, b + li, lj] += v
-                    else:
-                        return False
+                        slots[p] = Acq[oj - n, b + li, lj]
             elif oi < 0:
                 if oj < 0:
-                    corner[0] += v
+                    slots[p] = corner[0]
                 elif oj < n:
-                    row[oj, lj] += v
+                    slots[p] = row[oj, lj]
                 else:
-                    Acq[oj - n, 2 * b, lj] += v
+                    slots[p] = Acq[oj - n, 2 * b, lj]
             else:
                 k = oi - n
                 if oj >= n:
                     if oj != oi:
-                        return False
-                    Aqq[k, li, lj] += v
+                        continue
+                    slots[p] = Aqq[k, li, lj]
                 elif oj < 0:
-                    Aqc[k, li, 2 * b] += v
+                    slots[p] = Aqc[k, li, 2 * b]
                 else:
                     a = links[k]
                     if oj == a:
-                        Aqc[k, li, lj] += v
+                        slots[p] = Aqc[k, li, lj]
                     elif oj == (a + 1) % n:
-                        Aqc[k, li, b + lj] += v
-                    else:
-                        return False
+                        slots[p] = Aqc[k, li, b + lj]
+
+
+@njit(cache=True)
+def _ring_scatter(data, slots, flat):
+    """flat[slots[p]] += data[p] over the stored entries p of a CSC matrix in order (the sums of
+    :func:`_ring_slots`' places, in the order of the entries), skipping zeros; False if a nonzero entry has no
+    slot (-1: off the ring's pattern)."""
+    for p in range(data.size):
+        v = data[p]
+        if v == 0.0:
+            continue
+        k = slots[p]
+        if k < 0:
+            return False
+        flat[k] += v
     return True
 
 

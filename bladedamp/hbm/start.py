@@ -48,7 +48,7 @@ def _shifted(residual, shift):
 
 
 def robust_start(residual, guesses, omega, x_scale, forcing, base=None, residual_scale=None, tol=1e-10,
-                 factorize=lu_factorize, first_level=0.05, max_levels=80) -> StartResult:
+                 factorize=lu_factorize, first_level=0.05, max_levels=80, out_of_time=None) -> StartResult:
     """Solve R(x, omega) = 0 robustly; returns a :class:`StartResult` (the best iterate if none converged).
 
     Parameters
@@ -65,6 +65,10 @@ def robust_start(residual, guesses, omega, x_scale, forcing, base=None, residual
     tol : scaled residual tolerance (as :func:`bladedamp.hbm.continuation.continuation`'s)
     first_level : the homotopy's first excitation level (a fraction of f)
     max_levels : most homotopy levels tried (the increment halves on failure, grows on success)
+    out_of_time : None, or a function () -> bool, asked before each damped Newton solve (a guess
+        or a homotopy level): once it says True no further solve is begun and the best iterate
+        so far is returned (not converged; the zero-excitation ``base`` if none was tried), so an
+        analysis' CPU budget also bounds its start (issue 32 item 2)
     """
     if not isinstance(guesses, dict):
         guesses = {f"guess {k}": g for k, g in enumerate(guesses)}
@@ -77,8 +81,13 @@ def robust_start(residual, guesses, omega, x_scale, forcing, base=None, residual
         return newton(_shifted(residual, shift), x0, omega, x_scale, residual_scale, tol, max_iter=60,
                       factorize=factorize, line_search=START_LINE_SEARCH)
 
+    def timed_out():
+        return out_of_time is not None and out_of_time()
+
     best = None
     for name, x0 in guesses.items():
+        if timed_out():
+            break
         sol = damped_newton(x0, 0.0)
         if sol.converged:
             return StartResult(sol.x, True, sol.residual_norm, name)
@@ -86,10 +95,14 @@ def robust_start(residual, guesses, omega, x_scale, forcing, base=None, residual
             best = StartResult(sol.x, False, sol.residual_norm, name)
     # excitation homotopy: level s solves R(x) + (1 - s) f = 0, from the stuck state at small s
     base = np.zeros_like(forcing) if base is None else np.asarray(base, dtype=float)
+    if best is None and timed_out():  # out of time before any guess
+        return StartResult(base.copy(), False, np.inf, "none (out of time)")
     done, x_done = 0.0, None          # the last level solved and its solution
     previous = None                   # (level, x) solved before it, for the secant predictor
     increment = first_level
     for _ in range(max_levels):
+        if timed_out():
+            break
         trial = min(done + increment, 1.0)
         shift = (1.0 - trial) * forcing
         if x_done is None:
