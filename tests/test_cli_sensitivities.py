@@ -9,15 +9,9 @@ import bladedamp as bd
 from bladedamp.cli import main
 from bladedamp.design import load_design
 from bladedamp.fit import model_points
+from test_cli_outputs import one_error_line      # one line, no traceback, naming what is wrong
 
 FAST = "[analysis]\nfrequency_range_hz = [92.0, 99.0]\nharmonics = [1]\n"
-
-
-def one_error_line(err, *needles):
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and "Traceback" not in err, err
-    for needle in needles:
-        assert needle in lines[0], (needle, lines[0])
 
 
 @pytest.mark.filterwarnings("ignore::bladedamp.hbm.accuracy.AccuracyWarning")
