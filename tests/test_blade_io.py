@@ -400,7 +400,11 @@ def test_reference_blade_files_saved_before_the_blade_package_load(name):
     for read in readers:
         blade = read(path)
         assert type(blade) is ModalBlade
-        assert_same_blade(blade, reference_blade(), rtol=1e-9, atol=1e-9 * np.abs(blade.mode_shapes["tip"]).max())
+        # the beam model's eigenvectors differ between LAPACK builds: significant entries by 1e-9
+        # of their value, entries that are zero by symmetry (a flapwise mode's torsion) by noise
+        # up to 5e-8 of the shapes' largest (seen: 1e-8 on one machine, 5e-8 on another); a bound
+        # of 1e-6 of the largest leaves them a factor 20 and still catches a wrong shape
+        assert_same_blade(blade, reference_blade(), rtol=1e-9, atol=1e-6 * np.abs(blade.mode_shapes["tip"]).max())
 
 
 def test_solid_blade_file_saved_before_the_blade_package_loads():

@@ -63,6 +63,7 @@ def assembly_system(assembly, harmonics=(1,)):
     system = assembly.hbm_system(harmonics)
     for k in range(assembly.n_sector):
         system = system.add(CubicSpring(K3), assembly.point_map(system.basis, "tip", (0,), blade=k), f"tip cubic {k}")
+    system.storage = "sparse"       # what these tests check: the sparse path (automatic would choose dense at 32 unknowns)
     return system
 
 

@@ -87,6 +87,12 @@ class DenseLU:
         return float(np.sum(np.log(np.abs(np.diag(self.lu)))))
 
 
+def dense_array(matrix) -> np.ndarray:
+    """``matrix`` as a 2-D float ndarray (a scipy.sparse matrix converted, a scalar or a list made
+    an array): what a dense assembly of a system's matrices takes, whatever form they were given in."""
+    return np.atleast_2d(matrix.toarray() if sp.issparse(matrix) else np.asarray(matrix, dtype=float))
+
+
 def factorize(A):
     """LU factorisation of a dense ndarray (:class:`DenseLU`, which also gives the sign of det A)
     or a scipy.sparse matrix (sparse LU, COLAMD ordering); returns ``solve(b)`` for one or

@@ -98,7 +98,7 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse as sp
 
-from .linsolve import one_blas_thread, permutation_sign
+from .linsolve import dense_array, one_blas_thread, permutation_sign
 
 
 def hill_matrices(system, omega: float):
@@ -115,8 +115,7 @@ def hill_matrices(system, omega: float):
         d1 = 2 * omega * sp.kron(nabla, mass) + sp.kron(eye, damping)
         d2 = sp.kron(eye, mass)
         return d1.tocsc(), d2.tocsc()
-    mass = np.atleast_2d(np.asarray(system.mass, dtype=float))
-    damping = np.atleast_2d(np.asarray(system.damping, dtype=float))
+    mass, damping = dense_array(system.mass), dense_array(system.damping)     # given sparse, assembled dense
     d1 = 2 * omega * np.kron(basis.derivative, mass) + np.kron(np.eye(C), damping)
     d2 = np.kron(np.eye(C), mass)
     return d1, d2

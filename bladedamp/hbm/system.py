@@ -19,7 +19,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .fourier import HarmonicBasis
-from .linsolve import SPARSE_MIN_UNKNOWNS, prefers_sparse
+from .linsolve import SPARSE_MIN_UNKNOWNS, dense_array, prefers_sparse
 from .linsolve import factorize as lu_factorize
 
 
@@ -229,14 +229,14 @@ class HarmonicBalanceSystem:
         if sparse:
             return self._sparse_dynamic_stiffness(omega)
         if self._dense_parts is None:      # the Omega-independent parts and their nonzero pattern, built once
-            parts = self.basis.dynamic_stiffness_parts(*(_dense(m) for m in (self.mass, self.damping, self.stiffness)))
+            parts = self.basis.dynamic_stiffness_parts(*(dense_array(m) for m in (self.mass, self.damping, self.stiffness)))
             self._dense_parts = (parts, self.basis.dynamic_stiffness_pattern(parts))
         A, dA = self.basis.dynamic_stiffness(omega, None, None, None, self._dense_parts[0], derivative,
                                              self._dense_parts[1])
         if self.static_stiffness is not None and self.basis.has_static:
             n = self.n_dof
             j = self.basis.cos_index(0)
-            A[j * n:(j + 1) * n, j * n:(j + 1) * n] += _dense(self.static_stiffness)
+            A[j * n:(j + 1) * n, j * n:(j + 1) * n] += dense_array(self.static_stiffness)
         return A, dA
 
     def linear_solution(self, omega: float) -> np.ndarray:
@@ -363,11 +363,6 @@ def linear_forces(basis: HarmonicBasis, x: np.ndarray, omega: float, mass=None, 
         j = basis.cos_index(0)
         out[j] += times(static_stiffness, X[j:j + 1])[0]
     return out.ravel()
-
-
-def _dense(matrix):
-    """An ndarray of ``matrix`` (a scipy.sparse matrix is converted)."""
-    return matrix.toarray() if sp.issparse(matrix) else matrix
 
 
 def with_element(system: HarmonicBalanceSystem, element: NonlinearElement, matrix, name: str = "") -> HarmonicBalanceSystem:
