@@ -68,8 +68,12 @@ SHARE_REQUIRED = 0.93
 # cannot follow, disks 63, 67, 154, 105). Since the settle verdict judges the convergence of the
 # period-to-period map, disk 120's stop check finds a periodic motion beyond its stop (1.92 mm,
 # the damper separated all the period) that it called "not settled" before: 315 of 320 = 0.984375
-# (2026-12-07), exactly this floor, with no design to spare
-ANSWERED_REQUIRED = 0.984
+# (2026-12-07), exactly that day's machine. On another machine (2026-12-07, fourth session) the same
+# code answers 314: disk 35 (stops at max_points with an estimate of 8.2 %) and oscillator 95 (2.5 %
+# against 1 %) both fail there, the same on main and on the branch; one of them passed on the first
+# machine. A design at a non-smooth fold or a tolerance's edge flips with the BLAS kernel's rounding,
+# and a verdict must not depend on the kernel: the floor allows that one flip and no other
+ANSWERED_REQUIRED = 0.98
 # Harmonics of the oscillators cross-checked by time integration, and of the random inclined
 # oscillators (normal load varying with the motion, lifting off): the frequency_response default,
 # "auto" (the harmonics chosen by their error estimate, static term included; (0, 1, 2, 3) was
