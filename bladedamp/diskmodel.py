@@ -1018,6 +1018,13 @@ GEOMETRY_KEYS = {"disk.gamma_left_deg": ("gamma_left", np.pi / 180), "disk.gamma
                  "damper.length_mm": ("length", 1e-3)}
 
 
+#: the design-file keys of the contact properties and their ContactProperties fields
+CONTACT_FIELDS = {"damper.friction_coefficient": "friction_coefficient",
+                  "damper.tangential_stiffness_per_length_n_per_m2": "tangential_stiffness_per_length",
+                  "damper.normal_to_tangential_stiffness": "normal_to_tangential_stiffness",
+                  "damper.roughness_reference_load_n": "roughness_reference_load"}
+
+
 def parameter_unit(key: str) -> str:
     """The unit of a design-file key (:data:`SENSITIVITY_KEYS`): per this unit its derivatives are given."""
     name, index = parse_parameter_key(key)
@@ -1367,13 +1374,11 @@ class DiskModel:
 
         if name == "damper.mass_g":
             effect = centrifugal(1e-3 / damper.mass)
-            if self.damper_inertia:
-                dm = sp.lil_matrix((system.n_dof, system.n_dof))
+            if self.damper_inertia:                          # each damper's inertia is proportional to its mass
                 mass = sp.csr_matrix(system.mass)
-                for d in range(len(positions)):
-                    sl = self.damper_unknowns(d)
-                    dm[sl, sl] = mass[sl, sl].toarray() * (1e-3 / damper.mass)
-                effect.matrices["mass"] = dm.tocsr()
+                effect.matrices["mass"] = self.damper_blocks(system, [
+                    mass[self.damper_unknowns(d), self.damper_unknowns(d)].toarray() * (1e-3 / damper.mass)
+                    for d in range(len(positions))])
             return effect
         if name == "disk.damper_radius_mm":
             return centrifugal(1e-3 / self.damper_radius)
@@ -1435,11 +1440,7 @@ class DiskModel:
         n_local = coupling.matrix.shape[0] // basis.n_coeffs // len(positions)
         effect = ParameterEffect(coupling=self.contact_coupling(basis, kinematics, n_local, False))
         if self.damper_inertia and np.any(d_inertia):
-            dm = sp.lil_matrix((system.n_dof, system.n_dof))
-            for d in range(len(positions)):
-                sl = self.damper_unknowns(d)
-                dm[sl, sl] = unit * d_inertia
-            effect.matrices["mass"] = dm.tocsr()
+            effect.matrices["mass"] = self.damper_blocks(system, [unit * d_inertia] * len(positions))
         degree = damper.contact.roughness_exponent
         geometry = positions[0].damper_geometry()
         if parameter in ("contact_height", "length"):          # the points move along xi (height), eta (length)
@@ -1459,6 +1460,15 @@ class DiskModel:
             loads = unit * geometry.normal_load_log_derivatives(parameter) / degree
             effect.contact.update({"approach_left": loads[0], "approach_right": loads[1]})
         return effect
+
+    def damper_blocks(self, system: HarmonicBalanceSystem, blocks) -> sp.csr_matrix:
+        """(n_dof, n_dof) sparse: damper d's (6, 6) ``blocks[d]`` on its own coordinates, zero
+        elsewhere (the derivative of the dampers' part of a matrix)."""
+        out = sp.lil_matrix((system.n_dof, system.n_dof))
+        for d, block in enumerate(blocks):
+            sl = self.damper_unknowns(d)
+            out[sl, sl] = block
+        return out.tocsr()
 
     def parameter_value(self, key: str) -> float:
         """The value of the design-file ``key`` (:meth:`parameter_derivatives`) in this model, in
@@ -1491,11 +1501,7 @@ class DiskModel:
             return 1e3 * damper.contact_height if hasattr(damper, "contact_height") else float("nan")
         if name == "damper.length_mm":
             return 1e3 * damper.length
-        return float(getattr(damper.contact, {"damper.friction_coefficient": "friction_coefficient",
-                                              "damper.tangential_stiffness_per_length_n_per_m2":
-                                                  "tangential_stiffness_per_length",
-                                              "damper.normal_to_tangential_stiffness": "normal_to_tangential_stiffness",
-                                              "damper.roughness_reference_load_n": "roughness_reference_load"}[name]))
+        return float(getattr(damper.contact, CONTACT_FIELDS[name]))
 
     def with_parameters(self, values: dict) -> "DiskModel":
         """A copy of this model with the design-file keys of ``values`` ({key: value in the key's
@@ -1503,16 +1509,12 @@ class DiskModel:
         this model is left as it is. ``blade.natural_frequencies_hz[j]`` sets the design blade's
         f_j (each blade's is kappa_k f_j), ``mistuning.kappa[k]`` blade k's factor."""
         out = self
-        contact_fields = {"damper.friction_coefficient": "friction_coefficient",
-                          "damper.tangential_stiffness_per_length_n_per_m2": "tangential_stiffness_per_length",
-                          "damper.normal_to_tangential_stiffness": "normal_to_tangential_stiffness",
-                          "damper.roughness_reference_load_n": "roughness_reference_load"}
         for key, value in values.items():
             name, index = parse_parameter_key(key)
             value = float(value)
-            if name in contact_fields:
+            if name in CONTACT_FIELDS:
                 out = out.with_dampers(lambda d: dataclasses.replace(
-                    d, contact=dataclasses.replace(d.contact, **{contact_fields[name]: value})))
+                    d, contact=dataclasses.replace(d.contact, **{CONTACT_FIELDS[name]: value})))
             elif name == "damper.mass_g":
                 out = out.with_dampers(lambda d: dataclasses.replace(d, mass=1e-3 * value))
             elif name == "disk.damper_radius_mm":
