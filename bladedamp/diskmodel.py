@@ -2219,19 +2219,24 @@ class DiskModelResponse(FrequencyResponse):
                                     self.disk.parameter_derivatives(system, keys), keys,
                                     tuple(parameter_unit(k) for k in keys), [self.disk.parameter_value(k) for k in keys])
 
-    def peak_sensitivities(self, parameters, direction: int = 0) -> PeakSensitivities:
+    def peak_sensitivities(self, parameters, direction: int = 0, blade: int | None = None) -> PeakSensitivities:
         """The derivatives of the resonance peak (the largest blade's largest tip amplitude in
-        ``direction``, solved by the peak condition d|u|/dOmega = 0) in the design-file keys
-        ``parameters``: d peak amplitude / dp [m per unit] and d peak frequency / dp [Hz per unit]
-        (:func:`~bladedamp.response.solved_peak_sensitivities`). ValueError where the peak cannot be
-        solved (at an end of the range, next to a fold)."""
+        ``direction``, solved by the peak condition d|u|/dOmega = 0; ``blade`` k: blade k's own
+        peak) in the design-file keys ``parameters``: d peak amplitude / dp [m per unit] and d peak
+        frequency / dp [Hz per unit] (:func:`~bladedamp.response.solved_peak_sensitivities`).
+        ValueError where the peak cannot be solved (at an end of the range, next to a fold)."""
         validation.integer("direction", direction, minimum=0, maximum=2)
         keys = tuple(str(p) for p in parameters)
         system = self.model_system()
-        return solved_peak_sensitivities(system, self.omega, self.coefficients, self.blade_outputs(direction),
-                                         self.disk.parameter_derivatives(system, keys), keys,
-                                         tuple(parameter_unit(k) for k in keys),
-                                         [self.disk.parameter_value(k) for k in keys])
+        outputs = self.blade_outputs(direction)
+        if blade is not None:
+            blade = validation.integer("blade", blade, minimum=0, maximum=len(outputs) - 1)
+            outputs = outputs[blade:blade + 1]
+        result = solved_peak_sensitivities(system, self.omega, self.coefficients, outputs,
+                                           self.disk.parameter_derivatives(system, keys), keys,
+                                           tuple(parameter_unit(k) for k in keys),
+                                           [self.disk.parameter_value(k) for k in keys])
+        return result if blade is None else dataclasses.replace(result, blade=blade)
 
     @staticmethod
     def linear_energies(system: HarmonicBalanceSystem, branch) -> tuple[np.ndarray, np.ndarray]:

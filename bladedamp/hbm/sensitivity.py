@@ -59,8 +59,8 @@ def state_sensitivities(system, x: np.ndarray, omega: float, dR_dp: np.ndarray, 
     if solve is None:
         _, J, _ = system.residual(x, omega)
         solve = system.factorize(J)
-    dR_dp = np.atleast_2d(np.asarray(dR_dp, dtype=float))
-    return -np.array([solve(r) for r in dR_dp])
+    dR_dp = np.asarray(dR_dp, dtype=float).reshape(-1, len(x))         # (k, C*n_dof), k = 0 allowed
+    return -np.array([solve(r) for r in dR_dp]).reshape(dR_dp.shape)
 
 
 def output_sensitivities(output: np.ndarray, x: np.ndarray, dx: np.ndarray) -> tuple[float, np.ndarray]:

@@ -47,8 +47,10 @@ class DesignOptimum(Saveable):
     at_bound : (k,) whether each optimal value lies on its bound
     starts : (s, k) the local searches' starting points (the best screened); start_peaks : (s,) the
         peak each ended on [m] (NaN: it failed)
-    n_responses : frequency responses solved in all
+    n_responses : objective evaluations in all (frequency responses of the tuned disk by default)
     success, message : whether a start converged (the optimiser's test), and what happened
+    objective : what was minimised ("peak of the tuned disk", or a statistic over mistuned disks:
+        :func:`bladedamp.studies.robust.robust_design`); ``peak_amplitude`` and its derivatives are its value
     """
 
     parameters: tuple
@@ -66,6 +68,7 @@ class DesignOptimum(Saveable):
     n_responses: int
     success: bool
     message: str
+    objective: str = "peak of the tuned disk"
 
     def __getitem__(self, key: str) -> float:
         if key not in self.parameters:
@@ -86,9 +89,10 @@ class DesignOptimum(Saveable):
             flag = "  (on a bound)" if self.at_bound[j] else ""
             lines.append(f"{key:<{width}}  {self.initial[j]:>10.5g}  {self.optimum[j]:>10.5g}  "
                          f"{f'[{low:.4g}, {high:.4g}]':>20}  {self.units[j]}{flag}")
-        lines.append(f"peak {1e3 * self.peak_amplitude:.4f} mm at {self.peak_frequency_hz:.3f} Hz against "
+        what = "peak" if self.objective == "peak of the tuned disk" else self.objective
+        lines.append(f"{what} {1e3 * self.peak_amplitude:.4f} mm at {self.peak_frequency_hz:.3f} Hz against "
                      f"{1e3 * self.initial_peak_amplitude:.4f} mm of the design ({100 * self.reduction:.1f} % lower); "
-                     f"{self.n_responses} frequency responses; {self.message}")
+                     f"{self.n_responses} {'frequency responses' if what == 'peak' else 'evaluations'}; {self.message}")
         return "\n".join(lines)
 
     def plot(self, ax=None):
@@ -143,14 +147,18 @@ def sobol_starts(bounds: np.ndarray, n: int, seed: int, log: np.ndarray) -> np.n
 
 
 def optimal_design(disk, parameters, bounds, f_range_hz, harmonics=(1,), n_starts: int | None = None,
-                   n_screen: int | None = None, seed: int = 0, max_iterations: int = 25, **options) -> DesignOptimum:
+                   n_screen: int | None = None, seed: int = 0, max_iterations: int = 25, evaluate=None,
+                   objective: str = "peak of the tuned disk", **options) -> DesignOptimum:
     """The lowest resonance peak of ``disk`` (a TunedDisk) over the design-file keys ``parameters``
     within ``bounds`` ((k, 2) [the keys' units]): the peak at the design and at ``n_screen`` Sobol
     points (``seed``; default 4 k), then L-BFGS-B with the analytic gradient from the ``n_starts``
     best of them (default k). Each evaluation solves the frequency response over ``f_range_hz``
     [Hz] with ``harmonics`` and ``options`` (``frequency_response``'s) and its peak's derivatives.
-    ``max_iterations`` per start. ValueError for bad arguments or a design whose own peak cannot
-    be solved."""
+    ``max_iterations`` per start. ``evaluate(model) -> (value [m], frequency [Hz], gradient (k,) [m
+    per unit])``: another objective of the model with the keys set (``objective`` names it), e.g.
+    a statistic over mistuned disks (:func:`bladedamp.studies.robust.robust_design`); it raises
+    ValueError where it cannot be evaluated. ValueError for bad arguments or a design whose own
+    objective cannot be evaluated."""
     import scipy.optimize
 
     keys = tuple(str(p) for p in parameters)
@@ -177,28 +185,35 @@ def optimal_design(disk, parameters, bounds, f_range_hz, harmonics=(1,), n_start
         w = low + span * np.asarray(z)
         return np.where(log, np.exp(w), w)
 
+    def tuned_peak(model):
+        response = model.frequency_response(*f_range_hz, harmonics=harmonics, **options)
+        if not response.success:
+            raise ValueError(response.status_message)
+        result = response.peak_sensitivities(keys)
+        return result.peak_amplitude, result.peak_frequency_hz, result.d_peak_amplitude
+
     def peak(p):
+        """(value [m], frequency [Hz], gradient (k,)) of the objective at the parameters p"""
         key = tuple(np.round(p, 14))
         if key not in cache:
             count[0] += 1
-            model = disk.with_parameters(dict(zip(keys, p)))
-            response = model.frequency_response(*f_range_hz, harmonics=harmonics, **options)
-            if not response.success:
-                raise ValueError(f"at {dict(zip(keys, p))}: {response.status_message}")
-            cache[key] = response.peak_sensitivities(keys)
+            try:
+                cache[key] = (evaluate or tuned_peak)(disk.with_parameters(dict(zip(keys, p))))
+            except ValueError as exc:
+                raise ValueError(f"at {dict(zip(keys, p))}: {exc}") from None
         return cache[key]
 
-    def objective(z):
+    def objective_mm(z):
         p = to_p(z)
-        result = peak(p)
+        value, _, gradient = peak(p)
         dp_dz = np.where(log, p, 1.0) * span
-        return 1e3 * result.peak_amplitude, 1e3 * result.d_peak_amplitude * dp_dz      # mm: a well-scaled value
+        return 1e3 * value, 1e3 * np.asarray(gradient) * dp_dz      # mm: a well-scaled value
 
     first = peak(np.clip(initial, bounds[:, 0], bounds[:, 1]))
     screened = []
     for point in np.vstack([np.clip(initial, bounds[:, 0], bounds[:, 1]), sobol_starts(bounds, n_screen, seed, log)]):
         try:
-            screened.append((peak(point).peak_amplitude, tuple(point)))
+            screened.append((peak(point)[0], tuple(point)))
         except ValueError:                        # the response failed, or its peak left the range
             continue
     starts = np.array([p for _, p in sorted(screened)[:n_starts]])
@@ -206,27 +221,27 @@ def optimal_design(disk, parameters, bounds, f_range_hz, harmonics=(1,), n_start
     best, start_peaks, converged, messages = None, [], False, []
     for start in starts:
         try:
-            solution = scipy.optimize.minimize(objective, to_z(start), jac=True, method="L-BFGS-B", bounds=z_bounds,
+            solution = scipy.optimize.minimize(objective_mm, to_z(start), jac=True, method="L-BFGS-B", bounds=z_bounds,
                                                options={"maxiter": max_iterations, "ftol": PEAK_TOLERANCE_MM})
             p = to_p(solution.x)
             result = peak(p)
             converged |= bool(solution.success)
             messages.append(str(solution.message))
         except ValueError as exc:                 # the response failed or its peak left the range
-            known = [(v.peak_amplitude, k) for k, v in cache.items()]
+            known = [(v[0], k) for k, v in cache.items()]
             start_peaks.append(np.nan)
             messages.append(str(exc))
             if best is None and known:
                 a, k = min(known)
                 best = (a, np.array(k), cache[k])
             continue
-        start_peaks.append(result.peak_amplitude)
-        if best is None or result.peak_amplitude < best[0]:
-            best = (result.peak_amplitude, p, result)
+        start_peaks.append(result[0])
+        if best is None or result[0] < best[0]:
+            best = (result[0], p, result)
     a, p, result = best
     span = bounds[:, 1] - bounds[:, 0]
     at_bound = (np.abs(p - bounds[:, 0]) <= 1e-6 * span) | (np.abs(p - bounds[:, 1]) <= 1e-6 * span)
     message = "converged" if converged else f"no start converged ({messages[-1]})"
     return DesignOptimum(keys, tuple(parameter_unit(k) for k in keys), bounds, initial, p, float(a),
-                         float(result.peak_frequency_hz), float(first.peak_amplitude), result.d_peak_amplitude,
-                         at_bound, starts, np.array(start_peaks), count[0], converged, message)
+                         float(result[1]), float(first[0]), np.asarray(result[2], dtype=float),
+                         at_bound, starts, np.array(start_peaks), count[0], converged, message, objective)

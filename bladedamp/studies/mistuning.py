@@ -603,6 +603,73 @@ def local_worker_config():
     return dask.config.set({"distributed.nanny.pre-spawn-environ": environ})
 
 
+class DiskWorkers:
+    """Where a study's independent disks run: ``with DiskWorkers(scheduler, n_workers) as w:
+    w.map(function, shared, items)`` is ``[function(*shared, *item) for item in items]`` in order.
+
+    scheduler : None -> a local Dask cluster (``n_workers`` processes, one thread each; default the
+        CPU count; started without Dask's MALLOC_TRIM_THRESHOLD_, see :func:`local_worker_config`),
+        no set-up needed, started once for every ``map`` of the block; an address
+        ("tcp://host:8786") -> that Dask cluster; "serial" -> in this process, without Dask.
+    ``shared`` (e.g. the disk and its tuned assembly) is scattered once per ``map`` to every
+    worker, which keeps one copy for all its items; ``function`` must be a module-level function.
+    ``progress(done, total)`` is called as items finish. ``description``: what ran them."""
+
+    def __init__(self, scheduler=None, n_workers: int | None = None):
+        if n_workers is not None:
+            validation.integer("n_workers", n_workers, minimum=1)
+        self.scheduler, self.n_workers = scheduler, n_workers
+        self.client = self.cluster = None
+        self.description = "serial"
+
+    def __enter__(self) -> "DiskWorkers":
+        if self.scheduler == "serial":
+            return self
+        from dask.distributed import Client, LocalCluster
+
+        if self.scheduler is None:
+            workers = self.n_workers or os.cpu_count() or 1
+            with local_worker_config():
+                self.cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                            dashboard_address=None)
+            self.client = Client(self.cluster)
+            self.description = f"local cluster, {workers} workers"
+        else:
+            self.client = Client(self.scheduler)
+            self.description = f"scheduler {self.scheduler}"
+        return self
+
+    def __exit__(self, *exc):
+        if self.client is not None:
+            self.client.close()
+        if self.cluster is not None:
+            self.cluster.close()
+        self.client = self.cluster = None
+        return False
+
+    def map(self, function, shared: tuple, items: list, progress=None) -> list:
+        items = list(items)
+        results = [None] * len(items)
+        if self.client is None:
+            for i, item in enumerate(items):
+                results[i] = function(*shared, *item)
+                if progress:
+                    progress(i + 1, len(items))
+            return results
+        from dask.distributed import as_completed
+
+        # scattered once: each worker keeps one copy of the shared objects for all its items (the
+        # harmonic-balance systems are built there, on its first item: they are not pickled)
+        shared_futures = self.client.scatter(list(shared), broadcast=True)
+        futures = [self.client.submit(function, *shared_futures, *item, pure=False) for item in items]
+        index = {f.key: i for i, f in enumerate(futures)}
+        for done, future in enumerate(as_completed(futures), 1):
+            results[index[future.key]] = future.result()
+            if progress:
+                progress(done, len(items))
+        return results
+
+
 def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f_range_hz=None,
                 harmonics=(1,), max_step: float = MONTE_CARLO_MAX_STEP, scheduler=None, n_workers: int | None = None,
                 progress=None, out=None, tuned_peak_amplitude: float | None = None, tol: float = MONTE_CARLO_TOL,
@@ -641,46 +708,13 @@ def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f
     t0 = time.perf_counter()
     if tuned_peak_amplitude is None:
         tuned_peak_amplitude = tuned_peak(disk, f_range_hz or auto_range(disk, [1.0], 0.05), harmonics)[0]
-    results = [None] * n_disks
-    used = "serial"
     # the tuned full assembly, whose harmonic-balance set-up every disk shares (built once per
     # process, a noticeable share of a disk's time when each disk built its own)
     assembly = MistunedDisk.from_tuned(disk)
-    if scheduler == "serial":
-        for i, k in enumerate(kappas):
-            results[i] = _one_disk(disk, assembly, k, f_range_hz, _disk_settings(settings, i))
-            if progress:
-                progress(i + 1, n_disks)
-    else:
-        from dask.distributed import Client, LocalCluster, as_completed
-
-        cluster = None
-        if scheduler is None:
-            workers = n_workers or os.cpu_count() or 1
-            with local_worker_config():
-                cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                       dashboard_address=None)
-            client = Client(cluster)
-            used = f"local cluster, {workers} workers"
-        else:
-            client = Client(scheduler)
-            used = f"scheduler {scheduler}"
-        try:
-            # scattered once: each worker keeps one copy of the assembly for all its disks, and
-            # builds its set-up on its first disk (the systems are not pickled)
-            disk_future, assembly_future = client.scatter([disk, assembly], broadcast=True)
-            futures = [client.submit(_one_disk, disk_future, assembly_future, k, f_range_hz,
-                                     _disk_settings(settings, i), pure=False)
-                       for i, k in enumerate(kappas)]
-            index = {f.key: i for i, f in enumerate(futures)}
-            for done, fut in enumerate(as_completed(futures), 1):
-                results[index[fut.key]] = fut.result()
-                if progress:
-                    progress(done, n_disks)
-        finally:
-            client.close()
-            if cluster is not None:
-                cluster.close()
+    with DiskWorkers(scheduler, n_workers) as workers:
+        results = workers.map(_one_disk, (disk, assembly),
+                              [(k, f_range_hz, _disk_settings(settings, i)) for i, k in enumerate(kappas)], progress)
+        used = workers.description
     elapsed = time.perf_counter() - t0
     res = MonteCarloResult(kappas, np.array([r[0] for r in results]), np.array([r[1] for r in results]),
                            float(tuned_peak_amplitude), [r[2] for r in results],
