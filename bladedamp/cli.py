@@ -346,6 +346,8 @@ def optimize_command(args) -> int:
             raise UsageError(f"--contact-height-mm {h:g}: must be in (0, 100] mm")
     if args.parameters:
         return optimize_parameters(args, design, disk, t0)
+    if args.mistuning_std is not None:
+        raise UsageError("--mistuning-std: a design robust to mistuning is searched over --parameters (e.g. --parameters mass_g)")
     out = output_dir(output_folder(args), args.overwrite)
     progress = Progress()
     progress.compiling()
@@ -450,6 +452,17 @@ def optimize_parameters(args, design, disk, t0) -> int:
     if args.gamma_right_deg or args.contact_height_mm:
         raise UsageError("--parameters optimises the keys together: give gamma_right_deg as one of them instead of "
                          "--gamma-right-deg / --contact-height-mm")
+    if args.mistuning_std is not None and not 0 < args.mistuning_std < 0.2:
+        raise UsageError(f"--mistuning-std {args.mistuning_std:g}: must be in (0, 0.2)")
+    if args.disks < 2:
+        raise UsageError(f"--disks {args.disks}: must be at least 2")
+    if args.statistic != "mean":
+        try:
+            args.statistic = float(args.statistic)
+        except ValueError:
+            raise UsageError(f"--statistic {args.statistic}: 'mean' or a quantile in (0, 1)") from None
+        if not 0 < args.statistic < 1:
+            raise UsageError(f"--statistic {args.statistic:g}: 'mean' or a quantile in (0, 1)")
     keys = _parameter_keys(args, disk)
     a = design.analysis
     mass_g = tuple(1e3 * m for m in a.mass_bounds)
@@ -472,13 +485,25 @@ def optimize_parameters(args, design, disk, t0) -> int:
     progress.compiling()
     if args.starts is not None and args.starts < 1:
         raise UsageError(f"--starts {args.starts}: must be at least 1")
-    progress(f"lowest peak over {', '.join(keys)} (screening, then L-BFGS-B with the analytic gradient)")
-    optimum = optimal_design(disk, keys, [bounds[k] for k in keys], a.f_range_hz, harmonics=a.study_harmonics,
-                             n_starts=args.starts)
+    if args.mistuning_std is None:
+        progress(f"lowest peak over {', '.join(keys)} (screening, then L-BFGS-B with the analytic gradient)")
+        optimum = optimal_design(disk, keys, [bounds[k] for k in keys], a.f_range_hz, harmonics=a.study_harmonics,
+                                 n_starts=args.starts)
+    else:
+        from .studies.robust import robust_design
+
+        progress(f"lowest {args.statistic} largest blade peak of {args.disks} mistuned disks (std "
+                 f"{100 * args.mistuning_std:g} %) over {', '.join(keys)}, on "
+                 + ("this process" if args.processes == 1 else "a local Dask cluster"))
+        optimum = robust_design(disk, keys, [bounds[k] for k in keys], std=args.mistuning_std, n_disks=args.disks,
+                                seed=design.mistuning.seed if design.mistuning else 0, statistic=args.statistic,
+                                harmonics=a.study_harmonics, n_starts=args.starts,
+                                scheduler="serial" if args.processes == 1 else None, n_workers=args.processes)
     gradient_optimize_outputs(out, design, optimum, a.study_harmonics)
     print(optimum.table())
-    return _done(out, t0, f"peak {1e3 * optimum.peak_amplitude:.4f} mm at the optimum "
-                          f"({100 * optimum.reduction:.1f} % below the design's), {optimum.n_responses} frequency responses")
+    what = "peak" if args.mistuning_std is None else f"{args.statistic} largest blade peak of the mistuned disks"
+    return _done(out, t0, f"{what} {1e3 * optimum.peak_amplitude:.4f} mm at the optimum "
+                          f"({100 * optimum.reduction:.1f} % below the design's), {optimum.n_responses} evaluations")
 
 
 def engine_orders(args, design) -> tuple:
@@ -964,6 +989,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--starts", type=int, default=None,
                    help="with --parameters: local searches, from the best of the design and 4 Sobol points per\n"
                         "parameter in the box (default: one per parameter)")
+    p.add_argument("--mistuning-std", type=float, default=None, metavar="STD",
+                   help="with --parameters: a design robust to mistuning: minimise a statistic of the largest blade\n"
+                        "peak of --disks mistuned copies (blade frequencies times 1 + STD N(0, 1), the same copies for\n"
+                        "every design; STD in (0, 0.2), e.g. 0.02), on a local Dask cluster (--processes workers)")
+    p.add_argument("--disks", type=int, default=20, help="with --mistuning-std: mistuned copies (default 20)")
+    p.add_argument("--statistic", default="mean",
+                   help="with --mistuning-std: 'mean' (default) or a quantile in (0, 1), e.g. 0.95")
     processes_arg(p)
     out_arg(p, "results/<design file name>/optimize")
     figure_args(p)

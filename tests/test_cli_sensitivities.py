@@ -57,6 +57,11 @@ def test_fit_recovers_the_friction_coefficient_from_csv_files(tmp_path, capsys):
     (["sensitivities", "{d}", "--parameters", "rotor_speed_rpm"], ["rotor_speed_rpm", "fixed rotor speed"]),
     (["fit", "{d}", "{m}", "--excitation-n", "0.1", "0.2"], ["--excitation-n", "one force per measured file"]),
     (["fit", "{d}", "{d}"], ["{d}"]),
+    (["optimize", "{d}", "--mistuning-std", "0.02"], ["--mistuning-std", "--parameters"]),
+    (["optimize", "{d}", "--parameters", "mass_g", "--mistuning-std", "0.3"], ["--mistuning-std 0.3", "(0, 0.2)"]),
+    (["optimize", "{d}", "--parameters", "mass_g", "--mistuning-std", "0.02", "--statistic", "median"],
+     ["--statistic median", "quantile in (0, 1)"]),
+    (["optimize", "{d}", "--parameters", "mass_g", "--mistuning-std", "0.02", "--disks", "1"], ["--disks 1", "at least 2"]),
 ])
 def test_bad_options_and_files_end_in_one_line(tmp_path, capsys, argv, needles):
     design = tmp_path / "wing.toml"
@@ -66,3 +71,25 @@ def test_bad_options_and_files_end_in_one_line(tmp_path, capsys, argv, needles):
     argv = [a.format(d=design, m=measured) for a in argv] + ["--out", str(tmp_path / "o")]
     assert main(argv) == 2
     one_error_line(capsys.readouterr().err, *[n.format(d=design) for n in needles])
+
+
+@pytest.mark.slow
+@pytest.mark.filterwarnings("ignore::bladedamp.hbm.accuracy.AccuracyWarning")
+def test_optimize_robust_to_mistuning_writes_the_librarys_optimum(tmp_path, capsys):
+    """``optimize --parameters mass_g --mistuning-std`` is :func:`bladedamp.studies.robust.robust_design`
+    with the design's bounds: the same optimum (bit for bit: the same copies and searches), named as
+    the statistic over mistuned disks in its outputs."""
+    from bladedamp.studies.robust import robust_design
+
+    design = tmp_path / "wing.toml"
+    design.write_text(FAST + "mass_range_g = [0.4, 1.2]\n")
+    out = tmp_path / "robust"
+    assert main(["optimize", str(design), "--parameters", "mass_g", "--mistuning-std", "0.02", "--disks", "2",
+                 "--starts", "1", "--processes", "1", "--out", str(out)]) == 0
+    result = json.loads((out / "results.json").read_text())
+    d = load_design(design)
+    optimum = robust_design(d.disk, ["damper.mass_g"], [[0.4, 1.2]], std=0.02, n_disks=2, seed=0, n_starts=1,
+                            harmonics=(1,))
+    assert result["parameters"][0]["optimum"] == pytest.approx(optimum["damper.mass_g"], rel=1e-12)
+    assert "mistuned disks" in result["objective"]
+    assert "mistuned disks" in (out / "summary.md").read_text()

@@ -49,8 +49,9 @@ def test_quantile_weights_are_numpys_quantile(q):
     rounding = 1e-14 * np.abs(values).max()                      # a sum's rounding
     np.testing.assert_allclose(statistic_weights(values, q) @ values, np.quantile(values, q), rtol=0, atol=rounding)
     np.testing.assert_allclose(statistic_weights(values, "mean") @ values, values.mean(), rtol=0, atol=rounding)
-    with pytest.raises(ValueError, match="statistic"):
-        statistic_weights(values, 1.5)
+    for bad in (1.5, "median", None):
+        with pytest.raises(ValueError, match="statistic"):
+            statistic_weights(values, bad)
 
 
 def test_robust_objective_gradient_is_the_difference_of_its_copies(disk):

@@ -220,13 +220,22 @@ def perturbation_estimate(disk, std: float = PAPER_STD, quantile: float = 0.95, 
 # ---------------------------------------------------------------------------------------
 # the robust objective
 # ---------------------------------------------------------------------------------------
+def check_statistic(statistic):
+    """``statistic``: "mean" or a quantile in [0, 1] (a float); ValueError naming it otherwise."""
+    if isinstance(statistic, str) and statistic == "mean":
+        return statistic
+    if isinstance(statistic, (bool, str)) or not np.isscalar(statistic):
+        raise ValueError(f"statistic must be \"mean\" or a quantile in [0, 1] (got {statistic!r})")
+    return validation.in_range("statistic (a quantile)", statistic, 0.0, 1.0)
+
+
 def statistic_weights(values: np.ndarray, statistic) -> np.ndarray:
     """(N,) weights w with the ``statistic`` of ``values`` = w . values: "mean", or a quantile in
     (0, 1) (numpy's linear interpolation between the two order statistics around it)."""
     n = len(values)
-    if statistic == "mean":
+    if check_statistic(statistic) == "mean":
         return np.full(n, 1.0 / n)
-    q = validation.in_range("statistic (\"mean\" or a quantile in (0, 1))", statistic, 0.0, 1.0)
+    q = float(statistic)
     order = np.argsort(values, kind="stable")
     position = q * (n - 1)
     low = int(np.floor(position))
@@ -280,8 +289,7 @@ def robust_objective(disk, parameters, std: float = PAPER_STD, n_disks: int = 20
     on ``scheduler``. ValueError if a copy's peak cannot be solved or differentiated (its reason)."""
     keys = tuple(str(p) for p in parameters)
     n_disks = validation.integer("n_disks", n_disks, minimum=1)
-    if statistic != "mean":
-        validation.in_range("statistic (\"mean\" or a quantile in (0, 1))", statistic, 0.0, 1.0)
+    statistic = check_statistic(statistic)
     kappas = np.array([random_kappa(disk.n_blades, std, seed=[int(seed), i]) for i in range(n_disks)])
     settings = disk_settings(harmonics)
     assembly = MistunedDisk.from_tuned(disk)
