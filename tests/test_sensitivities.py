@@ -311,3 +311,40 @@ def test_oscillator_in_gross_slip_peaks_at_the_free_natural_frequency():
                                  harmonics=(0, 1, 2, 3), n_samples=64)
     _, frequency = peak.elasticities()
     assert frequency == pytest.approx([-0.5, 0.5], abs=1e-3)
+
+
+def test_zero_excitation_is_rest_with_the_stuck_receptance_as_derivative():
+    """Zero excitation: the response is rest, so the peak has no derivatives (a ValueError that says
+    so, not 'could not be solved'); at each frequency every key that leaves rest at rest has the
+    derivative 0 (to the AFT's rounding of the contacts' constant forces), and an excitation key the
+    one-sided derivative of |u| = F |H| as F grows, the stuck linear receptance |H| times the unit
+    force (F_x and M_x here: the tip's x motion). Against full Newton solves at F = 1 mN with
+    mu = 2 (the damper never slips and the normal law is linear: the response is exactly linear in
+    F), |u| / F to 1e-10 (measured 3e-14: the solves' tolerance 1e-14)."""
+    disk = bd.reference_disk("cylinder", 1e-3)
+    rest = dataclasses.replace(disk, excitation=np.zeros(6))
+    keys = ["disk.excitation_n_nm[0]", "disk.excitation_n_nm[4]", "damper.mass_g", "damper.friction_coefficient",
+            "blade.natural_frequencies_hz[0]", "blade.damping_ratio"]
+    with pytest.raises(ValueError, match="the excitation is zero: the response is rest and has no peak"):
+        bd.peak_sensitivities(rest, (90.0, 100.0), keys)
+    response = rest.frequency_response(90.0, 100.0)
+    sens = response.sensitivities(keys)
+    assert np.isfinite(sens.d_tip_amplitude).all() and not sens.tip_amplitude.any()
+    receptance = sens.d_tip_amplitude[:, :2, 0]
+    assert (receptance > 0).all()
+    # the other keys: 0 (p dA/dp against the receptance times 1 N: rounding, measured 1e-17)
+    others = np.abs(sens.d_tip_amplitude[:, 2:, 0]) * np.abs(sens.values[2:])
+    assert others.max() <= 1e-12 * receptance.max()
+    contact = dataclasses.replace(disk.damper.contact, friction_coefficient=2.0)
+    output = response.blade_outputs(0)[0]
+    for j in range(2):
+        force = 1e-3
+        loaded = dataclasses.replace(disk, damper=dataclasses.replace(disk.damper, contact=contact),
+                                     excitation=force * np.eye(6)[(0, 4)[j]])
+        system = loaded.hbm_system(response.basis.harmonics, response.basis.n_samples)
+        for i in range(0, len(response.omega), 10):
+            w = float(response.omega[i])
+            start = loaded.initial_guess(system, w)
+            solved = newton(system.residual, start, w, np.abs(start).max(), 1.0, tol=1e-14, factorize=system.factorize)
+            assert solved.converged
+            assert abs(abs(output @ solved.x) / force - receptance[i, j]) <= 1e-10 * receptance[i, j], (j, i)
