@@ -807,7 +807,8 @@ class Sensitivities(Saveable):
         derivatives are); values : (k,) their values in the model [the key's unit]
     frequency_hz : (n,) the branch's frequencies [Hz]
     tip_amplitude : (n, s) each blade's first-harmonic tip amplitude [m] (s = 1: the tuned sector)
-    d_tip_amplitude : (n, k, s) its derivatives [m per unit of each key]
+    d_tip_amplitude : (n, k, s) its derivatives [m per unit of each key] (where the amplitude is 0,
+        rest under a zero excitation, the one-sided derivative as the key grows, |du/dp|)
     d_coefficients : (n, k, C, n_dof) the derivatives of the harmonic coefficients [SI per unit]
     """
 
