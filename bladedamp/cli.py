@@ -267,6 +267,12 @@ def precompile_command(args) -> int:
     return 0
 
 
+def _check_mistuning(args, design) -> None:
+    """UsageError where ``--mistuned`` is given to a design without a [mistuning] table."""
+    if args.mistuned and design.mistuning is None:
+        raise UsageError(f"{design.path}: --mistuned needs a [mistuning] table (std and seed, or kappa)")
+
+
 def frf_command(args) -> int:
     """``bladedamp frf``: the frequency response of the design at each of its engine orders."""
     import dataclasses
@@ -276,8 +282,7 @@ def frf_command(args) -> int:
 
     t0 = time.perf_counter()
     design = _load(args)
-    if args.mistuned and design.mistuning is None:
-        raise UsageError(f"{design.path}: --mistuned needs a [mistuning] table (std and seed, or kappa)")
+    _check_mistuning(args, design)
     measured = None
     if args.measured is not None:                 # read before the solve: a bad file stops at once
         from .measurement import load_measurement
@@ -387,17 +392,19 @@ def _parameter_keys(args, disk) -> list:
 
 
 def sensitivities_command(args) -> int:
-    """``bladedamp sensitivities``: the derivatives of the resonance peak in design parameters."""
+    """``bladedamp sensitivities``: the derivatives of the resonance peak in design parameters (of
+    the design's tuned disk, or with ``--mistuned`` of its mistuned full assembly)."""
     from .report import sensitivity_outputs
 
     t0 = time.perf_counter()
     design = _load(args)
-    disk, a = design.disk, design.analysis
+    _check_mistuning(args, design)
+    disk, a = design.mistuned_disk() if args.mistuned else design.disk, design.analysis
     keys = _parameter_keys(args, disk)
     out = output_dir(output_folder(args), args.overwrite)
     progress = Progress()
     progress.compiling()
-    progress(f"frequency response {a.f_start_hz:g}-{a.f_end_hz:g} Hz")
+    progress(f"{'mistuned full assembly: ' if args.mistuned else ''}frequency response {a.f_start_hz:g}-{a.f_end_hz:g} Hz")
     response = disk.frequency_response(a.f_start_hz, a.f_end_hz, **a.options())
     if not response.success:
         print(f"bladedamp sensitivities: the frequency response is not a success, its peak is not differentiated: "
@@ -409,7 +416,7 @@ def sensitivities_command(args) -> int:
     except ValueError as exc:
         print(f"bladedamp sensitivities: {exc}", file=sys.stderr)
         return 1
-    sensitivity_outputs(out, design, peak)
+    sensitivity_outputs(out, design, peak, mistuned=args.mistuned)
     print(peak.table())
     return _done(out, t0, f"peak {1e3 * peak.peak_amplitude:.4f} mm at {peak.peak_frequency_hz:.4f} Hz")
 
@@ -1009,6 +1016,9 @@ def build_parser() -> argparse.ArgumentParser:
     parameters_arg(p, ["mass_g", "friction_coefficient", "tangential_stiffness_per_length_n_per_m2",
                        "normal_to_tangential_stiffness", "damper_radius_mm", "excitation_n_nm[0]",
                        "natural_frequencies_hz[0]", "damping_ratio"])
+    p.add_argument("--mistuned", action="store_true",
+                   help="the mistuned full assembly of the [mistuning] table instead of the tuned sector (its largest\n"
+                        "blade's peak; the keys may include kappa[k], blade k's mistuning factor)")
     out_arg(p, "results/<design file name>/sensitivities")
     figure_args(p)
 

@@ -1409,7 +1409,9 @@ class DiskModel:
         per length), and without a static harmonic a cylinder's seating: each patch's approach
         follows its frictionless load (:meth:`~bladedamp.damper.geometry.DamperGeometry.normal_load_log_derivatives`)
         and k_N. A wedge's seating leaves a moment to its faces, so its geometry needs the static
-        harmonic (the seating then is the harmonic balance's)."""
+        harmonic (the seating then is the harmonic balance's). Every position's dimension moves
+        together; each position has its own kinematics and inertia derivative (its damper's mass,
+        its angles), the dampers may differ in their mass only (ValueError otherwise)."""
         basis = system.basis
         damper = positions[0].damper if positions else None
         parameter, unit = GEOMETRY_KEYS[name]
@@ -1424,13 +1426,22 @@ class DiskModel:
             raise ValueError(f"parameter {key!r}: not with initial gaps (a misfit's seating is not differentiated)")
         if any(b.flexible_platform for b in self.model_blades):
             raise ValueError(f"parameter {key!r}: not with flexible platforms (their point maps follow the geometry)")
-        kinematics, d_inertia = [], None
+        # the patches' points, stiffnesses and seating below are position 0's: the dampers may differ
+        # in their mass only (the inertia and the kinematics are each position's own)
+        if any(dataclasses.replace(p.damper, mass=damper.mass) != damper for p in positions):
+            raise ValueError(f"parameter {key!r}: the dampers differ from position to position in more than their mass")
+        if not basis.has_static and parameter in ("gamma_left", "gamma_right") and \
+                len({(p.gamma_left, p.gamma_right) for p in positions}) > 1:
+            raise ValueError(f"parameter {key!r}: the platform angles differ from position to position: without the "
+                             "static harmonic their seating is not differentiated (include harmonic 0)")
+        kinematics, d_inertia = [], []
         blade = self.model_blades[0]
         zero_points = {"OL": np.zeros(3), "OR": np.zeros(3)}
         for position in positions:
             geometry = position.damper_geometry()
-            d_frames, d_centres, d_inertia = position.damper.geometry_derivative(position.gamma_left,
-                                                                                 position.gamma_right, parameter)
+            d_frames, d_centres, d_position_inertia = position.damper.geometry_derivative(
+                position.gamma_left, position.gamma_right, parameter)
+            d_inertia.append(unit * d_position_inertia)        # each damper's own: its mass, its angles
             offsets = position.platform_offsets(geometry, blade.points)
             # the offsets are affine in the centres: their derivative is the map of the centres' alone
             d_offsets = position.platform_offsets(dataclasses.replace(geometry, centres=d_centres), zero_points)
@@ -1440,7 +1451,7 @@ class DiskModel:
         n_local = coupling.matrix.shape[0] // basis.n_coeffs // len(positions)
         effect = ParameterEffect(coupling=self.contact_coupling(basis, kinematics, n_local, False))
         if self.damper_inertia and np.any(d_inertia):
-            effect.matrices["mass"] = self.damper_blocks(system, [unit * d_inertia] * len(positions))
+            effect.matrices["mass"] = self.damper_blocks(system, d_inertia)
         degree = damper.contact.roughness_exponent
         geometry = positions[0].damper_geometry()
         if parameter in ("contact_height", "length"):          # the points move along xi (height), eta (length)

@@ -19,7 +19,11 @@ estimate +- t_{(1+c)/2, m-k} x standard error (c the confidence). A parameter is
 identified where J^T J is singular in its direction (its singular value below
 :data:`IDENTIFIABLE_CONDITION` of the largest) or its standard error exceeds
 :data:`IDENTIFIABLE_RELATIVE_ERROR` of its estimate: its interval is then infinite, not a
-confident number.
+confident number. A parameter whose Jacobian column at the start is (near) zero, its norm below
+:data:`IDENTIFIABLE_CONDITION` of the largest column's (a direction J cannot see, whatever the
+others do: J's smallest singular value is at most that column's norm), is held at its start value
+and the others are fitted without it (a least squares over a direction without effect only spends
+its evaluations); it is reported as not identified, its interval unbounded.
 """
 from __future__ import annotations
 
@@ -53,7 +57,8 @@ class ContactFit(Saveable):
     standard_error : (k,) [the key's unit]; interval : (k, 2) the confidence interval
         (inf where not identified); confidence : its level (0.95)
     correlation : (k, k) the estimates' correlation matrix
-    identified : (k,) whether the data identify each parameter (see the module docstring)
+    identified : (k,) whether the data identify each parameter (see the module docstring; one
+        without effect at the start is held at its start value, its estimate that value)
     residual_rms : the root mean square of the relative residual at the estimate [-] (the
         measurement's relative noise, where the model fits)
     n_responses : frequency responses solved (every level at every evaluation)
@@ -263,20 +268,36 @@ def fit_contact(model: DiskModel, measured, parameters=("damper.friction_coeffic
             cache[key] = (np.concatenate(rows), np.vstack(jac), np.concatenate(curves))
         return cache[key]
 
-    start_curve = evaluate(np.ones(len(keys)))[2]
-    solution = scipy.optimize.least_squares(lambda z: evaluate(z)[0], np.ones(len(keys)), jac=lambda z: evaluate(z)[1],
-                                            bounds=(1e-3, 1e3), x_scale="jac", max_nfev=max_evaluations)
-    r, J, fitted = evaluate(solution.x)
-    m_rows, k = len(r), len(keys)
+    _, J0, start_curve = evaluate(np.ones(len(keys)))
+    columns = np.linalg.norm(J0, axis=0)
+    free = columns > IDENTIFIABLE_CONDITION * columns.max() if columns.max() > 0 else np.zeros(len(keys), bool)
+
+    def full(z_free):
+        z = np.ones(len(keys))
+        z[free] = z_free
+        return z
+
+    if free.any():
+        solution = scipy.optimize.least_squares(lambda z: evaluate(full(z))[0], np.ones(int(free.sum())),
+                                                jac=lambda z: evaluate(full(z))[1][:, free], bounds=(1e-3, 1e3),
+                                                x_scale="jac", max_nfev=max_evaluations)
+        z_fit, success, said = full(solution.x), bool(solution.success), str(solution.message).rstrip(".")
+    else:
+        z_fit, success, said = np.ones(len(keys)), False, "no parameter changes the response at the start: nothing fitted"
+    r, J, fitted = evaluate(z_fit)
+    m_rows, k = len(r), int(free.sum())
     dof = max(m_rows - k, 1)
     variance = float(r @ r) / dof
-    _, sv, vt = np.linalg.svd(J, full_matrices=False)
+    _, sv, vt = np.linalg.svd(J[:, free], full_matrices=False)
     good = sv > IDENTIFIABLE_CONDITION * sv.max() if sv.size and sv.max() > 0 else np.zeros(k, bool)
-    inverse = (vt[good].T / sv[good] ** 2) @ vt[good]
+    inverse = np.zeros((len(keys), len(keys)))
+    inverse[np.ix_(free, free)] = (vt[good].T / sv[good] ** 2) @ vt[good]
     covariance = variance * inverse * np.outer(initial, initial)
     standard_error = np.sqrt(np.maximum(np.diag(covariance), 0.0))
-    estimate = solution.x * initial
-    weak = np.abs(vt[~good]).max(axis=0) > 1e-3 if (~good).any() else np.zeros(k, bool)
+    estimate = z_fit * initial
+    weak = ~free
+    if (~good).any():
+        weak[free] = np.abs(vt[~good]).max(axis=0) > 1e-3
     identified = ~weak & (standard_error <= IDENTIFIABLE_RELATIVE_ERROR * np.abs(estimate))
     standard_error = np.where(weak, np.inf, standard_error)
     t = scipy.stats.t.ppf(0.5 + confidence / 2, dof)
@@ -298,12 +319,13 @@ def fit_contact(model: DiskModel, measured, parameters=("damper.friction_coeffic
                                       max_step=max_step, estimate_harmonic_error=False)
         curves.append((branch.frequency_hz, branch.tip_amplitude[:, 0] if branch.tip_amplitude.ndim == 2
                        else branch.tip_amplitude[:, 0, 0], np.full(len(branch.omega), l)))
-    said = str(solution.message).rstrip(".")
-    message = said if solution.success else f"not converged: {said}"
+    message = said if success else f"not converged: {said}"
     if not identified.all():
-        message += "; not identified by these data: " + ", ".join(k for k, i in zip(keys, identified) if not i)
+        message += "; not identified by these data: " + ", ".join(
+            k + ("" if f else " (no effect on the response at the start: held at its start value)")
+            for k, i, f in zip(keys, identified, free) if not i)
     return ContactFit(keys, tuple(parameter_unit(k) for k in keys), initial, estimate, standard_error, interval,
                       float(confidence), correlation, identified, float(np.sqrt(np.mean(r ** 2))), count[0],
-                      bool(solution.success), message, frequency, values, fitted, start_curve, level,
+                      success, message, frequency, values, fitted, start_curve, level,
                       np.array(levels), *(np.concatenate(c) for c in zip(*curves)))
 

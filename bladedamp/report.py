@@ -1164,26 +1164,32 @@ def campbell_outputs(out: Path, design, diagram) -> dict:
     return summary
 
 
-def sensitivity_outputs(out: Path, design, peak) -> dict:
+def sensitivity_outputs(out: Path, design, peak, mistuned: bool = False) -> dict:
     """sensitivities.png, results.json, summary.md and peak_sensitivities.npz of ``bladedamp
-    sensitivities`` (a :class:`~bladedamp.response.PeakSensitivities`)."""
+    sensitivities`` (a :class:`~bladedamp.response.PeakSensitivities`; ``mistuned``: of the
+    design's mistuned full assembly, whose mistuning factors are written with it)."""
     ea, ef = peak.elasticities()
     rows = [{"parameter": k, "unit": u, "value": v, "d_peak_amplitude_mm_per_unit": 1e3 * da,
              "d_peak_frequency_hz_per_unit": df, "relative_amplitude": a, "relative_frequency": f}
             for k, u, v, da, df, a, f in zip(peak.parameters, peak.units, peak.values, peak.d_peak_amplitude,
                                              peak.d_peak_frequency_hz, ea, ef)]
-    summary = {"design": design.path, "peak_amplitude_mm": 1e3 * peak.peak_amplitude,
+    model = "mistuned full assembly" if mistuned else "tuned sector"
+    summary = {"design": design.path, "model": model, "peak_amplitude_mm": 1e3 * peak.peak_amplitude,
                "peak_frequency_hz": peak.peak_frequency_hz, "blade": peak.blade, "sensitivities": rows}
+    if mistuned:
+        summary["mistuning_kappa"] = design.kappa
     fig = peak.plot()
-    fig.axes[0].set_title(design_title(design, "sensitivities of the peak") + "\n" + fig.axes[0].get_title(),
-                          fontsize="medium")
+    what = "sensitivities of the mistuned peak" if mistuned else "sensitivities of the peak"
+    fig.axes[0].set_title(design_title(design, what) + "\n" + fig.axes[0].get_title(), fontsize="medium")
     files = save_figure(fig, out / "sensitivities.png")
     saved = save_result(peak, out / "peak_sensitivities")
     files += [saved] if saved else []
     write_json(out / "results.json", summary)
     files.append("results.json")
+    where = (f"Mistuned full assembly (the [mistuning] table's factors kappa = "
+             f"{', '.join(f'{k:.4g}' for k in design.kappa)}): blade {peak.blade}'s peak u_x") if mistuned else "Peak u_x"
     lines = ["## Peak and its derivatives", "",
-             f"Peak u_x {_mm(peak.peak_amplitude)} at {peak.peak_frequency_hz:.4f} Hz, solved by d|u|/dOmega = 0 and "
+             f"{where} {_mm(peak.peak_amplitude)} at {peak.peak_frequency_hz:.4f} Hz, solved by d|u|/dOmega = 0 and "
              "differentiated with the analytic dR/dp (the implicit function theorem).", "",
              "| parameter | value | d peak / dp [mm per unit] | d frequency / dp [Hz per unit] | p/A dA/dp | p/f df/dp |",
              "|---|---|---|---|---|---|"]

@@ -807,7 +807,8 @@ class Sensitivities(Saveable):
         derivatives are); values : (k,) their values in the model [the key's unit]
     frequency_hz : (n,) the branch's frequencies [Hz]
     tip_amplitude : (n, s) each blade's first-harmonic tip amplitude [m] (s = 1: the tuned sector)
-    d_tip_amplitude : (n, k, s) its derivatives [m per unit of each key]
+    d_tip_amplitude : (n, k, s) its derivatives [m per unit of each key] (where the amplitude is 0,
+        rest under a zero excitation, the one-sided derivative as the key grows, |du/dp|)
     d_coefficients : (n, k, C, n_dof) the derivatives of the harmonic coefficients [SI per unit]
     """
 
@@ -972,13 +973,16 @@ def solved_peak_sensitivities(system, omega, coefficients, outputs, dR_dp, keys,
     """The :class:`PeakSensitivities` of the largest amplitude of the s complex ``outputs`` (s,
     C * n_dof) on a branch of ``system`` (as :func:`branch_sensitivities`): the peak solved by
     d|u|/dOmega = 0 (:class:`~bladedamp.hbm.peaks.PeakSolver`) next to the largest sample, then
-    differentiated (:func:`bladedamp.hbm.sensitivity.peak_sensitivities`). ValueError where it
-    cannot be solved (at an end of the range, next to a fold) or no pair of points beside it
-    brackets a maximum."""
+    differentiated (:func:`bladedamp.hbm.sensitivity.peak_sensitivities`). ValueError where the
+    response is rest at every point (a zero excitation: no peak), where the peak cannot be solved
+    (at an end of the range, next to a fold) or no pair of points beside it brackets a maximum."""
     outputs = np.atleast_2d(outputs)
     n = len(omega)
     X = np.asarray(coefficients, dtype=float).reshape(n, -1)
     curves = np.abs(X @ outputs.T)                                      # (n, s)
+    if n and not curves.any():
+        raise ValueError("the excitation is zero: the response is rest and has no peak (no peak derivatives; "
+                         "response.sensitivities gives each frequency's)")
     blade = int(np.argmax(curves.max(axis=0)))
     index = int(np.argmax(curves[:, blade]))
     solver = PeakSolver(system, omega, X)

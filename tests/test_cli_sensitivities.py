@@ -31,6 +31,42 @@ def test_sensitivities_writes_the_peak_derivatives_of_the_library(tmp_path, caps
     assert bd.load(out / "peak_sensitivities.npz").parameters == peak.parameters
 
 
+MISTUNED = ("[analysis]\nfrequency_range_hz = [97.0, 106.0]\nharmonics = [1]\n[disk]\nn_blades = 4\n"
+            "[mistuning]\nkappa = [1.0, 1.02, 0.99, 1.01]\n")
+
+
+@pytest.mark.filterwarnings("ignore::bladedamp.hbm.accuracy.AccuracyWarning")
+def test_sensitivities_of_the_mistuned_assembly_are_the_library_s(tmp_path, capsys):
+    """``--mistuned``: the peak derivatives of the design's mistuned full assembly (4 blades), the
+    keys with a blade's mistuning factor, as the Python API gives them (the same solves: to 1e-9,
+    the JSON's rounding being 1e-16); a design without a [mistuning] table: frf --mistuned's error."""
+    design = tmp_path / "ring.toml"
+    design.write_text(MISTUNED)
+    out = tmp_path / "sens"
+    keys = ["damper.mass_g", "damper.friction_coefficient", "mistuning.kappa[1]", "mistuning.kappa[3]"]
+    assert main(["sensitivities", str(design), "--mistuned", "--parameters", "mass_g", "friction_coefficient",
+                 "kappa[1]", "kappa[3]", "--out", str(out)]) == 0
+    result = json.loads((out / "results.json").read_text())
+    d = load_design(design)
+    peak = d.mistuned_disk().frequency_response(97.0, 106.0, **d.analysis.options()).peak_sensitivities(keys)
+    assert result["model"] == "mistuned full assembly" and result["mistuning_kappa"] == [1.0, 1.02, 0.99, 1.01]
+    assert [r["parameter"] for r in result["sensitivities"]] == keys
+    assert result["blade"] == peak.blade and result["peak_amplitude_mm"] == pytest.approx(1e3 * peak.peak_amplitude,
+                                                                                        rel=1e-9)
+    for row, da, df in zip(result["sensitivities"], peak.d_peak_amplitude, peak.d_peak_frequency_hz):
+        assert row["d_peak_amplitude_mm_per_unit"] == pytest.approx(1e3 * da, rel=1e-9), row["parameter"]
+        assert row["d_peak_frequency_hz_per_unit"] == pytest.approx(df, rel=1e-9), row["parameter"]
+    assert "Mistuned full assembly" in (out / "summary.md").read_text()
+    capsys.readouterr()
+    # without a [mistuning] table, and a kappa key without --mistuned (the tuned sector has none)
+    tuned = tmp_path / "tuned.toml"
+    tuned.write_text(MISTUNED.split("[mistuning]")[0])
+    assert main(["sensitivities", str(tuned), "--mistuned", "--parameters", "mass_g", "--out", str(tmp_path / "o")]) == 2
+    one_error_line(capsys.readouterr().err, "--mistuned needs a [mistuning] table")
+    assert main(["sensitivities", str(design), "--parameters", "kappa[1]", "--out", str(tmp_path / "t")]) == 2
+    one_error_line(capsys.readouterr().err, "--parameters", "MistunedDisk")
+
+
 def test_fit_recovers_the_friction_coefficient_from_csv_files(tmp_path, capsys):
     truth = bd.reference_disk("cylinder", 1e-3)
     f = np.linspace(92.0, 99.0, 20)

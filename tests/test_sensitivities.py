@@ -311,3 +311,103 @@ def test_oscillator_in_gross_slip_peaks_at_the_free_natural_frequency():
                                  harmonics=(0, 1, 2, 3), n_samples=64)
     _, frequency = peak.elasticities()
     assert frequency == pytest.approx([-0.5, 0.5], abs=1e-3)
+
+
+def test_zero_excitation_is_rest_with_the_stuck_receptance_as_derivative():
+    """Zero excitation: the response is rest, so the peak has no derivatives (a ValueError that says
+    so, not 'could not be solved'); at each frequency every key that leaves rest at rest has the
+    derivative 0 (to the AFT's rounding of the contacts' constant forces), and an excitation key the
+    one-sided derivative of |u| = F |H| as F grows, the stuck linear receptance |H| times the unit
+    force (F_x and M_x here: the tip's x motion). Against full Newton solves at F = 1 mN with
+    mu = 2 (the damper never slips and the normal law is linear: the response is exactly linear in
+    F), |u| / F to 1e-10 (measured 3e-14: the solves' tolerance 1e-14)."""
+    disk = bd.reference_disk("cylinder", 1e-3)
+    rest = dataclasses.replace(disk, excitation=np.zeros(6))
+    keys = ["disk.excitation_n_nm[0]", "disk.excitation_n_nm[4]", "damper.mass_g", "damper.friction_coefficient",
+            "blade.natural_frequencies_hz[0]", "blade.damping_ratio"]
+    with pytest.raises(ValueError, match="the excitation is zero: the response is rest and has no peak"):
+        bd.peak_sensitivities(rest, (90.0, 100.0), keys)
+    response = rest.frequency_response(90.0, 100.0)
+    sens = response.sensitivities(keys)
+    assert np.isfinite(sens.d_tip_amplitude).all() and not sens.tip_amplitude.any()
+    receptance = sens.d_tip_amplitude[:, :2, 0]
+    assert (receptance > 0).all()
+    # the other keys: 0 (p dA/dp against the receptance times 1 N: rounding, measured 1e-17)
+    others = np.abs(sens.d_tip_amplitude[:, 2:, 0]) * np.abs(sens.values[2:])
+    assert others.max() <= 1e-12 * receptance.max()
+    contact = dataclasses.replace(disk.damper.contact, friction_coefficient=2.0)
+    output = response.blade_outputs(0)[0]
+    for j in range(2):
+        force = 1e-3
+        loaded = dataclasses.replace(disk, damper=dataclasses.replace(disk.damper, contact=contact),
+                                     excitation=force * np.eye(6)[(0, 4)[j]])
+        system = loaded.hbm_system(response.basis.harmonics, response.basis.n_samples)
+        for i in range(0, len(response.omega), 10):
+            w = float(response.omega[i])
+            start = loaded.initial_guess(system, w)
+            solved = newton(system.residual, start, w, np.abs(start).max(), 1.0, tol=1e-14, factorize=system.factorize)
+            assert solved.converged
+            assert abs(abs(output @ solved.x) / force - receptance[i, j]) <= 1e-10 * receptance[i, j], (j, i)
+
+
+def test_geometry_derivatives_of_dampers_with_their_own_masses_match_differences():
+    """A mistuned wedge disk whose four dampers differ in mass: each damper's inertia derivative is
+    its own (m times a function of the section). Every position's height and angle move together
+    (``with_parameters``), against central differences as above. Giving every damper the last
+    one's inertia derivative was 1.5e-4 off in the height (measured), above the 1e-5. Dampers that
+    differ in more than their mass (the points and stiffnesses being position 0's) are refused."""
+    tuned = dataclasses.replace(bd.reference_disk("wedge", 0.3e-3), n_blades=4)
+    dampers = [dataclasses.replace(tuned.damper, mass=1e-3 * m) for m in (0.3, 0.5, 0.2, 0.4)]
+    disk = MistunedDisk.from_tuned(tuned, np.array([1.0, 1.01, 0.99, 1.02]), dampers=dampers)
+    response = disk.frequency_response(94.0, 98.0, harmonics=(0, 1, 2), n_samples=32, estimate_harmonic_error=False)
+    keys = ["damper.contact_height_mm", "disk.gamma_left_deg", "damper.length_mm"]
+    sens = response.sensitivities(keys)
+    i = int(np.argmax(sens.tip_amplitude.max(axis=1))) - 2
+    for j, key in enumerate(keys):
+        fd = central_difference(lambda k, h: disk.with_parameters({k: sens.values[j] + h}), key, sens.values[j],
+                                response, i)
+        assert np.abs(sens.d_tip_amplitude[i, j] - fd).max() <= RTOL * np.abs(fd).max(), key
+    longer = MistunedDisk.from_tuned(tuned, dampers=dampers[:3] + [dataclasses.replace(dampers[3], length=25e-3)])
+    with pytest.raises(ValueError, match="differ from position to position in more than their mass"):
+        longer.parameter_derivatives(longer.hbm_system((0, 1), 16), ["damper.contact_height_mm"])
+
+
+def test_peak_of_two_close_maxima_is_the_larger_and_differentiated():
+    """The reference 0.7 g cylinder with one harmonic over 92-100 Hz has two maxima 3 mHz apart
+    (the AFT's kinks: samples 216 and 218 of the branch are both local maxima, the sample between
+    falls on both sides, so neither pair beside the largest sample rose at its left end and the
+    peak solver gave up: no peak derivatives). The peak is that of a dense scan of Newton solves
+    over 95.150-95.175 Hz (0.05 mHz apart: the solved peak may lie above the scan's largest by the
+    largest slope times half a spacing, and not below it beyond the solves' 1e-12), the larger of
+    the two; its derivatives against central differences of peaks solved by bisection (as above)."""
+    disk = bd.reference_disk("cylinder", 0.7e-3)
+    response = disk.frequency_response(92.0, 100.0, harmonics=(1,), estimate_harmonic_error=False)
+    keys = ["damper.mass_g", "damper.friction_coefficient", "disk.excitation_n_nm[0]"]
+    peak = response.peak_sensitivities(keys)
+    system = response.model_system()
+    output = response.blade_outputs(0)[0]
+    X = response.coefficients.reshape(len(response.omega), -1)
+    i = int(np.argmax(np.abs(X @ output)))
+    scan, slopes, x = [], [], X[i]
+    for f in np.arange(95.150, 95.175, 5e-5):
+        solved = newton(system.residual, x, 2 * np.pi * f, np.abs(x).max(), 1.0, tol=1e-13, factorize=system.factorize)
+        assert solved.converged
+        x = solved.x
+        u, du = output @ x, output @ -solved.solve(solved.dR_domega)
+        scan.append(abs(u))
+        slopes.append(abs(np.real(np.conj(u) * du)) / abs(u))
+    scan = np.array(scan)
+    maxima = np.flatnonzero((scan[1:-1] > scan[:-2]) & (scan[1:-1] > scan[2:])) + 1
+    assert len(maxima) >= 2                                          # the case: more than one maximum
+    largest = int(np.argmax(scan))
+    bound = max(slopes) * 2 * np.pi * 2.5e-5
+    assert -1e-12 * scan[largest] <= peak.peak_amplitude - scan[largest] <= bound
+    assert abs(peak.peak_frequency_hz - (95.150 + 5e-5 * largest)) <= 5e-5
+    for key, value in zip(keys, peak.values):
+        h = STEP * abs(value)
+        plus = precise_peak(perturbed(disk, key, h), response, X[i], 2 * np.pi * peak.peak_frequency_hz)
+        minus = precise_peak(perturbed(disk, key, -h), response, X[i], 2 * np.pi * peak.peak_frequency_hz)
+        d_amplitude = (plus[0] - minus[0]) / (2 * h)
+        d_frequency = (plus[1] - minus[1]) / (2 * h) / (2 * np.pi)
+        assert abs(peak[key].peak_amplitude - d_amplitude) <= RTOL * abs(d_amplitude), key
+        assert abs(peak[key].peak_frequency_hz - d_frequency) <= RTOL * abs(d_frequency), key

@@ -92,12 +92,16 @@ class PeakSolver:
         A bracket [w0, w1] holds a local maximum as long as |u| rises at w0 (slope g0 > 0) and
         either falls at w1 (g1 < 0) or is lower there (a1 < a0: the curve has turned down in
         between, e.g. at a kink where a contact point starts to slip, with the slopes of both
-        sides positive). It starts between the sample and the neighbour on the side where |u|
-        still rises (or falls less steeply). The maximum of the cubic Hermite interpolant of the
-        ends is the next frequency (the bisection where the same end moved twice running), solved
-        there by Newton from the Taylor predictor of the nearer end (tolerance ``tol``, scaled as
-        the continuation's); the end it replaces keeps the invariant. It stops when the frequency
-        moves by less than 1e-9 relative (2-3 iterations on a smooth peak)."""
+        sides positive), or, mirrored, falls at w1 and is higher there than at w0 (a1 > a0 with
+        g0 <= 0: the curve turned up and down again in between, two maxima of the AFT's kinks a
+        few mHz apart, the sample the higher one's side). It starts between the sample and the
+        neighbour on the side where |u| still rises (or falls less steeply), else where the
+        mirrored form holds. The maximum of the cubic Hermite interpolant of the ends (the first
+        from w0, mirrored the last before w1) is the next frequency (the bisection where the same
+        end moved twice running), solved there by Newton from the Taylor predictor of the nearer
+        end (tolerance ``tol``, scaled as the continuation's); the end it replaces keeps a form
+        of the invariant. It stops when the frequency moves by less than 1e-9 relative (2-3
+        iterations on a smooth peak)."""
         omega, n = self.omega, len(self.omega)
         if not 0 < index < n - 1 or not (omega[index - 1] < omega[index] < omega[index + 1]):
             return None
@@ -107,14 +111,22 @@ class PeakSolver:
         ends = [(*self._sample(k), *self._slope(output, self._sample(k)[1], self._sample(k)[2]))
                 for k in (index - 1, index, index + 1)]                          # (w, x, dx, a, g)
         left, middle, right = ends
-        bracket = [(l, r) for l, r in ((middle, right), (left, middle)) if self._brackets(l, r)]
+        pairs = ((middle, right), (left, middle))
+        bracket = [(l, r) for l, r in pairs if self._brackets(l, r)] + \
+                  [(l, r) for l, r in pairs if self._brackets_mirrored(l, r)]
         if not bracket:
             return None
         (w0, x0, d0, a0, g0), (w1, x1, d1, a1, g1) = bracket[0]
         best, w_prev, moved = max((a0, w0, 0), (a1, w1, 1)), None, None
         best = best[:2] + ((x0, x1)[best[2]],)
         for _ in range(self.max_iter):
-            t = 0.5 if moved is not None and moved[0] == moved[1] else hermite_maximum(a0, g0, a1, g1, w1 - w0)
+            mirrored = not g0 > 0                      # then g1 < 0 < a1 - a0 (_brackets_mirrored)
+            if moved is not None and moved[0] == moved[1]:
+                t = 0.5
+            elif mirrored:
+                t = 1.0 - hermite_maximum(a1, -g1, a0, -g0, w1 - w0)
+            else:
+                t = hermite_maximum(a0, g0, a1, g1, w1 - w0)
             w = w0 + (w1 - w0) * t
             xp = x0 + d0 * (w - w0) if w - w0 <= w1 - w else x1 + d1 * (w - w1)
             r = newton(self.system.residual, xp, w, self.x_scale, self._residual_scale, tol=self.tol,
@@ -130,7 +142,10 @@ class PeakSolver:
             if w_prev is not None and abs(w - w_prev) <= 1e-9 * w:
                 break
             w_prev = w
-            side = "left" if g > 0 and a >= a0 else "right"
+            if mirrored:
+                side = "right" if g < 0 and a >= a1 else "left"
+            else:
+                side = "left" if g > 0 and a >= a0 else "right"
             moved = (moved[1] if moved else None, side)
             if side == "left":
                 w0, x0, a0, g0, d0 = w, r.x, a, g, d
@@ -140,5 +155,11 @@ class PeakSolver:
 
     @staticmethod
     def _brackets(left, right) -> bool:
-        """Whether the ends (w, x, dx, a, g) hold a local maximum between them."""
+        """Whether the ends (w, x, dx, a, g) hold a local maximum between them, rising at the left."""
         return left[4] > 0 and (right[4] < 0 or right[3] < left[3])
+
+    @staticmethod
+    def _brackets_mirrored(left, right) -> bool:
+        """Whether the ends (w, x, dx, a, g) hold a local maximum between them, the mirrored form:
+        falling at the right end and higher there."""
+        return right[4] < 0 and right[3] > left[3]

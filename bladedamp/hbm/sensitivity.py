@@ -65,11 +65,14 @@ def state_sensitivities(system, x: np.ndarray, omega: float, dR_dp: np.ndarray, 
 
 def output_sensitivities(output: np.ndarray, x: np.ndarray, dx: np.ndarray) -> tuple[float, np.ndarray]:
     """(|u|, d|u|/dp (k,)) of the complex output u = ``output`` @ x with the state derivatives
-    ``dx`` (k, C*n_dof) (0 where |u| = 0, the modulus' one-sided derivative being undefined)."""
+    ``dx`` (k, C*n_dof). Where u = 0 (rest: a zero excitation) the modulus has no two-sided
+    derivative; the one given is the one-sided one as p increases, |du/dp| (|u(p + h)| = h |du/dp|
+    + O(h^2) for h > 0): the receptance times the unit force for an excitation key, 0 for a key
+    that does not move rest."""
     u = complex(output @ x)
     du = np.atleast_2d(dx) @ output
     a = abs(u)
-    return a, (np.real(np.conj(u) * du) / a if a > 0 else np.zeros(len(du)))
+    return a, (np.real(np.conj(u) * du) / a if a > 0 else np.abs(du))
 
 
 @dataclass
