@@ -87,6 +87,7 @@ def test_robust_objective_gradient_is_the_difference_of_its_copies(disk):
 
 
 @pytest.mark.slow
+@pytest.mark.filterwarnings("ignore::bladedamp.hbm.accuracy.AccuracyWarning")   # the paper's one harmonic, on purpose
 def test_perturbation_estimate_within_its_error_of_a_1000_disk_monte_carlo(disk):
     """At a small mistuning (std 0.01 %) the first-order estimate of the mean largest blade peak
     (the expansion sampled 2e5 times, its error stated from 16 check disks) lies within its stated
@@ -110,21 +111,25 @@ def test_perturbation_estimate_within_its_error_of_a_1000_disk_monte_carlo(disk)
 
 
 @pytest.mark.slow
+@pytest.mark.filterwarnings("ignore::bladedamp.hbm.accuracy.AccuracyWarning")   # the paper's one harmonic, on purpose
 def test_robust_mass_optimum_is_lighter_than_the_tuned_optimum(disk):
-    """The damper mass minimising the mean largest blade peak of 20 mistuned disks (std 2 %, the
+    """The damper mass minimising the mean largest blade peak of 12 mistuned disks (std 2 %, the
     paper's) against the mass minimising the tuned peak. Physics: mistuning spreads the blades'
     resonances, and the neighbours' different motion raises the slip across a light damper, so
     mistuning lowers the peak of a slipping (light) damper, while a stuck (heavy) damper gains
     nothing and the disk's localisation raises it (the paper: at its tuned optimum, 1 g, the
     mistuned peak is close to the tuned one, at 5 g above it). The amplification mistuned / tuned
     so grows with the mass, and the robust optimum is lighter: at the tuned optimum the robust
-    objective still falls towards lighter dampers (positive derivative), and it ends lower there."""
-    bounds = [[0.2, 3.0]]
+    objective still falls towards lighter dampers (positive derivative), and it ends lower there.
+    Measured with 20 disks in [0.2, 3] g: the robust optimum 0.556 g against the tuned 0.997 g, the
+    mean largest blade peak 0.393 mm there against 0.464 mm at the tuned optimum, whose derivative
+    is +0.21 mm/g (12 disks: half the CPU time for the same question)."""
+    bounds = [[0.3, 2.0]]
     tuned = optimal_design(disk, ["damper.mass_g"], bounds, (88.0, 106.0), harmonics=(1,))
-    robust = robust_design(disk, ["damper.mass_g"], bounds, std=0.02, n_disks=20, seed=0, n_workers=2,
+    robust = robust_design(disk, ["damper.mass_g"], bounds, std=0.02, n_disks=12, seed=0, n_workers=2,
                            scheduler=None)
     at_tuned = robust_objective(disk.with_parameters({"damper.mass_g": tuned["damper.mass_g"]}), ["damper.mass_g"],
-                                0.02, 20, seed=0, n_workers=2, scheduler=None)
+                                0.02, 12, seed=0, n_workers=2, scheduler=None)
     print(tuned.table())
     print(robust.table())
     print(f"robust objective at the tuned optimum: {1e3 * at_tuned.value:.4f} mm, d/dm {1e3 * at_tuned.gradient[0]:.4f} mm/g")
