@@ -30,8 +30,10 @@ stability note of an unsettled peak (:func:`peak_stability_note`).
 """
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import textwrap
+import threading
 import warnings
 
 from dataclasses import dataclass, field
@@ -45,8 +47,8 @@ from . import validation
 from .blade import PLATFORM_ANGLE, ModalBlade
 from .contact.laws import LinearNormalLaw, RoughnessNormalLaw
 from .contact.patch import dof_jacobian, rigid_point_map
-from .contact.point import (MAX_PASSES, PERIODIC_TOL, PointContactSamples, damper_contact_forces, normal_law_parameters,
-                            point_contact_forces)
+from .contact.point import (MAX_PASSES, PARAMETER_DIRECTIONS, PERIODIC_TOL, PointContactSamples, damper_contact_forces,
+                            damper_parameter_forces, normal_law_parameters, point_contact_forces)
 from .damper.geometry import CylinderDamper, DamperGeometry, WedgeDamper
 from .damper.kinetics import centrifugal_force, retention_stiffness, seat
 from .hbm.accuracy import HARMONIC_TOLERANCE, AccuracyWarning, converged_response
@@ -79,6 +81,30 @@ AUTO_SAMPLES_GROWTH_DISSIPATION = 16
 # (benchmarks/README.md, 'Moved from the package's docstrings', disk.py, 'DAMPER_ARC_SCALE').
 # The oscillator has no such unknown.
 DAMPER_ARC_SCALE = 100.0
+
+#: parameter_derivatives stacks the matrix derivatives of all keys (k n_dof, n_dof) dense up to
+#: this many entries (a product with a few harmonics' coefficients: dense is the faster there), sparse above
+DENSE_STACK_MAX = 2_000_000
+#: the Jacobian evaluations whose parameter directions AssemblyContacts.keeping_directions keeps
+#: (the two points either side of a peak, hbm.sensitivity.peak_sensitivities, and a spare)
+KEPT_EVALUATIONS = 4
+#: per thread, {id(element): [map derivatives, kept evaluations]} of the elements within
+#: AssemblyContacts.keeping_directions (outside the elements: they stay plain, copyable data)
+class KeptDirections(threading.local):
+    """Per thread, {id(element): [map derivatives, kept evaluations]} of the elements within
+    AssemblyContacts.keeping_directions, or None (a class default: no exception to look it up)."""
+
+    requests: dict | None = None
+
+
+KEPT_DIRECTIONS = KeptDirections()
+
+
+def kept_request(element):
+    """The request of :meth:`AssemblyContacts.keeping_directions` open on ``element`` in this
+    thread ([map derivatives, [(local, omega, rows), ...]]), or None."""
+    requests = KEPT_DIRECTIONS.requests
+    return requests.get(id(element)) if requests else None
 
 STOP_CHECK_OFFSET_HZ = 0.05   # [Hz] stop_check's frequency beyond the furthest point (0.3 rad/s; the
 # offset at which the time integration tells the stopped random designs (benchmarks/README.md,
@@ -444,6 +470,7 @@ class AssemblyContacts:
     _index: dict = field(default_factory=dict, init=False, repr=False)
     _rotations: dict = field(default_factory=dict, init=False, repr=False)
     _last_approach: tuple | None = field(default=None, init=False, repr=False)
+    _direction_arguments: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self):
         sizes = {c.n_local for c in self.contacts}
@@ -614,7 +641,14 @@ class AssemblyContacts:
         L = self.n_local // nd
         local = np.asarray(local).reshape(C, nd, L)
         offsets, doffsets = self.approach(omega)
-        force, blocks = self.forces_at(local, basis, offsets, jacobian)
+        request = kept_request(self) if jacobian else None
+        if request is not None and self.fused_directions():
+            # the directions of parameter_forces from the same kernel pass (keeping_directions)
+            directions, blocks = self.directions_at(local, basis, offsets, request[0], (), True)
+            force = directions[len(PARAMETER_DIRECTIONS)]
+            request[1] = [(local.copy(), omega, directions)] + request[1][:KEPT_EVALUATIONS - 1]
+        else:
+            force, blocks = self.forces_at(local, basis, offsets, jacobian)
         if not jacobian:
             return force, None, None
         domega = None
@@ -629,7 +663,7 @@ class AssemblyContacts:
                 domega = (fp - fm) / (2 * h)
         return force, blocks.reshape(nd, C * L, C * L), domega
 
-    def parameter_forces(self, local, basis, omega, d_maps=()) -> dict:
+    def parameter_forces(self, local, basis, omega, d_maps=(), moves=()) -> dict:
         """The logarithmic derivatives p dF/dp (C, n_local) [N, N m] of the forces at ``local``
         (C, n_local) and ``omega`` [rad/s] in the contact parameters shared by every point, all
         from one evaluation of the point-contact kernel with its exact Jacobian (no differences):
@@ -649,60 +683,122 @@ class AssemblyContacts:
           degree p (linear: p = 1), so offset dF/doffset = p (F - J_t c_t) - J_zeta c_zeta;
           ``"approach_left"``, ``"approach_right"``: the same of the OL patch's points alone, of the OR's;
         * ``"point_maps"``: for each derivative dB (n_d, 2, P, 3, m) of the point maps in ``d_maps``
-          (points that move on their patch), dB^T f + B^T J (dB local) (a list, in that order).
+          (points that move on their patch), dB^T f + B^T J (dB local) (a list, in that order);
+        * ``"force"``: the forces F themselves (as :meth:`harmonic_forces`), and
+          ``"jacobian_times"``: for each direction v (C, n_local) [m] in ``moves`` the Jacobian's
+          product J v [N] (a list; v = dT x for a parameter of the map T from the structure:
+          the residual's T^T F(T x) changes by dT^T F + T^T J dT x).
 
-        Raises ValueError for dampers whose patches do not stack (:meth:`stacked_points`) or a
-        normal law of another kind than LinearNormalLaw and RoughnessNormalLaw."""
+        All in one call of the fused kernel :func:`~bladedamp.contact.point.damper_parameter_forces`
+        (the directions formed on each point's force coefficients and Jacobian, projected with
+        B^T there; no Jacobian blocks). Raises ValueError for dampers whose patches do not stack
+        (:meth:`stacked_points`) or a normal law of another kind than LinearNormalLaw and
+        RoughnessNormalLaw."""
+        self.check_parameter_directions()
+        forces = self.direction_rows(local, basis, omega, d_maps, moves)
+        n = len(PARAMETER_DIRECTIONS) + 1
+        out = dict(zip(PARAMETER_DIRECTIONS + ("force",), forces))
+        out["point_maps"] = list(forces[n:n + len(d_maps)])
+        out["jacobian_times"] = list(forces[n + len(d_maps):])
+        return out
+
+    def check_parameter_directions(self) -> None:
+        """ValueError unless :meth:`parameter_forces` applies: dampers whose two patches share their
+        normal law (LinearNormalLaw or RoughnessNormalLaw), friction coefficient and point count."""
         stack = self.stacked_points()
         if stack is None or type(stack.normal_law) not in (LinearNormalLaw, RoughnessNormalLaw):
             raise ValueError("contact parameter derivatives need dampers whose two patches share their normal law "
                              "(LinearNormalLaw or RoughnessNormalLaw), friction coefficient and point count")
+
+    def direction_rows(self, local, basis, omega, d_maps=(), moves=()) -> np.ndarray:
+        """The rows of :meth:`parameter_forces` as one array (7 + n_maps + n_v, C, n_local): the six
+        directions (:data:`~bladedamp.contact.point.PARAMETER_DIRECTIONS`), F, the maps', the
+        moves' products; taken from an evaluation kept by :meth:`keeping_directions` at the same
+        point where there is one, else one call of the fused kernel (:meth:`directions_at`); the
+        checks are :meth:`check_parameter_directions`'s (not repeated here)."""
         C, nd, L = basis.n_coeffs, self.n_dampers, self.damper_local
-        local = np.ascontiguousarray(np.asarray(local, dtype=float).reshape(C, nd, L))
+        local = np.asarray(local, dtype=float).reshape(C, nd, L)
+        forces = None
+        request = kept_request(self)
+        if request is not None and not len(moves) and len(d_maps) == len(request[0]) and \
+                all(a is b for a, b in zip(d_maps, request[0])):
+            forces = next((f for kept, w, f in request[1] if w == omega and np.array_equal(kept, local)), None)
+        if forces is None:
+            forces, _ = self.directions_at(local, basis, self.approach(omega)[0], d_maps, moves, False)
+        return forces.reshape(len(forces), C, self.n_local)
+
+    def fused_directions(self) -> bool:
+        """Whether a Jacobian evaluation can form the parameter directions in its own kernel pass
+        (:meth:`keeping_directions`): rigid platforms and a normal law the kernel evaluates, where
+        the kernel's Jacobian blocks are those of :func:`fused_point_map_forces`."""
+        stack = self.stacked_points()
+        return stack is not None and stack.maps.shape[-1] == 6 and type(stack.normal_law) in (LinearNormalLaw,
+                                                                                             RoughnessNormalLaw)
+
+    def directions_at(self, local, basis, offsets, d_maps, moves, jacobian):
+        """(forces (7 + n_maps + n_v, C, n_d, L) [N, N m], Jacobian blocks (n_d, C, L, C, L) or None):
+        the rows of :meth:`parameter_forces` (the six directions, F, the maps' and the moves'
+        products) at ``local`` (C, n_d, L) with the static approach ``offsets`` (n_d, 2, P) [m],
+        each damper on its own grid as :meth:`forces_at`; one call of the fused kernel
+        :func:`~bladedamp.contact.point.damper_parameter_forces` (with ``jacobian`` its blocks,
+        the same numbers as :meth:`forces_at`'s for rigid platforms)."""
+        C, nd, L = basis.n_coeffs, self.n_dampers, self.damper_local
         R = self.grid_rotations(basis)
+        key = (basis.n_samples, basis.harmonics, tuple(id(dB) for dB in d_maps))
+        fixed = self._direction_arguments.get(key)
+        if fixed is None:                   # the arguments that do not change from point to point, once
+            B, k_t, mu, weights, law = self.stacked_points()
+            kind, params = normal_law_parameters(law)
+            maps = np.stack([np.broadcast_to(np.asarray(dB, dtype=float), B.shape) for dB in d_maps]) \
+                if len(d_maps) else np.zeros((0,) + B.shape)
+            static_index = basis.cos_index(0) if basis.has_static else -1
+            fixed = ((np.ascontiguousarray(B, dtype=float), maps), (basis.synthesis, basis.analysis, k_t, mu, weights),
+                     (kind, params, float(getattr(law, "exponent", 1.0)), static_index, MAX_PASSES, PERIODIC_TOL),
+                     np.zeros((0, C, nd, L)), np.empty((1, 1, 1, 1, 1)), list(d_maps))
+            self._direction_arguments[key] = fixed          # (d_maps kept: their ids stay theirs)
+        (B, maps), basis_and_points, law_and_passes, no_moves, no_blocks, _ = fixed
+        local = np.ascontiguousarray(local, dtype=float).reshape(C, nd, L)
+        v = np.array([np.reshape(m, (C, nd, L)) for m in moves], dtype=float) if len(moves) else no_moves
         if R is not None:
             local = _rotated(R, local, False)
-        offsets, _ = self.approach(omega)
-        B, k_t, mu, weights, law = stack
-        m = B.shape[-1]
-        coeffs = np.einsum("dqpij,cdqj->cdqpi", B, local.reshape(C, nd, 2, m)).reshape(C, -1, 3)
-        pts = point_contact_forces(coeffs, basis, k_t, mu, law, weights, np.ravel(offsets), jacobian=True)
-        jac = pts.jacobian.reshape(pts.jacobian.shape[:3] + (3, C))            # (P', T, 3, direction, C)
-        along = (jac * np.moveaxis(coeffs, 0, -1)[:, None, None]).sum(axis=-1)   # J_direction c_direction
-        force, j_t, j_z = pts.force, along[..., 0] + along[..., 1], along[..., 2]
-        scale = force - j_t
-        friction = scale.copy()
-        friction[..., 2] = 0.0
-        degree = getattr(law, "exponent", 1.0)
-        approach = degree * scale - j_z
-        by_patch = approach.reshape(nd, 2, -1, *approach.shape[1:])
-        left, right = (np.zeros_like(by_patch) for _ in range(2))
-        left[:, 0], right[:, 1] = by_patch[:, 0], by_patch[:, 1]
-        names = ("tangential", "law", "friction", "approach", "approach_left", "approach_right")
-        samples = np.stack([j_t, scale, friction, approach, left.reshape(approach.shape),
-                            right.reshape(approach.shape)])                            # (6, P', T, 3)
-        # every direction at once: the analysis (T -> C), then the points' maps back to the dampers
-        n, P = len(names), B.shape[2]
-        f_points = (basis.analysis @ np.moveaxis(samples, 2, 0).reshape(samples.shape[2], -1)).reshape(C, n, nd, 2, P * 3)
-        by_contact = np.moveaxis(f_points, (2, 3), (0, 1)).reshape(nd * 2, C * n, P * 3)
-        forces = (by_contact @ B.reshape(nd * 2, P * 3, m)).reshape(nd, 2, C, n, m)
-        forces = np.moveaxis(forces, (3, 2), (0, 1)).reshape(n, C, nd, L)
-        out = {}
-        for name, f in zip(names, forces):
-            f = np.ascontiguousarray(f)
-            out[name] = (f if R is None else _rotated(R, f, True)).reshape(C, self.n_local)
-        out["point_maps"] = []
-        if len(d_maps):
-            f_coefficients = np.moveaxis(basis.to_coeffs(np.moveaxis(force, 1, 0)).reshape(C, nd, 2, P, 3), 0, -1)
-        for dB in d_maps:
-            dB = np.broadcast_to(dB, B.shape)
-            dc = np.einsum("dqpij,cdqj->cdqpi", dB, local.reshape(C, nd, 2, m)).reshape(C, -1, 3)
-            moved = (jac * np.moveaxis(dc, 0, -1)[:, None, None]).sum(axis=(-1, -2))          # (P', T, 3)
-            f_moved = np.moveaxis(basis.to_coeffs(np.moveaxis(moved, 1, 0)).reshape(C, nd, 2, P, 3), 0, -1)
-            f = (np.einsum("dqpic,dqpij->cdqj", f_moved, B) + np.einsum("dqpic,dqpij->cdqj", f_coefficients, dB))
-            f = np.ascontiguousarray(f.reshape(C, nd, L))
-            out["point_maps"].append((f if R is None else _rotated(R, f, True)).reshape(C, self.n_local))
-        return out
+            v = np.array([_rotated(R, np.ascontiguousarray(m), False) for m in v]) if len(v) else v
+        forces = np.empty((len(PARAMETER_DIRECTIONS) + 1 + len(maps) + len(v), C, nd, L))
+        blocks = np.empty((nd, C, L, C, L)) if jacobian else no_blocks
+        offsets = np.ascontiguousarray(offsets, dtype=float).ravel()
+        damper_parameter_forces(B, local, maps, v, *basis_and_points, offsets, *law_and_passes, forces, jacobian,
+                                blocks, True)
+        if R is not None:
+            forces = np.array([_rotated(R, f, True) for f in forces])
+            blocks = _rotated_blocks(R, blocks) if jacobian else None
+        return forces, blocks if jacobian else None
+
+    @contextlib.contextmanager
+    def keeping_directions(self, d_maps=()):
+        """Within this context (in this thread) every Jacobian evaluation (:meth:`evaluate`) also
+        forms the rows of :meth:`parameter_forces` with the map derivatives ``d_maps`` in its own
+        kernel pass, where :meth:`fused_directions` allows (the forces and Jacobian the same
+        numbers), and keeps the last :data:`KEPT_EVALUATIONS`; :meth:`parameter_forces` at one of
+        those points (the same local coefficients, omega and ``d_maps``, no ``moves``) returns
+        them instead of a kernel call of its own: dR/dp at a point whose Jacobian was just
+        evaluated costs no second pass of the return map."""
+        previous = kept_request(self)
+        if previous is not None and len(previous[0]) == len(d_maps) and \
+                all(a is b for a, b in zip(previous[0], d_maps)):
+            yield                               # nested in the same request: its evaluations stay kept
+            return
+        if KEPT_DIRECTIONS.requests is None:
+            KEPT_DIRECTIONS.requests = {}
+        requests = KEPT_DIRECTIONS.requests
+        requests[id(self)] = [list(d_maps), []]
+        try:
+            yield
+        finally:
+            if previous is None:
+                del requests[id(self)]
+                if not requests:
+                    KEPT_DIRECTIONS.requests = None
+            else:
+                requests[id(self)] = previous
 
     def harmonic_forces(self, local, basis, omega, jacobian=True):
         C = basis.n_coeffs
@@ -1090,6 +1186,61 @@ class ParameterEffect:
     point_maps: object = None
 
 
+class ParameterDerivatives:
+    """``dR_dp(x, omega) -> (k, C * n_dof)`` [N per unit of each key] of
+    :meth:`DiskModel.parameter_derivatives`: the linear part's stacked matrix derivatives (one
+    product per kind), the excitation's, and the contacts' directions (one call of the fused
+    kernel, :meth:`AssemblyContacts.parameter_forces`) weighted per key and carried back through
+    the contacts' map in one product. :meth:`reusing` gives the context in which the system's
+    Jacobian evaluations keep the contact directions, so that a call at a point whose Jacobian
+    was just evaluated (the same x and omega) takes them from that kernel pass."""
+
+    def __init__(self, system, effects, coupling, element, stacked, weights, d_maps, moved):
+        self.system, self.effects, self.coupling, self.element = system, effects, coupling, element
+        self.stacked, self.weights, self.d_maps, self.moved = stacked, weights, d_maps, moved
+        self.map_rows = [i for i, e in enumerate(effects) if e.point_maps is not None]
+        self.move_rows = [i for i, e in enumerate(effects) if e.coupling is not None]
+        self.needs_contacts = coupling is not None and any(
+            e.contact or e.point_maps is not None or e.coupling is not None for e in effects)
+        if self.needs_contacts:
+            element.check_parameter_directions()
+
+    def reusing(self):
+        """A context (:meth:`AssemblyContacts.keeping_directions`) in which each Jacobian
+        evaluation of the system also forms this object's contact directions in its kernel pass;
+        a null context where there is nothing to keep (no contact directions, or a map derivative
+        dT x that the element cannot know from its local coordinates)."""
+        if not self.needs_contacts or self.moved:
+            return contextlib.nullcontext()
+        return self.element.keeping_directions(self.d_maps)
+
+    def __call__(self, x, omega):
+        system, basis, coupling, element = self.system, self.system.basis, self.coupling, self.element
+        k, N = len(self.effects), system.n_unknowns
+        out = np.zeros((k, N))
+        if self.stacked:
+            out += linear_forces(basis, x, omega, **self.stacked).reshape(basis.n_coeffs, k, -1) \
+                .transpose(1, 0, 2).reshape(k, N)
+        for row, e in zip(out, self.effects):
+            if e.excitation is not None:
+                row -= e.excitation(omega)
+        if self.needs_contacts:
+            local = coupling.matrix @ x
+            rows = element.direction_rows(local, basis, omega, self.d_maps, [dT @ x for dT in self.moved])
+            rows = rows.reshape(len(rows), -1)                                  # (7 + n_maps + n_v, C L)
+            n = len(PARAMETER_DIRECTIONS)
+            forces = self.weights @ rows[:n]                                    # (k, C L)
+            if self.map_rows:
+                forces[self.map_rows] += rows[n + 1:n + 1 + len(self.d_maps)]
+            for i, dT, f in zip(self.move_rows, self.moved, rows[n + 1 + len(self.d_maps):]):
+                out[i] += dT.T @ rows[n]
+                forces[i] += f
+            contact = np.zeros((N, k))
+            coupling.add_forces(contact, forces.T)
+            out += contact.T
+        return out
+
+
 class DiskModel:
     """The behaviour of a bladed disk with underplatform dampers that does not depend on how it
     is assembled: the tuned disk's cyclic sector (:class:`TunedDisk`, one blade and one damper,
@@ -1242,46 +1393,29 @@ class DiskModel:
         ``blade.natural_frequencies_hz[j]``, per mm, per rpm, per N) [N per unit]. No differences:
         the linear part's matrices and the excitation are differentiated in closed form
         (:func:`~bladedamp.hbm.system.linear_forces`), the contacts by their homogeneity
-        (:meth:`AssemblyContacts.parameter_forces`). ValueError naming the key for an unknown key,
-        an index out of range, or a parameter this model does not have or cannot differentiate
-        (the list says which and why)."""
+        (:meth:`AssemblyContacts.parameter_forces`); a :class:`ParameterDerivatives`, whose
+        ``reusing()`` lets it take the contacts' terms from the system's Jacobian evaluation at the
+        same point. ValueError naming the key for an unknown key, an index out of range, or a
+        parameter this model does not have or cannot differentiate (the list says which and why)."""
         effects = [self.parameter_effect(system, key) for key in keys]
-        basis = system.basis
+        k = len(effects)
         coupling = next((c for c in system.couplings if isinstance(c.element, (DamperContacts, AssemblyContacts))),
                         None)
         element = None if coupling is None else getattr(coupling.element, "element", coupling.element)
-        needs_contacts = any(e.contact or e.point_maps is not None for e in effects)
         d_maps = [e.point_maps for e in effects if e.point_maps is not None]
-
-        needs_forces = any(e.coupling is not None for e in effects)
-
-        def dR_dp(x, omega):
-            out = np.zeros((len(effects), system.n_unknowns))
-            directions = forces = None
-            if (needs_contacts or needs_forces) and coupling is not None:
-                local = (coupling.matrix @ x).reshape(basis.n_coeffs, element.n_local)
-                if needs_contacts:
-                    directions = element.parameter_forces(local, basis, omega, d_maps)
-                    moved = iter(directions["point_maps"])
-                if needs_forces:
-                    force, jac, _ = coupling.element.harmonic_forces(local, basis, omega, True)
-                    forces = force.ravel(), jac
-            for row, e in zip(out, effects):
-                if e.coupling is not None and forces is not None:
-                    row += e.coupling.T @ forces[0]
-                    coupling.add_forces(row, forces[1] @ (e.coupling @ x))
-                if e.matrices:
-                    row += linear_forces(basis, x, omega, **e.matrices)
-                if e.excitation is not None:
-                    row -= e.excitation(omega)
-                if directions is not None:
-                    for name, factor in e.contact.items():
-                        coupling.add_forces(row, factor * directions[name].ravel())
-                    if e.point_maps is not None:
-                        coupling.add_forces(row, next(moved).ravel())
-            return out
-
-        return dR_dp
+        moved = [e.coupling for e in effects if e.coupling is not None]
+        # built once per system: the linear part's matrix derivatives of every key stacked
+        # ((k n_dof, n_dof) each, zero for a key without that matrix: one product per kind at a
+        # point) and each key's contact directions as a row of weights
+        stacked = {}
+        for kind in sorted({kind for e in effects for kind in e.matrices}):
+            blocks = [sp.csr_matrix(e.matrices[kind]) if kind in e.matrices else
+                      sp.csr_matrix((system.n_dof, system.n_dof)) for e in effects]
+            matrix = sp.vstack(blocks, format="csr")
+            stacked[kind] = matrix.toarray() if matrix.shape[0] * matrix.shape[1] <= DENSE_STACK_MAX else matrix
+        weights = np.array([[e.contact.get(name, 0.0) for name in PARAMETER_DIRECTIONS]
+                            for e in effects]).reshape(k, -1)
+        return ParameterDerivatives(system, effects, coupling, element, stacked, weights, d_maps, moved)
 
     def parameter_effect(self, system: HarmonicBalanceSystem, key: str) -> "ParameterEffect":
         """How ``system``'s residual depends on the design-file ``key`` (see

@@ -962,7 +962,7 @@ def branch_sensitivities(system, omega, coefficients, outputs, dR_dp, keys, unit
     dx = np.zeros((n, len(keys), N))
     amplitude, d_amplitude = np.zeros((n, len(outputs))), np.zeros((n, len(keys), len(outputs)))
     for i, (x, w) in enumerate(zip(X, omega)):
-        dx[i] = state_sensitivities(system, x, float(w), dR_dp(x, float(w)))
+        dx[i] = state_sensitivities(system, x, float(w), dR_dp)
         for b, output in enumerate(outputs):
             amplitude[i, b], d_amplitude[i, :, b] = output_sensitivities(output, x, dx[i])
     return Sensitivities(tuple(keys), tuple(units), np.asarray(values, dtype=float), np.asarray(omega) / (2 * np.pi),

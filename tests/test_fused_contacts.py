@@ -218,3 +218,80 @@ def test_fused_closed_form_jacobian_is_the_many_pass_limit(kind, harmonics):
         # of the periodic one: 5e-9 at the wedge's converged point with harmonics 0, 1, 2)
         assert e_j < 1e-7, f"{label}: Jacobian blocks differ from the many-pass limit by {e_j:.2e}"
         assert e_f < 1e-12, f"{label}: forces differ from the many-pass limit by {e_f:.2e}"
+
+
+def frictionless_element(kind, exponent, harmonics):
+    """The contact element of :func:`mistuned` with every patch's friction coefficient 0."""
+    disk = reference_disk(kind, 1e-3)
+    damper = disk.damper if exponent == 1.0 else reference_damper(kind, 1e-3, roughness_exponent=exponent)
+    contact = dataclasses.replace(damper.contact, friction_coefficient=0.0)
+    disk = dataclasses.replace(disk, damper=dataclasses.replace(damper, contact=contact))
+    return MistunedDisk.from_tuned(disk, random_kappa(16, 0.02, seed=2)).hbm_system(harmonics).couplings[0].element
+
+
+@pytest.mark.parametrize("harmonics", HARMONICS, ids=["h1", "h012"])
+@pytest.mark.parametrize("kind, exponent", [("cylinder", 1.0), ("wedge", 1.0), ("cylinder", 1.5)])
+def test_parameter_directions_against_the_newton_kernel(kind, exponent, harmonics):
+    """The contact parameter directions of the fused kernel (contact.point.damper_parameter_forces,
+    AssemblyContacts.directions_at) against the forces and Jacobian blocks of the Newton's kernel
+    (damper_contact_forces, forces_at) and the frictionless model, by the identities they obey:
+    k_T dF/dk_T + c dF/dc = J_t c_t + (F - J_t c_t) = F; J local = J_t c_t + p (F - J_t c_t) -
+    (p (F - J_t c_t) - J_z c_z) (p the law's degree); the OL and OR parts of the approach add up;
+    J v for v = local; the map derivative dB = B gives B^T f + B^T J (B local) = F + J local; and
+    the normal part F - J_t c_t less its tangential rows is the force with mu = 0 (the normal law
+    does not see mu). Rigid platforms: the forces and blocks the kernel forms alongside are the
+    Newton kernel's (the same arithmetic). Tolerance 1e-12 of the largest force: the identities
+    hold exactly, the sums over points, samples and coefficients (~1e3 terms) in another order
+    differ by ~1e-13."""
+    md = mistuned(kind, exponent)
+    system = md.hbm_system(harmonics)
+    basis = system.basis
+    w = 2 * np.pi * 97.0
+    x0 = md.initial_guess(system, w)
+    frictionless = frictionless_element(kind, exponent, harmonics)
+    rng = np.random.default_rng(5)
+    for scale in (0.0, 3.0, 30.0):
+        element, local, offsets = contact_state(system, x0 * (1 + scale * rng.standard_normal(x0.size)), w)
+        B = element.stacked_points().maps
+        rows, blocks = element.directions_at(local, basis, offsets, [B], [local], True)
+        force, jac = element.forces_at(local, basis, offsets, True)
+        assert np.array_equal(rows[6], force) and np.array_equal(blocks, jac)
+        tangential, law, friction, approach, left, right = rows[:6]
+        J_local = np.einsum("dambn,bdn->adm", jac, local)
+        bound = 1e-12 * np.abs(force).max()
+        errors = {"F": tangential + law - force, "J local": tangential + exponent * law - approach - J_local,
+                  "OL + OR": left + right - approach, "J v": rows[8] - J_local, "dB = B": rows[7] - force - J_local,
+                  "mu = 0": law - friction - frictionless.forces_at(local, basis, offsets, False)[0]}
+        worst = {name: float(np.abs(e).max() / np.abs(force).max()) for name, e in errors.items()}
+        print(f"\n[directions {kind} p={exponent} {harmonics} x{scale}] "
+              f"{state_counts(element, local, basis, offsets)}: {worst}")
+        assert all(np.abs(e).max() <= bound for e in errors.values()), worst
+
+
+def test_kept_directions_are_those_of_a_call_of_their_own():
+    """Within keeping_directions a Jacobian evaluation forms the directions in its own kernel pass:
+    the forces, Jacobian and d force / d omega are the evaluation's without it, and the model's
+    dR/dp at that point (taken from it) equals dR/dp evaluated afresh, to the last bit."""
+    md = mistuned("cylinder")
+    system = md.hbm_system((0, 1, 2))
+    w = 2 * np.pi * 97.0
+    x = md.initial_guess(system, w) * 3.0
+    keys = ["damper.mass_g", "damper.friction_coefficient", "damper.tangential_stiffness_per_length_n_per_m2",
+            "damper.normal_to_tangential_stiffness"]
+    dR_dp = md.parameter_derivatives(system, keys)
+    fresh = dR_dp(x, w)
+    plain = system.residual(x, w)
+    element = system.couplings[0].element
+    calls = []
+    with dR_dp.reusing():
+        kept = system.residual(x, w)
+        original = element.directions_at
+        element.directions_at = lambda *args: calls.append(args) or original(*args)
+        try:
+            reused = dR_dp(x, w)
+        finally:
+            del element.directions_at
+    assert not calls, "dR/dp evaluated the kernel again"
+    assert np.array_equal(reused, fresh)
+    for a, b in zip(plain, kept):
+        assert np.array_equal(a.toarray() if hasattr(a, "toarray") else a, b.toarray() if hasattr(b, "toarray") else b)

@@ -68,3 +68,14 @@ def test_admissible_points_and_failures_are_reported():
 def test_the_norm_is_checked():
     with pytest.raises(ValueError, match="norm"):
         newton(arctan, np.array([0.5]), 0.3, 1.0, 1.0, norm=1)
+
+
+def test_the_evaluated_iterate_is_one_step_before_the_result():
+    """On convergence ``evaluated`` is the iterate whose factorisation ``solve`` is: x = evaluated
+    + step, and solve(R(evaluated)) = -step."""
+    def fun(x, p):
+        return np.array([x[0] ** 3 - p, x[1] - 2.0]), np.array([[3 * x[0] ** 2, 0.0], [0.0, 1.0]]), np.zeros(2)
+
+    r = newton(fun, np.array([1.0, 0.0]), 8.0, 1.0, 1.0, tol=1e-12)
+    assert r.converged and np.array_equal(r.evaluated + r.step, r.x)
+    assert np.array_equal(-r.solve(fun(r.evaluated, 8.0)[0]), r.step)

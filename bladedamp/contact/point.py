@@ -698,6 +698,37 @@ def _point_jacobian(synthesis, analysis, kt, dnormal, state, df_flat, ds, analys
                 jt[a, r] += an * df_flat[t, r]
 
 
+@njit(cache=True, inline="always")
+def add_point_block(Bp, jt, jn, bj, acc):
+    """acc[a, m, b, n] += sum_ik Bp[i, m] jp[a, i, k, b] Bp[k, n]: one point's Jacobian block
+    projected with its rigid map Bp (3, 6) onto a patch's six local coordinates (C, 6, C, 6), jp
+    the point block d f_coef[a, i] / d c[b, k] as :func:`point_harmonics` writes it (jt the
+    tangential rows, jn the normal row, whose only column is zeta); bj (C, 6, 3, C) work array.
+    (The six is a constant: the compiler unrolls the loops over it; inlined into both kernels,
+    the arithmetic of the loops it replaced in damper_contact_forces, at their speed.)"""
+    C = acc.shape[0]
+    n3p = jt.shape[1] // 2
+    for a in range(C):
+        for m in range(6):
+            B0 = Bp[0, m]
+            B1 = Bp[1, m]
+            B2 = Bp[2, m]
+            for k in range(3):
+                for b in range(C):
+                    v = B0 * jt[a, k * C + b] + B1 * jt[a, n3p + k * C + b]
+                    if k == 2:
+                        v += B2 * jn[a, b]
+                    bj[a, m, k, b] = v
+    for a in range(C):
+        for m in range(6):
+            for b in range(C):
+                v0 = bj[a, m, 0, b]
+                v1 = bj[a, m, 1, b]
+                v2 = bj[a, m, 2, b]
+                for n in range(6):
+                    acc[a, m, b, n] += v0 * Bp[0, n] + v1 * Bp[1, n] + v2 * Bp[2, n]
+
+
 @njit(cache=True)
 def damper_contact_forces(B, local, synthesis, analysis, k_t, mu, weight, approach_offset, law_kind,
                           law_params, static_index, max_passes, tol, want_jac, force, blocks, closed_form):
@@ -758,33 +789,151 @@ def damper_contact_forces(B, local, synthesis, analysis, k_t, mu, weight, approa
                         force[a, d, col + j] += a0 * Bp[0, j] + a1 * Bp[1, j] + a2 * Bp[2, j]
                 if not want_jac:
                     continue
-                # acc[a, m, b, n] += sum_ik B[i, m] jp[a, i, k, b] B[k, n], jp the point block
-                # d f_coef[a, i] / d c[b, k] (normal row i = 2: zeta column k = 2 only)
-                for a in range(C):
-                    for m in range(6):
-                        B0 = Bp[0, m]
-                        B1 = Bp[1, m]
-                        B2 = Bp[2, m]
-                        for k in range(3):
-                            for b in range(C):
-                                v = B0 * jt[a, k * C + b] + B1 * jt[a, n3p + k * C + b]
-                                if k == 2:
-                                    v += B2 * jn[a, b]
-                                bj[a, m, k, b] = v
-                for a in range(C):
-                    for m in range(6):
-                        for b in range(C):
-                            v0 = bj[a, m, 0, b]
-                            v1 = bj[a, m, 1, b]
-                            v2 = bj[a, m, 2, b]
-                            for n in range(6):
-                                acc[a, m, b, n] += v0 * Bp[0, n] + v1 * Bp[1, n] + v2 * Bp[2, n]
+                add_point_block(Bp, jt, jn, bj, acc)
             if want_jac:
                 for a in range(C):
                     for m in range(6):
                         for b in range(C):
                             for n in range(6):
                                 blocks[d, a, col + m, b, col + n] = acc[a, m, b, n]
+
+
+#: the contact directions of :func:`damper_parameter_forces`, in the order of its output's first axis
+#: (then the forces themselves, then the maps' and the local directions' products)
+PARAMETER_DIRECTIONS = ("tangential", "law", "friction", "approach", "approach_left", "approach_right")
+
+
+@njit(cache=True)
+def damper_parameter_forces(B, local, d_maps, moves, synthesis, analysis, k_t, mu, weight, approach_offset, law_kind,
+                            law_params, degree, static_index, max_passes, tol, out, want_jac, blocks, closed_form):
+    """Directional derivatives of the contact forces of the two patches of n_d dampers in the
+    contact parameters (what :meth:`bladedamp.diskmodel.AssemblyContacts.parameter_forces`
+    returns, its equations there), fused: per point (d, q, p) the coefficients
+    c = B[d, q, p] @ local[:, d, q m:(q+1) m], :func:`point_harmonics` with the point's Jacobian
+    (jt, jn: d force coefficients / d c), its products with c (J_t c_t from the xi and eta
+    columns, J_z c_z from the zeta column) formed on the coefficients, the six directions
+    (:data:`PARAMETER_DIRECTIONS`), the forces F, each map derivative's dB^T f + B^T J (dB c)
+    and each local direction's B^T J (B v) (the Jacobian times v) projected with B^T, in one
+    numba call: no point samples, no Jacobian blocks B^T J B.
+
+    B (n_d, 2, P, 3, m) the point maps; local (C, n_d, 2 m) [m]; d_maps (n_maps, n_d, 2, P, 3, m)
+    derivatives of the maps; moves (n_v, C, n_d, 2 m) directions v of the local coordinates
+    (n_maps, n_v may be 0); synthesis (T, C), analysis (C, T); k_t, mu,
+    weight, approach_offset (n_d 2 P,) in (d, q, p) order [N/m, -, -, m]; law_kind / law_params
+    (:func:`normal_law_parameters`); ``degree`` the normal law's exponent p (1 for the linear
+    law); static_index, max_passes, tol, closed_form as :func:`damper_contact_forces`.
+    Output (overwritten): out (7 + n_maps + n_v, C, n_d, 2 m) [N, N m]: the logarithmic
+    derivatives p dF/dp in the six directions, F, dF/dp of each map derivative, then J v of each
+    direction v [N per unit of v]; with ``want_jac`` (rigid platforms, m = 6, else ValueError)
+    also blocks (n_d, C, 12, C, 12), the Jacobian blocks of :func:`damper_contact_forces` (the
+    same numbers: that kernel's projection, with its force in out[6]), else any array untouched:
+    the Newton's Jacobian and the directions from one pass. The same numbers as the
+    sampled computation (analysis of the samples' products) to rounding: the analysis is linear.
+    """
+    nd, P, m = B.shape[0], B.shape[2], B.shape[4]
+    n_maps, n_v = d_maps.shape[0], moves.shape[0]
+    first = 7 + n_maps              # the first row of the moves' products
+    C = synthesis.shape[1]
+    work = point_work(synthesis, analysis)
+    n3p = work[8].shape[2]
+    c = np.empty((C, 3))
+    dc = np.empty((C, 3))
+    fc = np.empty((C, 3))
+    jt = np.empty((C, 2 * n3p))
+    jn = np.empty((C, C))
+    v = np.empty((first + n_v, C, 3))   # the point's directions (force coefficients, contact frame)
+    if want_jac and m != 6:
+        raise ValueError("the Jacobian blocks are formed for rigid platforms (point maps (3, 6)) only")
+    bj = np.empty((C, 6, 3, C))
+    acc = np.empty((C, 6, C, 6))        # one patch's Jacobian block
+    out[:, :, :, :] = 0.0
+    if want_jac:
+        blocks[:, :, :, :, :] = 0.0
+    for d in range(nd):
+        for q in range(2):
+            col = m * q
+            if want_jac:
+                acc[:, :, :, :] = 0.0
+            for p in range(P):
+                g = (d * 2 + q) * P + p
+                Bp = B[d, q, p]
+                for a in range(C):
+                    for i in range(3):
+                        s = 0.0
+                        for j in range(m):
+                            s += Bp[i, j] * local[a, d, col + j]
+                        c[a, i] = s
+                point_harmonics(c, synthesis, analysis, k_t[g], mu[g], weight[g], approach_offset[g], law_kind,
+                                law_params, static_index, max_passes, tol, True, closed_form, work, fc, jt, jn)
+                for a in range(C):
+                    for i in range(2):
+                        tangential = 0.0
+                        normal = 0.0
+                        row = i * n3p
+                        for b in range(C):
+                            tangential += jt[a, row + b] * c[b, 0] + jt[a, row + C + b] * c[b, 1]
+                            normal += jt[a, row + 2 * C + b] * c[b, 2]
+                        scale = fc[a, i] - tangential
+                        v[0, a, i] = tangential                         # J_t c_t
+                        v[1, a, i] = scale                              # F - J_t c_t
+                        v[2, a, i] = scale                              # its tangential rows
+                        v[3, a, i] = degree * scale - normal            # p (F - J_t c_t) - J_z c_z
+                    normal = 0.0
+                    for b in range(C):
+                        normal += jn[a, b] * c[b, 2]
+                    v[0, a, 2] = 0.0                                    # N does not depend on u_t
+                    v[1, a, 2] = fc[a, 2]
+                    v[2, a, 2] = 0.0
+                    v[3, a, 2] = degree * fc[a, 2] - normal
+                    for i in range(3):
+                        v[4, a, i] = v[3, a, i] if q == 0 else 0.0
+                        v[5, a, i] = v[3, a, i] if q == 1 else 0.0
+                        v[6, a, i] = fc[a, i]
+                for k in range(n_maps + n_v):
+                    # the point's motion: dB c for a map, B v for a local direction
+                    for a in range(C):
+                        for i in range(3):
+                            s = 0.0
+                            if k < n_maps:
+                                for j in range(m):
+                                    s += d_maps[k, d, q, p, i, j] * local[a, d, col + j]
+                            else:
+                                for j in range(m):
+                                    s += Bp[i, j] * moves[k - n_maps, a, d, col + j]
+                            dc[a, i] = s
+                    for a in range(C):
+                        for i in range(2):
+                            s = 0.0
+                            row = i * n3p
+                            for kk in range(3):
+                                for b in range(C):
+                                    s += jt[a, row + kk * C + b] * dc[b, kk]
+                            v[7 + k, a, i] = s
+                        s = 0.0
+                        for b in range(C):
+                            s += jn[a, b] * dc[b, 2]
+                        v[7 + k, a, 2] = s
+                # B^T of every direction, and dB^T f of the maps'
+                for r in range(first + n_v):
+                    for a in range(C):
+                        a0 = v[r, a, 0]
+                        a1 = v[r, a, 1]
+                        a2 = v[r, a, 2]
+                        for j in range(m):
+                            out[r, a, d, col + j] += a0 * Bp[0, j] + a1 * Bp[1, j] + a2 * Bp[2, j]
+                for k in range(n_maps):
+                    dB = d_maps[k, d, q, p]
+                    for a in range(C):
+                        for j in range(m):
+                            out[7 + k, a, d, col + j] += fc[a, 0] * dB[0, j] + fc[a, 1] * dB[1, j] + fc[a, 2] * dB[2, j]
+                if want_jac:
+                    add_point_block(Bp, jt, jn, bj, acc)
+            if want_jac:
+                for a in range(C):
+                    for r in range(6):
+                        for b in range(C):
+                            for n in range(6):
+                                blocks[d, a, col + r, b, col + n] = acc[a, r, b, n]
 
 
 @njit(cache=True)

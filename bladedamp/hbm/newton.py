@@ -41,6 +41,8 @@ class NewtonResult:
         balance residual), for a tangent dx/dOmega = -solve(dR_domega) without another
         Jacobian; None if the solve did not converge
     step : (n,) the last Newton update computed (None if none was)
+    evaluated : on convergence the iterate whose residual and Jacobian gave ``solve`` and
+        ``dR_domega`` (x is it plus ``step``), else None
     """
 
     x: np.ndarray
@@ -50,6 +52,7 @@ class NewtonResult:
     solve: object = None
     dR_domega: np.ndarray | None = None
     step: np.ndarray | None = None
+    evaluated: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -157,10 +160,10 @@ def newton(fun, x0, parameter, x_scale, residual_scale, tol=1e-10, max_iter=30, 
         scaled_dx = dx / x_scale
         step = euclidean(scaled_dx) if norm == 2 else np.abs(scaled_dx).max()
         if rnorm < tol and step < np.sqrt(tol):
-            x = x + dx
+            last, x = x, x + dx
             if admissible is not None and not admissible(x):
                 return NewtonResult(x, False, it, rnorm, step=dx)
-            return NewtonResult(x, True, it, rnorm, solve, more[0] if more else None, step=dx)
+            return NewtonResult(x, True, it, rnorm, solve, more[0] if more else None, step=dx, evaluated=last)
         if line_search is None:
             x = x + dx
             continue

@@ -340,15 +340,17 @@ class HarmonicBalanceSystem:
 
 def linear_forces(basis: HarmonicBasis, x: np.ndarray, omega: float, mass=None, damping=None, stiffness=None,
                   static_stiffness=None) -> np.ndarray:
-    """``A(Omega) x`` (C*n,) of the given matrices (n, n) (dense or scipy.sparse; None: zero)
-    without forming A: the same dynamic stiffness as :meth:`HarmonicBasis.dynamic_stiffness`
-    (K_0 - Omega^2 M_2 + Omega G, harmonic-major) with ``static_stiffness`` on the static
-    harmonic, applied to the coefficients ``x`` (C*n,) [m] at ``omega`` [rad/s]. A is linear in
-    the matrices, so with their derivatives in a parameter this is dR/dp of the linear part
-    (:mod:`bladedamp.hbm.sensitivity`) [N per unit of the parameter]."""
+    """``A(Omega) x`` (C*m,) of the given matrices (m, n) (dense or scipy.sparse, all with the same
+    m rows; None: zero) without forming A: the same dynamic stiffness as
+    :meth:`HarmonicBasis.dynamic_stiffness` (K_0 - Omega^2 M_2 + Omega G, harmonic-major) with
+    ``static_stiffness`` on the static harmonic, applied to the coefficients ``x`` (C*n,) [m] at
+    ``omega`` [rad/s]. A is linear in the matrices, so with their derivatives in a parameter this
+    is dR/dp of the linear part (:mod:`bladedamp.hbm.sensitivity`) [N per unit of the parameter];
+    with k such derivatives stacked (m = k n) the k products at once, (C, k, n) harmonic-major."""
     C = basis.n_coeffs
     X = np.asarray(x, dtype=float).reshape(C, -1)
-    out = np.zeros(X.shape)
+    given = [m for m in (stiffness, mass, damping, static_stiffness) if m is not None]
+    out = np.zeros((C, given[0].shape[0] if given else X.shape[1]))
 
     def times(matrix, Y):                  # Y @ matrix.T, matrix dense or sparse
         return np.asarray((matrix @ Y.T).T)
