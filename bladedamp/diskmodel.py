@@ -1414,7 +1414,7 @@ class DiskModel:
             matrix = sp.vstack(blocks, format="csr")
             stacked[kind] = matrix.toarray() if matrix.shape[0] * matrix.shape[1] <= DENSE_STACK_MAX else matrix
         weights = np.array([[e.contact.get(name, 0.0) for name in PARAMETER_DIRECTIONS]
-                            for e in effects]).reshape(k, -1)
+                            for e in effects]).reshape(k, len(PARAMETER_DIRECTIONS))      # k = 0 allowed
         return ParameterDerivatives(system, effects, coupling, element, stacked, weights, d_maps, moved)
 
     def parameter_effect(self, system: HarmonicBalanceSystem, key: str) -> "ParameterEffect":
