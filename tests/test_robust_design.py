@@ -164,3 +164,11 @@ def test_a_copy_the_coarse_branch_misleads_is_solved_on_the_fine_branch():
     assert result.blade == direct.blade == 6
     assert result.peak_amplitude == direct.peak_amplitude
     np.testing.assert_array_equal(result.d_peak_amplitude, direct.d_peak_amplitude)
+
+
+@pytest.mark.parametrize("key, needle", [("damper.colour", "unknown"), ("mistuning.kappa[0]", "random"),
+                                         ("blade.natural_frequencies_hz[9]", "out of range")])
+def test_a_bad_key_is_refused_before_any_copy_is_solved(disk, key, needle):
+    with pytest.raises(ValueError, match=needle) as error:
+        robust_objective(disk, [key], 0.02, 200, seed=0)       # 200 copies would take minutes
+    assert key in str(error.value)

@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import validation
-from ..diskmodel import parameter_unit
+from ..diskmodel import parameter_unit, parse_parameter_key
 from ..io import Saveable
 from ..mistuned import MistunedDisk
 from .gradient import DesignOptimum, default_bounds, optimal_design
@@ -258,6 +258,22 @@ def statistic_weights(values: np.ndarray, statistic) -> np.ndarray:
     return w
 
 
+def design_values(disk, keys) -> np.ndarray:
+    """(k,) the tuned ``disk``'s values of the design-file ``keys``, checked before any copy is
+    solved: ValueError naming a key that is unknown, out of range, or a blade's mistuning factor
+    (the copies' factors are drawn, not designed)."""
+    values = []
+    for key in keys:
+        name, _ = parse_parameter_key(key)
+        if name == "mistuning.kappa":
+            raise ValueError(f"parameter {key!r}: the mistuned copies' factors are random, not a design parameter")
+        try:
+            values.append(disk.parameter_value(key))
+        except IndexError:
+            raise ValueError(f"parameter {key!r}: index out of range for this disk") from None
+    return np.array(values, dtype=float)
+
+
 @dataclass
 class MistunedObjective(Saveable):
     """A statistic of the largest blade peak over mistuned copies of a design and its gradient
@@ -302,6 +318,7 @@ def robust_objective(disk, parameters, std: float = PAPER_STD, n_disks: int = 20
     keys = tuple(str(p) for p in parameters)
     n_disks = validation.integer("n_disks", n_disks, minimum=1)
     statistic = check_statistic(statistic)
+    values = design_values(disk, keys)
     kappas = np.array([random_kappa(disk.n_blades, std, seed=[int(seed), i]) for i in range(n_disks)])
     settings = disk_settings(harmonics)
     assembly = MistunedDisk.from_tuned(disk)
@@ -319,8 +336,7 @@ def robust_objective(disk, parameters, std: float = PAPER_STD, n_disks: int = 20
     peaks = np.array([r.peak_amplitude for r, _ in results])
     gradients = np.array([r.d_peak_amplitude for r, _ in results]).reshape(n_disks, len(keys))
     w = statistic_weights(peaks, statistic)
-    return MistunedObjective(keys, tuple(parameter_unit(k) for k in keys),
-                             np.array([disk.parameter_value(k) for k in keys]), statistic, float(std), int(seed),
+    return MistunedObjective(keys, tuple(parameter_unit(k) for k in keys), values, statistic, float(std), int(seed),
                              float(w @ peaks), w @ gradients, kappas, peaks,
                              np.array([r.peak_frequency_hz for r, _ in results]), gradients, errors)
 
