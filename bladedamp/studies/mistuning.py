@@ -58,6 +58,13 @@ def random_kappa(n_blades: int, std: float = PAPER_STD, seed=None) -> np.ndarray
     return 1.0 + std * np.random.default_rng(seed).standard_normal(n)
 
 
+def disk_kappas(n_blades: int, n_disks: int, std: float = PAPER_STD, seed=0) -> np.ndarray:
+    """(n_disks, n_blades) the factors of a study's mistuned disks: disk i's are
+    ``random_kappa(n_blades, std, seed=[seed, i])`` (reproducible, independent of the scheduling;
+    the Monte Carlo's and the robust objective's copies, the same for the same seed)."""
+    return np.array([random_kappa(n_blades, std, seed=[int(seed), i]) for i in range(n_disks)])
+
+
 def alternating(n_blades: int, amplitude: float = PAPER_STD) -> np.ndarray:
     """1 + amplitude, 1 - amplitude, ... (paper's case d); ``n_blades`` must be even."""
     n = validation.integer("n_blades", n_blades, minimum=2)
@@ -698,7 +705,7 @@ def monte_carlo(disk: TunedDisk, n_disks: int, std: float = PAPER_STD, seed=0, f
     n_disks = validation.integer("n_disks", n_disks, minimum=1)
     progress = progress_callback(progress, "Monte Carlo disks")
     n = disk.n_blades
-    kappas = np.array([random_kappa(n, std, seed=[int(seed), i]) for i in range(n_disks)])
+    kappas = disk_kappas(n, n_disks, std, seed)
     settings = dict(harmonics=tuple(harmonics), max_step=validation.positive("max_step", max_step),
                     tol=validation.positive("tol", tol), n_samples=n_samples, chord=bool(chord),
                     target_iterations=validation.integer("target_iterations", target_iterations, minimum=1),

@@ -45,7 +45,7 @@ from ..io import Saveable
 from ..mistuned import MistunedDisk
 from .gradient import DesignOptimum, default_bounds, optimal_design
 from .mistuning import (MONTE_CARLO_MAX_STEP, MONTE_CARLO_RANGE_MARGIN, MONTE_CARLO_TARGET_ITERATIONS, PAPER_STD,
-                        DiskWorkers, mistuned_response, random_kappa)
+                        DiskWorkers, disk_kappas, mistuned_response, random_kappa)
 
 #: the continuation of each mistuned disk: the Monte Carlo's coarse branch (its peaks are solved
 #: by the peak condition), tolerance 1e-8, chosen tighter than the Monte Carlo's 1e-6 as a margin
@@ -319,7 +319,7 @@ def robust_objective(disk, parameters, std: float = PAPER_STD, n_disks: int = 20
     n_disks = validation.integer("n_disks", n_disks, minimum=1)
     statistic = check_statistic(statistic)
     values = design_values(disk, keys)
-    kappas = np.array([random_kappa(disk.n_blades, std, seed=[int(seed), i]) for i in range(n_disks)])
+    kappas = disk_kappas(disk.n_blades, n_disks, std, seed)
     settings = disk_settings(harmonics)
     assembly = MistunedDisk.from_tuned(disk)
     items = [(k, keys, f_range_hz, settings) for k in kappas]
